@@ -1,0 +1,1 @@
+//! limber-bench: latency scenarios (built by the benchmarks issue).

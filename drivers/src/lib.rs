@@ -1,0 +1,1 @@
+//! limber-drivers: P2OS, emulator, kinematics, the Pioneer driver and simarm.

@@ -1,0 +1,1 @@
+//! limber-interfaces: the wire contract.

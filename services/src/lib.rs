@@ -1,0 +1,1 @@
+//! limber-services: the iceoryx2 layer (built by the services issue).
