@@ -1,1 +1,154 @@
-//! limber-interfaces: the wire contract.
+//! # limber-interfaces: the wire contract
+//!
+//! Every message of Player 3's `actarray`, `limb` and `gripper` interfaces as a fixed-layout
+//! struct that travels through iceoryx2 shared memory without a copy, readable from C, C++
+//! and Python with the same layout.
+//!
+//! * Wire structs are `#[repr(C)]`, have no implicit padding (explicit `_pad` fields,
+//!   checked at compile time), derive zerocopy's `FromBytes`/`IntoBytes`/`KnownLayout`/
+//!   `Immutable` and iceoryx2's `ZeroCopySend`, and carry a versioned type name
+//!   (`limber.v1.ActArrayData`). iceoryx2 only compares name, size and alignment when a
+//!   service is opened, so the version in the name changes whenever a layout changes.
+//! * Units are SI: m, rad, s, m/s, rad/s, A. No `bool` or Rust enum on the wire: `u32`
+//!   codes, decoded by typed views that reject unknown values with a [`DecodeError`].
+//! * Each channel carries one envelope type: state (`*Data`, with a [`StateHeader`]),
+//!   commands (`*CmdMsg`), requests (`*ReqMsg`) and replies (`*ReplyMsg`). Commands,
+//!   requests and replies are `{meta, body}`, the body holding the per-message struct
+//!   named by `meta.kind` (Player's subtype numbers).
+//! * [`manifest()`] describes every struct and constant; the C header and the Python
+//!   classes are generated from it ([`codegen`]).
+//!
+//! ```
+//! use limber_interfaces::prelude::*;
+//!
+//! // A typed command, validated when built...
+//! let cmd = ActArrayCommand::position(2, 0.5).unwrap();
+//! // ...written into the wire envelope (in place, e.g. into an iceoryx2 loan)...
+//! let mut raw = ActArrayCmdMsg::default();
+//! cmd.write(&mut raw);
+//! assert_eq!(raw.meta.kind, limber_interfaces::actarray::cmd::POS);
+//! // ...and decoded on the other side.
+//! assert_eq!(ActArrayCommand::read(&raw).unwrap(), cmd);
+//! // Bad values never make it onto the wire.
+//! assert!(ActArrayCommand::position(2, f64::NAN).is_err());
+//! ```
+
+#![warn(missing_docs)]
+
+pub mod actarray;
+pub mod codegen;
+pub mod common;
+pub mod error;
+pub mod gripper;
+pub mod interface;
+pub mod limb;
+pub mod manifest;
+pub mod message;
+pub mod wire;
+
+pub use common::{
+    Bbox3, CmdOutcome, MAX_ACTUATORS, MsgMeta, Orientation3, Pose3, ReplyMeta, StateHeader, Status,
+    Vec3, device_flag,
+};
+pub use error::{DecodeError, ValueError};
+pub use interface::{ActArray, Gripper, HasHeader, Interface, InterfaceKind, Limb};
+pub use manifest::Manifest;
+pub use message::{Envelope, Message, ReplyBody, ReplyEnvelope};
+pub use wire::{WireField, WireStruct};
+
+/// The layout version carried in every type name.
+pub const LAYOUT_VERSION: u32 = 1;
+
+/// Everything a driver or client author needs, in one `use`.
+pub mod prelude {
+    pub use crate::actarray::{
+        ActArrayCmdMsg, ActArrayCommand, ActArrayData, ActArrayGeom, ActArrayReply,
+        ActArrayReplyMsg, ActArrayReqMsg, ActArrayRequest, ActuatorFlags, ActuatorGeom,
+        ActuatorKind, ActuatorState, JointSel, JointValues,
+    };
+    pub use crate::common::{
+        Bbox3, CmdOutcome, MAX_ACTUATORS, MsgMeta, Orientation3, Pose3, ReplyMeta, StateHeader,
+        Status, Vec3, device_flag,
+    };
+    pub use crate::error::{DecodeError, ValueError};
+    pub use crate::gripper::{
+        GripperCmdMsg, GripperCommand, GripperData, GripperGeom, GripperReply, GripperReplyMsg,
+        GripperReqMsg, GripperRequest, GripperState,
+    };
+    pub use crate::interface::{ActArray, Gripper, HasHeader, Interface, InterfaceKind, Limb};
+    pub use crate::limb::{
+        LimbCmdMsg, LimbCommand, LimbData, LimbGeom, LimbReply, LimbReplyMsg, LimbReqMsg,
+        LimbRequest, LimbState,
+    };
+    pub use crate::message::{Envelope, Message, ReplyBody, ReplyEnvelope};
+}
+
+/// The layout manifest of the whole contract: every wire struct (dependencies first) and
+/// every constant group.
+pub fn manifest() -> Manifest {
+    use crate::wire::WireStruct as _;
+    use actarray::*;
+    use common::*;
+    use gripper::*;
+    use limb::*;
+    let structs = vec![
+        Vec3::LAYOUT,
+        Orientation3::LAYOUT,
+        Pose3::LAYOUT,
+        Bbox3::LAYOUT,
+        CmdOutcome::LAYOUT,
+        StateHeader::LAYOUT,
+        MsgMeta::LAYOUT,
+        ReplyMeta::LAYOUT,
+        // actarray
+        ActuatorState::LAYOUT,
+        ActArrayData::LAYOUT,
+        ActArrayPositionCmd::LAYOUT,
+        ActArrayMultiPositionCmd::LAYOUT,
+        ActArraySpeedCmd::LAYOUT,
+        ActArrayMultiSpeedCmd::LAYOUT,
+        ActArrayHomeCmd::LAYOUT,
+        ActArrayCurrentCmd::LAYOUT,
+        ActArrayMultiCurrentCmd::LAYOUT,
+        ActArrayCmdMsg::LAYOUT,
+        ActArrayPowerReq::LAYOUT,
+        ActArrayBrakesReq::LAYOUT,
+        ActArraySpeedReq::LAYOUT,
+        ActArrayAccelReq::LAYOUT,
+        ActArrayReqMsg::LAYOUT,
+        ActuatorGeom::LAYOUT,
+        ActArrayGeom::LAYOUT,
+        ActArrayReplyMsg::LAYOUT,
+        // limb
+        LimbData::LAYOUT,
+        LimbSetPoseCmd::LAYOUT,
+        LimbSetPositionCmd::LAYOUT,
+        LimbVecMoveCmd::LAYOUT,
+        LimbCmdMsg::LAYOUT,
+        LimbPowerReq::LAYOUT,
+        LimbBrakesReq::LAYOUT,
+        LimbSpeedReq::LAYOUT,
+        LimbReqMsg::LAYOUT,
+        LimbGeom::LAYOUT,
+        LimbReplyMsg::LAYOUT,
+        // gripper
+        GripperData::LAYOUT,
+        GripperCmdMsg::LAYOUT,
+        GripperReqMsg::LAYOUT,
+        GripperGeom::LAYOUT,
+        GripperReplyMsg::LAYOUT,
+    ];
+    let mut constants = vec![
+        common::LIMITS_GROUP,
+        common::STATUS_GROUP,
+        common::DEVICE_FLAG_GROUP,
+    ];
+    constants.extend_from_slice(actarray::GROUPS);
+    constants.extend_from_slice(limb::GROUPS);
+    constants.extend_from_slice(gripper::GROUPS);
+    Manifest {
+        layout_version: LAYOUT_VERSION,
+        structs,
+        constants,
+    }
+}

@@ -1,0 +1,419 @@
+//! Every message round-trips through bytes and through its typed view; unknown codes and
+//! non-finite numbers are rejected with a named error.
+#![allow(clippy::field_reassign_with_default)]
+
+use limber_interfaces::prelude::*;
+use limber_interfaces::{actarray, gripper, limb};
+use proptest::prelude::*;
+use zerocopy::{FromBytes, IntoBytes};
+
+/// Through the raw bytes (as another process would see them) and back to the typed view.
+fn via_bytes<M: Message + PartialEq + core::fmt::Debug>(m: &M) -> M
+where
+    M::Raw: IntoBytes + FromBytes + zerocopy::Immutable,
+{
+    let mut raw = M::Raw::default();
+    m.write(&mut raw);
+    let bytes = raw.as_bytes().to_vec();
+    let back = M::Raw::read_from_bytes(&bytes).expect("size matches");
+    M::read(&back).expect("valid message decodes")
+}
+
+fn finite() -> impl Strategy<Value = f64> {
+    -1.0e6f64..1.0e6
+}
+fn vec3() -> impl Strategy<Value = Vec3> {
+    (finite(), finite(), finite()).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+}
+fn dir3() -> impl Strategy<Value = Vec3> {
+    vec3().prop_filter("non-zero", |v| v.norm() > 1e-3)
+}
+fn joint() -> impl Strategy<Value = i64> {
+    0i64..MAX_ACTUATORS as i64
+}
+fn values() -> impl Strategy<Value = Vec<f64>> {
+    prop::collection::vec(finite(), 0..=MAX_ACTUATORS)
+}
+
+fn actarray_command() -> impl Strategy<Value = ActArrayCommand> {
+    prop_oneof![
+        (joint(), finite()).prop_map(|(j, p)| ActArrayCommand::position(j, p).unwrap()),
+        values().prop_map(|v| ActArrayCommand::multi_position(&v).unwrap()),
+        (joint(), finite()).prop_map(|(j, s)| ActArrayCommand::speed(j, s).unwrap()),
+        values().prop_map(|v| ActArrayCommand::multi_speed(&v).unwrap()),
+        (-1i64..MAX_ACTUATORS as i64).prop_map(|j| ActArrayCommand::home(j).unwrap()),
+        (-1i64..MAX_ACTUATORS as i64, finite())
+            .prop_map(|(j, c)| ActArrayCommand::current(j, c).unwrap()),
+        values().prop_map(|v| ActArrayCommand::multi_current(&v).unwrap()),
+    ]
+}
+
+fn actarray_request() -> impl Strategy<Value = ActArrayRequest> {
+    prop_oneof![
+        any::<bool>().prop_map(ActArrayRequest::Power),
+        any::<bool>().prop_map(ActArrayRequest::Brakes),
+        Just(ActArrayRequest::GetGeom),
+        (joint(), finite()).prop_map(|(j, s)| ActArrayRequest::speed(j, s).unwrap()),
+        (joint(), finite()).prop_map(|(j, a)| ActArrayRequest::accel(j, a).unwrap()),
+    ]
+}
+
+fn limb_command() -> impl Strategy<Value = LimbCommand> {
+    prop_oneof![
+        Just(LimbCommand::Home),
+        Just(LimbCommand::Stop),
+        (vec3(), dir3(), dir3()).prop_map(|(p, a, o)| LimbCommand::set_pose(p, a, o).unwrap()),
+        vec3().prop_map(|p| LimbCommand::set_position(p).unwrap()),
+        (dir3(), finite()).prop_map(|(d, l)| LimbCommand::vec_move(d, l).unwrap()),
+    ]
+}
+
+fn limb_request() -> impl Strategy<Value = LimbRequest> {
+    prop_oneof![
+        any::<bool>().prop_map(LimbRequest::Power),
+        any::<bool>().prop_map(LimbRequest::Brakes),
+        Just(LimbRequest::Geom),
+        finite().prop_map(|s| LimbRequest::speed(s).unwrap()),
+    ]
+}
+
+fn gripper_command() -> impl Strategy<Value = GripperCommand> {
+    prop_oneof![
+        Just(GripperCommand::Open),
+        Just(GripperCommand::Close),
+        Just(GripperCommand::Stop),
+        Just(GripperCommand::Store),
+        Just(GripperCommand::Retrieve),
+    ]
+}
+
+fn actuator_geom() -> impl Strategy<Value = ActuatorGeom> {
+    (
+        1u32..=2,
+        0u32..=1,
+        finite(),
+        vec3(),
+        finite(),
+        finite(),
+        finite(),
+    )
+        .prop_map(
+            |(kind, has_brakes, length, axis, min, max, speed)| ActuatorGeom {
+                kind,
+                has_brakes,
+                length,
+                orientation: Orientation3 {
+                    roll: min,
+                    pitch: max,
+                    yaw: speed,
+                },
+                axis,
+                min: min.min(max),
+                centre: (min + max) / 2.0,
+                max: min.max(max),
+                home: min,
+                config_speed: speed,
+            },
+        )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+    #[test]
+    fn actarray_commands_roundtrip(c in actarray_command()) {
+        prop_assert_eq!(via_bytes(&c), c);
+    }
+
+    #[test]
+    fn actarray_requests_roundtrip(r in actarray_request()) {
+        prop_assert_eq!(via_bytes(&r), r);
+    }
+
+    #[test]
+    fn limb_commands_roundtrip(c in limb_command()) {
+        prop_assert_eq!(via_bytes(&c), c);
+    }
+
+    #[test]
+    fn limb_requests_roundtrip(r in limb_request()) {
+        prop_assert_eq!(via_bytes(&r), r);
+    }
+
+    #[test]
+    fn gripper_commands_roundtrip(c in gripper_command()) {
+        prop_assert_eq!(via_bytes(&c), c);
+        prop_assert_eq!(via_bytes(&GripperRequest::GetGeom), GripperRequest::GetGeom);
+    }
+
+    #[test]
+    fn actarray_replies_roundtrip(geoms in prop::collection::vec(actuator_geom(), 0..=MAX_ACTUATORS), base in vec3(), nack in 1u32..=10) {
+        let mut g = ActArrayGeom::default();
+        g.actuators_count = geoms.len() as u32;
+        g.actuators[..geoms.len()].copy_from_slice(&geoms);
+        g.base_pos = base;
+        let mut raw = ActArrayReplyMsg::default();
+        ActArrayReply::write(actarray::req::GET_GEOM, Ok(&ActArrayReply::Geom(g)), &mut raw);
+        let back = ActArrayReplyMsg::read_from_bytes(raw.as_bytes()).unwrap();
+        prop_assert_eq!(ActArrayReply::read(&back).unwrap(), Ok(ActArrayReply::Geom(g)));
+        let status = Status::try_from(nack).unwrap();
+        ActArrayReply::write(actarray::req::POWER, Err(status), &mut raw);
+        prop_assert_eq!(ActArrayReply::read(&raw).unwrap(), Err(status));
+        ActArrayReply::write(actarray::req::POWER, Ok(&ActArrayReply::Done), &mut raw);
+        prop_assert_eq!(ActArrayReply::read(&raw).unwrap(), Ok(ActArrayReply::Done));
+    }
+
+    #[test]
+    fn limb_and_gripper_replies_roundtrip(base in vec3(), pos in vec3(), nack in 1u32..=10) {
+        let mut raw = LimbReplyMsg::default();
+        let g = LimbGeom { base_pos: base };
+        LimbReply::write(limb::req::GEOM, Ok(&LimbReply::Geom(g)), &mut raw);
+        prop_assert_eq!(LimbReply::read(&raw).unwrap(), Ok(LimbReply::Geom(g)));
+        LimbReply::write(limb::req::SPEED, Err(Status::try_from(nack).unwrap()), &mut raw);
+        prop_assert_eq!(LimbReply::read(&raw).unwrap(), Err(Status::try_from(nack).unwrap()));
+        let mut graw = GripperReplyMsg::default();
+        let gg = GripperGeom {
+            pose: Pose3 { position: pos, orientation: Orientation3::default() },
+            outer_size: Bbox3 { width: 0.3, length: 0.2, height: 0.04 },
+            inner_size: Bbox3 { width: 0.2, length: 0.1, height: 0.04 },
+            num_beams: 2,
+            capacity: 0,
+        };
+        GripperReply::write(gripper::req::GET_GEOM, Ok(&GripperReply::Geom(gg)), &mut graw);
+        prop_assert_eq!(GripperReply::read(&graw).unwrap(), Ok(GripperReply::Geom(gg)));
+    }
+
+    #[test]
+    fn state_samples_roundtrip_through_bytes(pos in prop::collection::vec(finite(), 0..=MAX_ACTUATORS), st in 1u32..=5, seq in any::<u64>()) {
+        let mut d = ActArrayData::default();
+        d.header.seq = seq;
+        d.actuators_count = pos.len() as u32;
+        for (a, p) in d.actuators.iter_mut().zip(&pos) {
+            a.position = *p;
+            a.state = ActuatorFlags::IDLE.bits();
+        }
+        let back = ActArrayData::read_from_bytes(d.as_bytes()).unwrap();
+        prop_assert_eq!(back, d);
+        prop_assert!(back.validate().is_ok());
+        let mut l = LimbData::default();
+        l.state = st;
+        l.position = Vec3::new(pos.first().copied().unwrap_or(0.0), 0.0, 0.0);
+        prop_assert!(LimbData::read_from_bytes(l.as_bytes()).unwrap().validate().is_ok());
+    }
+
+    /// Arbitrary bytes never panic a decoder; what decodes re-encodes to the same view.
+    #[test]
+    fn arbitrary_bytes_never_panic(bytes in prop::collection::vec(any::<u8>(), 3416)) {
+        let raw = ActArrayCmdMsg::read_from_prefix(&bytes).unwrap().0;
+        if let Ok(c) = ActArrayCommand::read(&raw) { prop_assert_eq!(via_bytes(&c), c); }
+        let raw = ActArrayReqMsg::read_from_prefix(&bytes).unwrap().0;
+        if let Ok(r) = ActArrayRequest::read(&raw) { prop_assert_eq!(via_bytes(&r), r); }
+        let raw = LimbCmdMsg::read_from_prefix(&bytes).unwrap().0;
+        if let Ok(c) = LimbCommand::read(&raw) { prop_assert_eq!(via_bytes(&c), c); }
+        let raw = LimbReqMsg::read_from_prefix(&bytes).unwrap().0;
+        if let Ok(r) = LimbRequest::read(&raw) { prop_assert_eq!(via_bytes(&r), r); }
+        let raw = GripperCmdMsg::read_from_prefix(&bytes).unwrap().0;
+        let _ = GripperCommand::read(&raw);
+        let _ = ActArrayReply::read(&ActArrayReplyMsg::read_from_prefix(&bytes).unwrap().0);
+        let _ = LimbReply::read(&LimbReplyMsg::read_from_prefix(&bytes).unwrap().0);
+        let _ = GripperReply::read(&GripperReplyMsg::read_from_prefix(&bytes).unwrap().0);
+        let _ = ActArrayData::read_from_prefix(&bytes).unwrap().0.validate();
+        let _ = LimbData::read_from_prefix(&bytes).unwrap().0.validate();
+        let _ = GripperData::read_from_prefix(&bytes).unwrap().0.validate();
+    }
+}
+
+#[test]
+fn unknown_kinds_are_named_errors() {
+    let mut raw = ActArrayCmdMsg::default();
+    raw.meta.kind = 99;
+    assert_eq!(
+        ActArrayCommand::read(&raw),
+        Err(DecodeError::UnknownKind {
+            channel: "actarray command",
+            kind: 99
+        })
+    );
+    let mut raw = LimbReqMsg::default();
+    raw.meta.kind = 0;
+    assert!(matches!(
+        LimbRequest::read(&raw),
+        Err(DecodeError::UnknownKind { kind: 0, .. })
+    ));
+    let mut raw = GripperCmdMsg::default();
+    raw.meta.kind = 6;
+    assert!(matches!(
+        GripperCommand::read(&raw),
+        Err(DecodeError::UnknownKind { kind: 6, .. })
+    ));
+    let mut raw = GripperReplyMsg::default();
+    raw.meta.status = 42;
+    assert_eq!(
+        GripperReply::read(&raw),
+        Err(DecodeError::UnknownCode {
+            field: "status",
+            value: 42
+        })
+    );
+}
+
+#[test]
+fn unknown_codes_in_state_are_named_errors() {
+    let mut d = ActArrayData::default();
+    d.actuators_count = 1;
+    d.actuators[0].state = 16;
+    assert_eq!(
+        d.validate(),
+        Err(DecodeError::UnknownBits {
+            field: "actuator state",
+            bits: 16
+        })
+    );
+    d.actuators_count = 33;
+    assert!(matches!(
+        d.validate(),
+        Err(DecodeError::Value(ValueError::TooMany { .. }))
+    ));
+    let mut l = LimbData::default();
+    l.state = 6;
+    assert_eq!(
+        l.validate(),
+        Err(DecodeError::UnknownCode {
+            field: "limb state",
+            value: 6
+        })
+    );
+    let g = GripperData::default();
+    assert_eq!(
+        g.validate(),
+        Err(DecodeError::UnknownCode {
+            field: "gripper state",
+            value: 0
+        })
+    );
+    let mut geom = ActuatorGeom::default();
+    geom.kind = 3;
+    assert!(geom.actuator_kind().is_err());
+    assert!(Status::try_from(11).is_err());
+    let mut raw = ActArrayReqMsg::default();
+    raw.meta.kind = actarray::req::POWER;
+    raw.meta.body_len = 4;
+    raw.body[0] = 2;
+    assert_eq!(
+        ActArrayRequest::read(&raw),
+        Err(DecodeError::UnknownCode {
+            field: "power value",
+            value: 2
+        })
+    );
+}
+
+#[test]
+fn non_finite_values_are_rejected() {
+    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        assert_eq!(
+            ActArrayCommand::position(0, bad),
+            Err(ValueError::NotFinite { field: "position" })
+        );
+        assert_eq!(
+            ActArrayCommand::multi_position(&[0.0, bad]),
+            Err(ValueError::NotFinite { field: "positions" })
+        );
+        assert!(
+            LimbCommand::set_pose(
+                Vec3::new(bad, 0.0, 0.0),
+                Vec3::new(1.0, 0.0, 0.0),
+                Vec3::new(0.0, 0.0, 1.0)
+            )
+            .is_err()
+        );
+        assert!(LimbCommand::vec_move(Vec3::new(1.0, 0.0, 0.0), bad).is_err());
+        assert!(LimbRequest::speed(bad).is_err());
+        // A NaN written straight into the raw bytes (as a C program could) is caught on decode.
+        let mut raw = ActArrayCmdMsg::default();
+        ActArrayCommand::position(1, 0.0).unwrap().write(&mut raw);
+        raw.body[8..16].copy_from_slice(&bad.to_ne_bytes());
+        assert_eq!(
+            ActArrayCommand::read(&raw),
+            Err(DecodeError::Value(ValueError::NotFinite {
+                field: "position"
+            }))
+        );
+        let mut d = LimbData {
+            state: 1,
+            ..LimbData::default()
+        };
+        d.approach.y = bad;
+        assert!(matches!(
+            d.validate(),
+            Err(DecodeError::Value(ValueError::NotFinite {
+                field: "approach"
+            }))
+        ));
+    }
+    assert_eq!(
+        LimbCommand::set_pose(Vec3::default(), Vec3::default(), Vec3::new(0.0, 0.0, 1.0)),
+        Err(ValueError::ZeroVector { field: "approach" })
+    );
+    assert!(matches!(
+        ActArrayCommand::position(32, 0.0),
+        Err(ValueError::BadJoint { joint: 32, .. })
+    ));
+    assert!(matches!(
+        ActArrayCommand::position(-1, 0.0),
+        Err(ValueError::BadJoint { .. })
+    ));
+    assert!(ActArrayCommand::home(-1).is_ok());
+    assert!(matches!(
+        ActArrayCommand::multi_position(&[0.0; 33]),
+        Err(ValueError::TooMany { count: 33, .. })
+    ));
+}
+
+#[test]
+fn body_length_must_match_kind() {
+    let mut raw = LimbCmdMsg::default();
+    LimbCommand::set_position(Vec3::new(0.3, 0.0, 0.2))
+        .unwrap()
+        .write(&mut raw);
+    raw.meta.body_len = 16;
+    assert!(matches!(
+        LimbCommand::read(&raw),
+        Err(DecodeError::BodyLength {
+            expected: 24,
+            got: 16,
+            ..
+        })
+    ));
+    let mut raw = LimbCmdMsg::default();
+    LimbCommand::Home.write(&mut raw);
+    raw.meta.body_len = 1;
+    assert!(LimbCommand::read(&raw).is_err());
+}
+
+#[test]
+fn manifest_describes_every_struct_without_padding() {
+    let m = limber_interfaces::manifest();
+    assert!(m.structs.len() >= 40);
+    for s in &m.structs {
+        assert!(s.type_name.starts_with("limber.v1."), "{}", s.type_name);
+        let sum: usize = s.fields.iter().map(|f| f.size).sum();
+        assert_eq!(sum, s.size, "{} has padding", s.name);
+        let mut end = 0;
+        for f in s.fields {
+            assert_eq!(f.offset, end, "{}.{} leaves a gap", s.name, f.name);
+            end = f.offset + f.size;
+            if !f.ty.starts_with(['u', 'i', 'f']) || f.ty.len() > 3 {
+                assert!(
+                    m.find(f.ty).is_some(),
+                    "{}.{} has unknown type {}",
+                    s.name,
+                    f.name,
+                    f.ty
+                );
+            }
+        }
+    }
+    let json: serde_json::Value = serde_json::from_str(&m.to_json()).unwrap();
+    assert_eq!(json["structs"][0]["fields"][0]["name"], "x");
+}
