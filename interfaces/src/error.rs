@@ -88,3 +88,23 @@ impl DecodeError {
         DecodeError::Value(ValueError::NotFinite { field })
     }
 }
+
+impl DecodeError {
+    /// The status a driver answers when a message fails to decode.
+    pub const fn status(&self) -> crate::common::Status {
+        use crate::common::Status;
+        match self {
+            DecodeError::UnknownKind { .. } => Status::Unsupported,
+            DecodeError::Value(ValueError::NotFinite { .. }) => Status::NotFinite,
+            DecodeError::Value(ValueError::BadJoint { .. }) => Status::UnknownJoint,
+            _ => Status::InvalidArgument,
+        }
+    }
+}
+
+impl ValueError {
+    /// The status a driver answers for a message with this invalid value.
+    pub const fn status(&self) -> crate::common::Status {
+        DecodeError::Value(*self).status()
+    }
+}

@@ -1,1 +1,90 @@
-//! limber-services: the iceoryx2 layer (built by the services issue).
+//! # limber-services: the iceoryx2 layer
+//!
+//! How a driver offers a device and how any number of client processes on the same PC read
+//! its state, command it and ask it things: zero-copy shared memory, no copy of a sample,
+//! no broker.
+//!
+//! * [`naming`]: domains (`LIMBER_DOMAIN` → iceoryx2 prefix), device names
+//!   `robot/interface/index`, service names `limber/<robot>/<interface>/<index>/<channel>`.
+//! * [`host`]: [`DeviceHost`] offers a device; a driver implements [`DeviceHandler`] for
+//!   each interface it serves.
+//! * [`client`]: [`ActArrayClient`], [`LimbClient`], [`GripperClient`], in the spirit of
+//!   Player's proxies, with typed errors and timeouts on every wait.
+//! * [`discovery`]: [`list_devices`], with liveness.
+//!
+//! ## A driver in 20 lines
+//!
+//! ```
+//! use limber_services::prelude::*;
+//!
+//! /// A gripper that opens and closes at once.
+//! struct Instant;
+//! impl DeviceHandler<Gripper> for Instant {
+//!     fn command(&mut self, cmd: &GripperCommand, _: &Origin, state: &mut GripperData) -> Status {
+//!         match cmd {
+//!             GripperCommand::Open => { state.state = GripperState::Open as u32; Status::Ok }
+//!             GripperCommand::Close => { state.state = GripperState::Closed as u32; Status::Ok }
+//!             _ => Status::Unsupported,
+//!         }
+//!     }
+//!     fn request(&mut self, _: &GripperRequest, _: &Origin, _: &mut GripperData) -> Result<GripperReply, Status> {
+//!         Ok(GripperReply::Geom(GripperGeom { num_beams: 0, ..Default::default() }))
+//!     }
+//! }
+//!
+//! # let domain = Domain::unique_for_test();
+//! let ctx = Context::new(&domain, Role::Driver, "instant")?;
+//! let mut host = DeviceHost::<Gripper>::new(&ctx, &"demo/gripper/0".parse()?, "instant")?;
+//! host.state_mut().state = GripperState::Open as u32;
+//! host.publish()?;
+//! # for _ in 0..1 {
+//! host.process(&mut Instant)?; // in the driver's loop, after each wake-up
+//! # }
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! ## A client in 10 lines
+//!
+//! ```no_run
+//! use std::time::Duration;
+//! use limber_services::prelude::*;
+//!
+//! let ctx = Context::client_from_env()?;
+//! let mut arm = ActArrayClient::connect(&ctx, "pioneer/actarray/0")?;
+//! let geom = arm.geometry()?;                       // a request: typed reply or typed error
+//! let ticket = arm.move_to(2, geom.actuators[2].home)?; // a command: no allocation
+//! let status = arm.wait_outcome(ticket, Duration::from_secs(1))?;
+//! println!("{status}; joint 2 at {:.3} rad", arm.state().unwrap().actuators[2].position);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+#![warn(missing_docs)]
+
+pub mod client;
+pub mod context;
+pub mod discovery;
+pub mod host;
+pub mod naming;
+pub mod qos;
+
+pub use client::{
+    ActArrayClient, Client, CommandError, ConnectError, DriverStatus, Freshness, GripperClient,
+    LimbClient, RequestError, Ticket, WaitError, WaitMode,
+};
+pub use context::{Context, ContextError, Role, monotonic_ns};
+pub use discovery::{DeviceInfo, ListError, list_devices};
+pub use host::{Activity, DeviceHandler, DeviceHost, HostError, HostStats, Origin, ProcessError, PublishError};
+pub use naming::{Channel, DeviceName, Domain, NameError};
+
+/// Everything a driver or client author needs, in one `use`.
+pub mod prelude {
+    pub use crate::client::{
+        ActArrayClient, Client, CommandError, ConnectError, DriverStatus, Freshness,
+        GripperClient, LimbClient, RequestError, Ticket, WaitError, WaitMode,
+    };
+    pub use crate::context::{Context, Role, monotonic_ns};
+    pub use crate::discovery::{DeviceInfo, list_devices};
+    pub use crate::host::{DeviceHandler, DeviceHost, Origin};
+    pub use crate::naming::{DeviceName, Domain};
+    pub use limber_interfaces::prelude::*;
+}

@@ -1,0 +1,153 @@
+//! A process's participation in a domain: one iceoryx2 node shared by every client and
+//! driver host the process creates.
+
+use std::rc::Rc;
+use std::sync::atomic::{AtomicU32, Ordering};
+
+use iceoryx2::node::NodeCreationFailure;
+use iceoryx2::prelude::*;
+use thiserror::Error;
+
+use crate::naming::{CLIENT_NODE_PREFIX, DRIVER_NODE_PREFIX, Domain};
+
+/// The monotonic clock in ns (`CLOCK_MONOTONIC`), the time base of every stamp.
+pub fn monotonic_ns() -> u64 {
+    let t = rustix::time::clock_gettime(rustix::time::ClockId::Monotonic);
+    t.tv_sec as u64 * 1_000_000_000 + t.tv_nsec as u64
+}
+
+/// What a process is in the domain.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Role {
+    /// A driver: owns devices. Its node is named `limber-driver:<name>`.
+    Driver,
+    /// A client: uses devices. Its node is named `limber-client:<name>`.
+    Client,
+}
+
+/// Creating the context failed.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum ContextError {
+    /// The process name is not a valid node name (at most 100 ASCII characters).
+    #[error("invalid process name {0:?}")]
+    Name(String),
+    /// iceoryx2 could not create the node (permissions on /tmp/iceoryx2 or /dev/shm,
+    /// or a corrupted installation).
+    #[error("cannot join domain {domain}: {reason}")]
+    Node {
+        /// The domain.
+        domain: String,
+        /// iceoryx2's reason.
+        reason: String,
+    },
+}
+
+pub(crate) struct Inner {
+    pub(crate) domain: Domain,
+    pub(crate) node: Node<ipc::Service>,
+    pub(crate) role: Role,
+    pub(crate) name: String,
+}
+
+/// A process's membership of a domain. Cheap to clone; not `Send` (iceoryx2 ports of
+/// the `ipc` service are bound to their thread).
+#[derive(Clone)]
+pub struct Context {
+    pub(crate) inner: Rc<Inner>,
+}
+
+impl core::fmt::Debug for Context {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Context")
+            .field("domain", &self.inner.domain.name())
+            .field("role", &self.inner.role)
+            .field("name", &self.inner.name)
+            .finish()
+    }
+}
+
+static CLIENT_SEQ: AtomicU32 = AtomicU32::new(1);
+
+impl Context {
+    /// Joins `domain` as a driver or a client named `name` (shown by `limber list`).
+    ///
+    /// iceoryx2's own log output is limited to errors unless `IOX2_LOG_LEVEL` says
+    /// otherwise. A client context leaves SIGINT/SIGTERM to the program; a driver context
+    /// lets iceoryx2 catch them so the driver loop can stop cleanly (see
+    /// [`Context::termination_requested`]).
+    pub fn new(domain: &Domain, role: Role, name: &str) -> Result<Self, ContextError> {
+        set_log_level_from_env_or(LogLevel::Error);
+        let prefix = match role {
+            Role::Driver => DRIVER_NODE_PREFIX,
+            Role::Client => CLIENT_NODE_PREFIX,
+        };
+        let node_name: NodeName = format!("{prefix}{name}")
+            .as_str()
+            .try_into()
+            .map_err(|_| ContextError::Name(name.to_string()))?;
+        let mode = match role {
+            Role::Driver => SignalHandlingMode::HandleTerminationRequests,
+            Role::Client => SignalHandlingMode::Disabled,
+        };
+        let node = NodeBuilder::new()
+            .name(&node_name)
+            .config(domain.config())
+            .signal_handling_mode(mode)
+            .create::<ipc::Service>()
+            .map_err(|e: NodeCreationFailure| ContextError::Node {
+                domain: domain.name().to_string(),
+                reason: format!("{e:?}"),
+            })?;
+        Ok(Context {
+            inner: Rc::new(Inner {
+                domain: domain.clone(),
+                node,
+                role,
+                name: name.to_string(),
+            }),
+        })
+    }
+
+    /// A client context in the domain of `LIMBER_DOMAIN` (default `limber`), named after
+    /// the executable.
+    pub fn client_from_env() -> Result<Self, crate::ConnectError> {
+        let domain = Domain::from_env()?;
+        let name = std::env::args()
+            .next()
+            .and_then(|a| {
+                std::path::Path::new(&a)
+                    .file_name()
+                    .map(|s| s.to_string_lossy().to_string())
+            })
+            .unwrap_or_else(|| "client".to_string());
+        Ok(Context::new(&domain, Role::Client, &name)?)
+    }
+
+    /// The domain.
+    pub fn domain(&self) -> &Domain {
+        &self.inner.domain
+    }
+
+    /// The role.
+    pub fn role(&self) -> Role {
+        self.inner.role
+    }
+
+    /// The iceoryx2 node (for advanced use: extra services, WaitSets).
+    pub fn node(&self) -> &Node<ipc::Service> {
+        &self.inner.node
+    }
+
+    /// True once SIGINT or SIGTERM arrived (driver contexts only; always false for
+    /// clients, whose signals are the program's own).
+    pub fn termination_requested(&self) -> bool {
+        self.inner.role == Role::Driver && self.inner.node.wait(core::time::Duration::ZERO).is_err()
+    }
+
+    /// A new client id, unique in the domain while this process lives: the process id in
+    /// the high 32 bits, a per-process counter in the low 32 bits. Never 0.
+    pub fn new_client_id(&self) -> u64 {
+        let n = CLIENT_SEQ.fetch_add(1, Ordering::Relaxed);
+        ((std::process::id() as u64) << 32) | n as u64
+    }
+}

@@ -1,0 +1,95 @@
+//! Discovery: every device of a domain, with its driver and whether it is alive.
+
+use iceoryx2::prelude::*;
+use iceoryx2::service::static_config::messaging_pattern::MessagingPattern as Pattern;
+use limber_interfaces::InterfaceKind;
+use thiserror::Error;
+
+use crate::naming::{Channel, DRIVER_NODE_PREFIX, DeviceName, Domain, attr};
+
+/// One device found in a domain.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
+pub struct DeviceInfo {
+    /// Its name (`robot/interface/index`).
+    pub name: DeviceName,
+    /// The driver that offers it (its `limber.driver` attribute).
+    pub driver: String,
+    /// The layout version it speaks.
+    pub layout: String,
+    /// True while the driver's process lives.
+    pub alive: bool,
+    /// Processes attached to its state channel (driver and clients).
+    pub nodes: usize,
+}
+
+impl DeviceInfo {
+    /// The interface.
+    pub fn interface(&self) -> InterfaceKind {
+        self.name.interface()
+    }
+}
+
+/// Listing the devices failed.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum ListError {
+    /// iceoryx2 could not read the service directory (permissions?).
+    #[error("cannot list the services of domain {domain}: {reason}")]
+    Transport {
+        /// The domain.
+        domain: String,
+        /// iceoryx2's reason.
+        reason: String,
+    },
+}
+
+/// Every device of `domain`, sorted by name. A device whose driver died is listed as not
+/// alive until its services are cleaned up.
+pub fn list_devices(domain: &Domain) -> Result<Vec<DeviceInfo>, ListError> {
+    let mut out = Vec::new();
+    ipc::Service::list(domain.config(), |details| {
+        let name = details.static_details.name().as_str().to_string();
+        if !matches!(details.static_details.messaging_pattern(), Pattern::PublishSubscribe(_)) {
+            return CallbackProgression::Continue;
+        }
+        let Some((device, Channel::Data)) = DeviceName::from_service_name(&name) else {
+            return CallbackProgression::Continue;
+        };
+        let attrs = details.static_details.attributes();
+        let get = |k: &str| -> String {
+            attrs
+                .iter()
+                .find(|a| a.key().to_string() == k)
+                .map(|a| a.value().to_string())
+                .unwrap_or_default()
+        };
+        let (mut alive, mut nodes) = (false, 0);
+        if let Some(dynamic) = &details.dynamic_details {
+            for n in &dynamic.nodes {
+                nodes += 1;
+                if let NodeState::Alive(v) = n {
+                    use iceoryx2::node::NodeView;
+                    if v.details()
+                        .as_ref()
+                        .is_some_and(|d| d.name().as_str().starts_with(DRIVER_NODE_PREFIX))
+                    {
+                        alive = true;
+                    }
+                }
+            }
+        }
+        out.push(DeviceInfo {
+            name: device,
+            driver: get(attr::DRIVER),
+            layout: get(attr::LAYOUT),
+            alive,
+            nodes,
+        });
+        CallbackProgression::Continue
+    })
+    .map_err(|e| ListError::Transport {
+        domain: domain.name().to_string(),
+        reason: format!("{e:?}"),
+    })?;
+    out.sort();
+    Ok(out)
+}

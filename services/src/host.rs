@@ -1,0 +1,542 @@
+//! The driver side: [`DeviceHost`] offers one device and [`DeviceHandler`] is what a driver
+//! implements for each interface it serves.
+
+use core::marker::PhantomData;
+
+use iceoryx2::active_request::ActiveRequest;
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::server::Server;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::*;
+use iceoryx2::service::attribute::{AttributeKey, AttributeValue};
+use limber_interfaces::prelude::*;
+use thiserror::Error;
+
+use crate::context::{Context, monotonic_ns};
+use crate::naming::{Channel, DeviceName, attr};
+use crate::qos;
+
+/// Who sent a command or request.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Origin {
+    /// The client's id.
+    pub client_id: u64,
+    /// The client's sequence number of this message.
+    pub seq: u64,
+    /// When the client sent it (`CLOCK_MONOTONIC` ns).
+    pub sent_ns: u64,
+}
+
+/// What a driver implements for each interface it serves: `DeviceHandler<ActArray>`,
+/// `DeviceHandler<Limb>`, `DeviceHandler<Gripper>`. The Pioneer driver, the simulated arm
+/// and test doubles plug into a [`DeviceHost`] the same way.
+pub trait DeviceHandler<I: Interface> {
+    /// Carries out (or refuses) a validated command; `state` is the device state the host
+    /// publishes next. The returned status reaches the sender in the next state sample's
+    /// `last_cmd`. Must not block.
+    fn command(&mut self, cmd: &I::Command, from: &Origin, state: &mut I::Data) -> Status;
+
+    /// Answers a validated request: `Ok` is an ACK with that payload, `Err` a NACK with
+    /// the reason. Must not block.
+    fn request(
+        &mut self,
+        req: &I::Request,
+        from: &Origin,
+        state: &mut I::Data,
+    ) -> Result<I::Reply, Status>;
+}
+
+/// Offering a device failed.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum HostError {
+    /// A service of this device exists with other attributes or types: another driver
+    /// (or another layout version) serves this name, or its clients still hold it.
+    #[error("{device}: the name is held by an incompatible service ({reason})")]
+    Incompatible {
+        /// The device.
+        device: String,
+        /// iceoryx2's reason.
+        reason: String,
+    },
+    /// A driver is already serving this device (its node is alive).
+    #[error("{device}: already served by a running driver")]
+    AlreadyServed {
+        /// The device.
+        device: String,
+    },
+    /// iceoryx2 failed to create a service or port.
+    #[error("{device}: cannot create the {channel} channel: {reason}")]
+    Transport {
+        /// The device.
+        device: String,
+        /// The channel.
+        channel: &'static str,
+        /// iceoryx2's reason.
+        reason: String,
+    },
+}
+
+/// Publishing the state failed.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum PublishError {
+    /// No shared-memory sample could be loaned (all held by slow readers: impossible with
+    /// the QoS used, reported rather than hidden).
+    #[error("cannot loan a state sample: {0}")]
+    Loan(String),
+    /// The sample could not be delivered.
+    #[error("cannot send the state sample: {0}")]
+    Send(String),
+}
+
+/// Receiving commands or requests failed.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum ProcessError {
+    /// Receiving from shared memory failed.
+    #[error("cannot receive: {0}")]
+    Receive(String),
+    /// A reply could not be sent (the client is gone: not fatal, counted).
+    #[error("cannot publish the outcome: {0}")]
+    Publish(#[from] PublishError),
+}
+
+/// Counters of a host since it started.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct HostStats {
+    /// Commands received.
+    pub commands: u64,
+    /// Commands refused (any status other than ok).
+    pub refused: u64,
+    /// Commands lost before the driver saw them (gaps in a client's sequence numbers).
+    pub overflows: u64,
+    /// Requests answered.
+    pub requests: u64,
+    /// Replies that could not be delivered (client gone).
+    pub undelivered_replies: u64,
+    /// State samples published.
+    pub published: u64,
+}
+
+/// How many commands and requests one call of [`DeviceHost::process`] handled.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Activity {
+    /// Commands handled.
+    pub commands: usize,
+    /// Requests answered.
+    pub requests: usize,
+}
+
+const CLIENT_SLOTS: usize = 64;
+
+/// Per-client last sequence number, to detect lost commands. Fixed size, no allocation.
+struct ClientTable {
+    slots: [(u64, u64); CLIENT_SLOTS],
+    next: usize,
+}
+
+impl ClientTable {
+    fn new() -> Self {
+        ClientTable {
+            slots: [(0, 0); CLIENT_SLOTS],
+            next: 0,
+        }
+    }
+
+    /// Records `seq` from `client`; returns how many commands were skipped.
+    fn record(&mut self, client: u64, seq: u64) -> u64 {
+        if let Some(slot) = self.slots.iter_mut().find(|s| s.0 == client) {
+            let lost = seq.saturating_sub(slot.1 + 1);
+            slot.1 = slot.1.max(seq);
+            return lost;
+        }
+        // A client seen for the first time: its first command is seq 1.
+        self.slots[self.next] = (client, seq);
+        self.next = (self.next + 1) % CLIENT_SLOTS;
+        seq.saturating_sub(1)
+    }
+}
+
+/// Offers one device of interface `I`: publishes its state, drains its commands in
+/// arrival order, answers its requests, and wakes its clients.
+///
+/// Steady state allocates nothing: state samples are loaned from shared memory and written
+/// in place, commands and requests are read in place.
+pub struct DeviceHost<I: Interface> {
+    device: DeviceName,
+    data_svc: iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, I::Data, ()>,
+    publisher: Publisher<ipc::Service, I::Data, ()>,
+    commands: Subscriber<ipc::Service, I::CmdMsg, ()>,
+    server: Server<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()>,
+    wake: Listener<ipc::Service>,
+    notify: Notifier<ipc::Service>,
+    state: I::Data,
+    seq: u64,
+    outcome: CmdOutcome,
+    flags: u32,
+    clients: ClientTable,
+    stats: HostStats,
+    publish_each_outcome: bool,
+    _i: PhantomData<I>,
+}
+
+impl<I: Interface> core::fmt::Debug for DeviceHost<I> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("DeviceHost")
+            .field("device", &self.device.to_string())
+            .field("stats", &self.stats)
+            .finish()
+    }
+}
+
+fn attribute_verifier(
+    device: &DeviceName,
+    driver: &str,
+) -> Result<AttributeVerifier, HostError> {
+    let err = |reason: String| HostError::Transport {
+        device: device.to_string(),
+        channel: "attributes",
+        reason,
+    };
+    let kv = |k: &str, v: &str| -> Result<(AttributeKey, AttributeValue), HostError> {
+        Ok((
+            AttributeKey::new(k.as_bytes()).map_err(|e| err(format!("{e:?}")))?,
+            AttributeValue::new(v.as_bytes()).map_err(|e| err(format!("{e:?}")))?,
+        ))
+    };
+    let mut v = AttributeVerifier::new();
+    for (k, val) in [
+        (attr::ROBOT, device.robot().to_string()),
+        (attr::INTERFACE, device.interface().name().to_string()),
+        (attr::INDEX, device.index().to_string()),
+        (attr::DRIVER, driver.to_string()),
+        (attr::LAYOUT, limber_interfaces::LAYOUT_VERSION.to_string()),
+    ] {
+        let (k, val) = kv(k, &val)?;
+        v = v.require(&k, &val).map_err(|e| err(format!("{e:?}")))?;
+    }
+    Ok(v)
+}
+
+impl<I: Interface> DeviceHost<I> {
+    /// Offers `device` in the context's domain, as driver `driver` (shown by
+    /// `limber list`). The initial state is all zero: set it with [`DeviceHost::state_mut`]
+    /// and [`DeviceHost::publish`] before clients act on it.
+    pub fn new(ctx: &Context, device: &DeviceName, driver: &str) -> Result<Self, HostError> {
+        assert_eq!(device.interface(), I::KIND, "device {device} is not a {}", I::KIND);
+        let node = ctx.node();
+        let dev = device.to_string();
+        let verifier = attribute_verifier(device, driver)?;
+        let transport = |channel: &'static str, e: String| {
+            if e.contains("IncompatibleAttributes") || e.contains("IncompatibleTypes") {
+                HostError::Incompatible {
+                    device: dev.clone(),
+                    reason: e,
+                }
+            } else {
+                HostError::Transport {
+                    device: dev.clone(),
+                    channel,
+                    reason: e,
+                }
+            }
+        };
+
+        let data_svc = node
+            .service_builder(&device.service_name(Channel::Data))
+            .publish_subscribe::<I::Data>()
+            .history_size(1)
+            .subscriber_max_buffer_size(qos::DATA_BUFFER)
+            .subscriber_max_borrowed_samples(qos::DATA_BORROWED)
+            .max_publishers(qos::DATA_PUBLISHERS)
+            .max_subscribers(qos::MAX_CLIENTS)
+            .max_nodes(qos::MAX_NODES)
+            .enable_safe_overflow(true)
+            .open_or_create_with_attributes(&verifier)
+            .map_err(|e| transport("data", format!("{e:?}")))?;
+        // A live driver already publishing this device: refuse to serve it twice.
+        if data_svc.dynamic_config().number_of_publishers() > 0 {
+            data_svc.try_cleanup_dead_nodes();
+            if data_svc.dynamic_config().number_of_publishers() > 0 {
+                return Err(HostError::AlreadyServed { device: dev });
+            }
+        }
+        let publisher = data_svc
+            .publisher_builder()
+            .max_loaned_samples(1)
+            .create()
+            .map_err(|e| transport("data", format!("{e:?}")))?;
+
+        let cmd_svc = node
+            .service_builder(&device.service_name(Channel::Cmd))
+            .publish_subscribe::<I::CmdMsg>()
+            .history_size(0)
+            .subscriber_max_buffer_size(qos::CMD_BUFFER)
+            .subscriber_max_borrowed_samples(2)
+            .max_publishers(qos::MAX_CLIENTS)
+            .max_subscribers(qos::CMD_SUBSCRIBERS)
+            .max_nodes(qos::MAX_NODES)
+            .enable_safe_overflow(true)
+            .open_or_create_with_attributes(&verifier)
+            .map_err(|e| transport("cmd", format!("{e:?}")))?;
+        let commands = cmd_svc
+            .subscriber_builder()
+            .buffer_size(qos::CMD_BUFFER)
+            .create()
+            .map_err(|e| transport("cmd", format!("{e:?}")))?;
+
+        let req_svc = node
+            .service_builder(&device.service_name(Channel::Req))
+            .request_response::<I::ReqMsg, I::ReplyMsg>()
+            .max_clients(qos::MAX_CLIENTS)
+            .max_servers(qos::REQ_SERVERS)
+            .max_nodes(qos::MAX_NODES)
+            .max_active_requests_per_client(qos::MAX_ACTIVE_REQUESTS)
+            .max_response_buffer_size(2)
+            .enable_fire_and_forget_requests(false)
+            .open_or_create_with_attributes(&verifier)
+            .map_err(|e| transport("req", format!("{e:?}")))?;
+        let server = req_svc
+            .server_builder()
+            .create()
+            .map_err(|e| transport("req", format!("{e:?}")))?;
+
+        let wake_svc = node
+            .service_builder(&device.service_name(Channel::Wake))
+            .event()
+            .max_listeners(qos::WAKE_LISTENERS)
+            .max_notifiers(qos::MAX_CLIENTS)
+            .max_nodes(qos::MAX_NODES)
+            .open_or_create_with_attributes(&verifier)
+            .map_err(|e| transport("wake", format!("{e:?}")))?;
+        let wake = wake_svc
+            .listener_builder()
+            .create()
+            .map_err(|e| transport("wake", format!("{e:?}")))?;
+
+        let notify_svc = node
+            .service_builder(&device.service_name(Channel::Notify))
+            .event()
+            .max_listeners(qos::MAX_CLIENTS)
+            .max_notifiers(qos::NOTIFY_NOTIFIERS)
+            .max_nodes(qos::MAX_NODES)
+            .open_or_create_with_attributes(&verifier)
+            .map_err(|e| transport("notify", format!("{e:?}")))?;
+        let notify = notify_svc
+            .notifier_builder()
+            .create()
+            .map_err(|e| transport("notify", format!("{e:?}")))?;
+
+        Ok(DeviceHost {
+            device: device.clone(),
+            data_svc,
+            publisher,
+            commands,
+            server,
+            wake,
+            notify,
+            state: I::Data::default(),
+            seq: 0,
+            outcome: CmdOutcome::default(),
+            flags: 0,
+            clients: ClientTable::new(),
+            stats: HostStats::default(),
+            publish_each_outcome: true,
+            _i: PhantomData,
+        })
+    }
+
+    /// The device.
+    pub fn device(&self) -> &DeviceName {
+        &self.device
+    }
+
+    /// The state that [`DeviceHost::publish`] sends.
+    pub fn state(&self) -> &I::Data {
+        &self.state
+    }
+
+    /// The state, to update before publishing.
+    pub fn state_mut(&mut self) -> &mut I::Data {
+        &mut self.state
+    }
+
+    /// Sets the `DEVICE_FLAG` bits carried in every sample.
+    pub fn set_flags(&mut self, flags: u32) {
+        self.flags = flags;
+    }
+
+    /// The flags.
+    pub fn flags(&self) -> u32 {
+        self.flags
+    }
+
+    /// Whether a state sample is published after every command, so each sender sees its
+    /// own outcome (default: yes). Turn off to publish only when the driver calls
+    /// [`DeviceHost::publish`].
+    pub fn set_publish_each_outcome(&mut self, on: bool) {
+        self.publish_each_outcome = on;
+    }
+
+    /// Counters.
+    pub fn stats(&self) -> HostStats {
+        self.stats
+    }
+
+    /// The listener that a client's command or request wakes: attach it to the driver's
+    /// WaitSet (or poll its fd), then call [`DeviceHost::consume_wakeups`].
+    pub fn wake_listener(&self) -> &Listener<ipc::Service> {
+        &self.wake
+    }
+
+    /// Consumes pending wake-up events (without blocking); returns how many there were.
+    pub fn consume_wakeups(&self) -> u64 {
+        self.wake.try_wait(|_| {}).unwrap_or(0)
+    }
+
+    /// Publishes the state acquired at `stamp_ns` (`CLOCK_MONOTONIC`).
+    pub fn publish_acquired(&mut self, stamp_ns: u64) -> Result<(), PublishError> {
+        self.state.header_mut().stamp_ns = stamp_ns;
+        self.publish()
+    }
+
+    /// Publishes the current state (with a new sequence number, the last command's outcome,
+    /// the flags and the overflow count) and notifies waiting clients.
+    pub fn publish(&mut self) -> Result<(), PublishError> {
+        self.seq += 1;
+        let h = self.state.header_mut();
+        h.seq = self.seq;
+        if h.stamp_ns == 0 {
+            h.stamp_ns = monotonic_ns();
+        }
+        h.last_cmd = self.outcome;
+        h.flags = self.flags;
+        h.cmd_overflows = self.stats.overflows.min(u32::MAX as u64) as u32;
+        let sample = self
+            .publisher
+            .loan_uninit()
+            .map_err(|e| PublishError::Loan(format!("{e:?}")))?;
+        let sample = sample.write_payload(self.state);
+        sample
+            .send()
+            .map_err(|e| PublishError::Send(format!("{e:?}")))?;
+        self.stats.published += 1;
+        // Best effort: a client that waits with a timeout re-checks anyway.
+        let _ = self
+            .notify
+            .notify_with_custom_event_id(EventId::new(qos::EVENT_STATE));
+        Ok(())
+    }
+
+    /// Drains every pending command (in arrival order, per client in sending order) and
+    /// answers every pending request, calling `handler`. Never blocks.
+    pub fn process<H: DeviceHandler<I>>(&mut self, handler: &mut H) -> Result<Activity, ProcessError> {
+        let commands = self.process_commands(handler)?;
+        let requests = self.process_requests(handler)?;
+        Ok(Activity { commands, requests })
+    }
+
+    /// Drains every pending command. A command that does not decode is refused with the
+    /// matching status without reaching the handler.
+    pub fn process_commands<H: DeviceHandler<I>>(
+        &mut self,
+        handler: &mut H,
+    ) -> Result<usize, ProcessError> {
+        let mut n = 0;
+        loop {
+            let sample = match self.commands.receive() {
+                Ok(Some(s)) => s,
+                Ok(None) => break,
+                Err(e) => return Err(ProcessError::Receive(format!("{e:?}"))),
+            };
+            let raw: &I::CmdMsg = &sample;
+            let meta = *raw.meta();
+            let origin = Origin {
+                client_id: meta.client_id,
+                seq: meta.seq,
+                sent_ns: meta.stamp_ns,
+            };
+            self.stats.overflows += self.clients.record(meta.client_id, meta.seq);
+            let status = match I::Command::read(raw) {
+                Ok(cmd) => {
+                    drop(sample);
+                    handler.command(&cmd, &origin, &mut self.state)
+                }
+                Err(e) => e.status(),
+            };
+            self.stats.commands += 1;
+            if !status.is_ok() {
+                self.stats.refused += 1;
+            }
+            self.outcome = CmdOutcome {
+                client_id: meta.client_id,
+                cmd_seq: meta.seq,
+                kind: meta.kind,
+                status: status.code(),
+            };
+            n += 1;
+            if self.publish_each_outcome {
+                self.publish()?;
+            }
+        }
+        Ok(n)
+    }
+
+    /// Answers every pending request. A request that does not decode is NACKed with the
+    /// matching status without reaching the handler.
+    pub fn process_requests<H: DeviceHandler<I>>(
+        &mut self,
+        handler: &mut H,
+    ) -> Result<usize, ProcessError> {
+        let mut n = 0;
+        loop {
+            let active: ActiveRequest<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()> =
+                match self.server.receive() {
+                    Ok(Some(a)) => a,
+                    Ok(None) => break,
+                    Err(e) => return Err(ProcessError::Receive(format!("{e:?}"))),
+                };
+            let raw: &I::ReqMsg = active.payload();
+            let meta = *raw.meta();
+            let origin = Origin {
+                client_id: meta.client_id,
+                seq: meta.seq,
+                sent_ns: meta.stamp_ns,
+            };
+            let reply = match I::Request::read(raw) {
+                Ok(req) => handler.request(&req, &origin, &mut self.state),
+                Err(e) => Err(e.status()),
+            };
+            let sent = match active.loan_uninit() {
+                Ok(loan) => {
+                    let mut resp = loan.write_payload(I::ReplyMsg::default());
+                    let out: &mut I::ReplyMsg = resp.payload_mut();
+                    I::Reply::write(meta.kind, reply.as_ref().map_err(|s| *s), out);
+                    let m = out.meta_mut();
+                    m.client_id = meta.client_id;
+                    m.seq = meta.seq;
+                    m.stamp_ns = monotonic_ns();
+                    resp.send().is_ok()
+                }
+                Err(_) => false,
+            };
+            if !sent {
+                self.stats.undelivered_replies += 1;
+            }
+            drop(active);
+            self.stats.requests += 1;
+            n += 1;
+            let _ = self
+                .notify
+                .notify_with_custom_event_id(EventId::new(qos::EVENT_REPLY));
+        }
+        Ok(n)
+    }
+
+    /// Removes the resources of dead processes (crashed clients) from this device's
+    /// services. Cheap enough for a 1 Hz housekeeping tick, not for every cycle.
+    pub fn cleanup_dead(&self) {
+        use iceoryx2::service::port_factory::PortFactory;
+        self.data_svc.try_cleanup_dead_nodes();
+    }
+}

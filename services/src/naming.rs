@@ -1,0 +1,291 @@
+//! Domains, device names and service names.
+//!
+//! A device is named `robot/interface/index` (e.g. `pioneer/actarray/0`); each device has
+//! the iceoryx2 services `limber/<robot>/<interface>/<index>/<channel>` with channels
+//! `data` (state, pub/sub, history 1), `cmd` (commands, pub/sub, many clients), `req`
+//! (request/response), `wake` (event: clients → driver) and `notify` (event: driver →
+//! clients, new state or reply ready). A domain maps onto the iceoryx2 prefix, so
+//! robots and tests on one PC never meet.
+
+use core::fmt;
+use std::str::FromStr;
+use std::sync::atomic::{AtomicU32, Ordering};
+
+use iceoryx2::config::Config;
+use iceoryx2::prelude::{FileName, SemanticString, ServiceName};
+use limber_interfaces::InterfaceKind;
+use thiserror::Error;
+
+/// The environment variable that selects the domain.
+pub const DOMAIN_ENV: &str = "LIMBER_DOMAIN";
+/// The domain used when [`DOMAIN_ENV`] is not set.
+pub const DEFAULT_DOMAIN: &str = "limber";
+/// Longest domain name.
+pub const MAX_DOMAIN_LEN: usize = 48;
+/// Longest robot name.
+pub const MAX_ROBOT_LEN: usize = 64;
+
+/// A name could not be parsed or is not allowed.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum NameError {
+    /// A domain name is empty, too long, or has characters other than `[A-Za-z0-9_-]`.
+    #[error("invalid domain {0:?}: use 1 to 48 characters of [A-Za-z0-9_-]")]
+    Domain(String),
+    /// A robot name is empty, too long, or has characters other than `[A-Za-z0-9_-]`.
+    #[error("invalid robot name {0:?}: use 1 to 64 characters of [A-Za-z0-9_-]")]
+    Robot(String),
+    /// A device name is not `robot/interface/index`.
+    #[error(
+        "invalid device name {0:?}: expected robot/interface/index, e.g. pioneer/actarray/0 (interfaces: actarray, limb, gripper)"
+    )]
+    Device(String),
+}
+
+fn valid_ident(s: &str, max: usize) -> bool {
+    !s.is_empty()
+        && s.len() <= max
+        && s.bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-')
+}
+
+/// A domain: the set of devices and clients that can see each other.
+#[derive(Debug, Clone)]
+pub struct Domain {
+    name: String,
+    config: Config,
+}
+
+impl Domain {
+    /// A domain by name (`[A-Za-z0-9_-]`, 1 to 48 characters).
+    pub fn new(name: &str) -> Result<Self, NameError> {
+        if !valid_ident(name, MAX_DOMAIN_LEN) {
+            return Err(NameError::Domain(name.to_string()));
+        }
+        // Start from the built-in defaults so that a stray ./config/iceoryx2.toml does not
+        // change a robot's behaviour.
+        let mut config = Config::default();
+        let prefix = format!("{name}_");
+        config.global.prefix = FileName::new(prefix.as_bytes())
+            .map_err(|_| NameError::Domain(name.to_string()))?;
+        Ok(Domain {
+            name: name.to_string(),
+            config,
+        })
+    }
+
+    /// The domain named by `LIMBER_DOMAIN`, or `limber`.
+    pub fn from_env() -> Result<Self, NameError> {
+        match std::env::var(DOMAIN_ENV) {
+            Ok(v) if !v.is_empty() => Domain::new(&v),
+            _ => Domain::new(DEFAULT_DOMAIN),
+        }
+    }
+
+    /// A fresh domain for one test: `limber_t<pid>_<n>`, unique on this machine while this
+    /// process lives.
+    pub fn unique_for_test() -> Self {
+        static N: AtomicU32 = AtomicU32::new(0);
+        let n = N.fetch_add(1, Ordering::Relaxed);
+        let name = format!("limber_t{}_{}", std::process::id(), n);
+        Domain::new(&name).expect("generated test domain names are valid")
+    }
+
+    /// The name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The iceoryx2 configuration of this domain.
+    pub fn config(&self) -> &Config {
+        &self.config
+    }
+}
+
+impl fmt::Display for Domain {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.name)
+    }
+}
+
+/// A channel of a device.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Channel {
+    /// State, driver → clients (publish-subscribe, history 1).
+    Data,
+    /// Commands, clients → driver (publish-subscribe).
+    Cmd,
+    /// Requests and replies (request-response).
+    Req,
+    /// Wake-up of the driver (event, clients → driver).
+    Wake,
+    /// Wake-up of the clients (event, driver → clients: new state, reply ready).
+    Notify,
+}
+
+impl Channel {
+    /// The last segment of the service name.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Channel::Data => "data",
+            Channel::Cmd => "cmd",
+            Channel::Req => "req",
+            Channel::Wake => "wake",
+            Channel::Notify => "notify",
+        }
+    }
+}
+
+/// The name of a device: robot, interface, index.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct DeviceName {
+    robot: String,
+    interface: InterfaceKind,
+    index: u16,
+}
+
+impl DeviceName {
+    /// A device name; the robot name must be 1 to 64 characters of `[A-Za-z0-9_-]`.
+    pub fn new(robot: &str, interface: InterfaceKind, index: u16) -> Result<Self, NameError> {
+        if !valid_ident(robot, MAX_ROBOT_LEN) {
+            return Err(NameError::Robot(robot.to_string()));
+        }
+        Ok(DeviceName {
+            robot: robot.to_string(),
+            interface,
+            index,
+        })
+    }
+
+    /// The robot.
+    pub fn robot(&self) -> &str {
+        &self.robot
+    }
+
+    /// The interface.
+    pub fn interface(&self) -> InterfaceKind {
+        self.interface
+    }
+
+    /// The index.
+    pub fn index(&self) -> u16 {
+        self.index
+    }
+
+    /// The iceoryx2 service name of one channel.
+    pub fn service_name(&self, channel: Channel) -> ServiceName {
+        let s = format!(
+            "limber/{}/{}/{}/{}",
+            self.robot,
+            self.interface.name(),
+            self.index,
+            channel.name()
+        );
+        // Only [A-Za-z0-9_/-] and at most ~100 bytes: always a valid service name.
+        ServiceName::new(&s).expect("device service names are valid")
+    }
+
+    /// Parses a service name `limber/<robot>/<interface>/<index>/<channel>`.
+    pub fn from_service_name(s: &str) -> Option<(DeviceName, Channel)> {
+        let mut it = s.split('/');
+        if it.next()? != "limber" {
+            return None;
+        }
+        let dev: DeviceName = format!("{}/{}/{}", it.next()?, it.next()?, it.next()?)
+            .parse()
+            .ok()?;
+        let ch = match it.next()? {
+            "data" => Channel::Data,
+            "cmd" => Channel::Cmd,
+            "req" => Channel::Req,
+            "wake" => Channel::Wake,
+            "notify" => Channel::Notify,
+            _ => return None,
+        };
+        if it.next().is_some() {
+            return None;
+        }
+        Some((dev, ch))
+    }
+}
+
+impl fmt::Display for DeviceName {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}/{}/{}", self.robot, self.interface.name(), self.index)
+    }
+}
+
+impl FromStr for DeviceName {
+    type Err = NameError;
+    fn from_str(s: &str) -> Result<Self, NameError> {
+        let bad = || NameError::Device(s.to_string());
+        let mut it = s.split('/');
+        let (Some(robot), Some(iface), Some(index), None) =
+            (it.next(), it.next(), it.next(), it.next())
+        else {
+            return Err(bad());
+        };
+        let interface = InterfaceKind::from_name(iface).ok_or_else(bad)?;
+        let index: u16 = index.parse().map_err(|_| bad())?;
+        DeviceName::new(robot, interface, index)
+    }
+}
+
+/// Keys of the service attributes a driver sets on every service of a device.
+pub mod attr {
+    /// The robot name.
+    pub const ROBOT: &str = "limber.robot";
+    /// The interface (`actarray`, `limb`, `gripper`).
+    pub const INTERFACE: &str = "limber.interface";
+    /// The device index.
+    pub const INDEX: &str = "limber.index";
+    /// The driver's name (e.g. `pioneer`, `simarm`).
+    pub const DRIVER: &str = "limber.driver";
+    /// The layout version of the wire contract.
+    pub const LAYOUT: &str = "limber.layout";
+}
+
+/// The node name prefix of driver processes (liveness checks look for it).
+pub const DRIVER_NODE_PREFIX: &str = "limber-driver:";
+/// The node name prefix of client processes.
+pub const CLIENT_NODE_PREFIX: &str = "limber-client:";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn device_names_parse_and_print() {
+        let d: DeviceName = "pioneer/actarray/0".parse().unwrap();
+        assert_eq!(d.robot(), "pioneer");
+        assert_eq!(d.interface(), InterfaceKind::ActArray);
+        assert_eq!(d.to_string(), "pioneer/actarray/0");
+        assert_eq!(
+            d.service_name(Channel::Cmd).as_str(),
+            "limber/pioneer/actarray/0/cmd"
+        );
+        let (back, ch) = DeviceName::from_service_name("limber/pioneer/actarray/0/cmd").unwrap();
+        assert_eq!((back, ch), (d, Channel::Cmd));
+        for bad in [
+            "pioneer/arm/0",
+            "pioneer/actarray",
+            "pioneer/actarray/x",
+            "pi oneer/limb/0",
+            "a/limb/0/1",
+            "/limb/0",
+        ] {
+            assert!(bad.parse::<DeviceName>().is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn domains_validate() {
+        assert!(Domain::new("robot_1").is_ok());
+        assert!(Domain::new("").is_err());
+        assert!(Domain::new("a b").is_err());
+        assert!(Domain::new(&"x".repeat(49)).is_err());
+        assert_ne!(
+            Domain::unique_for_test().name(),
+            Domain::unique_for_test().name()
+        );
+    }
+}
