@@ -36,7 +36,9 @@ pub enum ConnectError {
     #[error(transparent)]
     Context(#[from] ContextError),
     /// No driver offers this device in this domain.
-    #[error("no driver offers {device} in domain {domain} (is the driver running? is LIMBER_DOMAIN the same?)")]
+    #[error(
+        "no driver offers {device} in domain {domain} (is the driver running? is LIMBER_DOMAIN the same?)"
+    )]
     NoDriver {
         /// The device.
         device: String,
@@ -679,11 +681,20 @@ impl Client<ActArray> {
     }
     /// CMD HOME: home `joint`, or every joint with `None`.
     pub fn home(&mut self, joint: Option<usize>) -> Result<Ticket, CommandError> {
-        self.send(&ActArrayCommand::home(joint.map(joint_index).unwrap_or(-1))?)
+        self.send(&ActArrayCommand::home(
+            joint.map(joint_index).unwrap_or(-1),
+        )?)
     }
     /// CMD CURRENT: drive `joint` (or all with `None`) with `current` A.
-    pub fn set_current(&mut self, joint: Option<usize>, current: f64) -> Result<Ticket, CommandError> {
-        self.send(&ActArrayCommand::current(joint.map(joint_index).unwrap_or(-1), current)?)
+    pub fn set_current(
+        &mut self,
+        joint: Option<usize>,
+        current: f64,
+    ) -> Result<Ticket, CommandError> {
+        self.send(&ActArrayCommand::current(
+            joint.map(joint_index).unwrap_or(-1),
+            current,
+        )?)
     }
     /// CMD MULTI_CURRENT: drive joints 0..n with `currents` A.
     pub fn set_current_multi(&mut self, currents: &[f64]) -> Result<Ticket, CommandError> {

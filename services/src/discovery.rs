@@ -48,7 +48,10 @@ pub fn list_devices(domain: &Domain) -> Result<Vec<DeviceInfo>, ListError> {
     let mut out = Vec::new();
     ipc::Service::list(domain.config(), |details| {
         let name = details.static_details.name().as_str().to_string();
-        if !matches!(details.static_details.messaging_pattern(), Pattern::PublishSubscribe(_)) {
+        if !matches!(
+            details.static_details.messaging_pattern(),
+            Pattern::PublishSubscribe(_)
+        ) {
             return CallbackProgression::Continue;
         }
         let Some((device, Channel::Data)) = DeviceName::from_service_name(&name) else {
@@ -58,7 +61,7 @@ pub fn list_devices(domain: &Domain) -> Result<Vec<DeviceInfo>, ListError> {
         let get = |k: &str| -> String {
             attrs
                 .iter()
-                .find(|a| a.key().to_string() == k)
+                .find(|a| a.key().as_bytes() == k.as_bytes())
                 .map(|a| a.value().to_string())
                 .unwrap_or_default()
         };

@@ -164,11 +164,12 @@ impl ClientTable {
 /// in place, commands and requests are read in place.
 pub struct DeviceHost<I: Interface> {
     device: DeviceName,
-    data_svc: iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, I::Data, ()>,
+    data_svc:
+        iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, I::Data, ()>,
     publisher: Publisher<ipc::Service, I::Data, ()>,
     commands: Subscriber<ipc::Service, I::CmdMsg, ()>,
     server: Server<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()>,
-    wake: Listener<ipc::Service>,
+    wake: Option<Listener<ipc::Service>>,
     notify: Notifier<ipc::Service>,
     state: I::Data,
     seq: u64,
@@ -189,10 +190,7 @@ impl<I: Interface> core::fmt::Debug for DeviceHost<I> {
     }
 }
 
-fn attribute_verifier(
-    device: &DeviceName,
-    driver: &str,
-) -> Result<AttributeVerifier, HostError> {
+fn attribute_verifier(device: &DeviceName, driver: &str) -> Result<AttributeVerifier, HostError> {
     let err = |reason: String| HostError::Transport {
         device: device.to_string(),
         channel: "attributes",
@@ -223,7 +221,12 @@ impl<I: Interface> DeviceHost<I> {
     /// `limber list`). The initial state is all zero: set it with [`DeviceHost::state_mut`]
     /// and [`DeviceHost::publish`] before clients act on it.
     pub fn new(ctx: &Context, device: &DeviceName, driver: &str) -> Result<Self, HostError> {
-        assert_eq!(device.interface(), I::KIND, "device {device} is not a {}", I::KIND);
+        assert_eq!(
+            device.interface(),
+            I::KIND,
+            "device {device} is not a {}",
+            I::KIND
+        );
         let node = ctx.node();
         let dev = device.to_string();
         let verifier = attribute_verifier(device, driver)?;
@@ -333,7 +336,7 @@ impl<I: Interface> DeviceHost<I> {
             publisher,
             commands,
             server,
-            wake,
+            wake: Some(wake),
             notify,
             state: I::Data::default(),
             seq: 0,
@@ -383,15 +386,25 @@ impl<I: Interface> DeviceHost<I> {
         self.stats
     }
 
-    /// The listener that a client's command or request wakes: attach it to the driver's
-    /// WaitSet (or poll its fd), then call [`DeviceHost::consume_wakeups`].
-    pub fn wake_listener(&self) -> &Listener<ipc::Service> {
-        &self.wake
+    /// The listener that a client's command or request wakes, while the host owns it.
+    pub fn wake_listener(&self) -> Option<&Listener<ipc::Service>> {
+        self.wake.as_ref()
     }
 
-    /// Consumes pending wake-up events (without blocking); returns how many there were.
+    /// Hands the wake listener to the driver's event loop (a WaitSet attachment borrows
+    /// it, so the loop must own it while the host is processed mutably). See
+    /// [`crate::event_loop::run`].
+    pub fn take_wake_listener(&mut self) -> Option<Listener<ipc::Service>> {
+        self.wake.take()
+    }
+
+    /// Consumes pending wake-up events (without blocking) while the host owns the
+    /// listener; returns how many there were.
     pub fn consume_wakeups(&self) -> u64 {
-        self.wake.try_wait(|_| {}).unwrap_or(0)
+        self.wake
+            .as_ref()
+            .and_then(|w| w.try_wait(|_| {}).ok())
+            .unwrap_or(0)
     }
 
     /// Publishes the state acquired at `stamp_ns` (`CLOCK_MONOTONIC`).
@@ -430,7 +443,10 @@ impl<I: Interface> DeviceHost<I> {
 
     /// Drains every pending command (in arrival order, per client in sending order) and
     /// answers every pending request, calling `handler`. Never blocks.
-    pub fn process<H: DeviceHandler<I>>(&mut self, handler: &mut H) -> Result<Activity, ProcessError> {
+    pub fn process<H: DeviceHandler<I>>(
+        &mut self,
+        handler: &mut H,
+    ) -> Result<Activity, ProcessError> {
         let commands = self.process_commands(handler)?;
         let requests = self.process_requests(handler)?;
         Ok(Activity { commands, requests })

@@ -63,9 +63,11 @@
 pub mod client;
 pub mod context;
 pub mod discovery;
+pub mod event_loop;
 pub mod host;
 pub mod naming;
 pub mod qos;
+pub mod testing;
 
 pub use client::{
     ActArrayClient, Client, CommandError, ConnectError, DriverStatus, Freshness, GripperClient,
@@ -73,14 +75,16 @@ pub use client::{
 };
 pub use context::{Context, ContextError, Role, monotonic_ns};
 pub use discovery::{DeviceInfo, ListError, list_devices};
-pub use host::{Activity, DeviceHandler, DeviceHost, HostError, HostStats, Origin, ProcessError, PublishError};
+pub use host::{
+    Activity, DeviceHandler, DeviceHost, HostError, HostStats, Origin, ProcessError, PublishError,
+};
 pub use naming::{Channel, DeviceName, Domain, NameError};
 
 /// Everything a driver or client author needs, in one `use`.
 pub mod prelude {
     pub use crate::client::{
-        ActArrayClient, Client, CommandError, ConnectError, DriverStatus, Freshness,
-        GripperClient, LimbClient, RequestError, Ticket, WaitError, WaitMode,
+        ActArrayClient, Client, CommandError, ConnectError, DriverStatus, Freshness, GripperClient,
+        LimbClient, RequestError, Ticket, WaitError, WaitMode,
     };
     pub use crate::context::{Context, Role, monotonic_ns};
     pub use crate::discovery::{DeviceInfo, list_devices};

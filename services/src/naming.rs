@@ -65,8 +65,8 @@ impl Domain {
         // change a robot's behaviour.
         let mut config = Config::default();
         let prefix = format!("{name}_");
-        config.global.prefix = FileName::new(prefix.as_bytes())
-            .map_err(|_| NameError::Domain(name.to_string()))?;
+        config.global.prefix =
+            FileName::new(prefix.as_bytes()).map_err(|_| NameError::Domain(name.to_string()))?;
         Ok(Domain {
             name: name.to_string(),
             config,

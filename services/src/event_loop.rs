@@ -1,0 +1,177 @@
+//! The driver loop's waiting: a WaitSet over the wake listeners of a driver's devices, a
+//! precise periodic timer (`timerfd`, not the WaitSet's 1 ms-rounded interval) and any
+//! other file descriptor (a serial port), returning on SIGINT/SIGTERM.
+
+use core::ops::ControlFlow;
+use core::time::Duration;
+use std::os::fd::{AsFd, AsRawFd, OwnedFd};
+
+use iceoryx2::port::listener::Listener;
+use iceoryx2::prelude::*;
+use iceoryx2::waitset::WaitSetRunResult;
+use rustix::time::{Itimerspec, TimerfdClockId, TimerfdFlags, TimerfdTimerFlags, Timespec};
+use thiserror::Error;
+
+/// The event loop failed.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum LoopError {
+    /// The timer could not be created (period zero or too small?).
+    #[error("cannot create the loop timer: {0}")]
+    Timer(String),
+    /// The WaitSet could not be created or an attachment failed (too many fds?).
+    #[error("cannot set up the wait set: {0}")]
+    WaitSet(String),
+}
+
+/// Why the loop returned.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LoopExit {
+    /// SIGINT or SIGTERM arrived.
+    Signal,
+    /// The callback asked to stop.
+    Stopped,
+}
+
+/// What woke the loop.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Wake {
+    /// A client sent a command or request (the wake events are already consumed).
+    Clients,
+    /// The periodic timer expired (`n` times since the last tick: more than 1 = overrun).
+    Tick(u64),
+    /// The extra file descriptor is readable.
+    Fd,
+}
+
+/// A periodic `CLOCK_MONOTONIC` timer as a file descriptor, with nanosecond resolution.
+#[derive(Debug)]
+pub struct TimerFd {
+    fd: OwnedFd,
+    handle: FileDescriptor,
+}
+
+impl TimerFd {
+    /// A timer that expires every `period`, first after one period.
+    pub fn periodic(period: Duration) -> Result<Self, LoopError> {
+        if period.is_zero() {
+            return Err(LoopError::Timer("period is zero".into()));
+        }
+        let fd = rustix::time::timerfd_create(
+            TimerfdClockId::Monotonic,
+            TimerfdFlags::NONBLOCK | TimerfdFlags::CLOEXEC,
+        )
+        .map_err(|e| LoopError::Timer(e.to_string()))?;
+        let ts = Timespec {
+            tv_sec: period.as_secs() as _,
+            tv_nsec: period.subsec_nanos() as _,
+        };
+        rustix::time::timerfd_settime(
+            &fd,
+            TimerfdTimerFlags::empty(),
+            &Itimerspec {
+                it_interval: ts,
+                it_value: ts,
+            },
+        )
+        .map_err(|e| LoopError::Timer(e.to_string()))?;
+        let handle = FileDescriptor::non_owning_new(fd.as_raw_fd())
+            .ok_or_else(|| LoopError::Timer("invalid fd".into()))?;
+        Ok(TimerFd { fd, handle })
+    }
+
+    /// Reads and resets the expiry count (0 if it has not expired).
+    pub fn consume(&self) -> u64 {
+        let mut buf = [0u8; 8];
+        match rustix::io::read(self.fd.as_fd(), &mut buf) {
+            Ok(8) => u64::from_ne_bytes(buf),
+            _ => 0,
+        }
+    }
+}
+
+impl FileDescriptorBased for TimerFd {
+    fn file_descriptor(&self) -> &FileDescriptor {
+        &self.handle
+    }
+}
+impl SynchronousMultiplexing for TimerFd {}
+
+/// Any readable file descriptor (a serial port, a socket) for a WaitSet. Does not own it.
+#[derive(Debug)]
+pub struct FdSource {
+    handle: FileDescriptor,
+}
+
+impl FdSource {
+    /// Wraps `fd`, which must stay open while the source is attached.
+    pub fn new(fd: &impl AsRawFd) -> Option<Self> {
+        FileDescriptor::non_owning_new(fd.as_raw_fd()).map(|handle| FdSource { handle })
+    }
+}
+
+impl FileDescriptorBased for FdSource {
+    fn file_descriptor(&self) -> &FileDescriptor {
+        &self.handle
+    }
+}
+impl SynchronousMultiplexing for FdSource {}
+
+/// Runs the loop of a driver: waits on the wake `listeners` of its devices, a timer of
+/// `period`, and `extra` (e.g. the serial port), and calls `on` for each wake-up until it
+/// returns `Break` or SIGINT/SIGTERM arrives. Listener events are consumed before `on` runs.
+pub fn run<F>(
+    listeners: &[Listener<ipc::Service>],
+    period: Duration,
+    extra: Option<&FdSource>,
+    mut on: F,
+) -> Result<LoopExit, LoopError>
+where
+    F: FnMut(Wake) -> ControlFlow<()>,
+{
+    let ws = WaitSetBuilder::new()
+        .create::<ipc::Service>()
+        .map_err(|e| LoopError::WaitSet(format!("{e:?}")))?;
+    let timer = TimerFd::periodic(period)?;
+    let mut guards = Vec::with_capacity(listeners.len());
+    for l in listeners {
+        guards.push(
+            ws.attach_notification(l)
+                .map_err(|e| LoopError::WaitSet(format!("{e:?}")))?,
+        );
+    }
+    let timer_guard = ws
+        .attach_notification(&timer)
+        .map_err(|e| LoopError::WaitSet(format!("{e:?}")))?;
+    let extra_guard = match extra {
+        Some(fd) => Some(
+            ws.attach_notification(fd)
+                .map_err(|e| LoopError::WaitSet(format!("{e:?}")))?,
+        ),
+        None => None,
+    };
+    let result = ws
+        .wait_and_process(|id| {
+            let wake = if id.has_event_from(&timer_guard) {
+                Wake::Tick(timer.consume())
+            } else if extra_guard.as_ref().is_some_and(|g| id.has_event_from(g)) {
+                Wake::Fd
+            } else {
+                for (l, g) in listeners.iter().zip(&guards) {
+                    if id.has_event_from(g) {
+                        let _ = l.try_wait(|_| {});
+                    }
+                }
+                Wake::Clients
+            };
+            if on(wake).is_break() {
+                CallbackProgression::Stop
+            } else {
+                CallbackProgression::Continue
+            }
+        })
+        .map_err(|e| LoopError::WaitSet(format!("{e:?}")))?;
+    Ok(match result {
+        WaitSetRunResult::Interrupt | WaitSetRunResult::TerminationRequest => LoopExit::Signal,
+        _ => LoopExit::Stopped,
+    })
+}

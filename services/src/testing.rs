@@ -1,0 +1,332 @@
+//! A small test driver: an arm whose joints reach their targets at once, a limb that
+//! accepts poses within a sphere, and a gripper. It implements the same [`DeviceHandler`]
+//! traits as real drivers, so tests and examples exercise the real services layer.
+
+use core::ops::ControlFlow;
+use core::time::Duration;
+
+use limber_interfaces::prelude::*;
+
+use crate::context::{Context, monotonic_ns};
+use crate::event_loop::{self, LoopError, LoopExit, Wake};
+use crate::host::{DeviceHandler, DeviceHost, HostError, Origin, ProcessError};
+use crate::naming::DeviceName;
+
+/// Joint limits of the test arm, rad.
+pub const JOINT_LIMIT: f64 = core::f64::consts::PI;
+/// Reach of the test limb, m: farther targets are out of reach.
+pub const REACH: f64 = 1.0;
+
+/// The test arm (`actarray`): `n` rotary joints in ±π, moving instantly.
+#[derive(Debug, Clone)]
+pub struct TestArm {
+    /// Number of joints.
+    pub joints: usize,
+    /// Every command received, in order: (client, seq, kind). Capacity fixed at creation
+    /// (further commands are not logged).
+    pub log: Vec<(u64, u64, u32)>,
+    /// Sleep this long in each request (to test clients that die mid-request).
+    pub reply_delay: Duration,
+}
+
+impl TestArm {
+    /// An arm of `joints` joints (at most 32).
+    pub fn new(joints: usize) -> Self {
+        TestArm {
+            joints: joints.min(MAX_ACTUATORS),
+            log: Vec::with_capacity(100_000),
+            reply_delay: Duration::ZERO,
+        }
+    }
+
+    fn check(&self, joint: usize, v: f64) -> Result<(), Status> {
+        if joint >= self.joints {
+            Err(Status::UnknownJoint)
+        } else if !(-JOINT_LIMIT..=JOINT_LIMIT).contains(&v) {
+            Err(Status::BeyondLimits)
+        } else {
+            Ok(())
+        }
+    }
+
+    /// The initial state: every joint idle at 0, power off.
+    pub fn initial_state(&self, state: &mut ActArrayData) {
+        state.actuators_count = self.joints as u32;
+        for a in &mut state.actuators[..self.joints] {
+            a.state = ActuatorFlags::IDLE.bits();
+            a.acceleration = -1.0;
+            a.current = -1.0;
+        }
+    }
+}
+
+impl DeviceHandler<ActArray> for TestArm {
+    fn command(
+        &mut self,
+        cmd: &ActArrayCommand,
+        from: &Origin,
+        state: &mut ActArrayData,
+    ) -> Status {
+        if self.log.len() < self.log.capacity() {
+            self.log.push((from.client_id, from.seq, cmd_kind(cmd)));
+        }
+        let r = match *cmd {
+            ActArrayCommand::Position { joint, position } => {
+                self.check(joint as usize, position).map(|()| {
+                    state.actuators[joint as usize].position = position;
+                })
+            }
+            ActArrayCommand::MultiPosition(v) => {
+                if v.len() > self.joints {
+                    Err(Status::UnknownJoint)
+                } else {
+                    v.as_slice()
+                        .iter()
+                        .enumerate()
+                        .try_for_each(|(j, p)| self.check(j, *p))
+                        .map(|()| {
+                            for (j, p) in v.as_slice().iter().enumerate() {
+                                state.actuators[j].position = *p;
+                            }
+                        })
+                }
+            }
+            ActArrayCommand::Home(JointSel::All) => {
+                for a in &mut state.actuators[..self.joints] {
+                    a.position = 0.0;
+                }
+                Ok(())
+            }
+            ActArrayCommand::Home(JointSel::One(j)) => self.check(j as usize, 0.0).map(|()| {
+                state.actuators[j as usize].position = 0.0;
+            }),
+            _ => Err(Status::Unsupported),
+        };
+        state.header.stamp_ns = monotonic_ns();
+        r.err().unwrap_or(Status::Ok)
+    }
+
+    fn request(
+        &mut self,
+        req: &ActArrayRequest,
+        _from: &Origin,
+        state: &mut ActArrayData,
+    ) -> Result<ActArrayReply, Status> {
+        if !self.reply_delay.is_zero() {
+            std::thread::sleep(self.reply_delay);
+        }
+        match *req {
+            ActArrayRequest::Power(on) => {
+                state.motor_state = on as u32;
+                Ok(ActArrayReply::Done)
+            }
+            ActArrayRequest::GetGeom => {
+                let mut g = ActArrayGeom {
+                    actuators_count: self.joints as u32,
+                    ..Default::default()
+                };
+                for a in &mut g.actuators[..self.joints] {
+                    a.kind = ActuatorKind::Rotary as u32;
+                    a.min = -JOINT_LIMIT;
+                    a.max = JOINT_LIMIT;
+                    a.config_speed = 1.0;
+                    a.axis = Vec3::new(0.0, 0.0, 1.0);
+                }
+                Ok(ActArrayReply::Geom(g))
+            }
+            ActArrayRequest::Speed { joint, .. } | ActArrayRequest::Accel { joint, .. } => {
+                if (joint as usize) < self.joints {
+                    Ok(ActArrayReply::Done)
+                } else {
+                    Err(Status::UnknownJoint)
+                }
+            }
+            ActArrayRequest::Brakes(_) => Err(Status::Unsupported),
+        }
+    }
+}
+
+fn cmd_kind(cmd: &ActArrayCommand) -> u32 {
+    use limber_interfaces::Message;
+    cmd.kind()
+}
+
+/// The test limb: accepts any pose within [`REACH`] of the origin.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct TestLimb;
+
+impl DeviceHandler<Limb> for TestLimb {
+    fn command(&mut self, cmd: &LimbCommand, _from: &Origin, state: &mut LimbData) -> Status {
+        let target = match *cmd {
+            LimbCommand::Home => Vec3::new(0.5, 0.0, 0.0),
+            LimbCommand::Stop => return Status::Ok,
+            LimbCommand::SetPose { position, .. } | LimbCommand::SetPosition { position } => {
+                position
+            }
+            LimbCommand::VecMove { direction, length } => {
+                let n = direction.norm();
+                let p = state.position;
+                Vec3::new(
+                    p.x + direction.x / n * length,
+                    p.y + direction.y / n * length,
+                    p.z + direction.z / n * length,
+                )
+            }
+        };
+        if target.norm() > REACH {
+            state.state = LimbState::OutOfReach as u32;
+            return Status::OutOfReach;
+        }
+        state.position = target;
+        state.state = LimbState::Idle as u32;
+        Status::Ok
+    }
+
+    fn request(
+        &mut self,
+        req: &LimbRequest,
+        _from: &Origin,
+        _state: &mut LimbData,
+    ) -> Result<LimbReply, Status> {
+        match req {
+            LimbRequest::Geom => Ok(LimbReply::Geom(LimbGeom::default())),
+            LimbRequest::Power(_) | LimbRequest::Speed(_) => Ok(LimbReply::Done),
+            LimbRequest::Brakes(_) => Err(Status::Unsupported),
+        }
+    }
+}
+
+/// The test gripper: opens and closes at once; cannot store.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct TestGripper;
+
+impl DeviceHandler<Gripper> for TestGripper {
+    fn command(&mut self, cmd: &GripperCommand, _from: &Origin, state: &mut GripperData) -> Status {
+        match cmd {
+            GripperCommand::Open => state.state = GripperState::Open as u32,
+            GripperCommand::Close => state.state = GripperState::Closed as u32,
+            GripperCommand::Stop => {}
+            GripperCommand::Store | GripperCommand::Retrieve => return Status::Unsupported,
+        }
+        Status::Ok
+    }
+
+    fn request(
+        &mut self,
+        _req: &GripperRequest,
+        _from: &Origin,
+        _state: &mut GripperData,
+    ) -> Result<GripperReply, Status> {
+        Ok(GripperReply::Geom(GripperGeom {
+            num_beams: 2,
+            ..Default::default()
+        }))
+    }
+}
+
+/// The three devices of the test driver, `<robot>/actarray/0`, `<robot>/limb/0`,
+/// `<robot>/gripper/0`.
+pub struct TestDriver {
+    /// The arm host.
+    pub arm_host: DeviceHost<ActArray>,
+    /// The arm.
+    pub arm: TestArm,
+    /// The limb host.
+    pub limb_host: DeviceHost<Limb>,
+    /// The limb.
+    pub limb: TestLimb,
+    /// The gripper host.
+    pub gripper_host: DeviceHost<Gripper>,
+    /// The gripper.
+    pub gripper: TestGripper,
+}
+
+impl core::fmt::Debug for TestDriver {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("TestDriver")
+            .field("arm", &self.arm.joints)
+            .finish()
+    }
+}
+
+impl TestDriver {
+    /// Offers the three devices of `robot` with an arm of `joints` joints, and publishes
+    /// their initial states.
+    pub fn new(ctx: &Context, robot: &str, joints: usize) -> Result<Self, HostError> {
+        let name = |i: InterfaceKind| {
+            DeviceName::new(robot, i, 0).map_err(|e| HostError::Transport {
+                device: robot.to_string(),
+                channel: "name",
+                reason: e.to_string(),
+            })
+        };
+        let arm = TestArm::new(joints);
+        let mut arm_host =
+            DeviceHost::<ActArray>::new(ctx, &name(InterfaceKind::ActArray)?, "testdriver")?;
+        arm.initial_state(arm_host.state_mut());
+        let mut limb_host =
+            DeviceHost::<Limb>::new(ctx, &name(InterfaceKind::Limb)?, "testdriver")?;
+        limb_host.state_mut().state = LimbState::Idle as u32;
+        let mut gripper_host =
+            DeviceHost::<Gripper>::new(ctx, &name(InterfaceKind::Gripper)?, "testdriver")?;
+        gripper_host.state_mut().state = GripperState::Open as u32;
+        let mut d = TestDriver {
+            arm_host,
+            arm,
+            limb_host,
+            limb: TestLimb,
+            gripper_host,
+            gripper: TestGripper,
+        };
+        d.publish_all().map_err(|e| HostError::Transport {
+            device: robot.to_string(),
+            channel: "data",
+            reason: e.to_string(),
+        })?;
+        Ok(d)
+    }
+
+    /// Publishes the state of all three devices.
+    pub fn publish_all(&mut self) -> Result<(), crate::host::PublishError> {
+        let now = monotonic_ns();
+        self.arm_host.publish_acquired(now)?;
+        self.limb_host.publish_acquired(now)?;
+        self.gripper_host.publish_acquired(now)
+    }
+
+    /// Handles everything pending on the three devices; never blocks.
+    pub fn process(&mut self) -> Result<usize, ProcessError> {
+        let a = self.arm_host.process(&mut self.arm)?;
+        let l = self.limb_host.process(&mut self.limb)?;
+        let g = self.gripper_host.process(&mut self.gripper)?;
+        Ok(a.commands + a.requests + l.commands + l.requests + g.commands + g.requests)
+    }
+
+    /// Serves until SIGINT/SIGTERM (or `stop` returns true, checked at every wake-up),
+    /// publishing every device's state each `period` and handling clients as they wake it.
+    pub fn run(
+        &mut self,
+        period: Duration,
+        mut stop: impl FnMut() -> bool,
+    ) -> Result<LoopExit, LoopError> {
+        let listeners: Vec<_> = [
+            self.arm_host.take_wake_listener(),
+            self.limb_host.take_wake_listener(),
+            self.gripper_host.take_wake_listener(),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        event_loop::run(&listeners, period, None, |wake| {
+            if let Wake::Tick(_) = wake {
+                let _ = self.publish_all();
+            }
+            let _ = self.process();
+            if stop() {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        })
+    }
+}

@@ -1,0 +1,65 @@
+//! A test client process. Modes:
+//! * `burst N`: send N position commands to `<robot>/actarray/0` as fast as possible;
+//! * `basic`: geometry, power, a move with its outcome, the state; prints `ok`;
+//! * `hold-request`: send a geometry request and wait (to be killed mid-request).
+
+use std::time::Duration;
+
+use clap::Parser;
+use limber_services::prelude::*;
+
+#[derive(Parser)]
+struct Args {
+    /// Robot name.
+    #[arg(long, default_value = "test")]
+    robot: String,
+    /// What to do.
+    mode: String,
+    /// Count for `burst`.
+    #[arg(default_value_t = 64)]
+    n: u64,
+}
+
+fn main() {
+    let a = Args::parse();
+    let ctx = Context::client_from_env().expect("join domain");
+    let dev = format!("{}/actarray/0", a.robot);
+    let mut arm =
+        ActArrayClient::connect_timeout(&ctx, &dev, Duration::from_secs(5)).expect("connect");
+    match a.mode.as_str() {
+        "burst" => {
+            for i in 0..a.n {
+                arm.move_to((i % 6) as usize, (i as f64) * 1e-3)
+                    .expect("send");
+            }
+            // Stay until the driver has applied the last one.
+            let last = limber_services::Ticket {
+                seq: a.n,
+                receivers: 1,
+            };
+            match arm.wait_outcome(last, Duration::from_secs(5)) {
+                Ok(_) | Err(WaitError::Missed { .. }) => println!("sent {}", a.n),
+                Err(e) => panic!("last outcome: {e}"),
+            }
+        }
+        "basic" => {
+            let g = arm.geometry().expect("geometry");
+            assert_eq!(g.actuators_count, 6);
+            arm.power(true).expect("power");
+            let t = arm.move_to(1, 0.25).expect("move");
+            assert_eq!(
+                arm.wait_outcome(t, Duration::from_secs(5))
+                    .expect("outcome"),
+                Status::Ok
+            );
+            let s = arm.wait_state(Duration::from_secs(5)).expect("state");
+            assert_eq!(s.actuators[1].position, 0.25);
+            println!("ok");
+        }
+        "hold-request" => {
+            println!("requesting");
+            let _ = arm.request_with_timeout(&ActArrayRequest::GetGeom, Duration::from_secs(60));
+        }
+        m => panic!("unknown mode {m}"),
+    }
+}

@@ -1,0 +1,124 @@
+//! A counting allocator checks what the steady state allocates.
+//!
+//! * Reading state on the client: nothing.
+//! * Sending a command, publishing a state, answering: limber itself allocates nothing, but
+//!   iceoryx2 0.10 allocates one 48-byte `Rc` per loaned sample (`ChunkMutSharedState::new`
+//!   through the single-threaded `ArcSyncPolicy` of `ipc::Service`), on every publish path
+//!   including `send_copy`. The test therefore allows exactly one allocation per sample
+//!   sent and fails on anything more.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+use limber_services::prelude::*;
+use limber_services::testing::TestDriver;
+use limber_services::{Domain, Role};
+
+struct Counting;
+
+thread_local! {
+    static ALLOCS: Cell<u64> = const { Cell::new(0) };
+}
+
+// SAFETY: forwards to the system allocator; only counts calls made on the current thread.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as ours.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: same contract as ours.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as ours.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocations_in(f: impl FnOnce()) -> u64 {
+    let before = ALLOCS.with(|c| c.get());
+    f();
+    ALLOCS.with(|c| c.get()) - before
+}
+
+struct Rig {
+    driver: TestDriver,
+    arm: ActArrayClient,
+    limb: LimbClient,
+    grip: GripperClient,
+}
+
+impl Rig {
+    /// One control cycle: 4 commands sent (4 samples), the driver publishes 3 states and
+    /// one outcome state per command (7 samples), the client reads 3 states.
+    const SAMPLES_PER_CYCLE: u64 = 11;
+
+    fn cycle(&mut self, i: u64) {
+        let p = (i % 100) as f64 * 1e-3;
+        self.arm.move_to((i % 6) as usize, p).unwrap();
+        self.arm.move_to_multi(&[p, p, p]).unwrap();
+        self.limb
+            .set_pose([0.3, 0.0, p], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0])
+            .unwrap();
+        self.grip.close().unwrap();
+        self.driver.publish_all().unwrap();
+        assert_eq!(self.driver.process().unwrap(), 4);
+        self.read();
+    }
+
+    fn read(&mut self) {
+        assert_eq!(self.arm.state().unwrap().actuators_count, 6);
+        let _ = self.limb.state().unwrap().position;
+        let _ = self.grip.state().unwrap().beams;
+        let _ = self.arm.state_age();
+    }
+}
+
+#[test]
+fn steady_state_allocations_are_only_iceoryx2_loans() {
+    let domain = Domain::unique_for_test();
+    let dctx = Context::new(&domain, Role::Driver, "alloc-driver").unwrap();
+    let driver = TestDriver::new(&dctx, "alloc", 6).unwrap();
+    let cctx = Context::new(&domain, Role::Client, "alloc-client").unwrap();
+    let mut rig = Rig {
+        driver,
+        arm: ActArrayClient::connect(&cctx, "alloc/actarray/0").unwrap(),
+        limb: LimbClient::connect(&cctx, "alloc/limb/0").unwrap(),
+        grip: GripperClient::connect(&cctx, "alloc/gripper/0").unwrap(),
+    };
+    // Warm up: connections and lazily created resources.
+    for i in 0..200 {
+        rig.cycle(i);
+    }
+
+    // Reading state allocates nothing at all.
+    rig.driver.publish_all().unwrap();
+    assert_eq!(allocations_in(|| rig.read()), 0, "state reads allocate");
+    assert_eq!(allocations_in(|| rig.read()), 0, "state reads allocate");
+
+    // Commands and host cycles: at most iceoryx2's one allocation per sample sent.
+    let cycles = 2000;
+    let n = allocations_in(|| {
+        for i in 0..cycles {
+            rig.cycle(i);
+        }
+    });
+    assert!(
+        n <= cycles * Rig::SAMPLES_PER_CYCLE,
+        "{n} allocations in {cycles} cycles: more than iceoryx2's one per sample sent"
+    );
+    eprintln!(
+        "{n} allocations in {cycles} cycles ({} per cycle, {} samples sent per cycle)",
+        n as f64 / cycles as f64,
+        Rig::SAMPLES_PER_CYCLE
+    );
+
+    // The counter sees allocations (the check can fail).
+    assert!(allocations_in(|| drop(vec![1u8; 10])) > 0);
+}

@@ -1,0 +1,236 @@
+//! The services layer across real processes, each test in a domain of its own.
+
+use std::time::{Duration, Instant};
+
+use limber_services::prelude::*;
+use limber_services::{ConnectError, Domain, Role};
+use limber_tests::Proc;
+
+const DRIVER: &str = env!("CARGO_BIN_EXE_limber-test-driver");
+const CLIENT: &str = env!("CARGO_BIN_EXE_limber-test-client");
+const T: Duration = Duration::from_secs(5);
+
+fn start_driver(domain: &Domain, extra: &[&str]) -> Proc {
+    let mut d = Proc::spawn(DRIVER, domain.name(), extra);
+    assert!(
+        d.read_until(|l| l == "ready").is_some(),
+        "driver did not start"
+    );
+    d
+}
+
+fn client_ctx(domain: &Domain) -> Context {
+    Context::new(domain, Role::Client, "test").unwrap()
+}
+
+#[test]
+fn several_client_processes_at_once() {
+    let domain = Domain::unique_for_test();
+    let _driver = start_driver(&domain, &[]);
+    let mut clients: Vec<Proc> = (0..3)
+        .map(|_| Proc::spawn(CLIENT, domain.name(), &["basic"]))
+        .collect();
+    for c in &mut clients {
+        assert_eq!(c.wait_timeout(Duration::from_secs(20)), Some(0));
+        assert!(c.rest_of_stdout().contains("ok"));
+    }
+}
+
+#[test]
+fn state_commands_requests_and_refusals_from_this_process() {
+    let domain = Domain::unique_for_test();
+    let _driver = start_driver(&domain, &[]);
+    let ctx = client_ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&ctx, "test/actarray/0", T).unwrap();
+    let s = arm.wait_state(T).unwrap();
+    assert_eq!(s.actuators_count, 6);
+    // A refused command is visible to its sender, with the reason.
+    let t = arm.move_to(7, 0.1).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::UnknownJoint);
+    let t = arm.move_to(2, 4.0).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::BeyondLimits);
+    let t = arm.move_to(2, 1.0).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
+    assert_eq!(arm.state().unwrap().actuators[2].position, 1.0);
+    // Invalid values never leave the client.
+    assert!(matches!(
+        arm.move_to(2, f64::NAN),
+        Err(CommandError::Invalid(_))
+    ));
+    // Requests: typed ACK payloads and NACK reasons.
+    assert_eq!(arm.geometry().unwrap().actuators_count, 6);
+    assert_eq!(
+        arm.brakes(true),
+        Err(RequestError::Nack(Status::Unsupported))
+    );
+    assert_eq!(
+        arm.set_speed_config(9, 1.0),
+        Err(RequestError::Nack(Status::UnknownJoint))
+    );
+    // The other two interfaces.
+    let mut limb = LimbClient::connect(&ctx, "test/limb/0").unwrap();
+    let t = limb
+        .set_pose([3.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0])
+        .unwrap();
+    assert_eq!(limb.wait_outcome(t, T).unwrap(), Status::OutOfReach);
+    assert_eq!(
+        limb.state().unwrap().limb_state().unwrap(),
+        LimbState::OutOfReach
+    );
+    let t = limb.set_position([0.3, 0.0, 0.2]).unwrap();
+    assert_eq!(limb.wait_outcome(t, T).unwrap(), Status::Ok);
+    assert_eq!(limb.state().unwrap().limb_state().unwrap(), LimbState::Idle);
+    let mut grip = GripperClient::connect(&ctx, "test/gripper/0").unwrap();
+    let t = grip.close().unwrap();
+    assert_eq!(grip.wait_outcome(t, T).unwrap(), Status::Ok);
+    assert_eq!(
+        grip.state().unwrap().gripper_state().unwrap(),
+        GripperState::Closed
+    );
+    assert_eq!(grip.geometry().unwrap().num_beams, 2);
+    let t = grip.store().unwrap();
+    assert_eq!(grip.wait_outcome(t, T).unwrap(), Status::Unsupported);
+    // A wrong interface or an absent device is a clear error.
+    assert!(matches!(
+        LimbClient::connect(&ctx, "test/actarray/0"),
+        Err(ConnectError::Incompatible { .. })
+    ));
+    assert!(matches!(
+        GripperClient::connect(&ctx, "test/gripper/5"),
+        Err(ConnectError::NoDriver { .. })
+    ));
+}
+
+#[test]
+fn no_driver_is_reported_at_once() {
+    let domain = Domain::unique_for_test();
+    let ctx = client_ctx(&domain);
+    let start = Instant::now();
+    let err = ActArrayClient::connect(&ctx, "nobody/actarray/0").unwrap_err();
+    assert!(matches!(err, ConnectError::NoDriver { .. }), "{err}");
+    assert!(
+        err.to_string()
+            .contains("no driver offers nobody/actarray/0")
+    );
+    let err =
+        ActArrayClient::connect_timeout(&ctx, "nobody/actarray/0", Duration::from_millis(100))
+            .unwrap_err();
+    assert!(matches!(err, ConnectError::NoDriver { .. }));
+    let _ = start;
+}
+
+#[test]
+fn a_client_dying_mid_request_does_not_hurt_the_driver() {
+    let domain = Domain::unique_for_test();
+    let _driver = start_driver(&domain, &["--reply-delay-ms", "300"]);
+    let mut victim = Proc::spawn(CLIENT, domain.name(), &["hold-request"]);
+    assert!(victim.read_until(|l| l == "requesting").is_some());
+    std::thread::sleep(Duration::from_millis(100));
+    victim.signal(libc::SIGKILL);
+    let _ = victim.wait_timeout(T);
+    // The driver answers the dead client (undeliverable) and goes on serving.
+    let ctx = client_ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&ctx, "test/actarray/0", T).unwrap();
+    for _ in 0..3 {
+        assert_eq!(arm.geometry().unwrap().actuators_count, 6);
+    }
+}
+
+#[test]
+fn a_killed_driver_is_noticed_and_a_restarted_one_picked_up() {
+    let domain = Domain::unique_for_test();
+    let mut driver = start_driver(&domain, &[]);
+    let ctx = client_ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&ctx, "test/actarray/0", T).unwrap();
+    arm.wait_state(T).unwrap();
+    assert_eq!(arm.driver_status(), DriverStatus::Alive);
+
+    driver.signal(libc::SIGKILL);
+    let _ = driver.wait_timeout(T);
+    // Noticed within a bounded time, well before the (long) timeout.
+    let mut noticed = false;
+    for _ in 0..5 {
+        match arm.wait_state(Duration::from_secs(30)) {
+            Err(WaitError::DriverGone) => {
+                noticed = true;
+                break;
+            }
+            Ok(_) => continue, // samples still buffered from before the kill
+            Err(e) => panic!("expected DriverGone, got {e}"),
+        }
+    }
+    assert!(noticed);
+    assert_ne!(arm.driver_status(), DriverStatus::Alive);
+    assert!(matches!(
+        arm.geometry(),
+        Err(RequestError::NoDriver | RequestError::DriverGone)
+    ));
+    let devices = list_devices(&domain).unwrap();
+    assert!(devices.iter().all(|d| !d.alive), "{devices:?}");
+
+    // Restart: the same client object works again, without reconnecting.
+    let _driver2 = start_driver(&domain, &[]);
+    let deadline = Instant::now() + T;
+    loop {
+        match arm.geometry() {
+            Ok(g) => {
+                assert_eq!(g.actuators_count, 6);
+                break;
+            }
+            Err(e) if Instant::now() < deadline => {
+                let _ = e;
+                std::thread::sleep(Duration::from_millis(20));
+            }
+            Err(e) => panic!("restarted driver not picked up: {e}"),
+        }
+    }
+    let t = arm.move_to(0, 0.5).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
+    assert_eq!(arm.driver_status(), DriverStatus::Alive);
+}
+
+#[test]
+fn bursts_from_two_clients_lose_nothing_and_keep_order() {
+    let domain = Domain::unique_for_test();
+    let mut driver = start_driver(&domain, &["--period-ms", "50"]);
+    let n = 200u64;
+    let ns = n.to_string();
+    let mut a = Proc::spawn(CLIENT, domain.name(), &["burst", &ns]);
+    let mut b = Proc::spawn(CLIENT, domain.name(), &["burst", &ns]);
+    assert_eq!(a.wait_timeout(Duration::from_secs(20)), Some(0));
+    assert_eq!(b.wait_timeout(Duration::from_secs(20)), Some(0));
+    driver.signal(libc::SIGTERM);
+    assert_eq!(driver.wait_timeout(T), Some(0));
+    let out = driver.rest_of_stdout();
+    let mut per_client: std::collections::BTreeMap<u64, Vec<u64>> = Default::default();
+    for line in out.lines().filter(|l| l.starts_with("cmd ")) {
+        let f: Vec<u64> = line[4..].split(' ').map(|x| x.parse().unwrap()).collect();
+        per_client.entry(f[0]).or_default().push(f[1]);
+    }
+    assert_eq!(per_client.len(), 2, "{out}");
+    for seqs in per_client.values() {
+        assert_eq!(
+            seqs,
+            &(1..=n).collect::<Vec<_>>(),
+            "lost or reordered commands"
+        );
+    }
+    assert!(out.contains("overflows=0"), "{out}");
+    assert!(out.contains("exit Signal"), "{out}");
+}
+
+#[test]
+fn discovery_lists_devices_with_driver_and_liveness() {
+    let domain = Domain::unique_for_test();
+    let _driver = start_driver(&domain, &["--robot", "r2"]);
+    let devices = list_devices(&domain).unwrap();
+    let names: Vec<String> = devices.iter().map(|d| d.name.to_string()).collect();
+    assert_eq!(names, ["r2/actarray/0", "r2/limb/0", "r2/gripper/0"]);
+    assert!(
+        devices
+            .iter()
+            .all(|d| d.alive && d.driver == "testdriver" && d.layout == "1")
+    );
+    // Another domain sees nothing.
+    assert!(list_devices(&Domain::unique_for_test()).unwrap().is_empty());
+}
