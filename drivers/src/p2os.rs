@@ -1,1 +1,0 @@
-//! The P2OS/ARCOS protocol of the Pioneer controller (built by the P2OS issue).

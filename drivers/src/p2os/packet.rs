@@ -1,0 +1,677 @@
+//! Typed robot → client packets, with their encoders (used by the emulator).
+
+use super::codec::{EncodeError, Frame, PayloadBuilder};
+use super::command::ArmJoint;
+use super::vendor_conventions as vc;
+use thiserror::Error;
+
+/// Robot → client packet types (payload byte 0).
+pub mod ptype {
+    /// Standard SIP, lowest type value.
+    pub const SIP_FIRST: u8 = 0x30;
+    /// Standard SIP, motors stopped.
+    pub const SIP_STOPPED: u8 = 0x32;
+    /// Standard SIP, motors moving.
+    pub const SIP_MOVING: u8 = 0x33;
+    /// Standard SIP, highest type value.
+    pub const SIP_LAST: u8 = 0x34;
+    /// CONFIGpac.
+    pub const CONFIG: u8 = 0x20;
+    /// ARMpac.
+    pub const ARM: u8 = 0xA0;
+    /// ARMINFOpac.
+    pub const ARM_INFO: u8 = 0xA1;
+    /// ARIA's gripper packet.
+    pub const GRIPPER: u8 = 0xE0;
+}
+
+/// Why a robot packet could not be parsed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
+pub enum PacketError {
+    /// The payload is empty.
+    #[error("empty packet")]
+    Empty,
+    /// The payload is shorter than its type requires.
+    #[error("packet type {packet_type:#04x}: {len} bytes is too short (need {need})")]
+    TooShort {
+        /// Packet type byte.
+        packet_type: u8,
+        /// Payload length.
+        len: usize,
+        /// Minimum length.
+        need: usize,
+    },
+    /// An ARMpac whose length is not exactly 9 payload bytes (N = 11).
+    #[error("ARMpac payload of {0} bytes (expected 9)")]
+    ArmPacketLength(usize),
+    /// An ARMINFOpac without the NUL ending its version string.
+    #[error("ARMINFOpac version string is not terminated")]
+    ArmInfoVersion,
+    /// An ARMINFOpac announcing more joints than the arm has (6).
+    #[error("ARMINFOpac announces {0} joints (at most 6)")]
+    ArmInfoJoints(u8),
+    /// A SIP announcing more sonar readings than [`MAX_SONAR`].
+    #[error("SIP announces {0} sonar readings (at most {MAX_SONAR})")]
+    TooManySonars(u8),
+}
+
+/// The gripper switch byte (see [`vc`] for the bit layout, ARIA's reading).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct GripperSwitches(pub u8);
+
+/// The paddles' state as read from the switches.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PaddleState {
+    /// Fully open.
+    Open,
+    /// Closed (both paddle contacts triggered).
+    Closed,
+    /// Moving.
+    Moving,
+    /// Stopped in between.
+    Between,
+}
+
+/// The facts a gripper switch byte carries, for encoding.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct GripperSwitchFacts {
+    /// Paddles fully open.
+    pub paddles_open: bool,
+    /// Left paddle contact.
+    pub left_contact: bool,
+    /// Right paddle contact.
+    pub right_contact: bool,
+    /// Paddles moving.
+    pub paddles_moving: bool,
+    /// Lift at the top or bottom limit.
+    pub lift_at_limit: bool,
+    /// Lift moving.
+    pub lift_moving: bool,
+    /// Outer breakbeam broken.
+    pub outer_beam: bool,
+    /// Inner breakbeam broken.
+    pub inner_beam: bool,
+}
+
+impl GripperSwitches {
+    /// Encodes the facts with the vendor's (active-low) bit layout.
+    pub fn from_facts(f: GripperSwitchFacts) -> GripperSwitches {
+        let mut b = 0u8;
+        if !f.paddles_open {
+            b |= vc::GRIP_SW_OPEN_LIMIT_N;
+        }
+        if !f.lift_at_limit {
+            b |= vc::GRIP_SW_LIFT_LIMIT_N;
+        }
+        if f.outer_beam {
+            b |= vc::GRIP_SW_OUTER_BEAM;
+        }
+        if f.inner_beam {
+            b |= vc::GRIP_SW_INNER_BEAM;
+        }
+        if !f.left_contact {
+            b |= vc::GRIP_SW_LEFT_CONTACT_N;
+        }
+        if !f.right_contact {
+            b |= vc::GRIP_SW_RIGHT_CONTACT_N;
+        }
+        if f.lift_moving {
+            b |= vc::GRIP_SW_LIFT_MOVING;
+        }
+        if f.paddles_moving {
+            b |= vc::GRIP_SW_PADDLES_MOVING;
+        }
+        GripperSwitches(b)
+    }
+
+    /// Decodes the byte into facts.
+    pub fn facts(self) -> GripperSwitchFacts {
+        let b = self.0;
+        GripperSwitchFacts {
+            paddles_open: b & vc::GRIP_SW_OPEN_LIMIT_N == 0,
+            left_contact: b & vc::GRIP_SW_LEFT_CONTACT_N == 0,
+            right_contact: b & vc::GRIP_SW_RIGHT_CONTACT_N == 0,
+            paddles_moving: b & vc::GRIP_SW_PADDLES_MOVING != 0,
+            lift_at_limit: b & vc::GRIP_SW_LIFT_LIMIT_N == 0,
+            lift_moving: b & vc::GRIP_SW_LIFT_MOVING != 0,
+            outer_beam: b & vc::GRIP_SW_OUTER_BEAM != 0,
+            inner_beam: b & vc::GRIP_SW_INNER_BEAM != 0,
+        }
+    }
+
+    /// The paddles' state.
+    pub fn paddles(self) -> PaddleState {
+        let f = self.facts();
+        if f.paddles_moving {
+            PaddleState::Moving
+        } else if f.paddles_open {
+            PaddleState::Open
+        } else if f.left_contact && f.right_contact {
+            PaddleState::Closed
+        } else {
+            PaddleState::Between
+        }
+    }
+
+    /// Outer breakbeam broken.
+    pub fn outer_beam(self) -> bool {
+        self.facts().outer_beam
+    }
+
+    /// Inner breakbeam broken.
+    pub fn inner_beam(self) -> bool {
+        self.facts().inner_beam
+    }
+
+    /// Lift at a limit (top or bottom).
+    pub fn lift_at_limit(self) -> bool {
+        self.facts().lift_at_limit
+    }
+
+    /// Lift moving.
+    pub fn lift_moving(self) -> bool {
+        self.facts().lift_moving
+    }
+}
+
+/// Maximum number of sonar readings a [`Sip`] holds.
+pub const MAX_SONAR: usize = 32;
+
+/// One sonar reading of a SIP.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SonarReading {
+    /// Sonar index.
+    pub index: u8,
+    /// Raw range (× RangeConvFactor = mm).
+    pub range: u16,
+}
+
+/// A standard SIP (types 0x30..=0x34). Raw units, as on the wire.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Sip {
+    /// Type byte (0x32 stopped, 0x33 moving).
+    pub packet_type: u8,
+    /// Raw x position.
+    pub x: u16,
+    /// Raw y position.
+    pub y: u16,
+    /// Heading (× AngleConvFactor rad).
+    pub heading: i16,
+    /// Left wheel velocity (× VelConvFactor mm/s).
+    pub left_vel: i16,
+    /// Right wheel velocity.
+    pub right_vel: i16,
+    /// Battery, 0.1 V units.
+    pub battery: u8,
+    /// Bit 0 left stall, bits 1..7 rear bumpers.
+    pub left_stall: u8,
+    /// Bit 0 right stall, bits 1..7 front bumpers.
+    pub right_stall: u8,
+    /// Setpoint heading.
+    pub control: i16,
+    /// PTU (unused).
+    pub ptu: u16,
+    /// Compass, 2° units.
+    pub compass: u8,
+    sonar_count: u8,
+    sonars: [SonarReading; MAX_SONAR],
+    /// "Timer" field; its high byte is the gripper switch byte.
+    pub timer: u16,
+    /// Selected analog input.
+    pub analog: u8,
+    /// Digital inputs.
+    pub digin: u8,
+    /// Digital outputs.
+    pub digout: u8,
+}
+
+impl Default for Sip {
+    fn default() -> Self {
+        Sip {
+            packet_type: ptype::SIP_STOPPED,
+            x: 0,
+            y: 0,
+            heading: 0,
+            left_vel: 0,
+            right_vel: 0,
+            battery: 130,
+            left_stall: 0,
+            right_stall: 0,
+            control: 0,
+            ptu: 0,
+            compass: 0,
+            sonar_count: 0,
+            sonars: [SonarReading::default(); MAX_SONAR],
+            timer: 0,
+            analog: 0,
+            digin: 0,
+            digout: 0,
+        }
+    }
+}
+
+fn le16(p: &[u8], i: usize) -> u16 {
+    u16::from_le_bytes([p[i], p[i + 1]])
+}
+
+impl Sip {
+    /// Minimum payload: fields up to the sonar count (20) + timer, analog,
+    /// digin, digout (5).
+    pub const MIN_LEN: usize = 25;
+
+    /// Parses a SIP payload (type byte first).
+    pub fn parse(p: &[u8]) -> Result<Sip, PacketError> {
+        let short = |need: usize| PacketError::TooShort {
+            packet_type: p.first().copied().unwrap_or(0),
+            len: p.len(),
+            need,
+        };
+        if p.len() < Self::MIN_LEN {
+            return Err(short(Self::MIN_LEN));
+        }
+        let n = p[19];
+        if usize::from(n) > MAX_SONAR {
+            return Err(PacketError::TooManySonars(n));
+        }
+        let tail = 20 + 3 * usize::from(n);
+        if p.len() < tail + 5 {
+            return Err(short(tail + 5));
+        }
+        let mut sonars = [SonarReading::default(); MAX_SONAR];
+        for (k, s) in sonars.iter_mut().take(usize::from(n)).enumerate() {
+            let o = 20 + 3 * k;
+            *s = SonarReading {
+                index: p[o],
+                range: le16(p, o + 1),
+            };
+        }
+        Ok(Sip {
+            packet_type: p[0],
+            x: le16(p, 1),
+            y: le16(p, 3),
+            heading: le16(p, 5) as i16,
+            left_vel: le16(p, 7) as i16,
+            right_vel: le16(p, 9) as i16,
+            battery: p[11],
+            left_stall: p[12],
+            right_stall: p[13],
+            control: le16(p, 14) as i16,
+            ptu: le16(p, 16),
+            compass: p[18],
+            sonar_count: n,
+            sonars,
+            timer: le16(p, tail),
+            analog: p[tail + 2],
+            digin: p[tail + 3],
+            digout: p[tail + 4],
+        })
+    }
+
+    /// The sonar readings.
+    pub fn sonars(&self) -> &[SonarReading] {
+        &self.sonars[..usize::from(self.sonar_count).min(MAX_SONAR)]
+    }
+
+    /// Replaces the sonar readings (at most [`MAX_SONAR`] are kept).
+    pub fn set_sonars(&mut self, readings: &[SonarReading]) {
+        let n = readings.len().min(MAX_SONAR);
+        self.sonars[..n].copy_from_slice(&readings[..n]);
+        self.sonar_count = n as u8;
+    }
+
+    /// The base motors are moving (type 0x33).
+    pub fn motors_moving(&self) -> bool {
+        self.packet_type == ptype::SIP_MOVING
+    }
+
+    /// The gripper switch byte (high byte of the timer field).
+    pub fn gripper_switches(&self) -> GripperSwitches {
+        GripperSwitches((self.timer >> 8) as u8)
+    }
+
+    /// Encodes the SIP (type byte first).
+    pub fn encode(&self) -> Result<Frame, EncodeError> {
+        let mut b = PayloadBuilder::new(self.packet_type);
+        b.u16_le(self.x)
+            .u16_le(self.y)
+            .u16_le(self.heading as u16)
+            .u16_le(self.left_vel as u16)
+            .u16_le(self.right_vel as u16)
+            .byte(self.battery)
+            .byte(self.left_stall)
+            .byte(self.right_stall)
+            .u16_le(self.control as u16)
+            .u16_le(self.ptu)
+            .byte(self.compass)
+            .byte(self.sonar_count);
+        for s in self.sonars() {
+            b.byte(s.index).u16_le(s.range);
+        }
+        b.u16_le(self.timer)
+            .byte(self.analog)
+            .byte(self.digin)
+            .byte(self.digout);
+        b.frame()
+    }
+}
+
+/// An ARMpac (0xA0): arm status and the current tick of each joint.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ArmPacket {
+    /// The 16-bit status word in the vendor's reading (see [`vc`]).
+    pub status: u16,
+    /// Current tick of joints 1..6 (index 0..5).
+    pub ticks: [u8; 6],
+}
+
+impl ArmPacket {
+    /// Payload length of an ARMpac (N = 11).
+    pub const LEN: usize = 9;
+
+    /// Parses an ARMpac payload.
+    pub fn parse(p: &[u8]) -> Result<ArmPacket, PacketError> {
+        if p.len() != Self::LEN {
+            return Err(PacketError::ArmPacketLength(p.len()));
+        }
+        let (lo, hi) = if vc::ARMPAC_STATUS_LOW_BYTE_FIRST {
+            (p[1], p[2])
+        } else {
+            (p[2], p[1])
+        };
+        let mut ticks = [0u8; 6];
+        ticks.copy_from_slice(&p[3..9]);
+        Ok(ArmPacket {
+            status: u16::from_le_bytes([lo, hi]),
+            ticks,
+        })
+    }
+
+    /// Encodes the ARMpac.
+    pub fn encode(&self) -> Result<Frame, EncodeError> {
+        let [lo, hi] = self.status.to_le_bytes();
+        let (a, b) = if vc::ARMPAC_STATUS_LOW_BYTE_FIRST {
+            (lo, hi)
+        } else {
+            (hi, lo)
+        };
+        let mut pb = PayloadBuilder::new(ptype::ARM);
+        pb.byte(a).byte(b).bytes(&self.ticks);
+        pb.frame()
+    }
+
+    /// The joint is moving.
+    pub fn joint_moving(&self, joint: ArmJoint) -> bool {
+        self.status & (1 << joint.index()) != 0
+    }
+
+    /// Bits 0..5: joints 1..6 moving.
+    pub fn moving_mask(&self) -> u8 {
+        (self.status & vc::ARM_STATUS_MOVING_MASK) as u8
+    }
+
+    /// The arm controller is alive and communicating.
+    pub fn is_good(&self) -> bool {
+        self.status & vc::ARM_STATUS_GOOD != 0
+    }
+
+    /// The arm controller is initialised.
+    pub fn is_inited(&self) -> bool {
+        self.status & vc::ARM_STATUS_INITED != 0
+    }
+
+    /// The arm servos are powered.
+    pub fn is_powered(&self) -> bool {
+        self.status & vc::ARM_STATUS_POWERED != 0
+    }
+
+    /// The arm is homing.
+    pub fn is_homing(&self) -> bool {
+        self.status & vc::ARM_STATUS_HOMING != 0
+    }
+
+    /// Tick of a joint.
+    pub fn tick(&self, joint: ArmJoint) -> u8 {
+        self.ticks[joint.index()]
+    }
+}
+
+/// Calibration of one arm joint from ARMINFOpac (all raw ticks).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct JointCalibration {
+    /// Default speed, ms per step.
+    pub speed: u8,
+    /// Home tick.
+    pub home: u8,
+    /// Minimum tick.
+    pub min: u8,
+    /// Centre tick (angle 0).
+    pub centre: u8,
+    /// Maximum tick.
+    pub max: u8,
+    /// Ticks per 90 degrees.
+    pub ticks_per_90: u8,
+}
+
+/// Longest ARMINFOpac version string kept.
+pub const MAX_VERSION: usize = 64;
+
+/// An ARMINFOpac (0xA1): firmware version and per-joint calibration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ArmInfo {
+    version: [u8; MAX_VERSION],
+    version_len: u8,
+    /// Number of joints (6 on the Pioneer arm, including the gripper).
+    pub num_joints: u8,
+    /// Calibration of joints 1..num_joints (index 0..).
+    pub joints: [JointCalibration; 6],
+}
+
+impl ArmInfo {
+    /// Builds an ARMINFOpac (the version is cut at [`MAX_VERSION`] bytes and
+    /// at any NUL).
+    pub fn new(version: &str, joints: &[JointCalibration]) -> ArmInfo {
+        let v = version.as_bytes();
+        let v = &v[..v.iter().position(|&c| c == 0).unwrap_or(v.len())];
+        let n = v.len().min(MAX_VERSION);
+        let mut buf = [0u8; MAX_VERSION];
+        buf[..n].copy_from_slice(&v[..n]);
+        let mut js = [JointCalibration::default(); 6];
+        let nj = joints.len().min(6);
+        js[..nj].copy_from_slice(&joints[..nj]);
+        ArmInfo {
+            version: buf,
+            version_len: n as u8,
+            num_joints: nj as u8,
+            joints: js,
+        }
+    }
+
+    /// Parses an ARMINFOpac payload.
+    pub fn parse(p: &[u8]) -> Result<ArmInfo, PacketError> {
+        let rest = p.get(1..).ok_or(PacketError::Empty)?;
+        let nul = rest
+            .iter()
+            .position(|&c| c == 0)
+            .ok_or(PacketError::ArmInfoVersion)?;
+        let version = &rest[..nul];
+        let rest = &rest[nul + 1..];
+        let (&nj, rest) = rest.split_first().ok_or(PacketError::TooShort {
+            packet_type: ptype::ARM_INFO,
+            len: p.len(),
+            need: p.len() + 1,
+        })?;
+        if nj > 6 {
+            return Err(PacketError::ArmInfoJoints(nj));
+        }
+        if rest.len() < 6 * usize::from(nj) {
+            return Err(PacketError::TooShort {
+                packet_type: ptype::ARM_INFO,
+                len: p.len(),
+                need: p.len() - rest.len() + 6 * usize::from(nj),
+            });
+        }
+        let mut joints = [JointCalibration::default(); 6];
+        for (j, c) in rest.chunks_exact(6).take(usize::from(nj)).enumerate() {
+            joints[j] = JointCalibration {
+                speed: c[0],
+                home: c[1],
+                min: c[2],
+                centre: c[3],
+                max: c[4],
+                ticks_per_90: c[5],
+            };
+        }
+        let mut info = ArmInfo::new("", &joints[..usize::from(nj)]);
+        let n = version.len().min(MAX_VERSION);
+        info.version[..n].copy_from_slice(&version[..n]);
+        info.version_len = n as u8;
+        Ok(info)
+    }
+
+    /// Encodes the ARMINFOpac.
+    pub fn encode(&self) -> Result<Frame, EncodeError> {
+        let mut b = PayloadBuilder::new(ptype::ARM_INFO);
+        b.bytes(self.version_bytes()).byte(0).byte(self.num_joints);
+        for c in self.calibrations() {
+            b.bytes(&[c.speed, c.home, c.min, c.centre, c.max, c.ticks_per_90]);
+        }
+        b.frame()
+    }
+
+    /// The raw version string.
+    pub fn version_bytes(&self) -> &[u8] {
+        &self.version[..usize::from(self.version_len)]
+    }
+
+    /// The version string, lossily decoded.
+    pub fn version(&self) -> String {
+        String::from_utf8_lossy(self.version_bytes()).into_owned()
+    }
+
+    /// Calibrations of the joints announced.
+    pub fn calibrations(&self) -> &[JointCalibration] {
+        &self.joints[..usize::from(self.num_joints).min(6)]
+    }
+}
+
+/// ARIA's gripper packet (0xE0).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct GripperPacket {
+    /// 0 none, 1 User-I/O, 2 General-I/O.
+    pub gripper_type: u8,
+    /// The switch byte.
+    pub switches: GripperSwitches,
+    /// Grasp time, 20 ms units.
+    pub grasp_time: u8,
+}
+
+impl GripperPacket {
+    /// Parses a 0xE0 payload (extra trailing bytes are ignored).
+    pub fn parse(p: &[u8]) -> Result<GripperPacket, PacketError> {
+        if p.len() < 4 {
+            return Err(PacketError::TooShort {
+                packet_type: ptype::GRIPPER,
+                len: p.len(),
+                need: 4,
+            });
+        }
+        Ok(GripperPacket {
+            gripper_type: p[1],
+            switches: GripperSwitches(p[2]),
+            grasp_time: p[3],
+        })
+    }
+
+    /// Encodes the gripper packet.
+    pub fn encode(&self) -> Result<Frame, EncodeError> {
+        let mut b = PayloadBuilder::new(ptype::GRIPPER);
+        b.byte(self.gripper_type)
+            .byte(self.switches.0)
+            .byte(self.grasp_time);
+        b.frame()
+    }
+}
+
+/// The identity strings of a SYNC2 reply.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct RobotIdentity {
+    /// Robot (or simulator) name.
+    pub name: String,
+    /// Robot class, e.g. "Pioneer".
+    pub class: String,
+    /// Robot subclass, e.g. "p3dx".
+    pub subclass: String,
+}
+
+impl RobotIdentity {
+    /// Parses the bytes after the SYNC2 command byte: three NUL-terminated
+    /// strings (missing ones are empty).
+    pub fn parse(bytes: &[u8]) -> RobotIdentity {
+        let mut parts = bytes
+            .split(|&b| b == 0)
+            .map(|s| String::from_utf8_lossy(s).into_owned());
+        RobotIdentity {
+            name: parts.next().unwrap_or_default(),
+            class: parts.next().unwrap_or_default(),
+            subclass: parts.next().unwrap_or_default(),
+        }
+    }
+
+    /// Encodes a SYNC2 reply carrying this identity.
+    pub fn encode_sync2(&self) -> Result<Frame, EncodeError> {
+        let mut b = PayloadBuilder::new(2);
+        for s in [&self.name, &self.class, &self.subclass] {
+            b.bytes(s.as_bytes()).byte(0);
+        }
+        b.frame()
+    }
+}
+
+/// A robot → client packet.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RobotPacket<'a> {
+    /// Reply to SYNC0/1/2 (step 0..2); for step 2 `rest` holds the identity
+    /// (see [`RobotIdentity::parse`]).
+    Sync {
+        /// Sync step 0, 1 or 2.
+        step: u8,
+        /// Bytes after the step byte.
+        rest: &'a [u8],
+    },
+    /// A standard SIP.
+    Sip(Sip),
+    /// An ARMpac.
+    Arm(ArmPacket),
+    /// An ARMINFOpac.
+    ArmInfo(ArmInfo),
+    /// A 0xE0 gripper packet.
+    Gripper(GripperPacket),
+    /// Any other packet type.
+    Other {
+        /// Type byte.
+        packet_type: u8,
+        /// Whole payload.
+        payload: &'a [u8],
+    },
+}
+
+impl<'a> RobotPacket<'a> {
+    /// Parses a payload (type byte first). Does not allocate.
+    pub fn parse(p: &'a [u8]) -> Result<RobotPacket<'a>, PacketError> {
+        let &t = p.first().ok_or(PacketError::Empty)?;
+        Ok(match t {
+            0..=2 => RobotPacket::Sync {
+                step: t,
+                rest: &p[1..],
+            },
+            ptype::SIP_FIRST..=ptype::SIP_LAST => RobotPacket::Sip(Sip::parse(p)?),
+            ptype::ARM => RobotPacket::Arm(ArmPacket::parse(p)?),
+            ptype::ARM_INFO => RobotPacket::ArmInfo(ArmInfo::parse(p)?),
+            ptype::GRIPPER => RobotPacket::Gripper(GripperPacket::parse(p)?),
+            _ => RobotPacket::Other {
+                packet_type: t,
+                payload: p,
+            },
+        })
+    }
+}
