@@ -5,12 +5,18 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod layout;
+mod list;
 
 /// limber: Player's generic limb interfaces (actarray, limb, gripper) over zero-copy
 /// shared memory, with a real-time driver for the Pioneer arm.
 #[derive(Debug, Parser)]
 #[command(name = "limber", version, about, long_about = None, propagate_version = true)]
 struct Cli {
+    /// The domain to work in (default: $LIMBER_DOMAIN, or "limber"). Robots and tests in
+    /// different domains never see each other.
+    #[arg(long, global = true, value_name = "NAME")]
+    domain: Option<String>,
+
     #[command(subcommand)]
     command: Command,
 }
@@ -22,12 +28,19 @@ enum Command {
     /// Without a flag, a readable catalogue. `--json` prints the layout manifest that the
     /// C header and the Python classes are generated from.
     Layout(layout::LayoutArgs),
+    /// List every device of the domain by its name robot/interface/index, with its driver
+    /// and whether the driver is alive.
+    List(list::ListArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Some(d) = &cli.domain {
+        set_domain_env(d);
+    }
     let result = match cli.command {
         Command::Layout(args) => layout::run(args),
+        Command::List(args) => list::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -36,6 +49,32 @@ fn main() -> ExitCode {
             ExitCode::from(e.exit_code())
         }
     }
+}
+
+fn set_domain_env(d: &str) {
+    // SAFETY: called first thing in main, before any other thread exists.
+    unsafe { std::env::set_var(limber_services::naming::DOMAIN_ENV, d) };
+}
+
+/// The domain selected by `--domain` or `LIMBER_DOMAIN`.
+pub fn domain() -> Result<limber_services::Domain, CliError> {
+    limber_services::Domain::from_env().map_err(|e| CliError::new(exit::USAGE, e.to_string()))
+}
+
+/// Exit codes of the `limber` command.
+pub mod exit {
+    /// Bad arguments (as clap uses).
+    pub const USAGE: u8 = 2;
+    /// No driver offers the device.
+    pub const NO_DRIVER: u8 = 3;
+    /// The driver died.
+    pub const DRIVER_GONE: u8 = 4;
+    /// The driver refused the command or request (the reason is printed).
+    pub const REFUSED: u8 = 5;
+    /// No answer in time.
+    pub const TIMEOUT: u8 = 6;
+    /// Anything else (I/O, shared memory).
+    pub const FAILURE: u8 = 1;
 }
 
 /// An error of a verb, with the exit code it maps to.

@@ -1,0 +1,59 @@
+//! `limber list`: every device of the domain.
+
+use clap::Args;
+use limber_services::list_devices;
+
+use crate::{CliError, domain, exit};
+
+/// Arguments of `limber list`.
+#[derive(Debug, Args)]
+pub struct ListArgs {
+    /// One JSON object per device and line, for scripts.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Runs `limber list`.
+pub fn run(args: ListArgs) -> Result<(), CliError> {
+    let domain = domain()?;
+    let devices = list_devices(&domain).map_err(|e| CliError::new(exit::FAILURE, e.to_string()))?;
+    if args.json {
+        for d in &devices {
+            println!(
+                "{}",
+                serde_json::json!({
+                    "device": d.name.to_string(),
+                    "robot": d.name.robot(),
+                    "interface": d.name.interface().name(),
+                    "index": d.name.index(),
+                    "driver": d.driver,
+                    "alive": d.alive,
+                    "layout": d.layout,
+                    "processes": d.nodes,
+                })
+            );
+        }
+        return Ok(());
+    }
+    if devices.is_empty() {
+        println!(
+            "no devices in domain {} (start a driver, e.g. `limber pioneer --emulated`, or check --domain / LIMBER_DOMAIN)",
+            domain.name()
+        );
+        return Ok(());
+    }
+    println!(
+        "{:<28} {:<12} {:<6} {:>9}",
+        "DEVICE", "DRIVER", "STATE", "PROCESSES"
+    );
+    for d in &devices {
+        println!(
+            "{:<28} {:<12} {:<6} {:>9}",
+            d.name.to_string(),
+            d.driver,
+            if d.alive { "alive" } else { "dead" },
+            d.nodes
+        );
+    }
+    Ok(())
+}

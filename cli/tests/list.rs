@@ -1,0 +1,74 @@
+//! `limber list` against a running driver.
+
+use std::process::Command;
+use std::sync::mpsc;
+use std::time::Duration;
+
+use limber_services::testing::TestDriver;
+use limber_services::{Context, Domain, Role};
+
+const LIMBER: &str = env!("CARGO_BIN_EXE_limber");
+
+/// Runs the test driver on a thread of this process until `stop` is dropped.
+fn driver(domain: &str) -> mpsc::Sender<()> {
+    let (tx, rx) = mpsc::channel::<()>();
+    let (ready_tx, ready_rx) = mpsc::channel();
+    let name = domain.to_string();
+    std::thread::spawn(move || {
+        let domain = Domain::new(&name).unwrap();
+        let ctx = Context::new(&domain, Role::Driver, "testdriver").unwrap();
+        let mut d = TestDriver::new(&ctx, "cli", 6).unwrap();
+        ready_tx.send(()).unwrap();
+        let _ = d.run(Duration::from_millis(10), || {
+            !matches!(rx.try_recv(), Err(mpsc::TryRecvError::Empty))
+        });
+    });
+    ready_rx.recv_timeout(Duration::from_secs(10)).unwrap();
+    tx
+}
+
+#[test]
+fn list_shows_devices_drivers_and_liveness() {
+    let domain = Domain::unique_for_test();
+    let _stop = driver(domain.name());
+    let out = Command::new(LIMBER)
+        .args(["list", "--domain", domain.name()])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    for dev in ["cli/actarray/0", "cli/limb/0", "cli/gripper/0"] {
+        let line = text
+            .lines()
+            .find(|l| l.starts_with(dev))
+            .unwrap_or_else(|| panic!("{text}"));
+        assert!(
+            line.contains("testdriver") && line.contains("alive"),
+            "{line}"
+        );
+    }
+    let out = Command::new(LIMBER)
+        .args(["list", "--json"])
+        .env("LIMBER_DOMAIN", domain.name())
+        .output()
+        .unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(text.lines().count(), 3);
+    assert!(text.contains(r#""device":"cli/limb/0""#), "{text}");
+}
+
+#[test]
+fn list_of_an_empty_domain_says_so_and_bad_domains_are_refused() {
+    let out = Command::new(LIMBER)
+        .args(["list", "--domain", Domain::unique_for_test().name()])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("no devices"));
+    let out = Command::new(LIMBER)
+        .args(["list", "--domain", "a b"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("invalid domain"));
+}
