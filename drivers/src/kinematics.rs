@@ -36,6 +36,8 @@
 //! * No solver allocates; no solver panics or returns NaN on bad (NaN, infinite,
 //!   degenerate) input: such input is a typed error.
 
+#![warn(missing_docs)]
+
 pub mod bench;
 pub mod chain;
 pub mod pioneer;

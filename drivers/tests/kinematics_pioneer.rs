@@ -978,3 +978,60 @@ fn vecmove_out_of_reach_stops_with_an_error() {
     );
     let _ = FRAC_PI_2;
 }
+
+/// When the preferred approach is impossible, SETPOSITION takes the in-plane approach
+/// (gripper level, wrist roll 0 or π) nearest to it: one step closer is infeasible.
+#[test]
+fn setposition_falls_back_to_the_nearest_in_plane_approach() {
+    let g = geom();
+    let o = opts();
+    let target = Vector3::new(0.22, 0.08, -0.25);
+    let preferred = Vector3::new(1.0, 0.0, 0.0);
+    assert!(
+        g.solve_position_approach(&target, &preferred, &[0.0; 5], &o)
+            .is_err()
+    );
+    let sol = g
+        .solve_position(
+            &target,
+            ApproachPreference::Direction(preferred),
+            &[0.0; 5],
+            &o,
+        )
+        .unwrap();
+    let pose = g.fk(&sol.theta).unwrap();
+    assert!((pose.position - target).norm() < 1e-6);
+    let a = pose.approach();
+    // In the vertical plane through the yaw axis and the target.
+    let plane_normal = Vector3::new(-target.y, target.x, 0.0).normalize();
+    assert!(a.dot(&plane_normal).abs() < 1e-6, "{a:?}");
+    // Nearest: tilting it 1e-4 rad towards the preferred elevation fails.
+    let radial = Vector3::new(target.x, target.y, 0.0).normalize();
+    let phi = a.z.atan2(a.dot(&radial));
+    let closer = phi + 1e-4 * (0.0 - phi).signum();
+    let a2 = radial * closer.cos() + Vector3::z() * closer.sin();
+    assert!(
+        g.solve_position_approach(&target, &a2, &[0.0; 5], &o)
+            .is_err()
+    );
+}
+
+/// Positions reachable only with θ1 on its limit (the target's vertical plane is
+/// beyond it) are still found.
+#[test]
+fn setposition_at_the_yaw_limit() {
+    let g = geom();
+    let theta = [
+        1.5124862068729268,
+        -1.5480789923911729,
+        -0.15774691699986487,
+        -1.4035144795892425,
+        0.1289359815486788,
+    ];
+    let target = g.fk(&theta).unwrap().position;
+    let sol = g
+        .solve_position(&target, ApproachPreference::Current, &[0.0; 5], &opts())
+        .unwrap();
+    assert!(g.within_limits(&sol.theta));
+    assert!((g.fk(&sol.theta).unwrap().position - target).norm() < 1e-6);
+}

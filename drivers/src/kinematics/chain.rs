@@ -661,7 +661,8 @@ impl Chain {
     /// `max_restarts` attempts start at deterministic random configurations. Each
     /// attempt is Levenberg–Marquardt on the damped least-squares step
     /// `Δq = Jᵀ(JJᵀ + λI)⁻¹e` with λ adapted to the cost, the step limited to 0.5 rad
-    /// (or m) per joint, joints pushing against a limit frozen for that step, and the
+    /// (or m) per joint, abandoned when the cost falls by less than 10 % in 10
+    /// iterations, joints pushing against a limit frozen for that step, and the
     /// result clamped into the limits. No allocation.
     // The error carries the best configuration on the stack (136 bytes) so that a
     // failed solve does not allocate either.
@@ -752,7 +753,15 @@ impl Chain {
             let mut e = residual(&pose);
             let mut cost = e.norm_squared();
             let mut lambda = 1e-3;
+            let mut checkpoint = cost;
             for it in 0..=options.max_iterations {
+                // Stalled (less than 10 % progress in 10 iterations): restart.
+                if it > 0 && it % 10 == 0 {
+                    if cost > 0.9 * checkpoint {
+                        break;
+                    }
+                    checkpoint = cost;
+                }
                 if !cost.is_finite() {
                     break;
                 }

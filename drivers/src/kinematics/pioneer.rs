@@ -180,8 +180,8 @@ pub struct PioneerIkOptions {
     /// Accepted orientation (or approach) error, rad (1e-6). Also the accepted
     /// deviation from perpendicular of Player's approach and orientation vectors.
     pub orientation_tolerance: f64,
-    /// SETPOSITION approach search resolution, rad (2° = 0.0349): approach directions
-    /// are tried on cones of this angular step around the preferred approach.
+    /// SETPOSITION approach search step, rad (1° = 0.01745); see
+    /// [`PioneerGeometry::solve_position`].
     pub approach_search_step: f64,
 }
 
@@ -190,7 +190,7 @@ impl Default for PioneerIkOptions {
         Self {
             position_tolerance: 1e-6,
             orientation_tolerance: 1e-6,
-            approach_search_step: 2f64.to_radians(),
+            approach_search_step: 1f64.to_radians(),
         }
     }
 }
@@ -597,16 +597,30 @@ impl PioneerGeometry {
             .select(current, options)
     }
 
-    /// SETPOSITION (position only, relative to the arm base): tries the preferred
-    /// approach, then approaches on cones of growing angle around it
-    /// ([`PioneerIkOptions::approach_search_step`] apart, azimuths at the same spacing),
-    /// and returns, from the first cone that has any solution, the in-limit solution
-    /// nearest to `current`; failing every cone, it tries the direction from the shoulder
-    /// circle to the target (the only approach at full stretch). The result's `orientation_error` is the achieved approach's
-    /// error to the *chosen* approach. Fails with [`PioneerIkError::OutOfReach`] when
-    /// the position is beyond L2 + L4 + L5 from the shoulder circle, or when no approach
-    /// works and none reached the position; with [`PioneerIkError::OutsideJointLimits`]
-    /// when solutions exist only outside the limits.
+    /// SETPOSITION (position only, relative to the arm base). The approach is chosen
+    /// deterministically, in this order:
+    ///
+    /// 1. the preferred approach itself, if an in-limit solution attains it;
+    /// 2. the approach *in the arm's vertical plane* (through the yaw axis and the
+    ///    target, so the wrist roll is 0 or π and the gripper stays level) nearest in
+    ///    angle to the preferred one: elevations are scanned outward from the preferred
+    ///    approach's elevation in steps of [`PioneerIkOptions::approach_search_step`],
+    ///    alternately up and down, and the first feasible one is refined by bisection
+    ///    towards the preferred elevation to 1e-9 rad;
+    /// 3. if that plane lies beyond the base yaw limits, θ1 held on a limit, with the
+    ///    wrist centre scanned (same step) around the circle where that arm plane cuts
+    ///    the sphere of radius L5 about the target, keeping the feasible approach
+    ///    closest to the preferred one;
+    /// 4. failing that, approaches out of the plane, on cones around the preferred one
+    ///    five search steps apart, and finally the direction from the shoulder circle to
+    ///    the target (the only approach at full stretch).
+    ///
+    /// For the chosen approach the in-limit solution nearest to `current` wins. The
+    /// result's `orientation_error` is the error to the chosen approach. Fails with
+    /// [`PioneerIkError::OutOfReach`] when the position is beyond L2 + L4 + L5 from the
+    /// shoulder circle or no approach reaches it, and with
+    /// [`PioneerIkError::OutsideJointLimits`] when solutions exist only outside the
+    /// limits.
     pub fn solve_position(
         &self,
         position: &Vector3<f64>,
@@ -642,67 +656,136 @@ impl PioneerGeometry {
                 max,
             });
         }
-        let (u, v) = perpendicular_basis(&preferred);
-        let step = options.approach_search_step;
-        let rings = (PI / step).ceil() as usize;
         let mut any_exact = false;
-        for k in 0..=rings {
-            let cone = (k as f64 * step).min(PI);
-            let (sc, cc) = cone.sin_cos();
-            let count = if k == 0 || k == rings {
-                1
-            } else {
-                ((TAU * sc / step).ceil() as usize).max(1)
-            };
-            let mut best: Option<(f64, IkCandidate)> = None;
-            for j in 0..count {
-                let phi = TAU * j as f64 / count as f64;
-                let (sp, cp) = phi.sin_cos();
-                let a = preferred * cc + (u * cp + v * sp) * sc;
-                let Ok(cands) = self.candidates(
+        let mut attempt = |a: &Vector3<f64>| -> Option<IkCandidate> {
+            let cands = self
+                .candidates(
                     position,
-                    WristGoal::Approach(&a),
+                    WristGoal::Approach(a),
                     current,
                     options.position_tolerance,
-                ) else {
-                    continue;
-                };
-                match cands.select(current, options) {
-                    Ok(c) => {
-                        let d = joint_distance(&c.theta, current);
-                        if best.is_none_or(|(bd, _)| d < bd) {
-                            best = Some((d, c));
+                )
+                .ok()?;
+            match cands.select(current, options) {
+                Ok(c) => Some(c),
+                Err(PioneerIkError::OutsideJointLimits) => {
+                    any_exact = true;
+                    None
+                }
+                Err(_) => None,
+            }
+        };
+        // 1. The preferred approach.
+        if let Some(c) = attempt(&preferred) {
+            return Ok(c);
+        }
+        // 2. In the vertical plane through the yaw axis and the target.
+        let yaw = if h > 1e-12 {
+            position.y.atan2(position.x)
+        } else {
+            current[0]
+        };
+        let radial = Vector3::new(yaw.cos(), yaw.sin(), 0.0);
+        let in_plane = |phi: f64| radial * phi.cos() + Vector3::z() * phi.sin();
+        let phi0 = preferred.z.atan2(preferred.dot(&radial));
+        let step = options.approach_search_step;
+        let steps = (PI / step).ceil() as usize;
+        for k in 0..=steps {
+            for sign in [1.0, -1.0] {
+                let phi = phi0 + sign * (k as f64 * step).min(PI);
+                if let Some(found) = attempt(&in_plane(phi)) {
+                    if k == 0 {
+                        return Ok(found);
+                    }
+                    let mut good = (phi, found);
+                    let mut bad = phi0 + sign * ((k - 1) as f64 * step);
+                    for _ in 0..64 {
+                        if (good.0 - bad).abs() <= 1e-9 {
+                            break;
+                        }
+                        let mid = 0.5 * (good.0 + bad);
+                        match attempt(&in_plane(mid)) {
+                            Some(c) => good = (mid, c),
+                            None => bad = mid,
                         }
                     }
-                    Err(PioneerIkError::OutsideJointLimits) => any_exact = true,
-                    Err(_) => {}
+                    return Ok(good.1);
+                }
+                if k == 0 {
+                    break;
+                }
+            }
+        }
+        // 3. Targets whose vertical plane lies beyond the base yaw limits: hold θ1 on
+        //    a limit; the wrist centre then lies on the circle where that arm plane
+        //    cuts the sphere of radius L5 around the target. Take the feasible approach
+        //    on it closest to the preferred one.
+        let yaw_limit = self.limits[0];
+        let yaw_ok = |y: f64| {
+            fit_angle_to_limits(y, yaw_limit.min, yaw_limit.max, current[0], LIMIT_TOLERANCE)
+                .is_some()
+        };
+        if !yaw_ok(yaw) || !yaw_ok(yaw + PI) {
+            let mut best: Option<(f64, IkCandidate)> = None;
+            for t1 in [yaw_limit.min, yaw_limit.max] {
+                let (s1, c1) = t1.sin_cos();
+                let normal = Vector3::new(-s1, c1, 0.0);
+                let off = position.dot(&normal);
+                if off.abs() >= self.l5 {
+                    continue;
+                }
+                let r = (self.l5 * self.l5 - off * off).sqrt();
+                let centre = position - normal * off;
+                let e1 = Vector3::new(c1, s1, 0.0);
+                for j in 0..steps * 2 {
+                    let psi = j as f64 * step;
+                    let w = centre + (e1 * psi.cos() + Vector3::z() * psi.sin()) * r;
+                    let a = (position - w) / self.l5;
+                    if let Some(c) = attempt(&a) {
+                        let score = -a.dot(&preferred);
+                        if best.is_none_or(|(bs, _)| score < bs) {
+                            best = Some((score, c));
+                        }
+                    }
                 }
             }
             if let Some((_, c)) = best {
                 return Ok(c);
             }
         }
-        // Near the outer boundary the feasible approaches form a cap narrower than the
-        // search step around the direction from the shoulder circle to the target
-        // (at full stretch it is that direction alone): try it.
-        if from_circle > 1e-12 {
-            let c = if h > 1e-12 {
-                Vector3::new(position.x / h, position.y / h, 0.0) * self.l1
+        // 4. Out of the plane: cones around the preferred approach.
+        let (u, v) = perpendicular_basis(&preferred);
+        let coarse = (5.0 * step).min(PI / 4.0);
+        let rings = (PI / coarse).ceil() as usize;
+        for k in 1..=rings {
+            let cone = (k as f64 * coarse).min(PI);
+            let (sc, cc) = cone.sin_cos();
+            let count = if k == rings {
+                1
             } else {
-                Vector3::new(current[0].cos(), current[0].sin(), 0.0) * self.l1
+                ((TAU * sc / coarse).ceil() as usize).max(1)
             };
-            let radial = (position - c) / from_circle;
-            if let Ok(cands) = self.candidates(
-                position,
-                WristGoal::Approach(&radial),
-                current,
-                options.position_tolerance,
-            ) {
-                match cands.select(current, options) {
-                    Ok(c) => return Ok(c),
-                    Err(PioneerIkError::OutsideJointLimits) => any_exact = true,
-                    Err(_) => {}
+            let mut best: Option<(f64, IkCandidate)> = None;
+            for j in 0..count {
+                let phi = TAU * j as f64 / count as f64;
+                let (sp, cp) = phi.sin_cos();
+                let a = preferred * cc + (u * cp + v * sp) * sc;
+                if let Some(c) = attempt(&a) {
+                    let d = joint_distance(&c.theta, current);
+                    if best.is_none_or(|(bd, _)| d < bd) {
+                        best = Some((d, c));
+                    }
                 }
+            }
+            if let Some((_, c)) = best {
+                return Ok(c);
+            }
+        }
+        if from_circle > 1e-12 {
+            let c = radial * self.l1;
+            let toward = (position - c) / from_circle;
+            if let Some(c) = attempt(&toward) {
+                return Ok(c);
             }
         }
         if any_exact {
