@@ -4,6 +4,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod device;
+mod echo;
 mod layout;
 mod list;
 
@@ -31,6 +33,22 @@ enum Command {
     /// List every device of the domain by its name robot/interface/index, with its driver
     /// and whether the driver is alive.
     List(list::ListArgs),
+    /// Print the live state of a device (one line per sample; --json for scripts).
+    Echo(echo::EchoArgs),
+    /// Command an actuator array: pos, multipos, speed, multispeed, home, current,
+    /// multicurrent; requests power, brakes, geom, speedcfg, accel.
+    ///
+    /// Example: limber actarray pioneer/actarray/0 pos 2 0.5
+    Actarray(device::ActArrayArgs),
+    /// Command a limb: home, stop, setpose, setposition, vecmove; requests power, brakes,
+    /// geom, speed.
+    ///
+    /// Example: limber limb pioneer/limb/0 setpose 0.3 0 0.2 --approach 0 0 -1 --orient 1 0 0
+    Limb(device::LimbArgs),
+    /// Command a gripper: open, close, stop, store, retrieve; request geom.
+    ///
+    /// Example: limber gripper pioneer/gripper/0 open
+    Gripper(device::GripperArgs),
 }
 
 fn main() -> ExitCode {
@@ -41,6 +59,10 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Layout(args) => layout::run(args),
         Command::List(args) => list::run(args),
+        Command::Echo(args) => echo::run(args),
+        Command::Actarray(args) => device::actarray(args),
+        Command::Limb(args) => device::limb(args),
+        Command::Gripper(args) => device::gripper(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,31 +1,11 @@
 //! `limber list` against a running driver.
 
 use std::process::Command;
-use std::sync::mpsc;
-use std::time::Duration;
 
-use limber_services::testing::TestDriver;
-use limber_services::{Context, Domain, Role};
+use limber_services::Domain;
 
-const LIMBER: &str = env!("CARGO_BIN_EXE_limber");
-
-/// Runs the test driver on a thread of this process until `stop` is dropped.
-fn driver(domain: &str) -> mpsc::Sender<()> {
-    let (tx, rx) = mpsc::channel::<()>();
-    let (ready_tx, ready_rx) = mpsc::channel();
-    let name = domain.to_string();
-    std::thread::spawn(move || {
-        let domain = Domain::new(&name).unwrap();
-        let ctx = Context::new(&domain, Role::Driver, "testdriver").unwrap();
-        let mut d = TestDriver::new(&ctx, "cli", 6).unwrap();
-        ready_tx.send(()).unwrap();
-        let _ = d.run(Duration::from_millis(10), || {
-            !matches!(rx.try_recv(), Err(mpsc::TryRecvError::Empty))
-        });
-    });
-    ready_rx.recv_timeout(Duration::from_secs(10)).unwrap();
-    tx
-}
+mod common;
+use common::{LIMBER, driver};
 
 #[test]
 fn list_shows_devices_drivers_and_liveness() {

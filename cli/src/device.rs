@@ -1,0 +1,424 @@
+//! `limber actarray|limb|gripper <device> <command>`: every command and request of each
+//! interface from the shell, and `limber echo <device>`: the live state.
+
+use std::time::Duration;
+
+use clap::{Args, Subcommand, ValueEnum};
+use limber_services::prelude::*;
+use limber_services::{CommandError, ConnectError, RequestError, WaitError};
+
+use crate::{CliError, exit};
+
+/// How long commands wait for their outcome and requests for their reply.
+#[derive(Debug, Args)]
+pub struct Common {
+    /// Seconds to wait for the driver's answer (the outcome of a command, the reply to a
+    /// request, the connection).
+    #[arg(long, global = true, default_value_t = 2.0, value_name = "S")]
+    timeout: f64,
+    /// Send commands without waiting for their outcome.
+    #[arg(long, global = true)]
+    no_wait: bool,
+}
+
+impl Common {
+    fn timeout(&self) -> Duration {
+        Duration::from_secs_f64(self.timeout.clamp(0.0, 3600.0))
+    }
+}
+
+/// On or off.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum OnOff {
+    /// On.
+    On,
+    /// Off.
+    Off,
+}
+
+impl OnOff {
+    fn on(self) -> bool {
+        matches!(self, OnOff::On)
+    }
+}
+
+/// Arguments of `limber actarray`.
+#[derive(Debug, Args)]
+pub struct ActArrayArgs {
+    /// The device, e.g. pioneer/actarray/0.
+    device: String,
+    #[command(subcommand)]
+    cmd: ActArrayVerb,
+    #[command(flatten)]
+    common: Common,
+}
+
+/// An actarray command or request.
+#[derive(Debug, Subcommand)]
+pub enum ActArrayVerb {
+    /// Move one joint to a position (rad or m).
+    Pos {
+        /// Joint index (0-based).
+        joint: usize,
+        /// Target position.
+        #[arg(allow_negative_numbers = true)]
+        position: f64,
+    },
+    /// Move joints 0..n to these positions.
+    Multipos {
+        /// One position per joint, joint 0 first.
+        #[arg(required = true, allow_negative_numbers = true)]
+        positions: Vec<f64>,
+    },
+    /// Move one joint at a speed (rad/s or m/s).
+    Speed {
+        /// Joint index.
+        joint: usize,
+        /// Speed.
+        #[arg(allow_negative_numbers = true)]
+        speed: f64,
+    },
+    /// Move joints 0..n at these speeds.
+    Multispeed {
+        /// One speed per joint.
+        #[arg(required = true, allow_negative_numbers = true)]
+        speeds: Vec<f64>,
+    },
+    /// Home one joint, or every joint ("all", the default).
+    Home {
+        /// Joint index or "all".
+        #[arg(default_value = "all")]
+        joint: String,
+    },
+    /// Drive a joint (or "all") with a current, A.
+    Current {
+        /// Joint index or "all".
+        joint: String,
+        /// Current in A.
+        #[arg(allow_negative_numbers = true)]
+        current: f64,
+    },
+    /// Drive joints 0..n with these currents, A.
+    Multicurrent {
+        /// One current per joint.
+        #[arg(required = true, allow_negative_numbers = true)]
+        currents: Vec<f64>,
+    },
+    /// Power on or off (request).
+    Power {
+        /// on or off.
+        value: OnOff,
+    },
+    /// Brakes on or off (request).
+    Brakes {
+        /// on or off.
+        value: OnOff,
+    },
+    /// Print the geometry: every actuator's type, limits, home and speed (request).
+    Geom,
+    /// Set the speed of one joint for later moves (request).
+    Speedcfg {
+        /// Joint index.
+        joint: usize,
+        /// Speed, rad/s or m/s.
+        speed: f64,
+    },
+    /// Set the acceleration of one joint for later moves (request).
+    Accel {
+        /// Joint index.
+        joint: usize,
+        /// Acceleration.
+        accel: f64,
+    },
+}
+
+/// Arguments of `limber limb`.
+#[derive(Debug, Args)]
+pub struct LimbArgs {
+    /// The device, e.g. pioneer/limb/0.
+    device: String,
+    #[command(subcommand)]
+    cmd: LimbVerb,
+    #[command(flatten)]
+    common: Common,
+}
+
+/// A limb command or request.
+#[derive(Debug, Subcommand)]
+pub enum LimbVerb {
+    /// Go to the home pose.
+    Home,
+    /// Stop every joint now.
+    Stop,
+    /// Move the end effector to a pose: position x y z (m, robot frame), with the approach
+    /// and orientation vectors.
+    Setpose {
+        /// x, y, z in m.
+        #[arg(num_args = 3, required = true, allow_negative_numbers = true, value_names = ["X", "Y", "Z"])]
+        position: Vec<f64>,
+        /// Approach vector (forward along the gripper).
+        #[arg(long, num_args = 3, allow_negative_numbers = true, default_values_t = [1.0, 0.0, 0.0], value_names = ["AX", "AY", "AZ"])]
+        approach: Vec<f64>,
+        /// Orientation vector ("up" from the gripper).
+        #[arg(long, num_args = 3, allow_negative_numbers = true, default_values_t = [0.0, 0.0, 1.0], value_names = ["OX", "OY", "OZ"])]
+        orient: Vec<f64>,
+    },
+    /// Move the end effector to a position; the driver chooses the orientation.
+    Setposition {
+        /// x, y, z in m.
+        #[arg(num_args = 3, required = true, allow_negative_numbers = true, value_names = ["X", "Y", "Z"])]
+        position: Vec<f64>,
+    },
+    /// Move the end effector in a straight line: direction dx dy dz, length in m.
+    Vecmove {
+        /// Direction and length.
+        #[arg(num_args = 4, required = true, allow_negative_numbers = true, value_names = ["DX", "DY", "DZ", "LEN"])]
+        args: Vec<f64>,
+    },
+    /// Power on or off (request).
+    Power {
+        /// on or off.
+        value: OnOff,
+    },
+    /// Brakes on or off (request).
+    Brakes {
+        /// on or off.
+        value: OnOff,
+    },
+    /// Print the geometry (base position) (request).
+    Geom,
+    /// Set the end-effector speed, m/s (request).
+    Speed {
+        /// Speed in m/s.
+        speed: f64,
+    },
+}
+
+/// Arguments of `limber gripper`.
+#[derive(Debug, Args)]
+pub struct GripperArgs {
+    /// The device, e.g. pioneer/gripper/0.
+    device: String,
+    #[command(subcommand)]
+    cmd: GripperVerb,
+    #[command(flatten)]
+    common: Common,
+}
+
+/// A gripper command or request.
+#[derive(Debug, Subcommand)]
+pub enum GripperVerb {
+    /// Open.
+    Open,
+    /// Close.
+    Close,
+    /// Stop.
+    Stop,
+    /// Store the held object.
+    Store,
+    /// Retrieve a stored object.
+    Retrieve,
+    /// Print the geometry (request).
+    Geom,
+}
+
+pub(crate) fn connect_err(e: ConnectError) -> CliError {
+    let code = match e {
+        ConnectError::NoDriver { .. } => exit::NO_DRIVER,
+        ConnectError::Name(_) => exit::USAGE,
+        _ => exit::FAILURE,
+    };
+    CliError::new(code, e.to_string())
+}
+
+fn command_err(e: CommandError) -> CliError {
+    let code = match e {
+        CommandError::Invalid(_) => exit::USAGE,
+        CommandError::NoDriver => exit::NO_DRIVER,
+        CommandError::Transport(_) => exit::FAILURE,
+    };
+    CliError::new(code, e.to_string())
+}
+
+fn request_err(e: RequestError) -> CliError {
+    let code = match e {
+        RequestError::Nack(_) => exit::REFUSED,
+        RequestError::Timeout(_) => exit::TIMEOUT,
+        RequestError::NoDriver => exit::NO_DRIVER,
+        RequestError::DriverGone => exit::DRIVER_GONE,
+        RequestError::Invalid(_) => exit::USAGE,
+        _ => exit::FAILURE,
+    };
+    CliError::new(code, e.to_string())
+}
+
+pub(crate) fn wait_err(e: WaitError) -> CliError {
+    let code = match e {
+        WaitError::Timeout(_) => exit::TIMEOUT,
+        WaitError::DriverGone => exit::DRIVER_GONE,
+        _ => exit::FAILURE,
+    };
+    CliError::new(code, e.to_string())
+}
+
+fn connect<I: Interface>(device: &str, timeout: Duration) -> Result<Client<I>, CliError> {
+    let ctx = Context::client_from_env().map_err(connect_err)?;
+    let mut c = Client::<I>::connect_timeout(&ctx, device, timeout.min(Duration::from_millis(500)))
+        .map_err(connect_err)?;
+    c.set_request_timeout(timeout);
+    Ok(c)
+}
+
+/// Sends a command and reports its outcome.
+fn finish<I: Interface>(
+    c: &mut Client<I>,
+    sent: Result<Ticket, CommandError>,
+    common: &Common,
+) -> Result<(), CliError> {
+    let ticket = sent.map_err(command_err)?;
+    if common.no_wait {
+        println!("sent");
+        return Ok(());
+    }
+    match c.wait_outcome(ticket, common.timeout()) {
+        Ok(Status::Ok) => {
+            println!("ok");
+            Ok(())
+        }
+        Ok(s) => Err(CliError::new(exit::REFUSED, format!("refused: {s}"))),
+        Err(WaitError::Missed { .. }) => {
+            println!("ok (applied; outcome overwritten by a later command)");
+            Ok(())
+        }
+        Err(e) => Err(wait_err(e)),
+    }
+}
+
+fn joint_sel(s: &str) -> Result<Option<usize>, CliError> {
+    if s == "all" || s == "-1" {
+        return Ok(None);
+    }
+    s.parse().map(Some).map_err(|_| {
+        CliError::new(
+            exit::USAGE,
+            format!("joint must be an index or \"all\", not {s:?}"),
+        )
+    })
+}
+
+fn done(r: Result<(), RequestError>) -> Result<(), CliError> {
+    r.map_err(request_err)?;
+    println!("ok");
+    Ok(())
+}
+
+/// Runs `limber actarray`.
+pub fn actarray(a: ActArrayArgs) -> Result<(), CliError> {
+    let mut c = connect::<ActArray>(&a.device, a.common.timeout())?;
+    let sent = match a.cmd {
+        ActArrayVerb::Pos { joint, position } => c.move_to(joint, position),
+        ActArrayVerb::Multipos { positions } => c.move_to_multi(&positions),
+        ActArrayVerb::Speed { joint, speed } => c.move_at_speed(joint, speed),
+        ActArrayVerb::Multispeed { speeds } => c.move_at_speed_multi(&speeds),
+        ActArrayVerb::Home { joint } => c.home(joint_sel(&joint)?),
+        ActArrayVerb::Current { joint, current } => c.set_current(joint_sel(&joint)?, current),
+        ActArrayVerb::Multicurrent { currents } => c.set_current_multi(&currents),
+        ActArrayVerb::Power { value } => return done(c.power(value.on())),
+        ActArrayVerb::Brakes { value } => return done(c.brakes(value.on())),
+        ActArrayVerb::Speedcfg { joint, speed } => return done(c.set_speed_config(joint, speed)),
+        ActArrayVerb::Accel { joint, accel } => return done(c.set_accel_config(joint, accel)),
+        ActArrayVerb::Geom => {
+            let g = c.geometry().map_err(request_err)?;
+            println!(
+                "{:<5} {:<7} {:>9} {:>9} {:>9} {:>9} {:>9} {:>7}",
+                "joint", "type", "min", "centre", "max", "home", "speed", "brakes"
+            );
+            for (i, a) in g.actuators().iter().enumerate() {
+                let kind = match a.actuator_kind() {
+                    Ok(ActuatorKind::Rotary) => "rotary",
+                    Ok(ActuatorKind::Linear) => "linear",
+                    Err(_) => "?",
+                };
+                println!(
+                    "{i:<5} {kind:<7} {:>9.4} {:>9.4} {:>9.4} {:>9.4} {:>9.4} {:>7}",
+                    a.min,
+                    a.centre,
+                    a.max,
+                    a.home,
+                    a.config_speed,
+                    if a.has_brakes != 0 { "yes" } else { "no" }
+                );
+            }
+            println!(
+                "base position ({:.4}, {:.4}, {:.4}) m",
+                g.base_pos.x, g.base_pos.y, g.base_pos.z
+            );
+            return Ok(());
+        }
+    };
+    finish(&mut c, sent, &a.common)
+}
+
+fn v3(v: &[f64]) -> [f64; 3] {
+    [v[0], v[1], v[2]]
+}
+
+/// Runs `limber limb`.
+pub fn limb(a: LimbArgs) -> Result<(), CliError> {
+    let mut c = connect::<Limb>(&a.device, a.common.timeout())?;
+    let sent = match a.cmd {
+        LimbVerb::Home => c.home(),
+        LimbVerb::Stop => c.stop(),
+        LimbVerb::Setpose {
+            position,
+            approach,
+            orient,
+        } => c.set_pose(v3(&position), v3(&approach), v3(&orient)),
+        LimbVerb::Setposition { position } => c.set_position(v3(&position)),
+        LimbVerb::Vecmove { args } => c.vec_move(v3(&args), args[3]),
+        LimbVerb::Power { value } => return done(c.power(value.on())),
+        LimbVerb::Brakes { value } => return done(c.brakes(value.on())),
+        LimbVerb::Speed { speed } => return done(c.set_speed(speed)),
+        LimbVerb::Geom => {
+            let g = c.geometry().map_err(request_err)?;
+            println!(
+                "base position ({:.4}, {:.4}, {:.4}) m",
+                g.base_pos.x, g.base_pos.y, g.base_pos.z
+            );
+            return Ok(());
+        }
+    };
+    finish(&mut c, sent, &a.common)
+}
+
+/// Runs `limber gripper`.
+pub fn gripper(a: GripperArgs) -> Result<(), CliError> {
+    let mut c = connect::<Gripper>(&a.device, a.common.timeout())?;
+    let sent = match a.cmd {
+        GripperVerb::Open => c.open(),
+        GripperVerb::Close => c.close(),
+        GripperVerb::Stop => c.stop(),
+        GripperVerb::Store => c.store(),
+        GripperVerb::Retrieve => c.retrieve(),
+        GripperVerb::Geom => {
+            let g = c.geometry().map_err(request_err)?;
+            let p = g.pose.position;
+            println!(
+                "pose ({:.4}, {:.4}, {:.4}) m; outer {:.3} x {:.3} x {:.3} m; inner {:.3} x {:.3} x {:.3} m; {} beams; capacity {}",
+                p.x,
+                p.y,
+                p.z,
+                g.outer_size.width,
+                g.outer_size.length,
+                g.outer_size.height,
+                g.inner_size.width,
+                g.inner_size.length,
+                g.inner_size.height,
+                g.num_beams,
+                g.capacity
+            );
+            return Ok(());
+        }
+    };
+    finish(&mut c, sent, &a.common)
+}

@@ -1,0 +1,50 @@
+//! Shared by the CLI tests: a test driver on a thread of the test process.
+
+#![allow(dead_code)]
+
+use std::process::{Command, Output};
+use std::sync::mpsc;
+use std::time::Duration;
+
+use limber_services::testing::TestDriver;
+use limber_services::{Context, Domain, Role};
+
+/// The binary under test.
+pub const LIMBER: &str = env!("CARGO_BIN_EXE_limber");
+
+/// Runs the test driver on a thread of this process until `stop` is dropped.
+pub fn driver(domain: &str) -> mpsc::Sender<()> {
+    let (tx, rx) = mpsc::channel::<()>();
+    let (ready_tx, ready_rx) = mpsc::channel();
+    let name = domain.to_string();
+    std::thread::spawn(move || {
+        let domain = Domain::new(&name).unwrap();
+        let ctx = Context::new(&domain, Role::Driver, "testdriver").unwrap();
+        let mut d = TestDriver::new(&ctx, "cli", 6).unwrap();
+        ready_tx.send(()).unwrap();
+        let _ = d.run(Duration::from_millis(10), || {
+            !matches!(rx.try_recv(), Err(mpsc::TryRecvError::Empty))
+        });
+    });
+    ready_rx.recv_timeout(Duration::from_secs(10)).unwrap();
+    tx
+}
+
+/// Runs `limber <args>` in `domain`.
+pub fn limber(domain: &str, args: &[&str]) -> Output {
+    Command::new(LIMBER)
+        .args(args)
+        .env("LIMBER_DOMAIN", domain)
+        .output()
+        .expect("limber runs")
+}
+
+/// Stdout as text.
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).to_string()
+}
+
+/// Stderr as text.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).to_string()
+}
