@@ -318,6 +318,10 @@ pub(super) fn run(
                     });
                     wire.stats.bad_checksums_in = decoder.stats().bad_checksums;
                     close_after_send = closed;
+                    if !was_open && robot.stage() == SyncStage::Open {
+                        // The first SIP goes out right after OPEN.
+                        next_cycle = now;
+                    }
                 }
             }
         }
@@ -330,6 +334,9 @@ pub(super) fn run(
                 next_cycle = now + cycle;
             }
         }
+        // Publish the state before sending: a client that sees a packet
+        // finds the snapshot at least as new.
+        publish(&shared, &robot, &wire, &ep);
         for f in out.drain(..) {
             if let Err(e) = wire.send(&mut ep, f, &faults) {
                 if matches!(ep, Endpoint::Tcp { .. }) {
@@ -344,10 +351,14 @@ pub(super) fn run(
             // Like the simulator: CLOSE drops the TCP connection.
             ep.disconnect();
         }
-        let mut st = lock(&shared.state);
-        st.robot = robot.state();
-        st.stats = wire.stats;
-        st.connected = ep.connected();
+        publish(&shared, &robot, &wire, &ep);
     }
     Ok(())
+}
+
+fn publish(shared: &Shared, robot: &Robot, wire: &Wire, ep: &Endpoint) {
+    let mut st = lock(&shared.state);
+    st.robot = robot.state();
+    st.stats = wire.stats;
+    st.connected = ep.connected();
 }
