@@ -1,1 +1,15 @@
-//! Shared helpers for the limber examples.
+//! The two sample programs of Biggs & MacDonald's paper, written against the limber client
+//! API only, so they run unchanged on the Pioneer arm and on a simulated arm:
+//!
+//! * [`random_moves`] (Listing 1): random joint moves within the limits read from the
+//!   actuator array's geometry.
+//! * [`pick_block`] (Listing 2): pick up a block with the limb and gripper interfaces,
+//!   carry it and put it down.
+//!
+//! Each is a library function (the `limber demo` command runs the same code) and a cargo
+//! example with its own README: `cargo run -p limber-examples --example pick_block`.
+
+#![warn(missing_docs)]
+
+pub mod pick_block;
+pub mod random_moves;
