@@ -103,6 +103,15 @@ extern "C" {
 #define LIMBER_GRIPPER_STATE_MOVING 3 /* moving */
 #define LIMBER_GRIPPER_STATE_ERROR 4 /* error */
 
+/* DriverStats.hardware bits */
+#define LIMBER_HARDWARE_ARM 1 /* 5-DOF arm present */
+#define LIMBER_HARDWARE_GRIPPER 2 /* body gripper present */
+#define LIMBER_HARDWARE_LIFT 4 /* gripper lift present */
+
+/* DriverStats.loop_mode */
+#define LIMBER_LOOP_MODE_EVENT 1 /* event-driven */
+#define LIMBER_LOOP_MODE_SPIN 2 /* busy-polling */
+
 /* limber.v1.Vec3 (size 24, align 8) */
 typedef struct limber_vec3 {
     double x;
@@ -650,6 +659,69 @@ LIMBER_STATIC_ASSERT(sizeof(limber_gripper_reply_msg) == 136, "limber_gripper_re
 LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_gripper_reply_msg) == 8, "limber_gripper_reply_msg alignment");
 LIMBER_STATIC_ASSERT(offsetof(limber_gripper_reply_msg, meta) == 0, "limber_gripper_reply_msg.meta offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_gripper_reply_msg, body) == 32, "limber_gripper_reply_msg.body offset");
+
+/* limber.v1.DriverStats (size 352, align 8) */
+typedef struct limber_driver_stats {
+    limber_state_header header;
+    uint8_t driver[32];
+    uint8_t robot_name[32];
+    uint8_t robot_class[32];
+    uint8_t robot_subclass[32];
+    uint32_t hardware;
+    uint32_t loop_mode;
+    uint64_t cycles;
+    uint64_t overruns;
+    uint64_t period_p50_ns;
+    uint64_t period_p99_ns;
+    uint64_t period_max_ns;
+    uint64_t jitter_p99_ns;
+    uint64_t cmd_to_wire_p50_ns;
+    uint64_t cmd_to_wire_p99_ns;
+    uint64_t cmd_to_wire_max_ns;
+    double sips_per_s;
+    uint64_t bytes_in;
+    uint64_t bytes_out;
+    uint64_t packets_in;
+    uint64_t bad_checksums;
+    uint64_t resync_bytes;
+    uint64_t reconnects;
+    uint64_t link_faults;
+    uint64_t commands;
+    uint64_t refused;
+    uint64_t requests;
+    uint64_t cmd_overflows;
+} limber_driver_stats;
+#define LIMBER_DRIVER_STATS_TYPE_NAME "limber.v1.DriverStats"
+LIMBER_STATIC_ASSERT(sizeof(limber_driver_stats) == 352, "limber_driver_stats size");
+LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_driver_stats) == 8, "limber_driver_stats alignment");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, header) == 0, "limber_driver_stats.header offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, driver) == 48, "limber_driver_stats.driver offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, robot_name) == 80, "limber_driver_stats.robot_name offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, robot_class) == 112, "limber_driver_stats.robot_class offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, robot_subclass) == 144, "limber_driver_stats.robot_subclass offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, hardware) == 176, "limber_driver_stats.hardware offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, loop_mode) == 180, "limber_driver_stats.loop_mode offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, cycles) == 184, "limber_driver_stats.cycles offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, overruns) == 192, "limber_driver_stats.overruns offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, period_p50_ns) == 200, "limber_driver_stats.period_p50_ns offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, period_p99_ns) == 208, "limber_driver_stats.period_p99_ns offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, period_max_ns) == 216, "limber_driver_stats.period_max_ns offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, jitter_p99_ns) == 224, "limber_driver_stats.jitter_p99_ns offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, cmd_to_wire_p50_ns) == 232, "limber_driver_stats.cmd_to_wire_p50_ns offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, cmd_to_wire_p99_ns) == 240, "limber_driver_stats.cmd_to_wire_p99_ns offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, cmd_to_wire_max_ns) == 248, "limber_driver_stats.cmd_to_wire_max_ns offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, sips_per_s) == 256, "limber_driver_stats.sips_per_s offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, bytes_in) == 264, "limber_driver_stats.bytes_in offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, bytes_out) == 272, "limber_driver_stats.bytes_out offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, packets_in) == 280, "limber_driver_stats.packets_in offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, bad_checksums) == 288, "limber_driver_stats.bad_checksums offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, resync_bytes) == 296, "limber_driver_stats.resync_bytes offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, reconnects) == 304, "limber_driver_stats.reconnects offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, link_faults) == 312, "limber_driver_stats.link_faults offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, commands) == 320, "limber_driver_stats.commands offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, refused) == 328, "limber_driver_stats.refused offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, requests) == 336, "limber_driver_stats.requests offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, cmd_overflows) == 344, "limber_driver_stats.cmd_overflows offset");
 
 #ifdef __cplusplus
 }

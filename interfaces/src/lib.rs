@@ -38,6 +38,7 @@
 pub mod actarray;
 pub mod codegen;
 pub mod common;
+pub mod diagnostics;
 pub mod error;
 pub mod gripper;
 pub mod interface;
@@ -66,6 +67,7 @@ pub mod prelude {
         ActArrayReplyMsg, ActArrayReqMsg, ActArrayRequest, ActuatorFlags, ActuatorGeom,
         ActuatorKind, ActuatorState, JointSel, JointValues,
     };
+    pub use crate::diagnostics::DriverStats;
     pub use crate::common::{
         Bbox3, CmdOutcome, MAX_ACTUATORS, MsgMeta, Orientation3, Pose3, ReplyMeta, StateHeader,
         Status, Vec3, device_flag,
@@ -137,6 +139,8 @@ pub fn manifest() -> Manifest {
         GripperReqMsg::LAYOUT,
         GripperGeom::LAYOUT,
         GripperReplyMsg::LAYOUT,
+        // diagnostics
+        diagnostics::DriverStats::LAYOUT,
     ];
     let mut constants = vec![
         common::LIMITS_GROUP,
@@ -146,6 +150,7 @@ pub fn manifest() -> Manifest {
     constants.extend_from_slice(actarray::GROUPS);
     constants.extend_from_slice(limb::GROUPS);
     constants.extend_from_slice(gripper::GROUPS);
+    constants.extend_from_slice(diagnostics::GROUPS);
     Manifest {
         layout_version: LAYOUT_VERSION,
         structs,

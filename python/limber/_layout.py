@@ -92,6 +92,15 @@ GRIPPER_STATE_CLOSED = 2  # closed
 GRIPPER_STATE_MOVING = 3  # moving
 GRIPPER_STATE_ERROR = 4  # error
 
+# DriverStats.hardware bits
+HARDWARE_ARM = 1  # 5-DOF arm present
+HARDWARE_GRIPPER = 2  # body gripper present
+HARDWARE_LIFT = 4  # gripper lift present
+
+# DriverStats.loop_mode
+LOOP_MODE_EVENT = 1  # event-driven
+LOOP_MODE_SPIN = 2  # busy-polling
+
 
 class Vec3(ctypes.Structure):
     """limber.v1.Vec3 (size 24, align 8)."""
@@ -682,6 +691,45 @@ class GripperReplyMsg(ctypes.Structure):
         return "limber.v1.GripperReplyMsg"
 
 
+class DriverStats(ctypes.Structure):
+    """limber.v1.DriverStats (size 352, align 8)."""
+
+    _fields_ = [
+        ("header", StateHeader),
+        ("driver", ctypes.c_uint8 * 32),
+        ("robot_name", ctypes.c_uint8 * 32),
+        ("robot_class", ctypes.c_uint8 * 32),
+        ("robot_subclass", ctypes.c_uint8 * 32),
+        ("hardware", ctypes.c_uint32),
+        ("loop_mode", ctypes.c_uint32),
+        ("cycles", ctypes.c_uint64),
+        ("overruns", ctypes.c_uint64),
+        ("period_p50_ns", ctypes.c_uint64),
+        ("period_p99_ns", ctypes.c_uint64),
+        ("period_max_ns", ctypes.c_uint64),
+        ("jitter_p99_ns", ctypes.c_uint64),
+        ("cmd_to_wire_p50_ns", ctypes.c_uint64),
+        ("cmd_to_wire_p99_ns", ctypes.c_uint64),
+        ("cmd_to_wire_max_ns", ctypes.c_uint64),
+        ("sips_per_s", ctypes.c_double),
+        ("bytes_in", ctypes.c_uint64),
+        ("bytes_out", ctypes.c_uint64),
+        ("packets_in", ctypes.c_uint64),
+        ("bad_checksums", ctypes.c_uint64),
+        ("resync_bytes", ctypes.c_uint64),
+        ("reconnects", ctypes.c_uint64),
+        ("link_faults", ctypes.c_uint64),
+        ("commands", ctypes.c_uint64),
+        ("refused", ctypes.c_uint64),
+        ("requests", ctypes.c_uint64),
+        ("cmd_overflows", ctypes.c_uint64),
+    ]
+
+    @staticmethod
+    def type_name():
+        return "limber.v1.DriverStats"
+
+
 STRUCTS = [
     Vec3,
     Orientation3,
@@ -725,4 +773,5 @@ STRUCTS = [
     GripperReqMsg,
     GripperGeom,
     GripperReplyMsg,
+    DriverStats,
 ]
