@@ -1,7 +1,11 @@
-"""limber for Python: the wire contract (ctypes classes generated from the layout manifest).
+"""limber for Python: clients of limber devices and the wire contract.
 
-The classes in :mod:`limber._layout` have exactly the layout of the Rust structs, so a
-sample received through the ``iceoryx2`` Python binding can be read in place::
+* :mod:`limber.client`: :class:`ActArrayClient`, :class:`LimbClient`, :class:`GripperClient`
+  (connect, state, commands with outcomes, requests), :class:`Domain`, :class:`Status` and
+  the errors. See ``python/README.md``.
+* :mod:`limber._layout`: the ctypes classes generated from the layout manifest, with exactly
+  the layout of the Rust structs, so a sample received through the ``iceoryx2`` Python
+  binding can be read in place::
 
     from limber import ActArrayData
     state = sample.payload().contents   # an ActArrayData living in shared memory
@@ -9,3 +13,28 @@ sample received through the ``iceoryx2`` Python binding can be read in place::
 
 from ._layout import *  # noqa: F401,F403
 from ._layout import LAYOUT_VERSION, STRUCTS  # noqa: F401
+from .client import (  # noqa: F401
+    DEFAULT_DOMAIN,
+    DEFAULT_REQUEST_TIMEOUT,
+    DOMAIN_ENV,
+    ActArrayClient,
+    DecodeError,
+    DeviceName,
+    Domain,
+    DriverGoneError,
+    DriverStatus,
+    Freshness,
+    GripperClient,
+    IncompatibleError,
+    LimberError,
+    LimbClient,
+    NackError,
+    NoDriverError,
+    OutcomeMissed,
+    RequestTimeout,
+    Status,
+    Ticket,
+    TransportError,
+    UnexpectedReplyError,
+    WaitTimeout,
+)

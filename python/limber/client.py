@@ -1,0 +1,1137 @@
+"""Clients of limber devices: the Python counterpart of ``limber_services::client``.
+
+A client connects to one device (``robot/interface/index``) of a domain, reads its state,
+sends commands and makes requests, with the same wire messages and the same semantics as
+the Rust ``Client<I>``:
+
+* commands are fire-and-forget; each returns a :class:`Ticket` whose outcome the driver
+  publishes in a later state sample (``header.last_cmd``); :meth:`wait_outcome` waits for it;
+* requests wait for the driver's reply (ACK with a typed result, or NACK with a
+  :class:`Status`), with a timeout and a liveness check of the driver;
+* invalid values (NaN, a joint index outside the array capacity, too many values, a zero
+  direction vector) raise :class:`ValueError` before anything is sent.
+
+Every iceoryx2 object (node, services, ports) is owned by the client instance. Call
+:meth:`close` (or use ``with``) when done; clients still open at interpreter exit are closed
+by an ``atexit`` hook, so no dead node is left behind even for clients kept in module
+globals. A client is not thread-safe: use it from the thread that created it.
+
+Example::
+
+    from limber import ActArrayClient, Status
+
+    with ActArrayClient.connect("pioneer/actarray/0", timeout=2.0) as arm:
+        print(arm.geometry().actuators_count)
+        ticket = arm.move_to(1, 0.25)
+        assert arm.wait_outcome(ticket, timeout=2.0) == Status.OK
+        print(arm.state().actuators[1].position)
+"""
+
+from __future__ import annotations
+
+import atexit
+import ctypes
+import enum
+import itertools
+import math
+import operator
+import os
+import re
+import sys
+import time
+import weakref
+from dataclasses import dataclass
+from typing import ClassVar, Iterable, Optional, Sequence, Type
+
+from . import _layout as L
+
+__all__ = [
+    "DOMAIN_ENV",
+    "DEFAULT_DOMAIN",
+    "DEFAULT_REQUEST_TIMEOUT",
+    "LIVENESS_PERIOD",
+    "Domain",
+    "DeviceName",
+    "Status",
+    "DriverStatus",
+    "Freshness",
+    "Ticket",
+    "LimberError",
+    "NoDriverError",
+    "IncompatibleError",
+    "TransportError",
+    "NackError",
+    "RequestTimeout",
+    "WaitTimeout",
+    "DriverGoneError",
+    "OutcomeMissed",
+    "DecodeError",
+    "UnexpectedReplyError",
+    "ActArrayClient",
+    "LimbClient",
+    "GripperClient",
+]
+
+#: The environment variable that selects the domain.
+DOMAIN_ENV = "LIMBER_DOMAIN"
+#: The domain used when ``LIMBER_DOMAIN`` is not set.
+DEFAULT_DOMAIN = "limber"
+#: Default time a request waits for its reply, seconds (Rust: ``DEFAULT_REQUEST_TIMEOUT``).
+DEFAULT_REQUEST_TIMEOUT = 2.0
+#: How often a waiting client checks that the driver is still alive, seconds.
+LIVENESS_PERIOD = 0.020
+
+MAX_DOMAIN_LEN = 48
+MAX_ROBOT_LEN = 64
+MAX_ACTUATORS = L.LIMITS_MAX_ACTUATORS
+#: Direction vectors shorter than this count as zero (Rust: ``limb::MIN_VECTOR_NORM``).
+MIN_VECTOR_NORM = 1e-9
+
+_DRIVER_NODE_PREFIX = "limber-driver:"
+_CLIENT_NODE_PREFIX = "limber-client:"
+_LAYOUT_ATTR = "limber.layout"
+_EVENT_COMMAND = 1  # on `wake`
+_EVENT_REQUEST = 2  # on `wake`
+_OUTCOME_SLOTS = 16
+_IDENT = re.compile(r"^[A-Za-z0-9_-]+$")
+
+
+def _iox2():
+    """The iceoryx2 binding, imported on first use (so the layout classes work without it)."""
+    import iceoryx2
+
+    return iceoryx2
+
+
+def monotonic_ns() -> int:
+    """``CLOCK_MONOTONIC`` in ns: the time base of every stamp (as in Rust)."""
+    return time.clock_gettime_ns(time.CLOCK_MONOTONIC)
+
+
+# ----- status codes and small types ------------------------------------------------------
+
+
+class Status(enum.IntEnum):
+    """Why a command or request was refused, or ``OK`` (Rust ``Status``; wire ``STATUS_*``)."""
+
+    OK = L.STATUS_OK
+    UNSUPPORTED = L.STATUS_UNSUPPORTED
+    UNKNOWN_JOINT = L.STATUS_UNKNOWN_JOINT
+    NOT_FINITE = L.STATUS_NOT_FINITE
+    BEYOND_LIMITS = L.STATUS_BEYOND_LIMITS
+    OUT_OF_REACH = L.STATUS_OUT_OF_REACH
+    NOT_CALIBRATED = L.STATUS_NOT_CALIBRATED
+    LINK_DOWN = L.STATUS_LINK_DOWN
+    BUSY = L.STATUS_BUSY
+    TIMEOUT = L.STATUS_TIMEOUT
+    INVALID_ARGUMENT = L.STATUS_INVALID_ARGUMENT
+
+    @property
+    def is_ok(self) -> bool:
+        return self is Status.OK
+
+    def __str__(self) -> str:
+        return self.name
+
+    def describe(self) -> str:
+        """The short human-readable reason (the same text as Rust's ``Status::describe``)."""
+        return _STATUS_TEXT[self]
+
+
+_STATUS_TEXT = {
+    Status.OK: "ok",
+    Status.UNSUPPORTED: "unsupported by this device",
+    Status.UNKNOWN_JOINT: "unknown joint",
+    Status.NOT_FINITE: "value not finite",
+    Status.BEYOND_LIMITS: "beyond the joint limits",
+    Status.OUT_OF_REACH: "out of reach",
+    Status.NOT_CALIBRATED: "not calibrated yet",
+    Status.LINK_DOWN: "link to the hardware is down",
+    Status.BUSY: "device busy",
+    Status.TIMEOUT: "hardware timeout",
+    Status.INVALID_ARGUMENT: "invalid argument",
+}
+
+
+class DriverStatus(enum.Enum):
+    """Whether the driver of a device is running (Rust ``DriverStatus``)."""
+
+    ALIVE = "alive"
+    #: Its process died without cleaning up (found dead and cleaned up now).
+    DEAD = "dead"
+    #: No driver is attached.
+    ABSENT = "absent"
+
+
+class Freshness(enum.Enum):
+    """How fresh the latest state is (Rust ``Freshness``)."""
+
+    FRESH = "fresh"
+    STALE = "stale"
+    GONE = "gone"
+    NO_DATA = "no data"
+
+
+@dataclass(frozen=True)
+class Ticket:
+    """A command that was sent, to wait for its outcome (Rust ``Ticket``)."""
+
+    #: The command's sequence number (per client, from 1).
+    seq: int
+    #: How many driver processes received it (normally 1).
+    receivers: int
+
+
+# ----- errors ----------------------------------------------------------------------------
+
+
+class LimberError(Exception):
+    """Base of every limber error (invalid values raise the builtin ``ValueError``)."""
+
+
+class NoDriverError(LimberError):
+    """No driver offers this device in this domain (connect), receives its commands (send),
+    or serves its requests (request). Rust: ``ConnectError::NoDriver``,
+    ``CommandError::NoDriver``, ``RequestError::NoDriver``."""
+
+
+class IncompatibleError(LimberError):
+    """The device exists but speaks another layout version or is another interface."""
+
+
+class TransportError(LimberError):
+    """iceoryx2 failed (opening a service, creating a port, loaning, sending, receiving)."""
+
+
+class NackError(LimberError):
+    """The driver refused a request (NACK) and said why: :attr:`status`."""
+
+    def __init__(self, status: Status):
+        self.status = status
+        super().__init__(f"refused: {status.describe()} ({status.name})")
+
+
+class RequestTimeout(LimberError, TimeoutError):
+    """No reply within the timeout (the driver is alive but did not answer)."""
+
+
+class WaitTimeout(LimberError, TimeoutError):
+    """No new state / no outcome within the timeout (the driver is alive)."""
+
+
+class DriverGoneError(LimberError):
+    """The driver died (or was never there) while waiting."""
+
+
+class OutcomeMissed(LimberError):
+    """The outcome of this command was overwritten before it was read (a later command of
+    this client has been applied since). :attr:`newer_seq` is that command's number."""
+
+    def __init__(self, newer_seq: int):
+        self.newer_seq = newer_seq
+        super().__init__(f"outcome missed; a later command (seq {newer_seq}) was applied since")
+
+
+class DecodeError(LimberError):
+    """A reply could not be decoded (driver of another layout, or corrupted)."""
+
+
+class UnexpectedReplyError(DecodeError):
+    """The reply was an ACK of an unexpected kind."""
+
+
+# ----- names -----------------------------------------------------------------------------
+
+
+class Domain:
+    """A domain: the set of devices and clients that can see each other.
+
+    ``Domain()`` is the domain named by ``LIMBER_DOMAIN`` (default ``limber``); ``Domain(name)``
+    a domain by name (1 to 48 characters of ``[A-Za-z0-9_-]``). It maps onto the iceoryx2
+    prefix ``"<name>_"`` on top of iceoryx2's built-in defaults (a ``./config/iceoryx2.toml``
+    is ignored, as in Rust).
+    """
+
+    __slots__ = ("_name",)
+
+    def __init__(self, name: Optional[str] = None):
+        if name is None:
+            name = os.environ.get(DOMAIN_ENV) or DEFAULT_DOMAIN
+        if not isinstance(name, str) or len(name) > MAX_DOMAIN_LEN or not _IDENT.match(name):
+            raise ValueError(f"invalid domain {name!r}: use 1 to 48 characters of [A-Za-z0-9_-]")
+        self._name = name
+
+    @classmethod
+    def from_env(cls) -> "Domain":
+        """The domain named by ``LIMBER_DOMAIN``, or ``limber``."""
+        return cls(None)
+
+    @property
+    def name(self) -> str:
+        return self._name
+
+    @property
+    def prefix(self) -> str:
+        """The iceoryx2 prefix of this domain."""
+        return f"{self._name}_"
+
+    def iceoryx2_config(self):
+        """A fresh iceoryx2 config for this domain (defaults plus the domain's prefix)."""
+        iox2 = _iox2()
+        cfg = iox2.config.default()
+        cfg.global_cfg.prefix = iox2.FileName.new(self.prefix)
+        return cfg
+
+    def __str__(self) -> str:
+        return self._name
+
+    def __repr__(self) -> str:
+        return f"Domain({self._name!r})"
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, Domain) and other._name == self._name
+
+    def __hash__(self) -> int:
+        return hash(self._name)
+
+
+_INTERFACES = ("actarray", "limb", "gripper")
+
+
+@dataclass(frozen=True)
+class DeviceName:
+    """The name of a device: ``robot/interface/index``, e.g. ``pioneer/actarray/0``."""
+
+    robot: str
+    interface: str
+    index: int
+
+    @classmethod
+    def parse(cls, s: str) -> "DeviceName":
+        parts = s.split("/") if isinstance(s, str) else []
+        bad = ValueError(
+            f"invalid device name {s!r}: expected robot/interface/index, e.g. "
+            "pioneer/actarray/0 (interfaces: actarray, limb, gripper)"
+        )
+        if len(parts) != 3:
+            raise bad
+        robot, iface, index = parts
+        if iface not in _INTERFACES or not index.isdigit() or not index.isascii():
+            raise bad
+        n = int(index)
+        if n > 0xFFFF:
+            raise bad
+        if len(robot) > MAX_ROBOT_LEN or not _IDENT.match(robot):
+            raise ValueError(
+                f"invalid robot name {robot!r}: use 1 to 64 characters of [A-Za-z0-9_-]"
+            )
+        return cls(robot, iface, n)
+
+    def service_name(self, channel: str) -> str:
+        """The iceoryx2 service name of one channel (data, cmd, req, wake, notify)."""
+        return f"limber/{self.robot}/{self.interface}/{self.index}/{channel}"
+
+    def __str__(self) -> str:
+        return f"{self.robot}/{self.interface}/{self.index}"
+
+
+# ----- validation (the Rust constructors' rules) -----------------------------------------
+
+
+def _finite(field: str, v) -> float:
+    f = float(v)
+    if not math.isfinite(f):
+        raise ValueError(f"{field} is not finite")
+    return f
+
+
+def _joint(j) -> int:
+    """A joint index within the array capacity (0..32), as Rust's ``joint()``."""
+    if isinstance(j, bool):
+        raise TypeError("a joint index must be an int, not bool")
+    j = operator.index(j)
+    if not 0 <= j < MAX_ACTUATORS:
+        raise ValueError(f"joint {j} is not a valid joint index (0..{MAX_ACTUATORS})")
+    return j
+
+
+def _joint_sel(j) -> int:
+    """``None`` (every joint, -1 on the wire) or a joint index."""
+    return -1 if j is None else _joint(j)
+
+
+def _values(field: str, values: Iterable) -> list:
+    vs = list(values)
+    if len(vs) > MAX_ACTUATORS:
+        raise ValueError(f"{field}: {len(vs)} values, at most {MAX_ACTUATORS} allowed")
+    out = [float(v) for v in vs]
+    if not all(math.isfinite(v) for v in out):
+        raise ValueError(f"{field} is not finite")
+    return out
+
+
+def _vec3(field: str, v: Sequence) -> "L.Vec3":
+    vs = list(v)
+    if len(vs) != 3:
+        raise ValueError(f"{field} needs 3 components, got {len(vs)}")
+    x, y, z = (float(c) for c in vs)
+    if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
+        raise ValueError(f"{field} is not finite")
+    return L.Vec3(x, y, z)
+
+
+def _direction(field: str, v: Sequence) -> "L.Vec3":
+    d = _vec3(field, v)
+    if math.sqrt(d.x * d.x + d.y * d.y + d.z * d.z) < MIN_VECTOR_NORM:
+        raise ValueError(f"{field} has zero length")
+    return d
+
+
+def _copy(cls, ptr: int):
+    """A copy of the ``cls`` struct at address ``ptr``."""
+    out = cls()
+    ctypes.memmove(ctypes.addressof(out), ptr, ctypes.sizeof(cls))
+    return out
+
+
+def _body(cls, raw_body):
+    """The ``cls`` struct at the front of an envelope's ``body`` (a copy)."""
+    return cls.from_buffer_copy(bytes(raw_body)[: ctypes.sizeof(cls)])
+
+
+def _all_finite(*vals) -> bool:
+    return all(math.isfinite(v) for v in vals)
+
+
+# ----- the generic client ----------------------------------------------------------------
+
+_client_seq = itertools.count(1)
+_open_clients: "weakref.WeakSet[_Client]" = weakref.WeakSet()
+
+
+def _new_client_id() -> int:
+    """Process id in the high 32 bits, a per-process counter in the low 32 bits (as Rust's
+    ``Context::new_client_id``): unique in the domain while this process lives, never 0."""
+    return ((os.getpid() & 0xFFFFFFFF) << 32) | (next(_client_seq) & 0xFFFFFFFF)
+
+
+def _default_process_name() -> str:
+    name = os.path.basename(sys.argv[0]) if sys.argv and sys.argv[0] else ""
+    name = re.sub(r"[^A-Za-z0-9_.-]", "_", name) or "python"
+    return name[:64]
+
+
+class _Client:
+    """A connection to one device. Use :class:`ActArrayClient`, :class:`LimbClient` or
+    :class:`GripperClient`."""
+
+    INTERFACE: ClassVar[str]
+    DATA: ClassVar[type]
+    CMD_MSG: ClassVar[type]
+    REQ_MSG: ClassVar[type]
+    REPLY_MSG: ClassVar[type]
+
+    def __init__(self):  # use connect()
+        self._closed = True
+        self._node = None
+        self._data_svc = None
+        self._states = None
+        self._commands = None
+        self._req_svc = None
+        self._requests = None
+        self._wake = None
+        self._notify_svc = None
+        self._notify = None
+
+    # ----- connecting -------------------------------------------------------------------
+
+    @classmethod
+    def connect(
+        cls,
+        device: str,
+        domain: "Domain | str | None" = None,
+        timeout: float = 0.0,
+        *,
+        name: Optional[str] = None,
+        request_timeout: float = DEFAULT_REQUEST_TIMEOUT,
+        wake_driver: bool = True,
+    ):
+        """Connects to ``device`` (``robot/interface/index``) in ``domain`` (a :class:`Domain`,
+        a domain name, or ``None`` for ``LIMBER_DOMAIN``/``limber``).
+
+        With ``timeout == 0`` (default) it fails at once with :class:`NoDriverError` if no
+        driver offers the device (Rust ``Client::connect``); with ``timeout > 0`` it waits up
+        to that many seconds for a driver (Rust ``Client::connect_timeout``).
+
+        Raises ``ValueError`` for an invalid name, :class:`IncompatibleError` for another
+        interface or layout version, :class:`TransportError` if iceoryx2 fails.
+        ``name`` names this process in ``limber list`` (default: the script's name).
+        """
+        dev = DeviceName.parse(device)
+        if dev.interface != cls.INTERFACE:
+            raise IncompatibleError(
+                f"{dev} is incompatible: it is a {dev.interface} device, not a {cls.INTERFACE}"
+            )
+        dom = domain if isinstance(domain, Domain) else Domain(domain)
+        deadline = time.monotonic() + max(0.0, float(timeout))
+        proc_name = name or _default_process_name()
+        while True:
+            self = cls()
+            try:
+                self._open(dev, dom, proc_name)
+            except LimberError as e:
+                err = e
+            except BaseException:
+                self.close()
+                raise
+            else:
+                self.request_timeout = float(request_timeout)
+                self.wake_driver = bool(wake_driver)
+                return self
+            self.close()
+            if isinstance(err, NoDriverError) and time.monotonic() < deadline:
+                time.sleep(0.020)
+                continue
+            # Drop the failed attempt's frames (they still name iceoryx2 objects) so that
+            # a caller keeping the exception does not keep a node alive.
+            err.__context__ = err.__cause__ = None
+            raise err.with_traceback(None)
+
+    def _open(self, dev: DeviceName, domain: Domain, proc_name: str) -> None:
+        iox2 = _iox2()
+        self._device = dev
+        self._domain = domain
+        self._client_id = _new_client_id()
+        self._cmd_seq = 0
+        self._req_seq = 0
+        self._outcomes = [(0, 0)] * _OUTCOME_SLOTS
+        self._latest = None
+        self.request_timeout = DEFAULT_REQUEST_TIMEOUT
+        self.wake_driver = True
+        iox2.set_log_level_from_env_or(iox2.LogLevel.Error)
+        node_name = (_CLIENT_NODE_PREFIX + proc_name)[: iox2.NodeName.max_len()]
+        try:
+            self._node = (
+                iox2.NodeBuilder.new()
+                .name(iox2.NodeName.new(node_name))
+                .config(domain.iceoryx2_config())
+                .signal_handling_mode(iox2.SignalHandlingMode.Disabled)
+                .create(iox2.ServiceType.Ipc)
+            )
+        except Exception as e:
+            raise TransportError(f"cannot join domain {domain}: {e!r}") from None
+        self._closed = False
+        _open_clients.add(self)
+
+        def fail(channel: str, e: Exception) -> LimberError:
+            text = repr(e)
+            if "DoesNotExist" in text:
+                return NoDriverError(
+                    f"no driver offers {dev} in domain {domain} "
+                    f"(is the driver running? is {DOMAIN_ENV} the same?)"
+                )
+            if "Incompatible" in text:
+                return IncompatibleError(
+                    f"{dev} is incompatible: {channel}: {text} (another layout version?)"
+                )
+            return TransportError(f"{dev}: cannot open the {channel} channel: {text}")
+
+        layout = iox2.AttributeVerifier.new().require(
+            iox2.AttributeKey.new(_LAYOUT_ATTR), iox2.AttributeValue.new(str(L.LAYOUT_VERSION))
+        )
+        name = dev.service_name
+        # Open, never create; same types and attributes as the Rust client, QoS left to the
+        # driver (an opener's unset values are not checked).
+        try:
+            self._data_svc = (
+                self._node.service_builder(iox2.ServiceName.new(name("data")))
+                .publish_subscribe(self.DATA)
+                .open_with_attributes(layout)
+            )
+            self._states = self._data_svc.subscriber_builder().create()
+        except Exception as e:
+            raise fail("data", e) from None
+        try:
+            cmd_svc = (
+                self._node.service_builder(iox2.ServiceName.new(name("cmd")))
+                .publish_subscribe(self.CMD_MSG)
+                .open_with_attributes(layout)
+            )
+            self._commands = cmd_svc.publisher_builder().max_loaned_samples(1).create()
+            del cmd_svc
+        except Exception as e:
+            raise fail("cmd", e) from None
+        try:
+            self._req_svc = (
+                self._node.service_builder(iox2.ServiceName.new(name("req")))
+                .request_response(self.REQ_MSG, self.REPLY_MSG)
+                .enable_fire_and_forget_requests(False)
+                .open_with_attributes(layout)
+            )
+            self._requests = self._req_svc.client_builder().create()
+        except Exception as e:
+            raise fail("req", e) from None
+        try:
+            wake_svc = self._node.service_builder(iox2.ServiceName.new(name("wake"))).event().open_with_attributes(layout)
+            self._wake = wake_svc.notifier_builder().create()
+            del wake_svc
+        except Exception as e:
+            raise fail("wake", e) from None
+        try:
+            self._notify_svc = (
+                self._node.service_builder(iox2.ServiceName.new(name("notify"))).event().open_with_attributes(layout)
+            )
+        except Exception as e:
+            raise fail("notify", e) from None
+
+    # ----- lifetime ---------------------------------------------------------------------
+
+    def close(self) -> None:
+        """Releases every port and the node (idempotent). The client is unusable afterwards."""
+        for attr in ("_notify", "_wake", "_requests", "_commands", "_states"):
+            port = self.__dict__.get(attr)
+            if port is not None:
+                try:
+                    port.delete()
+                except Exception:
+                    pass
+            self.__dict__[attr] = None
+        for attr in ("_notify_svc", "_req_svc", "_data_svc", "_node"):
+            self.__dict__[attr] = None
+        if not self.__dict__.get("_closed", True):
+            self._closed = True
+            _open_clients.discard(self)
+
+    @property
+    def closed(self) -> bool:
+        return self._closed
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
+
+    def __repr__(self) -> str:
+        dev = self.__dict__.get("_device", "?")
+        state = "closed" if self.__dict__.get("_closed", True) else "open"
+        return f"<{type(self).__name__} {dev} {state}>"
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise LimberError(f"{type(self).__name__} is closed")
+
+    # ----- identity ---------------------------------------------------------------------
+
+    @property
+    def device(self) -> DeviceName:
+        return self._device
+
+    @property
+    def domain(self) -> Domain:
+        return self._domain
+
+    @property
+    def client_id(self) -> int:
+        """This client's id (carried in every command and request it sends)."""
+        return self._client_id
+
+    # ----- state ------------------------------------------------------------------------
+
+    def refresh(self) -> bool:
+        """Takes every state sample that arrived; returns True if there was a new one."""
+        self._check_open()
+        got = False
+        last = None
+        while True:
+            try:
+                s = self._states.receive()
+            except Exception as e:
+                raise TransportError(f"receiving failed: {e!r}") from None
+            if s is None:
+                break
+            try:
+                ptr = s.payload_ptr
+                h = L.StateHeader.from_address(ptr)  # the header is at offset 0
+                if h.last_cmd.client_id == self._client_id:
+                    seq = h.last_cmd.cmd_seq
+                    self._outcomes[seq % _OUTCOME_SLOTS] = (seq, h.last_cmd.status)
+                last = _copy(self.DATA, ptr)
+                got = True
+            finally:
+                s.delete()
+        if last is not None:
+            self._latest = last
+        return got
+
+    def state(self):
+        """The latest state, after taking what arrived: a *copy* of the ``*Data`` ctypes
+        struct (``ActArrayData``, ``LimbData``, ``GripperData``; same fields as in Rust), or
+        ``None`` if no sample arrived yet."""
+        self.refresh()
+        return self._latest
+
+    def last_state(self):
+        """The latest state already taken, without looking for a newer one."""
+        return self._latest
+
+    def state_age(self) -> Optional[float]:
+        """Age of the latest state in seconds: now minus its acquisition time."""
+        if self._latest is None:
+            return None
+        return max(0, monotonic_ns() - self._latest.header.stamp_ns) / 1e9
+
+    def freshness(self, max_age: float) -> Freshness:
+        """Fresh (younger than ``max_age`` s), stale (older, driver alive), gone, or no data."""
+        self.refresh()
+        age = self.state_age()
+        if age is None:
+            return Freshness.NO_DATA
+        if age <= max_age:
+            return Freshness.FRESH
+        return Freshness.STALE if self.driver_status() is DriverStatus.ALIVE else Freshness.GONE
+
+    def wait_state(self, timeout: float):
+        """Waits up to ``timeout`` s for a state sample newer than the latest one taken and
+        returns it (a copy). Raises :class:`WaitTimeout` or :class:`DriverGoneError`."""
+        self._check_open()
+        deadline = time.monotonic() + timeout
+        next_check = time.monotonic() + LIVENESS_PERIOD
+        while True:
+            if self.refresh():
+                return self._latest
+            now = time.monotonic()
+            if now >= deadline:
+                raise WaitTimeout(f"no state within {timeout} s")
+            if now >= next_check:
+                next_check = now + LIVENESS_PERIOD
+                if self.driver_status() is not DriverStatus.ALIVE:
+                    raise DriverGoneError("the driver is gone")
+            self._pause(min(deadline, next_check))
+
+    def wait_outcome(self, ticket: Ticket, timeout: float) -> Status:
+        """Waits up to ``timeout`` s for the outcome of the command of ``ticket``, as
+        published by the driver, and returns its :class:`Status` (``Status.OK`` if carried
+        out). Raises :class:`OutcomeMissed`, :class:`WaitTimeout` or :class:`DriverGoneError`."""
+        self._check_open()
+        deadline = time.monotonic() + timeout
+        next_check = time.monotonic() + LIVENESS_PERIOD
+        while True:
+            self.refresh()
+            seq, status = self._outcomes[ticket.seq % _OUTCOME_SLOTS]
+            if seq == ticket.seq:
+                try:
+                    return Status(status)
+                except ValueError:
+                    return Status.INVALID_ARGUMENT  # as Rust: an unknown code
+            d = self._latest
+            if (
+                d is not None
+                and d.header.last_cmd.client_id == self._client_id
+                and d.header.last_cmd.cmd_seq > ticket.seq
+            ):
+                raise OutcomeMissed(d.header.last_cmd.cmd_seq)
+            now = time.monotonic()
+            if now >= deadline:
+                raise WaitTimeout(f"no outcome of command {ticket.seq} within {timeout} s")
+            if now >= next_check:
+                next_check = now + LIVENESS_PERIOD
+                if self.driver_status() is not DriverStatus.ALIVE:
+                    raise DriverGoneError("the driver is gone")
+            self._pause(min(deadline, next_check))
+
+    def _pause(self, until: float) -> None:
+        """Blocks until ``until`` (time.monotonic) or the driver's next notification."""
+        iox2 = _iox2()
+        if self._notify is None:
+            try:
+                self._notify = self._notify_svc.listener_builder().create()
+            except Exception as e:
+                raise TransportError(f"cannot listen for notifications: {e!r}") from None
+            return  # something may have arrived before the listener existed
+        left = until - time.monotonic()
+        if left <= 0:
+            return
+        try:
+            self._notify.timed_wait(iox2.Duration.from_secs_f64(left))
+        except Exception as e:
+            raise TransportError(f"waiting failed: {e!r}") from None
+
+    # ----- liveness ---------------------------------------------------------------------
+
+    def driver_status(self) -> DriverStatus:
+        """Whether the device's driver process is alive. A dead driver's resources are
+        cleaned up on the way, so that a restarted driver is picked up by this client."""
+        self._check_open()
+        iox2 = _iox2()
+        alive = dead = False
+        try:
+            nodes = self._data_svc.nodes
+        except Exception:
+            nodes = []
+        for n in nodes:
+            try:
+                view = n[0]
+                details = view.details
+                is_driver = details is not None and details.name.as_str().startswith(
+                    _DRIVER_NODE_PREFIX
+                )
+            except Exception:
+                continue
+            if not is_driver:
+                continue
+            if isinstance(n, iox2.NodeState.Alive):
+                alive = True
+            elif isinstance(n, iox2.NodeState.Dead):
+                dead = True
+        if alive:
+            return DriverStatus.ALIVE
+        if dead:
+            try:
+                self._data_svc.try_cleanup_dead_nodes()
+            except Exception:
+                pass
+            return DriverStatus.DEAD
+        return DriverStatus.ABSENT
+
+    # ----- commands ---------------------------------------------------------------------
+
+    def _send(self, kind: int, body=None) -> Ticket:
+        """Sends a command of ``kind`` with ``body`` (a ctypes struct or None)."""
+        self._check_open()
+        iox2 = _iox2()
+        msg = self.CMD_MSG()
+        msg.meta.kind = kind
+        if body is not None:
+            n = ctypes.sizeof(body)
+            ctypes.memmove(ctypes.addressof(msg.body), ctypes.addressof(body), n)
+            msg.meta.body_len = n
+        try:
+            loan = self._commands.loan_uninit()
+        except Exception as e:
+            raise TransportError(f"cannot send the command: {e!r}") from None
+        self._cmd_seq += 1
+        msg.meta.client_id = self._client_id
+        msg.meta.seq = self._cmd_seq
+        msg.meta.stamp_ns = monotonic_ns()
+        try:
+            receivers = loan.write_payload(msg).send()
+        except Exception as e:
+            raise TransportError(f"cannot send the command: {e!r}") from None
+        if self.wake_driver:
+            try:
+                self._wake.notify_with_custom_event_id(iox2.EventId.new(_EVENT_COMMAND))
+            except Exception:
+                pass
+        if receivers == 0:
+            raise NoDriverError("no driver receives commands")
+        return Ticket(self._cmd_seq, receivers)
+
+    # ----- requests ---------------------------------------------------------------------
+
+    def _request(self, kind: int, body=None, timeout: Optional[float] = None):
+        """Sends a request and waits for the reply; returns the reply envelope (a copy) of
+        an ACK, raises :class:`NackError` for a NACK."""
+        self._check_open()
+        iox2 = _iox2()
+        if timeout is None:
+            timeout = self.request_timeout
+        msg = self.REQ_MSG()
+        msg.meta.kind = kind
+        if body is not None:
+            n = ctypes.sizeof(body)
+            ctypes.memmove(ctypes.addressof(msg.body), ctypes.addressof(body), n)
+            msg.meta.body_len = n
+        try:
+            loan = self._requests.loan_uninit()
+        except Exception as e:
+            raise TransportError(f"request transport failed: {e!r}") from None
+        self._req_seq += 1
+        msg.meta.client_id = self._client_id
+        msg.meta.seq = self._req_seq
+        msg.meta.stamp_ns = monotonic_ns()
+        try:
+            pending = loan.write_payload(msg).send()
+        except Exception as e:
+            raise TransportError(f"request transport failed: {e!r}") from None
+        try:
+            if pending.number_of_server_connections == 0:
+                raise NoDriverError("no driver serves requests")
+            if self.wake_driver:
+                try:
+                    self._wake.notify_with_custom_event_id(iox2.EventId.new(_EVENT_REQUEST))
+                except Exception:
+                    pass
+            deadline = time.monotonic() + timeout
+            next_check = time.monotonic() + LIVENESS_PERIOD
+            while True:
+                reply = self._take_reply(pending)
+                if reply is not None:
+                    return self._check_reply(reply, kind)
+                if not pending.is_connected:
+                    # The server may have answered and closed in between: look once more.
+                    reply = self._take_reply(pending)
+                    if reply is not None:
+                        return self._check_reply(reply, kind)
+                    raise DriverGoneError("the driver is gone")
+                now = time.monotonic()
+                if now >= deadline:
+                    raise RequestTimeout(f"no reply within {timeout} s")
+                if now >= next_check:
+                    next_check = now + LIVENESS_PERIOD
+                    if self.driver_status() is not DriverStatus.ALIVE:
+                        raise DriverGoneError("the driver is gone")
+                self._pause(min(deadline, next_check))
+        finally:
+            # Closes the request at once (frees the slot; max 4 in flight per client).
+            pending.delete()
+
+    def _take_reply(self, pending):
+        try:
+            r = pending.receive()
+        except Exception as e:
+            raise TransportError(f"request transport failed: {e!r}") from None
+        if r is None:
+            return None
+        try:
+            return _copy(self.REPLY_MSG, r.payload_ptr)
+        finally:
+            r.delete()
+
+    def _check_reply(self, reply, kind: int):
+        try:
+            status = Status(reply.meta.status)
+        except ValueError:
+            raise DecodeError(f"undecodable reply: unknown status code {reply.meta.status}") from None
+        if status is not Status.OK:
+            raise NackError(status)
+        if reply.meta.kind != kind:
+            raise UnexpectedReplyError(f"reply of kind {reply.meta.kind} to a request of kind {kind}")
+        return reply
+
+
+# ----- actarray --------------------------------------------------------------------------
+
+
+class ActArrayClient(_Client):
+    """A client of an actuator array (Player's ``ActArrayProxy``; Rust ``ActArrayClient``).
+
+    Commands return a :class:`Ticket`. Joint indices outside the array capacity (0..31),
+    non-finite values and more than 32 values raise ``ValueError`` (nothing sent); a joint
+    the device does not have is refused by the driver with ``Status.UNKNOWN_JOINT``.
+    """
+
+    INTERFACE = "actarray"
+    DATA = L.ActArrayData
+    CMD_MSG = L.ActArrayCmdMsg
+    REQ_MSG = L.ActArrayReqMsg
+    REPLY_MSG = L.ActArrayReplyMsg
+
+    def move_to(self, joint: int, position: float) -> Ticket:
+        """CMD POS: move ``joint`` to ``position`` (rad or m)."""
+        body = L.ActArrayPositionCmd(joint=_joint(joint), position=_finite("position", position))
+        return self._send(L.ACTARRAY_CMD_POS, body)
+
+    def move_to_multi(self, positions: Sequence[float]) -> Ticket:
+        """CMD MULTI_POS: move joints 0..n to ``positions``."""
+        vs = _values("positions", positions)
+        body = L.ActArrayMultiPositionCmd(count=len(vs))
+        body.positions[: len(vs)] = vs
+        return self._send(L.ACTARRAY_CMD_MULTI_POS, body)
+
+    def move_at_speed(self, joint: int, speed: float) -> Ticket:
+        """CMD SPEED: move ``joint`` at ``speed`` (rad/s or m/s)."""
+        body = L.ActArraySpeedCmd(joint=_joint(joint), speed=_finite("speed", speed))
+        return self._send(L.ACTARRAY_CMD_SPEED, body)
+
+    def move_at_speed_multi(self, speeds: Sequence[float]) -> Ticket:
+        """CMD MULTI_SPEED: move joints 0..n at ``speeds``."""
+        vs = _values("speeds", speeds)
+        body = L.ActArrayMultiSpeedCmd(count=len(vs))
+        body.speeds[: len(vs)] = vs
+        return self._send(L.ACTARRAY_CMD_MULTI_SPEED, body)
+
+    def home(self, joint: Optional[int] = None) -> Ticket:
+        """CMD HOME: home ``joint``, or every joint with ``None``."""
+        return self._send(L.ACTARRAY_CMD_HOME, L.ActArrayHomeCmd(joint=_joint_sel(joint)))
+
+    def set_current(self, joint: Optional[int], current: float) -> Ticket:
+        """CMD CURRENT: drive ``joint`` (or every joint with ``None``) with ``current`` A."""
+        body = L.ActArrayCurrentCmd(joint=_joint_sel(joint), current=_finite("current", current))
+        return self._send(L.ACTARRAY_CMD_CURRENT, body)
+
+    def set_current_multi(self, currents: Sequence[float]) -> Ticket:
+        """CMD MULTI_CURRENT: drive joints 0..n with ``currents`` A."""
+        vs = _values("currents", currents)
+        body = L.ActArrayMultiCurrentCmd(count=len(vs))
+        body.currents[: len(vs)] = vs
+        return self._send(L.ACTARRAY_CMD_MULTI_CURRENT, body)
+
+    def power(self, on: bool, *, timeout: Optional[float] = None) -> None:
+        """REQ POWER."""
+        self._request(L.ACTARRAY_REQ_POWER, L.ActArrayPowerReq(value=int(bool(on))), timeout)
+
+    def brakes(self, on: bool, *, timeout: Optional[float] = None) -> None:
+        """REQ BRAKES."""
+        self._request(L.ACTARRAY_REQ_BRAKES, L.ActArrayBrakesReq(value=int(bool(on))), timeout)
+
+    def set_speed_config(self, joint: int, speed: float, *, timeout: Optional[float] = None) -> None:
+        """REQ SPEED: the speed of ``joint`` for later moves."""
+        body = L.ActArraySpeedReq(joint=_joint(joint), speed=_finite("speed", speed))
+        self._request(L.ACTARRAY_REQ_SPEED, body, timeout)
+
+    def set_accel_config(self, joint: int, accel: float, *, timeout: Optional[float] = None) -> None:
+        """REQ ACCEL: the acceleration of ``joint`` for later moves."""
+        body = L.ActArrayAccelReq(joint=_joint(joint), accel=_finite("accel", accel))
+        self._request(L.ACTARRAY_REQ_ACCEL, body, timeout)
+
+    def geometry(self, *, timeout: Optional[float] = None) -> "L.ActArrayGeom":
+        """REQ GET_GEOM: the geometry (an ``ActArrayGeom`` ctypes struct, validated)."""
+        reply = self._request(L.ACTARRAY_REQ_GET_GEOM, None, timeout)
+        g = _body(L.ActArrayGeom, reply.body)
+        if g.actuators_count > MAX_ACTUATORS:
+            raise DecodeError(f"undecodable reply: {g.actuators_count} actuators")
+        for a in g.actuators[: g.actuators_count]:
+            if a.kind not in (L.ACTUATOR_KIND_LINEAR, L.ACTUATOR_KIND_ROTARY):
+                raise DecodeError(f"undecodable reply: unknown actuator kind {a.kind}")
+            if not _all_finite(a.length, a.min, a.centre, a.max, a.home, a.config_speed,
+                               a.axis.x, a.axis.y, a.axis.z, a.orientation.roll,
+                               a.orientation.pitch, a.orientation.yaw):
+                raise DecodeError("undecodable reply: a geometry value is not finite")
+        return g
+
+    def positions(self) -> list:
+        """The positions of the valid actuators in the latest state (empty if none yet)."""
+        s = self.state()
+        if s is None:
+            return []
+        return [a.position for a in s.actuators[: min(s.actuators_count, MAX_ACTUATORS)]]
+
+
+# ----- limb ------------------------------------------------------------------------------
+
+
+class LimbClient(_Client):
+    """A client of a limb (Player's ``LimbProxy``; Rust ``LimbClient``). Vectors are any
+    3-sequences (robot frame, m); direction vectors must not be zero."""
+
+    INTERFACE = "limb"
+    DATA = L.LimbData
+    CMD_MSG = L.LimbCmdMsg
+    REQ_MSG = L.LimbReqMsg
+    REPLY_MSG = L.LimbReplyMsg
+
+    def home(self) -> Ticket:
+        """CMD HOME."""
+        return self._send(L.LIMB_CMD_HOME)
+
+    def stop(self) -> Ticket:
+        """CMD STOP: stop every joint now."""
+        return self._send(L.LIMB_CMD_STOP)
+
+    def set_pose(self, position: Sequence[float], approach: Sequence[float],
+                 orientation: Sequence[float]) -> Ticket:
+        """CMD SETPOSE: end effector to ``position`` with ``approach`` and ``orientation``."""
+        body = L.LimbSetPoseCmd(
+            position=_vec3("position", position),
+            approach=_direction("approach", approach),
+            orientation=_direction("orientation", orientation),
+        )
+        return self._send(L.LIMB_CMD_SETPOSE, body)
+
+    def set_position(self, position: Sequence[float]) -> Ticket:
+        """CMD SETPOSITION: end effector to ``position``, orientation chosen by the driver."""
+        return self._send(L.LIMB_CMD_SETPOSITION,
+                          L.LimbSetPositionCmd(position=_vec3("position", position)))
+
+    def vec_move(self, direction: Sequence[float], length: float) -> Ticket:
+        """CMD VECMOVE: move ``length`` m along ``direction`` in a straight line."""
+        length = _finite("length", length)
+        body = L.LimbVecMoveCmd(direction=_direction("direction", direction), length=length)
+        return self._send(L.LIMB_CMD_VECMOVE, body)
+
+    def power(self, on: bool, *, timeout: Optional[float] = None) -> None:
+        """REQ POWER."""
+        self._request(L.LIMB_REQ_POWER, L.LimbPowerReq(value=int(bool(on))), timeout)
+
+    def brakes(self, on: bool, *, timeout: Optional[float] = None) -> None:
+        """REQ BRAKES."""
+        self._request(L.LIMB_REQ_BRAKES, L.LimbBrakesReq(value=int(bool(on))), timeout)
+
+    def set_speed(self, speed: float, *, timeout: Optional[float] = None) -> None:
+        """REQ SPEED: end-effector speed, m/s."""
+        self._request(L.LIMB_REQ_SPEED, L.LimbSpeedReq(speed=_finite("speed", speed)), timeout)
+
+    def geometry(self, *, timeout: Optional[float] = None) -> "L.LimbGeom":
+        """REQ GEOM: the geometry (a ``LimbGeom`` ctypes struct)."""
+        reply = self._request(L.LIMB_REQ_GEOM, None, timeout)
+        g = _body(L.LimbGeom, reply.body)
+        if not _all_finite(g.base_pos.x, g.base_pos.y, g.base_pos.z):
+            raise DecodeError("undecodable reply: base_pos is not finite")
+        return g
+
+
+# ----- gripper ---------------------------------------------------------------------------
+
+
+class GripperClient(_Client):
+    """A client of a gripper (Player's ``GripperProxy``; Rust ``GripperClient``)."""
+
+    INTERFACE = "gripper"
+    DATA = L.GripperData
+    CMD_MSG = L.GripperCmdMsg
+    REQ_MSG = L.GripperReqMsg
+    REPLY_MSG = L.GripperReplyMsg
+
+    def open(self) -> Ticket:
+        """CMD OPEN."""
+        return self._send(L.GRIPPER_CMD_OPEN)
+
+    def close_gripper(self) -> Ticket:
+        """CMD CLOSE. (Not ``close()``: on every client, :meth:`close` releases the
+        connection, so that a cleanup call can never move the hardware.)"""
+        return self._send(L.GRIPPER_CMD_CLOSE)
+
+    def open_gripper(self) -> Ticket:
+        """CMD OPEN (the same as :meth:`open`, named to pair with :meth:`close_gripper`)."""
+        return self._send(L.GRIPPER_CMD_OPEN)
+
+    def stop(self) -> Ticket:
+        """CMD STOP."""
+        return self._send(L.GRIPPER_CMD_STOP)
+
+    def store(self) -> Ticket:
+        """CMD STORE."""
+        return self._send(L.GRIPPER_CMD_STORE)
+
+    def retrieve(self) -> Ticket:
+        """CMD RETRIEVE."""
+        return self._send(L.GRIPPER_CMD_RETRIEVE)
+
+    def geometry(self, *, timeout: Optional[float] = None) -> "L.GripperGeom":
+        """REQ GET_GEOM: the geometry (a ``GripperGeom`` ctypes struct)."""
+        reply = self._request(L.GRIPPER_REQ_GET_GEOM, None, timeout)
+        g = _body(L.GripperGeom, reply.body)
+        p, o, i = g.pose, g.outer_size, g.inner_size
+        if not _all_finite(p.position.x, p.position.y, p.position.z, p.orientation.roll,
+                           p.orientation.pitch, p.orientation.yaw, o.width, o.length,
+                           o.height, i.width, i.length, i.height):
+            raise DecodeError("undecodable reply: gripper geometry is not finite")
+        return g
+
+
+@atexit.register
+def _close_all() -> None:
+    """Closes every client still open at interpreter exit, before module teardown, so that
+    no dead node is left behind (clients in module globals would otherwise leak)."""
+    for c in list(_open_clients):
+        try:
+            c.close()
+        except Exception:
+            pass
