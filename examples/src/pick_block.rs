@@ -23,8 +23,11 @@ pub struct PickParams {
     pub grasp_height: f64,
     /// How far above the grasp point to approach and lift (the paper: 5 cm).
     pub clearance: f64,
-    /// Direction across the block that the fingers should close along (x, y).
-    pub across: [f64; 2],
+    /// Horizontal direction of the orientation vector (x, y). `None`: radially outward
+    /// from the limb's base (from its geometry) towards the block, which is what a 5-DOF
+    /// arm like the Pioneer's can reach with the gripper pointing down, and what the
+    /// paper computed from the laser scan.
+    pub across: Option<[f64; 2]>,
     /// Time allowed for each motion.
     pub motion_timeout: Duration,
 }
@@ -36,7 +39,7 @@ impl Default for PickParams {
             drop: [0.38, -0.10],
             grasp_height: 0.17,
             clearance: 0.05,
-            across: [0.0, 1.0],
+            across: None,
             motion_timeout: Duration::from_secs(30),
         }
     }
@@ -176,7 +179,14 @@ pub fn run(
 ) -> Result<Summary, PickError> {
     let start = Instant::now();
     let mut steps = 0;
-    let orient = [p.across[0], p.across[1], 0.0];
+    let base = match p.across {
+        Some(_) => [0.0; 3],
+        None => dev.limb.geometry()?.base_pos.to_array(),
+    };
+    let orient = |x: [f64; 3]| match p.across {
+        Some(v) => [v[0], v[1], 0.0],
+        None => radial(base, [x[0], x[1]]),
+    };
     let above = |xy: [f64; 2]| [xy[0], xy[1], p.grasp_height + p.clearance];
     let at = |xy: [f64; 2]| [xy[0], xy[1], p.grasp_height];
 
@@ -207,7 +217,7 @@ pub fn run(
             | Step::Lift(x)
             | Step::Carry(x)
             | Step::PutDown(x)
-            | Step::Retreat(x) => Some(dev.limb.set_pose(x, DOWN, orient)?),
+            | Step::Retreat(x) => Some(dev.limb.set_pose(x, DOWN, orient(x))?),
         };
         if let Some(ticket) = sent {
             wait_limb(dev, step, ticket, p.motion_timeout, observe)?;
@@ -258,6 +268,17 @@ pub fn run(
         released_at,
         elapsed: start.elapsed(),
     })
+}
+
+/// The unit horizontal vector from `base` towards `xy` (x forward if they coincide).
+pub fn radial(base: [f64; 3], xy: [f64; 2]) -> [f64; 3] {
+    let (dx, dy) = (xy[0] - base[0], xy[1] - base[1]);
+    let n = (dx * dx + dy * dy).sqrt();
+    if n < 1e-9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [dx / n, dy / n, 0.0]
+    }
 }
 
 /// Waits for the outcome of a limb command, then until the limb stops moving.

@@ -62,6 +62,7 @@
 
 pub mod client;
 pub mod context;
+pub mod diagnostics;
 pub mod discovery;
 pub mod event_loop;
 pub mod host;

@@ -1,0 +1,163 @@
+//! The `driver` channel: a driver's loop, link and robot facts ([`DriverStats`]), published
+//! on `limber/<robot>/driver/0/data` (history 1) and read by `limber echo <robot>/driver`.
+
+use core::time::Duration;
+use std::time::Instant;
+
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::*;
+use iceoryx2::sample::Sample;
+use limber_interfaces::diagnostics::DriverStats;
+use thiserror::Error;
+
+use crate::context::{Context, monotonic_ns};
+use crate::qos;
+
+/// The service name of a robot's driver statistics.
+pub fn service_name(robot: &str) -> Result<ServiceName, DiagnosticsError> {
+    if !robot
+        .bytes()
+        .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-')
+        || robot.is_empty()
+        || robot.len() > crate::naming::MAX_ROBOT_LEN
+    {
+        return Err(DiagnosticsError::Name(robot.to_string()));
+    }
+    ServiceName::new(&format!("limber/{robot}/driver/0/data"))
+        .map_err(|_| DiagnosticsError::Name(robot.to_string()))
+}
+
+/// Opening or using the driver channel failed.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum DiagnosticsError {
+    /// The robot name is invalid.
+    #[error("invalid robot name {0:?}")]
+    Name(String),
+    /// No driver publishes statistics for this robot.
+    #[error("no driver statistics for robot {0} (is its driver running?)")]
+    NoDriver(String),
+    /// iceoryx2 failed.
+    #[error("driver statistics channel: {0}")]
+    Transport(String),
+    /// Nothing new within the timeout.
+    #[error("no new driver statistics within {0:?}")]
+    Timeout(Duration),
+}
+
+/// Publishes a driver's statistics.
+pub struct StatsPublisher {
+    publisher: Publisher<ipc::Service, DriverStats, ()>,
+    seq: u64,
+}
+
+impl core::fmt::Debug for StatsPublisher {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("StatsPublisher").field("seq", &self.seq).finish()
+    }
+}
+
+impl StatsPublisher {
+    /// Offers the statistics of `robot`'s driver.
+    pub fn new(ctx: &Context, robot: &str) -> Result<Self, DiagnosticsError> {
+        let svc = ctx
+            .node()
+            .service_builder(&service_name(robot)?)
+            .publish_subscribe::<DriverStats>()
+            .history_size(1)
+            .subscriber_max_buffer_size(qos::DATA_BUFFER)
+            .max_publishers(qos::DATA_PUBLISHERS)
+            .max_subscribers(qos::MAX_CLIENTS)
+            .max_nodes(qos::MAX_NODES)
+            .open_or_create()
+            .map_err(|e| DiagnosticsError::Transport(format!("{e:?}")))?;
+        let publisher = svc
+            .publisher_builder()
+            .create()
+            .map_err(|e| DiagnosticsError::Transport(format!("{e:?}")))?;
+        Ok(StatsPublisher { publisher, seq: 0 })
+    }
+
+    /// Publishes `stats` (stamping its header's sequence number and time).
+    pub fn publish(&mut self, stats: &mut DriverStats) -> Result<(), DiagnosticsError> {
+        self.seq += 1;
+        stats.header.seq = self.seq;
+        stats.header.stamp_ns = monotonic_ns();
+        self.publisher
+            .send_copy(*stats)
+            .map(|_| ())
+            .map_err(|e| DiagnosticsError::Transport(format!("{e:?}")))
+    }
+}
+
+/// Reads a driver's statistics.
+pub struct StatsReader {
+    subscriber: Subscriber<ipc::Service, DriverStats, ()>,
+    latest: Option<Sample<ipc::Service, DriverStats, ()>>,
+}
+
+impl core::fmt::Debug for StatsReader {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("StatsReader").finish()
+    }
+}
+
+impl StatsReader {
+    /// Opens the statistics of `robot`'s driver.
+    pub fn open(ctx: &Context, robot: &str) -> Result<Self, DiagnosticsError> {
+        let svc = ctx
+            .node()
+            .service_builder(&service_name(robot)?)
+            .publish_subscribe::<DriverStats>()
+            .open()
+            .map_err(|e| {
+                let e = format!("{e:?}");
+                if e.contains("DoesNotExist") {
+                    DiagnosticsError::NoDriver(robot.to_string())
+                } else {
+                    DiagnosticsError::Transport(e)
+                }
+            })?;
+        let subscriber = svc
+            .subscriber_builder()
+            .create()
+            .map_err(|e| DiagnosticsError::Transport(format!("{e:?}")))?;
+        Ok(StatsReader {
+            subscriber,
+            latest: None,
+        })
+    }
+
+    /// Takes what arrived; true if there was something new.
+    pub fn refresh(&mut self) -> Result<bool, DiagnosticsError> {
+        let mut got = false;
+        while let Some(s) = self
+            .subscriber
+            .receive()
+            .map_err(|e| DiagnosticsError::Transport(format!("{e:?}")))?
+        {
+            self.latest = Some(s);
+            got = true;
+        }
+        Ok(got)
+    }
+
+    /// The latest statistics.
+    pub fn latest(&self) -> Option<&DriverStats> {
+        self.latest.as_deref()
+    }
+
+    /// Waits (polling every 5 ms) for new statistics.
+    pub fn wait(&mut self, timeout: Duration) -> Result<&DriverStats, DiagnosticsError> {
+        let deadline = Instant::now() + timeout;
+        loop {
+            if self.refresh()? {
+                return Ok(self.latest.as_deref().expect("just received"));
+            }
+            if Instant::now() >= deadline {
+                return Err(DiagnosticsError::Timeout(timeout));
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+}
