@@ -62,7 +62,7 @@ fn solvers_do_not_allocate() {
             g.solve_position(&far, ApproachPreference::Current, &[0.0; 5], &o)
                 .is_err()
         );
-        let plan = g
+        let mut plan = g
             .vecmove(
                 &theta,
                 &Vector3::new(0.0, -1.0, 0.0),
@@ -70,7 +70,7 @@ fn solvers_do_not_allocate() {
                 &VecMoveOptions::default(),
             )
             .unwrap();
-        assert!(plan.map(|w| w.is_ok()).all(|ok| ok));
+        assert!(plan.all(|w| w.is_ok()));
         assert!(c6.ik(&IkTarget::Pose(t6), &h6, &no).is_ok());
         assert!(c6.ik(&IkTarget::Position(t6.position), &h6, &no).is_ok());
         assert!(c7.ik(&IkTarget::Pose(t7), &h7, &no).is_ok());

@@ -137,14 +137,14 @@ fn numeric_ik_solves_99_percent_7dof_pose() {
 
 #[test]
 fn numeric_ik_solves_99_percent_position_only() {
-    check_rate(&Chain::default_6dof(), 200, false, 3);
-    check_rate(&Chain::default_7dof(), 200, false, 4);
+    check_rate(&Chain::default_6dof(), 100, false, 3);
+    check_rate(&Chain::default_7dof(), 100, false, 4);
 }
 
 #[test]
 fn numeric_ik_solves_the_5dof_pioneer_chain() {
-    check_rate(&Chain::pioneer5(), 200, true, 5);
-    check_rate(&Chain::pioneer5(), 200, false, 6);
+    check_rate(&Chain::pioneer5(), 150, true, 5);
+    check_rate(&Chain::pioneer5(), 100, false, 6);
 }
 
 #[test]

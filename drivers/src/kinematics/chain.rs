@@ -43,7 +43,7 @@
 use std::ops::{Deref, DerefMut};
 use std::path::Path;
 
-use nalgebra::{Matrix6, Rotation3, SMatrix, Unit, Vector3, Vector6};
+use nalgebra::{Rotation3, SMatrix, Unit, Vector3, Vector6};
 use serde::Deserialize;
 
 use super::pose::{Pose, all_finite};
@@ -783,7 +783,7 @@ impl Chain {
                     break;
                 }
                 iterations += 1;
-                let Some(mut dq) = dls_step(&jac, &e, lambda) else {
+                let Some(mut dq) = dls_step(&jac, &e, lambda, n) else {
                     lambda *= 10.0;
                     continue;
                 };
@@ -798,7 +798,7 @@ impl Chain {
                     }
                 }
                 if frozen {
-                    match dls_step(&jf, &e, lambda) {
+                    match dls_step(&jf, &e, lambda, n) {
                         Some(d) => dq = d,
                         None => {
                             lambda *= 10.0;
@@ -854,11 +854,69 @@ impl Chain {
     }
 }
 
-/// `Jᵀ (J Jᵀ + λ I)⁻¹ e`, `None` if the 6×6 system is not positive definite.
-fn dls_step(jac: &Jacobian, e: &Vector6<f64>, lambda: f64) -> Option<SMatrix<f64, MAX_JOINTS, 1>> {
-    let a: Matrix6<f64> = jac * jac.transpose() + Matrix6::identity() * lambda;
-    let y = a.cholesky()?.solve(e);
-    let dq = jac.transpose() * y;
+/// `Jᵀ (J Jᵀ + λ I)⁻¹ e` over the first `n` columns, `None` if the 6×6 system is not
+/// positive definite. Plain loops and a hand-written Cholesky: small, allocation-free
+/// and fast even in unoptimised builds.
+#[allow(clippy::needless_range_loop)]
+fn dls_step(
+    jac: &Jacobian,
+    e: &Vector6<f64>,
+    lambda: f64,
+    n: usize,
+) -> Option<SMatrix<f64, MAX_JOINTS, 1>> {
+    let mut a = [[0.0f64; 6]; 6];
+    for (r, row) in a.iter_mut().enumerate() {
+        for (c, cell) in row.iter_mut().enumerate().take(r + 1) {
+            let mut sum = 0.0;
+            for i in 0..n {
+                sum += jac[(r, i)] * jac[(c, i)];
+            }
+            *cell = sum;
+        }
+        row[r] += lambda;
+    }
+    // Cholesky A = L·Lᵀ in place (lower triangle).
+    for j in 0..6 {
+        let mut d = a[j][j];
+        for k in 0..j {
+            d -= a[j][k] * a[j][k];
+        }
+        if !(d > 0.0 && d.is_finite()) {
+            return None;
+        }
+        let d = d.sqrt();
+        a[j][j] = d;
+        for i in j + 1..6 {
+            let mut v = a[i][j];
+            for k in 0..j {
+                v -= a[i][k] * a[j][k];
+            }
+            a[i][j] = v / d;
+        }
+    }
+    let mut y = [0.0f64; 6];
+    for i in 0..6 {
+        let mut v = e[i];
+        for k in 0..i {
+            v -= a[i][k] * y[k];
+        }
+        y[i] = v / a[i][i];
+    }
+    for i in (0..6).rev() {
+        let mut v = y[i];
+        for k in i + 1..6 {
+            v -= a[k][i] * y[k];
+        }
+        y[i] = v / a[i][i];
+    }
+    let mut dq = SMatrix::<f64, MAX_JOINTS, 1>::zeros();
+    for i in 0..n {
+        let mut v = 0.0;
+        for (r, yr) in y.iter().enumerate() {
+            v += jac[(r, i)] * yr;
+        }
+        dq[i] = v;
+    }
     dq.iter().all(|v| v.is_finite()).then_some(dq)
 }
 
