@@ -258,7 +258,9 @@ pub struct IkCandidate {
     pub branch: Branch,
     /// Every angle lies inside its limit (with [`LIMIT_TOLERANCE`]).
     pub within_limits: bool,
-    /// Distance between the FK of `theta` and the requested position, m.
+    /// Distance between the FK of `theta` and the requested position, m (computed
+    /// before an angle is clamped onto its limit, which moves it by at most
+    /// [`LIMIT_TOLERANCE`]).
     pub position_error: f64,
     /// Orientation error of the FK of `theta`, rad (approach error for SETPOSITION).
     pub orientation_error: f64,
@@ -397,6 +399,21 @@ impl DriverAngleMap {
     }
 }
 
+/// Sines and cosines of θ1, θ2, θ2+θ3, θ4, θ5.
+#[derive(Clone, Copy)]
+struct Trig {
+    s1: f64,
+    c1: f64,
+    s2: f64,
+    c2: f64,
+    s23: f64,
+    c23: f64,
+    s4: f64,
+    c4: f64,
+    s5: f64,
+    c5: f64,
+}
+
 /// Which wrist solution to compute.
 #[derive(Clone, Copy)]
 enum WristGoal<'a> {
@@ -471,6 +488,34 @@ impl PioneerGeometry {
         let (s23, c23) = (t[1] + t[2]).sin_cos();
         let (s4, c4) = t[3].sin_cos();
         let (s5, c5) = t[4].sin_cos();
+        self.fk_trig(&Trig {
+            s1,
+            c1,
+            s2,
+            c2,
+            s23,
+            c23,
+            s4,
+            c4,
+            s5,
+            c5,
+        })
+    }
+
+    /// FK from the sines and cosines (the IK reuses the ones it already has).
+    fn fk_trig(&self, t: &Trig) -> Pose {
+        let Trig {
+            s1,
+            c1,
+            s2,
+            c2,
+            s23,
+            c23,
+            s4,
+            c4,
+            s5,
+            c5,
+        } = *t;
         let n = Vector3::new(-s1 * c4 - c1 * s23 * s4, c1 * c4 - s1 * s23 * s4, c23 * s4);
         let o = Vector3::new(
             -c1 * c23 * s5 + s1 * s4 * c5 - c1 * s23 * c4 * c5,
@@ -895,6 +940,7 @@ impl PioneerGeometry {
                 let fz = Vector3::new(-c1 * s23, -s1 * s23, c23);
                 let local = |v: &Vector3<f64>| Vector3::new(fx.dot(v), fy.dot(v), fz.dot(v));
                 let al = local(&a);
+                let (s2, c2) = t2.sin_cos();
                 let mut push = |t4: f64, t5: f64, wrist: Wrist| {
                     let mut theta = [t1, t2, t3, wrap_pi(t4), wrap_pi(t5)];
                     let mut within = true;
@@ -911,7 +957,20 @@ impl PioneerGeometry {
                             None => within = false,
                         }
                     }
-                    let fk = self.fk_raw(&theta);
+                    let (s4, c4) = t4.sin_cos();
+                    let (s5, c5) = t5.sin_cos();
+                    let fk = self.fk_trig(&Trig {
+                        s1,
+                        c1,
+                        s2,
+                        c2,
+                        s23,
+                        c23,
+                        s4,
+                        c4,
+                        s5,
+                        c5,
+                    });
                     let position_error = (fk.position - p).norm();
                     let orientation_error = match goal {
                         WristGoal::Frame(pose) => fk.orientation_error(pose),

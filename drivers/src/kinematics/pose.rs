@@ -143,6 +143,10 @@ pub fn fit_angle_to_limits(angle: f64, min: f64, max: f64, near: f64, tol: f64) 
     if !(angle.is_finite() && min.is_finite() && max.is_finite() && near.is_finite()) {
         return None;
     }
+    if angle >= min - tol && angle <= max + tol && (max - min) + 2.0 * tol < TAU {
+        // Only one representative fits.
+        return Some(angle.clamp(min, max));
+    }
     let kmin = ((min - tol - angle) / TAU).ceil();
     let kmax = ((max + tol - angle) / TAU).floor();
     if kmin > kmax {
