@@ -41,7 +41,7 @@ import sys
 import time
 import weakref
 from dataclasses import dataclass
-from typing import ClassVar, Iterable, Optional, Sequence, Type
+from typing import ClassVar, Iterable, Optional, Sequence
 
 from . import _layout as L
 
@@ -572,14 +572,20 @@ class _Client:
         except Exception as e:
             raise fail("req", e) from None
         try:
-            wake_svc = self._node.service_builder(iox2.ServiceName.new(name("wake"))).event().open_with_attributes(layout)
+            wake_svc = (
+                self._node.service_builder(iox2.ServiceName.new(name("wake")))
+                .event()
+                .open_with_attributes(layout)
+            )
             self._wake = wake_svc.notifier_builder().create()
             del wake_svc
         except Exception as e:
             raise fail("wake", e) from None
         try:
             self._notify_svc = (
-                self._node.service_builder(iox2.ServiceName.new(name("notify"))).event().open_with_attributes(layout)
+                self._node.service_builder(iox2.ServiceName.new(name("notify")))
+                .event()
+                .open_with_attributes(layout)
             )
         except Exception as e:
             raise fail("notify", e) from None
@@ -908,11 +914,15 @@ class _Client:
         try:
             status = Status(reply.meta.status)
         except ValueError:
-            raise DecodeError(f"undecodable reply: unknown status code {reply.meta.status}") from None
+            raise DecodeError(
+                f"undecodable reply: unknown status code {reply.meta.status}"
+            ) from None
         if status is not Status.OK:
             raise NackError(status)
         if reply.meta.kind != kind:
-            raise UnexpectedReplyError(f"reply of kind {reply.meta.kind} to a request of kind {kind}")
+            raise UnexpectedReplyError(
+                f"reply of kind {reply.meta.kind} to a request of kind {kind}"
+            )
         return reply
 
 
@@ -981,12 +991,16 @@ class ActArrayClient(_Client):
         """REQ BRAKES."""
         self._request(L.ACTARRAY_REQ_BRAKES, L.ActArrayBrakesReq(value=int(bool(on))), timeout)
 
-    def set_speed_config(self, joint: int, speed: float, *, timeout: Optional[float] = None) -> None:
+    def set_speed_config(
+        self, joint: int, speed: float, *, timeout: Optional[float] = None
+    ) -> None:
         """REQ SPEED: the speed of ``joint`` for later moves."""
         body = L.ActArraySpeedReq(joint=_joint(joint), speed=_finite("speed", speed))
         self._request(L.ACTARRAY_REQ_SPEED, body, timeout)
 
-    def set_accel_config(self, joint: int, accel: float, *, timeout: Optional[float] = None) -> None:
+    def set_accel_config(
+        self, joint: int, accel: float, *, timeout: Optional[float] = None
+    ) -> None:
         """REQ ACCEL: the acceleration of ``joint`` for later moves."""
         body = L.ActArrayAccelReq(joint=_joint(joint), accel=_finite("accel", accel))
         self._request(L.ACTARRAY_REQ_ACCEL, body, timeout)
