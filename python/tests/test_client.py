@@ -546,3 +546,45 @@ def test_python_sees_what_the_rust_driver_logged(own_driver):
         (cid, 4, L.ACTARRAY_CMD_POS),
     ]
     assert "overflows=0" in d.output
+
+
+def test_limber_list_counts_the_python_process(driver, gripper):
+    out = cli(driver, "list")
+    assert out.returncode == 0, out.stderr
+    rows = {line.split()[0]: line.split() for line in out.stdout.splitlines()[1:] if line}
+    row = rows[driver.dev("gripper")]
+    assert row[1:3] == ["testdriver", "alive"]
+    assert int(row[3]) >= 2  # the driver and this Python process
+
+
+def test_python_and_rust_clients_command_one_device_together(own_driver):
+    d = own_driver()
+    rust_client = os.path.join(os.path.dirname(driver_bin()), "limber-test-client")
+    if not os.access(rust_client, os.X_OK):
+        pytest.skip(f"{rust_client} not built") if os.environ.get("CI") != "true" \
+            else pytest.fail(f"{rust_client} not built")
+    n = 40
+    with ActArrayClient.connect(d.dev("actarray"), d.domain, timeout=T) as arm:
+        rust = subprocess.Popen([rust_client, "--robot", d.robot, "burst", str(n)],
+                                env=dict(os.environ, LIMBER_DOMAIN=d.domain),
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        tickets = [arm.move_to(i % 6, i * 1e-3) for i in range(n)]
+        out, err = rust.communicate(timeout=60)
+        assert rust.returncode == 0, err
+        assert out.strip() == f"sent {n}"
+        # While the Rust client commanded too, the outcome of our last command may have
+        # been pushed out of our 2-sample buffer by its outcomes (see README: as in Rust,
+        # wait_outcome then times out). Alone again, our next outcome is certain to be seen,
+        # and commands of one client are applied in order.
+        last = arm.move_to(0, 0.0)
+        assert last.seq == n + 1
+        assert arm.wait_outcome(last, T) is Status.OK
+        assert [t.seq for t in tickets] == list(range(1, n + 1))
+        cid = arm.client_id
+    log = d.commands()
+    mine = [s for c, s, _ in log if c == cid]
+    theirs = {c for c, _, _ in log if c != cid}
+    assert mine == list(range(1, n + 2))  # every command, in order
+    assert len(theirs) == 1  # one Rust client, with another id
+    assert len(log) == 2 * n + 1
+    assert "overflows=0" in d.output
