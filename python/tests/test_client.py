@@ -43,26 +43,30 @@ T = 5.0  # generous timeout of every wait: a slow machine only makes the test sl
 _domains = itertools.count()
 
 
-def _binary(env_var: str, default: str, what: str) -> str:
-    """The path of a Rust binary: `$env_var`, else `<repo>/target/debug/<default>`. Missing:
-    skip on a developer's machine, fail in CI (CI=true), where it must have been built."""
-    path = os.environ.get(env_var) or os.path.join(REPO, "target", "debug", default)
+def _require(path: str, what: str, hint: str) -> str:
+    """`path` if it is an executable; otherwise skip on a developer's machine and fail in CI
+    (CI=true), where the binaries must have been built."""
     if not os.access(path, os.X_OK):
-        msg = (f"{what} not found at {path}: build it with `cargo build -p "
-               f"{'limber-tests' if default == 'limber-test-driver' else 'limber-cli'}` "
-               f"or set {env_var}")
+        msg = f"{what} not found at {path}: {hint}"
         if os.environ.get("CI") == "true":
             pytest.fail(msg)
         pytest.skip(msg)
     return path
 
 
+def _binary(env_var: str, default: str, what: str, package: str) -> str:
+    """A Rust binary: `$env_var`, else `<repo>/target/debug/<default>`."""
+    path = os.environ.get(env_var) or os.path.join(REPO, "target", "debug", default)
+    return _require(path, what, f"build it with `cargo build -p {package}` or set {env_var}")
+
+
 def driver_bin() -> str:
-    return _binary("LIMBER_TEST_DRIVER", "limber-test-driver", "the Rust test driver")
+    return _binary("LIMBER_TEST_DRIVER", "limber-test-driver", "the Rust test driver",
+                   "limber-tests")
 
 
 def cli_bin() -> str:
-    return _binary("LIMBER_BIN", "limber", "the limber CLI")
+    return _binary("LIMBER_BIN", "limber", "the limber CLI", "limber-cli")
 
 
 _used_domains = []
@@ -431,6 +435,7 @@ def test_driver_stopped(own_driver):
         assert arm.wait_state(T) is not None
         d.stop()
         assert arm.driver_status() is DriverStatus.ABSENT
+        arm.refresh()  # samples published before the driver stopped are still readable
         with pytest.raises(DriverGoneError):
             arm.wait_state(T)
         with pytest.raises(NoDriverError):
@@ -447,8 +452,11 @@ def test_driver_killed(own_driver):
     try:
         assert arm.wait_state(T) is not None
         d.kill()
+        # The dead server still looks connected: the liveness check tells (or, once the dead
+        # node is cleaned up, nobody serves requests any more).
         with pytest.raises((DriverGoneError, NoDriverError)):
             arm.geometry(timeout=T)
+        arm.refresh()  # samples published before the driver died are still readable
         with pytest.raises(DriverGoneError):
             arm.wait_state(T)
         # The dead driver was cleaned up on the way: nothing is left to answer.
@@ -559,10 +567,8 @@ def test_limber_list_counts_the_python_process(driver, gripper):
 
 def test_python_and_rust_clients_command_one_device_together(own_driver):
     d = own_driver()
-    rust_client = os.path.join(os.path.dirname(driver_bin()), "limber-test-client")
-    if not os.access(rust_client, os.X_OK):
-        pytest.skip(f"{rust_client} not built") if os.environ.get("CI") != "true" \
-            else pytest.fail(f"{rust_client} not built")
+    rust_client = _require(os.path.join(os.path.dirname(driver_bin()), "limber-test-client"),
+                           "the Rust test client", "build it with `cargo build -p limber-tests`")
     n = 40
     with ActArrayClient.connect(d.dev("actarray"), d.domain, timeout=T) as arm:
         rust = subprocess.Popen([rust_client, "--robot", d.robot, "burst", str(n)],
