@@ -419,6 +419,19 @@ def test_incompatible_and_invalid_names(driver):
             limber.Domain(bad)
 
 
+def test_another_layout_version_or_type_is_incompatible(driver, monkeypatch):
+    class WrongData(ActArrayClient):
+        DATA = L.LimbData  # same interface, another payload type
+
+    with pytest.raises(IncompatibleError, match="data"):
+        WrongData.connect(driver.dev("actarray"), driver.domain, timeout=T)
+    monkeypatch.setattr(L, "LAYOUT_VERSION", L.LAYOUT_VERSION + 1)
+    with pytest.raises(IncompatibleError, match="layout"):
+        ActArrayClient.connect(driver.dev("actarray"), driver.domain, timeout=T)
+    # The failed attempts left no node behind, alive or dead.
+    assert [n for _, n in node_states(driver.domain) if n != "limber-driver:testdriver"] == []
+
+
 def test_domain_from_env(monkeypatch):
     monkeypatch.delenv("LIMBER_DOMAIN", raising=False)
     assert limber.Domain().name == "limber"
