@@ -582,6 +582,19 @@ impl Chain {
         q
     }
 
+    /// Shortest time, s, to move every joint from `from` to `to` at its `max_speed`
+    /// (the slowest joint decides; a synchronised move takes this long).
+    pub fn min_travel_time(&self, from: &[f64], to: &[f64]) -> Result<f64, ChainFkError> {
+        self.check_q(from)?;
+        self.check_q(to)?;
+        Ok(self
+            .joints
+            .iter()
+            .zip(from.iter().zip(to))
+            .map(|(j, (a, b))| (b - a).abs() / j.max_speed)
+            .fold(0.0, f64::max))
+    }
+
     fn check_q(&self, q: &[f64]) -> Result<(), ChainFkError> {
         if q.len() != self.dof() {
             return Err(ChainFkError::WrongJointCount {

@@ -320,35 +320,57 @@ impl IkCandidates {
 
     /// The candidate that reaches the target within the tolerances, lies inside the
     /// limits and is nearest (Euclidean, in θ) to `current`; ties go to the lower index.
+    /// Candidates that reproduce the target to round-off ([`EXACT_POSITION`],
+    /// [`EXACT_ORIENTATION`]) are preferred; only when no exact one lies inside the
+    /// limits is one that is merely within the tolerances chosen (near a singularity,
+    /// or for a slightly inconsistent target), and then the most accurate one (smallest
+    /// sum of the errors relative to their tolerances).
     pub fn select(
         &self,
         current: &Theta,
         options: &PioneerIkOptions,
     ) -> Result<IkCandidate, PioneerIkError> {
-        let mut best: Option<(f64, IkCandidate)> = None;
-        let mut any_exact = false;
+        let mut best: [Option<(f64, IkCandidate)>; 2] = [None, None];
+        let mut any_acceptable = false;
         let mut min_orientation = f64::INFINITY;
         for c in self.as_slice() {
-            let exact = c.position_error <= options.position_tolerance
+            let acceptable = c.position_error <= options.position_tolerance
                 && c.orientation_error <= options.orientation_tolerance;
+            let exact =
+                c.position_error <= EXACT_POSITION && c.orientation_error <= EXACT_ORIENTATION;
             min_orientation = min_orientation.min(c.orientation_error);
-            any_exact |= exact;
-            if exact && c.within_limits {
-                let d = joint_distance(&c.theta, current);
-                if best.is_none_or(|(bd, _)| d < bd) {
-                    best = Some((d, *c));
+            any_acceptable |= acceptable;
+            if acceptable && c.within_limits {
+                // Exact tier: nearest to current. Other tier: most accurate.
+                let (tier, score) = if exact {
+                    (&mut best[0], joint_distance(&c.theta, current))
+                } else {
+                    (
+                        &mut best[1],
+                        c.position_error / options.position_tolerance
+                            + c.orientation_error / options.orientation_tolerance,
+                    )
+                };
+                if tier.is_none_or(|(bs, _)| score < bs) {
+                    *tier = Some((score, *c));
                 }
             }
         }
         match best {
-            Some((_, c)) => Ok(c),
-            None if any_exact => Err(PioneerIkError::OutsideJointLimits),
-            None => Err(PioneerIkError::UnreachableOrientation {
+            [Some((_, c)), _] | [None, Some((_, c))] => Ok(c),
+            [None, None] if any_acceptable => Err(PioneerIkError::OutsideJointLimits),
+            [None, None] => Err(PioneerIkError::UnreachableOrientation {
                 error: min_orientation,
             }),
         }
     }
 }
+
+/// Position error, m, below which a candidate counts as exact (round-off).
+pub const EXACT_POSITION: f64 = 1e-10;
+
+/// Orientation error, rad, below which a candidate counts as exact (round-off).
+pub const EXACT_ORIENTATION: f64 = 1e-10;
 
 /// Where SETPOSITION should look for an approach vector.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -549,8 +571,9 @@ impl PioneerGeometry {
     }
 
     /// All closed-form candidates for a full pose (SETPOSE) relative to the arm base:
-    /// up to 4 (2 base yaws × 2 elbows), each scored by the FK error and marked for the
-    /// limits. `current` only picks the 2π representative of each angle and the base
+    /// up to 4 (2 base yaws × 2 elbows; up to 8 within 1e-3 rad of a straight or folded
+    /// elbow, where a variant with θ2+θ3 taken from the frame is added), each scored by
+    /// the FK error and marked for the limits. `current` only picks the 2π representative of each angle and the base
     /// yaw when the wrist centre is on the yaw axis.
     pub fn pose_candidates(
         &self,
@@ -927,12 +950,40 @@ impl PioneerGeometry {
             if d > dmax + tol || d < dmin - tol {
                 continue;
             }
-            let c3 = ((d * d - self.l2 * self.l2 - self.l4 * self.l4) / (2.0 * self.l2 * self.l4))
-                .clamp(-1.0, 1.0);
-            let g = c3.acos();
+            // |θ3| by the half-angle formula, tan²(θ3/2) = (1 − c3)/(1 + c3) with
+            // 1 − c3 = ((L2+L4)² − d²)/(2·L2·L4) and 1 + c3 = (d² − (L2−L4)²)/(2·L2·L4),
+            // each factored so that it keeps its precision near the straight (and the
+            // folded) elbow, where acos(c3) would lose half the digits.
+            let one_minus = (dmax - d).max(0.0) * (dmax + d);
+            let one_plus = (d - dmin).max(0.0) * (d + dmin);
+            let g = 2.0 * one_minus.sqrt().atan2(one_plus.sqrt());
+            let mut arms = [(Elbow::Down, 0.0, 0.0); 4];
+            let mut n_arms = 0;
             for (elbow, t3) in [(Elbow::Down, g), (Elbow::Up, -g)] {
                 let (s3, c3) = t3.sin_cos();
                 let t2 = wrap_pi(z.atan2(r) - (self.l4 * s3).atan2(self.l2 + self.l4 * c3));
+                arms[n_arms] = (elbow, t2, t3);
+                n_arms += 1;
+                // Near a straight (or folded) elbow the position fixes θ2+θ3 only to
+                // about √ε; a full frame fixes it better whenever the wrist rolls
+                // (n·forearm = 0 gives (s4·s23, s4·c23) = (−(c1·n_x + s1·n_y), n_z)).
+                // Add that variant; the FK check and the selection keep the better one.
+                if let WristGoal::Frame(pose) = goal {
+                    let n = pose.normal();
+                    let (ax, bx) = (-(c1 * n.x + s1 * n.y), n.z);
+                    if s3.abs() < 1e-3 && ax.hypot(bx) > 1e-2 {
+                        let mut t23 = ax.atan2(bx);
+                        if wrap_pi(t23 - (t2 + t3)).abs() > FRAC_PI_2 {
+                            t23 = wrap_pi(t23 + PI);
+                        }
+                        let (s23, c23) = t23.sin_cos();
+                        let t2b = (z - self.l4 * s23).atan2(r - self.l4 * c23);
+                        arms[n_arms] = (elbow, t2b, wrap_pi(t23 - t2b));
+                        n_arms += 1;
+                    }
+                }
+            }
+            for &(elbow, t2, t3) in &arms[..n_arms] {
                 let (s23, c23) = (t2 + t3).sin_cos();
                 // Columns of R0 = Rz(θ1)·Ry(−θ23).
                 let fx = Vector3::new(c1 * c23, s1 * c23, s23);
