@@ -658,7 +658,7 @@ proptest! {
         let target = g.fk(&theta).unwrap().position;
         let sol = g.solve_position(&target, ApproachPreference::Current, &[0.0; 5], &opts()).unwrap();
         prop_assert!(g.within_limits(&sol.theta));
-        prop_assert!((g.fk(&sol.theta).unwrap().position - target).norm() < 1e-6);
+        prop_assert!((g.fk(&sol.theta).unwrap().position - target).norm() < 1e-9);
     }
 }
 

@@ -725,16 +725,24 @@ impl PioneerGeometry {
             });
         }
         let mut any_exact = false;
-        let mut attempt = |a: &Vector3<f64>| -> Option<IkCandidate> {
+        // The search accepts only exact solutions (round-off), so that the bisection
+        // cannot settle on a reach boundary blurred by the tolerance; the last resort
+        // (full stretch) accepts the tolerances.
+        let strict = PioneerIkOptions {
+            position_tolerance: EXACT_POSITION,
+            orientation_tolerance: EXACT_ORIENTATION,
+            ..*options
+        };
+        let mut attempt_with = |a: &Vector3<f64>, opts: &PioneerIkOptions| {
             let cands = self
                 .candidates(
                     position,
                     WristGoal::Approach(a),
                     current,
-                    options.position_tolerance,
+                    opts.position_tolerance,
                 )
                 .ok()?;
-            match cands.select(current, options) {
+            match cands.select(current, opts) {
                 Ok(c) => Some(c),
                 Err(PioneerIkError::OutsideJointLimits) => {
                     any_exact = true;
@@ -743,6 +751,7 @@ impl PioneerGeometry {
                 Err(_) => None,
             }
         };
+        let mut attempt = |a: &Vector3<f64>| attempt_with(a, &strict);
         // 1. The preferred approach.
         if let Some(c) = attempt(&preferred) {
             return Ok(c);
@@ -852,7 +861,7 @@ impl PioneerGeometry {
         if from_circle > 1e-12 {
             let c = radial * self.l1;
             let toward = (position - c) / from_circle;
-            if let Some(c) = attempt(&toward) {
+            if let Some(c) = attempt_with(&toward, options) {
                 return Ok(c);
             }
         }
