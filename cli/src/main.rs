@@ -49,6 +49,11 @@ enum Command {
     ///
     /// Example: limber gripper pioneer/gripper/0 open
     Gripper(device::GripperArgs),
+    /// Run the Pioneer driver: the arm, limb, grippers and lift over P2OS (serial, pty or
+    /// tcp://host:port). `--emulated` drives the built-in emulator.
+    Pioneer(limber_drivers::pioneer::PioneerArgs),
+    /// Run a Pioneer controller emulator on a pty (prints its path) or on TCP.
+    Emulator(limber_drivers::emulator::EmulatorArgs),
 }
 
 fn main() -> ExitCode {
@@ -63,6 +68,10 @@ fn main() -> ExitCode {
         Command::Actarray(args) => device::actarray(args),
         Command::Limb(args) => device::limb(args),
         Command::Gripper(args) => device::gripper(args),
+        Command::Pioneer(args) => limber_drivers::pioneer::run_cli(args)
+            .map_err(|e| CliError::new(exit::FAILURE, e.to_string())),
+        Command::Emulator(args) => limber_drivers::emulator::run_cli(args)
+            .map_err(|e| CliError::new(exit::FAILURE, e.to_string())),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -4,3 +4,4 @@
 pub mod emulator;
 pub mod kinematics;
 pub mod p2os;
+pub mod pioneer;

@@ -1,0 +1,193 @@
+//! The Pioneer driver's configuration (TOML). Every field has a default that fits a
+//! Pioneer 3 with the 5-DOF arm, the body gripper and its lift.
+
+use std::path::Path;
+use std::time::Duration;
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+/// A configuration could not be loaded.
+#[derive(Debug, Error)]
+pub enum ConfigError {
+    /// The file could not be read.
+    #[error("cannot read {path}: {source}")]
+    Read {
+        /// The file.
+        path: String,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The TOML is malformed or has unknown keys.
+    #[error("invalid configuration: {0}")]
+    Parse(String),
+    /// A value is out of range.
+    #[error("invalid configuration: {0}")]
+    Invalid(String),
+}
+
+/// Geometry of a gripper as reported by GET_GEOM.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GripperGeometry {
+    /// Pose in the robot frame: x, y, z (m), roll, pitch, yaw (rad).
+    pub pose: [f64; 6],
+    /// Outer size: width, length, height (m).
+    pub outer: [f64; 3],
+    /// Space between the open fingers: width, length, height (m).
+    pub inner: [f64; 3],
+}
+
+/// The driver's configuration.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PioneerConfig {
+    /// The link: a serial device (`/dev/ttyS0`), a pty, or `tcp://host:port` (a
+    /// simulator or an ethernet-serial bridge; 8101 is the simulator port).
+    pub port: String,
+    /// Serial baud rate; unset: try 9600, 38400, 19200, 115200, 57600 in turn.
+    pub baud: Option<u32>,
+    /// The robot name in device names (`<robot>/actarray/0`, ...).
+    pub robot: String,
+    /// Arm base position in the robot frame, m.
+    pub arm_base: [f64; 3],
+    /// Arm link lengths L1, L2, L4, L5 of Gan et al. (m).
+    pub arm_links: [f64; 4],
+    /// Angular calibration offsets of joints 0..4, rad.
+    pub limb_offsets: [f64; 5],
+    /// Link lengths reported per actuator in the arm geometry (m), joints 0..5.
+    pub arm_geometry_lengths: [f64; 6],
+    /// The body gripper's geometry.
+    pub gripper: GripperGeometry,
+    /// The arm gripper's geometry (pose relative to the end effector).
+    pub arm_gripper: GripperGeometry,
+    /// Lift stroke (m): position 0 = down, this = up.
+    pub lift_stroke: f64,
+    /// Lift speed (m/s); a full stroke takes stroke/speed.
+    pub lift_speed: f64,
+    /// Loop tick, ms: housekeeping, motion streaming and state estimates.
+    pub tick_ms: u64,
+    /// No packet from the robot for this long means the link is down, ms.
+    pub link_timeout_ms: u64,
+    /// Pause between reconnection attempts, ms.
+    pub reconnect_interval_ms: u64,
+    /// How long ARM_INFO may go unanswered before the robot counts as armless, ms.
+    pub arm_info_timeout_ms: u64,
+    /// Send PULSE when nothing was sent for this long, ms.
+    pub pulse_interval_ms: u64,
+    /// A joint that stays short of its target for this long, not moving, is stalled, ms.
+    pub stall_timeout_ms: u64,
+    /// End-effector speed for limb motions until a limb SPEED request changes it, m/s.
+    pub limb_speed: f64,
+    /// Largest deviation from the straight line allowed in VECMOVE, m.
+    pub vecmove_deviation: f64,
+}
+
+impl Default for PioneerConfig {
+    fn default() -> Self {
+        PioneerConfig {
+            port: "/dev/ttyS0".into(),
+            baud: None,
+            robot: "pioneer".into(),
+            arm_base: [0.105, 0.0, 0.3185],
+            arm_links: [0.06875, 0.16, 0.13775, 0.11321],
+            limb_offsets: [0.0; 5],
+            arm_geometry_lengths: [0.06875, 0.16, 0.0, 0.13775, 0.11321, 0.0],
+            gripper: GripperGeometry {
+                pose: [0.2, 0.0, 0.05, 0.0, 0.0, 0.0],
+                outer: [0.315, 0.195, 0.035],
+                inner: [0.205, 0.095, 0.035],
+            },
+            arm_gripper: GripperGeometry {
+                pose: [0.0; 6],
+                outer: [0.09, 0.09, 0.041],
+                inner: [0.054, 0.025, 0.041],
+            },
+            lift_stroke: 0.07,
+            lift_speed: 0.02,
+            tick_ms: 10,
+            link_timeout_ms: 1000,
+            reconnect_interval_ms: 500,
+            arm_info_timeout_ms: 1000,
+            pulse_interval_ms: 1000,
+            stall_timeout_ms: 2000,
+            limb_speed: 0.1,
+            vecmove_deviation: 0.002,
+        }
+    }
+}
+
+impl PioneerConfig {
+    /// Loads a TOML file; absent keys take their defaults, unknown keys are an error.
+    pub fn from_file(path: &Path) -> Result<Self, ConfigError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Self::from_toml(&text)
+    }
+
+    /// Parses TOML text.
+    pub fn from_toml(text: &str) -> Result<Self, ConfigError> {
+        let c: PioneerConfig =
+            toml::from_str(text).map_err(|e| ConfigError::Parse(e.to_string()))?;
+        c.validate()?;
+        Ok(c)
+    }
+
+    /// The defaults as TOML (what `limber pioneer --print-config` shows).
+    pub fn to_toml(&self) -> String {
+        toml::to_string_pretty(self).unwrap_or_default()
+    }
+
+    /// Checks ranges.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let bad = |m: &str| Err(ConfigError::Invalid(m.to_string()));
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        if !finite(&self.arm_base)
+            || !finite(&self.arm_links)
+            || !finite(&self.limb_offsets)
+            || !finite(&self.arm_geometry_lengths)
+        {
+            return bad("arm values must be finite");
+        }
+        if self.arm_links.iter().any(|l| *l < 0.0)
+            || self.arm_links[1] <= 0.0
+            || self.arm_links[2] <= 0.0
+        {
+            return bad("arm_links must be >= 0 (L2 and L4 > 0)");
+        }
+        if !(self.lift_stroke > 0.0 && self.lift_stroke.is_finite()) {
+            return bad("lift_stroke must be > 0");
+        }
+        if !(self.lift_speed > 0.0 && self.lift_speed.is_finite()) {
+            return bad("lift_speed must be > 0");
+        }
+        if !(self.limb_speed > 0.0 && self.limb_speed.is_finite()) {
+            return bad("limb_speed must be > 0");
+        }
+        if !(self.vecmove_deviation > 0.0 && self.vecmove_deviation.is_finite()) {
+            return bad("vecmove_deviation must be > 0");
+        }
+        if self.tick_ms == 0 || self.tick_ms > 1000 {
+            return bad("tick_ms must be 1..=1000");
+        }
+        if self.link_timeout_ms < 200 {
+            return bad("link_timeout_ms must be >= 200 (a robot sends a SIP every 100 ms)");
+        }
+        if self.robot.is_empty()
+            || !self
+                .robot
+                .bytes()
+                .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-')
+        {
+            return bad("robot must be [A-Za-z0-9_-]+");
+        }
+        Ok(())
+    }
+
+    /// The loop tick.
+    pub fn tick(&self) -> Duration {
+        Duration::from_millis(self.tick_ms)
+    }
+}
