@@ -602,16 +602,26 @@ impl PioneerDriver {
 
     /// Runs until SIGINT/SIGTERM; then stops the arm, closes the link and returns.
     pub fn run(&mut self, opts: RunOptions) -> Result<LoopExit, DriverError> {
+        self.run_until(opts, || false)
+    }
+
+    /// Runs until SIGINT/SIGTERM or until `stop` (checked at every wake-up, at least every
+    /// tick) returns true; then stops the arm, closes the link and returns.
+    pub fn run_until(
+        &mut self,
+        opts: RunOptions,
+        mut stop: impl FnMut() -> bool,
+    ) -> Result<LoopExit, DriverError> {
         self.mode = opts.mode;
         let exit = match opts.mode {
-            LoopMode::Event => self.run_event()?,
-            LoopMode::Spin => self.run_spin(),
+            LoopMode::Event => self.run_event(&mut stop)?,
+            LoopMode::Spin => self.run_spin(&mut stop),
         };
         self.shutdown();
         Ok(exit)
     }
 
-    fn run_event(&mut self) -> Result<LoopExit, DriverError> {
+    fn run_event(&mut self, stop: &mut dyn FnMut() -> bool) -> Result<LoopExit, DriverError> {
         let listeners: Vec<_> = [
             self.hosts.arm.as_mut().and_then(|h| h.take_wake_listener()),
             self.hosts
@@ -644,6 +654,7 @@ impl PioneerDriver {
                 .as_ref()
                 .and_then(|c| FdSource::new(c.link()));
             let had_link = fd.is_some();
+            let mut stopped = false;
             let exit = event_loop::run(&listeners, tick, fd.as_ref(), |wake| {
                 let now = Instant::now();
                 match wake {
@@ -663,6 +674,10 @@ impl PioneerDriver {
                     }
                 }
                 self.publish_all(now);
+                if stop() {
+                    stopped = true;
+                    return ControlFlow::Break(());
+                }
                 // Leave the wait to re-attach when the link went down or came up.
                 if self.core.conn.is_some() != had_link {
                     ControlFlow::Break(())
@@ -674,10 +689,13 @@ impl PioneerDriver {
             if exit == LoopExit::Signal {
                 return Ok(LoopExit::Signal);
             }
+            if stopped {
+                return Ok(LoopExit::Stopped);
+            }
         }
     }
 
-    fn run_spin(&mut self) -> LoopExit {
+    fn run_spin(&mut self, stop: &mut dyn FnMut() -> bool) -> LoopExit {
         let tick = self.core.cfg.tick();
         let nominal = tick.as_nanos() as u64;
         let mut next_tick = Instant::now() + tick;
@@ -696,8 +714,13 @@ impl PioneerDriver {
             }
             self.publish_all(now);
             n += 1;
-            if n.is_multiple_of(1024) && self.ctx.termination_requested() {
-                return LoopExit::Signal;
+            if n.is_multiple_of(1024) {
+                if self.ctx.termination_requested() {
+                    return LoopExit::Signal;
+                }
+                if stop() {
+                    return LoopExit::Stopped;
+                }
             }
             core::hint::spin_loop();
         }

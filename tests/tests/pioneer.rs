@@ -1,0 +1,309 @@
+//! The Pioneer driver as a process, against the emulator (owned by this test process so it
+//! can inject faults), with clients in this process. Each test has its own domain.
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use limber_drivers::emulator::{Emulator, EmulatorConfig, Faults, ModelConfig};
+use limber_examples::pick_block::{self, Devices, PickParams, Step};
+use limber_examples::random_moves::{self, RandomParams};
+use limber_interfaces::diagnostics::hardware;
+use limber_services::diagnostics::StatsReader;
+use limber_services::prelude::*;
+use limber_services::{Domain, RequestError, Role, WaitError};
+use limber_tests::Proc;
+
+const PIONEER: &str = env!("CARGO_BIN_EXE_limber-test-pioneer");
+const T: Duration = Duration::from_secs(5);
+
+/// Short timeouts so faults are detected quickly in tests.
+fn config_file(name: &str) -> PathBuf {
+    let p = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("{name}.toml"));
+    std::fs::write(
+        &p,
+        "link_timeout_ms = 400\nreconnect_interval_ms = 100\narm_info_timeout_ms = 500\nstall_timeout_ms = 1500\n",
+    )
+    .unwrap();
+    p
+}
+
+fn start(domain: &Domain, emu: &Emulator, name: &str) -> Proc {
+    let port = match emu.tcp_addr() {
+        Some(a) => format!("tcp://{a}"),
+        None => emu.pty_path().unwrap().display().to_string(),
+    };
+    let cfg = config_file(name);
+    let mut d = Proc::spawn(
+        PIONEER,
+        domain.name(),
+        &["--port", &port, "--config", cfg.to_str().unwrap()],
+    );
+    assert!(
+        d.read_until(|l| l.ends_with("ready")).is_some(),
+        "driver did not start"
+    );
+    d
+}
+
+fn ctx(domain: &Domain) -> Context {
+    Context::new(domain, Role::Client, "pioneer-test").unwrap()
+}
+
+/// Fastest servo steps, so motions take fractions of a second.
+fn fast(arm: &mut ActArrayClient) {
+    for j in 0..6 {
+        arm.set_speed_config(j, 20.0).unwrap();
+    }
+}
+
+#[test]
+fn the_papers_programs_run_on_the_emulated_pioneer() {
+    let domain = Domain::unique_for_test();
+    let emu = Emulator::start_pty(EmulatorConfig::default()).unwrap();
+    let _driver = start(&domain, &emu, "programs");
+    let c = ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
+    arm.power(true).unwrap();
+    fast(&mut arm);
+
+    // Listing 1: random joint moves inside the geometry's limits.
+    let geom = arm.geometry().unwrap();
+    assert_eq!(geom.actuators_count, 6);
+    let q = random_moves::run(
+        &mut arm,
+        &RandomParams {
+            rounds: 2,
+            ..Default::default()
+        },
+        &mut |_, _| {},
+    )
+    .unwrap();
+    for (j, g) in geom.actuators().iter().enumerate() {
+        assert!(
+            q[j] >= g.min - 1e-9 && q[j] <= g.max + 1e-9,
+            "joint {j} at {} outside [{}, {}]",
+            q[j],
+            g.min,
+            g.max
+        );
+    }
+    let s = arm.state().unwrap();
+    assert!(
+        s.actuators()
+            .iter()
+            .all(|a| a.flags().unwrap() == ActuatorFlags::IDLE),
+        "{s:?}"
+    );
+
+    // Listing 2: pick a block with the limb and the arm gripper.
+    let mut dev = Devices::connect(&c, "pioneer/limb/0", "pioneer/gripper/1", T).unwrap();
+    let mut steps = Vec::new();
+    let summary = pick_block::run(&mut dev, &PickParams::default(), &mut |e| {
+        if let pick_block::Event::Done(step, l, _) = e {
+            steps.push((step, l.position));
+        }
+    })
+    .unwrap();
+    assert_eq!(summary.steps, 11);
+    // The end effector went where the program asked, to within a servo tick or so.
+    for (step, p) in &steps {
+        let want = match step {
+            Step::Descend(x) | Step::PutDown(x) | Step::Approach(x) | Step::Carry(x) => *x,
+            _ => continue,
+        };
+        let err =
+            ((p.x - want[0]).powi(2) + (p.y - want[1]).powi(2) + (p.z - want[2]).powi(2)).sqrt();
+        assert!(err < 0.01, "{step:?}: at {p:?}, {err} m from {want:?}");
+    }
+    assert_eq!(
+        dev.limb.state().unwrap().limb_state().unwrap(),
+        LimbState::Idle
+    );
+    assert_eq!(
+        dev.gripper.state().unwrap().gripper_state().unwrap(),
+        GripperState::Open
+    );
+    // And the emulated servos are where the driver says.
+    let st = emu.state();
+    let home = limber_drivers::emulator::default_arm_info();
+    for j in 0..5 {
+        assert_eq!(
+            st.robot.servo_ticks[j], home.joints[j].home,
+            "joint {j} not home"
+        );
+    }
+}
+
+#[test]
+fn out_of_reach_is_reported_and_cleared_by_the_next_valid_command() {
+    let domain = Domain::unique_for_test();
+    let emu = Emulator::start_pty(EmulatorConfig::default()).unwrap();
+    let _driver = start(&domain, &emu, "oor");
+    let c = ctx(&domain);
+    let mut limb = LimbClient::connect_timeout(&c, "pioneer/limb/0", T).unwrap();
+    let before = emu.state().stats.bytes_in;
+    let t = limb
+        .set_pose([1.5, 0.0, 0.3], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0])
+        .unwrap();
+    assert_eq!(limb.wait_outcome(t, T).unwrap(), Status::OutOfReach);
+    assert_eq!(
+        limb.state().unwrap().limb_state().unwrap(),
+        LimbState::OutOfReach
+    );
+    // Nothing reached the robot for the refused pose (only keep-alives may have).
+    std::thread::sleep(Duration::from_millis(50));
+    let sent = emu.state().stats.bytes_in - before;
+    assert!(
+        sent % 6 == 0 && sent <= 6 * 3,
+        "{sent} bytes sent after a refused pose"
+    );
+    let t = limb.set_position([0.35, 0.0, 0.25]).unwrap();
+    assert_eq!(limb.wait_outcome(t, T).unwrap(), Status::Ok);
+    assert_ne!(
+        limb.state().unwrap().limb_state().unwrap(),
+        LimbState::OutOfReach
+    );
+}
+
+fn wait_flag(arm: &mut ActArrayClient, up: bool, timeout: Duration) -> bool {
+    let deadline = Instant::now() + timeout;
+    while Instant::now() < deadline {
+        if let Ok(s) = arm.wait_state(Duration::from_millis(200))
+            && s.header.link_up() == up
+        {
+            return true;
+        }
+    }
+    false
+}
+
+#[test]
+fn a_killed_link_is_detected_reported_and_recovered_without_restart() {
+    let domain = Domain::unique_for_test();
+    let emu =
+        Emulator::start_tcp(EmulatorConfig::default(), "127.0.0.1:0".parse().unwrap()).unwrap();
+    let _driver = start(&domain, &emu, "recover");
+    let c = ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
+    assert!(wait_flag(&mut arm, true, T));
+
+    emu.disconnect();
+    assert!(wait_flag(&mut arm, false, T), "link down not reported");
+    assert!(
+        wait_flag(&mut arm, true, Duration::from_secs(10)),
+        "link not recovered"
+    );
+    arm.power(true).unwrap();
+    let t = arm.move_to(0, 0.3).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
+    let mut stats = StatsReader::open(&c, "pioneer").unwrap();
+    let s = stats.wait(Duration::from_secs(3)).unwrap();
+    assert!(s.reconnects >= 1 && s.link_faults >= 1, "{s:?}");
+}
+
+#[test]
+fn silence_and_garbage_are_detected_and_survived() {
+    let domain = Domain::unique_for_test();
+    let emu = Emulator::start_pty(EmulatorConfig::default()).unwrap();
+    let _driver = start(&domain, &emu, "faults");
+    let c = ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
+    assert!(wait_flag(&mut arm, true, T));
+
+    // Garbage and bad checksums: counted, and the arm keeps working.
+    emu.set_faults(Faults {
+        garbage_rate: 0.2,
+        bad_checksum_rate: 0.1,
+        ..Faults::default()
+    });
+    std::thread::sleep(Duration::from_millis(1500));
+    let t = arm.move_to(1, -0.5).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
+    let mut stats = StatsReader::open(&c, "pioneer").unwrap();
+    let deadline = Instant::now() + Duration::from_secs(5);
+    loop {
+        let s = *stats.wait(Duration::from_secs(3)).unwrap();
+        if s.bad_checksums > 0 && s.resync_bytes > 0 {
+            break;
+        }
+        assert!(Instant::now() < deadline, "faults not counted: {s:?}");
+    }
+
+    // Silence: the link is reported down, and recovered once the robot talks again.
+    emu.set_faults(Faults {
+        silent: true,
+        ..Faults::default()
+    });
+    assert!(wait_flag(&mut arm, false, T), "silence not detected");
+    // Commands while the link is down are refused, not queued.
+    let t = arm.move_to(1, 0.2).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::LinkDown);
+    emu.set_faults(Faults::default());
+    assert!(
+        wait_flag(&mut arm, true, Duration::from_secs(10)),
+        "not recovered"
+    );
+    // The refused command was not replayed after recovery.
+    std::thread::sleep(Duration::from_millis(300));
+    let target_tick = emu.state().robot.servo_targets[1];
+    let cal = limber_drivers::emulator::default_arm_info();
+    let refused_tick = limber_drivers::p2os::ArmCalibration::from(cal)
+        .radians_to_ticks(limber_drivers::p2os::ArmJoint::new(2).unwrap(), 0.2)
+        .unwrap()
+        .tick;
+    assert_ne!(target_tick, refused_tick, "a refused command was replayed");
+}
+
+#[test]
+fn sigterm_stops_the_arm_closes_the_link_and_exits_zero() {
+    let domain = Domain::unique_for_test();
+    let emu = Emulator::start_pty(EmulatorConfig::default()).unwrap();
+    let mut driver = start(&domain, &emu, "sigterm");
+    let c = ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
+    arm.power(true).unwrap();
+    let t = arm.move_to(0, 1.5).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
+    driver.signal(libc::SIGTERM);
+    assert_eq!(driver.wait_timeout(T), Some(0));
+    let (closed, st) = emu.wait_for(T, |s| {
+        s.robot.stage == limber_drivers::emulator::SyncStage::NoSync
+    });
+    assert!(closed, "no CLOSE: {:?}", st.robot.stage);
+    // The arm was stopped where it was, not left running to the old target.
+    assert_eq!(st.robot.servo_targets[0], st.robot.servo_ticks[0]);
+    drop(arm);
+}
+
+#[test]
+fn a_robot_without_an_arm_is_served_for_what_it_has() {
+    let domain = Domain::unique_for_test();
+    let cfg = EmulatorConfig {
+        model: ModelConfig {
+            arm: None,
+            ..ModelConfig::default()
+        },
+        ..EmulatorConfig::default()
+    };
+    let emu = Emulator::start_pty(cfg).unwrap();
+    let _driver = start(&domain, &emu, "noarm");
+    let c = ctx(&domain);
+    let names: Vec<String> = list_devices(&domain)
+        .unwrap()
+        .iter()
+        .map(|d| d.name.to_string())
+        .collect();
+    assert_eq!(names, ["pioneer/actarray/1", "pioneer/gripper/0"]);
+    let mut stats = StatsReader::open(&c, "pioneer").unwrap();
+    let s = stats.wait(Duration::from_secs(3)).unwrap();
+    assert_eq!(s.hardware & hardware::ARM, 0);
+    assert_ne!(s.hardware & hardware::GRIPPER, 0);
+    let mut grip = GripperClient::connect(&c, "pioneer/gripper/0").unwrap();
+    let t = grip.close().unwrap();
+    assert_eq!(grip.wait_outcome(t, T).unwrap(), Status::Ok);
+    assert!(matches!(
+        ActArrayClient::connect(&c, "pioneer/actarray/0"),
+        Err(limber_services::ConnectError::NoDriver { .. })
+    ));
+    let _ = (RequestError::Timeout(T), WaitError::Timeout(T));
+}
