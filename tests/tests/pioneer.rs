@@ -154,7 +154,7 @@ fn out_of_reach_is_reported_and_cleared_by_the_next_valid_command() {
     std::thread::sleep(Duration::from_millis(50));
     let sent = emu.state().stats.bytes_in - before;
     assert!(
-        sent % 6 == 0 && sent <= 6 * 3,
+        sent.is_multiple_of(6) && sent <= 6 * 3,
         "{sent} bytes sent after a refused pose"
     );
     let t = limb.set_position([0.35, 0.0, 0.25]).unwrap();
