@@ -340,6 +340,11 @@ impl PioneerDriver {
             last_cleanup: Instant::now(),
             mode: LoopMode::Event,
         };
+        // Like Player when the first client subscribes: power the arm. (Left on at exit:
+        // an unpowered arm drops under gravity.)
+        if d.hardware.arm {
+            let _ = d.core.send(&Command::ArmPower(true), &origin_internal());
+        }
         d.core.dirty.arm = true;
         d.core.dirty.body = true;
         d.publish_all(Instant::now());
