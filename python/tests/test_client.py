@@ -24,6 +24,7 @@ from limber import (
     ActArrayClient,
     DriverGoneError,
     DriverStatus,
+    Freshness,
     GripperClient,
     IncompatibleError,
     LimberError,
@@ -446,8 +447,10 @@ def test_driver_stopped(own_driver):
     arm = ActArrayClient.connect(d.dev("actarray"), d.domain, timeout=T)
     try:
         assert arm.wait_state(T) is not None
+        assert arm.freshness(3600.0) is Freshness.FRESH
         d.stop()
         assert arm.driver_status() is DriverStatus.ABSENT
+        assert arm.freshness(0.0) is Freshness.GONE
         arm.refresh()  # samples published before the driver stopped are still readable
         with pytest.raises(DriverGoneError):
             arm.wait_state(T)
