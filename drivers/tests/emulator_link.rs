@@ -567,3 +567,33 @@ fn emulator_stops_and_reports_its_endpoint() {
     assert!(matches!(emu.link_target(), LinkTarget::Tcp(_)));
     drop(emu);
 }
+
+#[test]
+fn keep_alive_beats_the_watchdog_and_silence_trips_it() {
+    let mut cfg = fast_config();
+    cfg.watchdog = Some(Duration::from_millis(500));
+    let emu = start(Wire::Tcp, cfg);
+    let mut c = connect(&emu);
+    // Connection::recv sends PULSE every 200 ms: 60 SIPs (over 1 s, two
+    // watchdog periods) arrive without a gap.
+    let mut sips = 0;
+    while sips < 60 {
+        if let RobotPacket::Sip(_) = c.recv(WAIT).unwrap() {
+            sips += 1;
+        }
+    }
+    assert_eq!(emu.state().stats.watchdog_trips, 0);
+    // A bare link sends nothing: the stream stops.
+    let mut link = c.into_link();
+    let mut stopped = false;
+    for _ in 0..1000 {
+        if let Err(e) = link.recv(Duration::from_secs(1)) {
+            assert!(matches!(e, LinkError::Timeout(_)), "{e:?}");
+            stopped = true;
+            break;
+        }
+    }
+    assert!(stopped);
+    assert_eq!(emu.state().stats.watchdog_trips, 1);
+    assert!(link.last_receive().is_some());
+}

@@ -62,6 +62,10 @@ pub struct EmulatorArgs {
     /// Seed of the fault generator.
     #[arg(long, default_value_t = 0x5EED)]
     pub seed: u64,
+    /// Stop streaming after this many milliseconds without a command (the
+    /// simulator does so after about 60 000).
+    #[arg(long)]
+    pub watchdog_ms: Option<u64>,
     /// Keep running when stdin closes (for `&` in scripts, whose stdin is
     /// /dev/null); stop with SIGINT/SIGTERM only.
     #[arg(long)]
@@ -96,6 +100,7 @@ impl EmulatorArgs {
                 silent: false,
                 slow_wire_baud: self.slow_wire,
             },
+            watchdog: self.watchdog_ms.map(Duration::from_millis),
             ..EmulatorConfig::default()
         };
         if self.no_arm {

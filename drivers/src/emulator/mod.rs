@@ -98,6 +98,10 @@ pub struct EmulatorConfig {
     pub faults: Faults,
     /// Seed of the fault generator.
     pub seed: u64,
+    /// Like the simulator: after this long without any command (PULSE
+    /// counts) the controller stops streaming and forgets the client, who
+    /// must sync again. `None` (the default) disables it.
+    pub watchdog: Option<Duration>,
 }
 
 impl Default for EmulatorConfig {
@@ -108,6 +112,7 @@ impl Default for EmulatorConfig {
             baud: None,
             faults: Faults::default(),
             seed: 0x5EED,
+            watchdog: None,
         }
     }
 }
@@ -140,6 +145,8 @@ pub struct EmulatorStats {
     pub wrong_baud_bytes: u64,
     /// TCP clients accepted.
     pub connections: u64,
+    /// Times the command watchdog stopped the stream.
+    pub watchdog_trips: u64,
 }
 
 /// A snapshot of the emulator.

@@ -449,6 +449,8 @@ impl Robot {
     fn flush_arm_pac(&mut self, out: &mut Vec<Frame>) {
         if self.wants_arm_pac && self.arm_status == 2 && self.stage == SyncStage::Open {
             push(out, self.arm_packet().encode());
+            // The client now knows which joints move.
+            self.last_moving = self.moving_mask();
         }
         self.wants_arm_pac = false;
     }

@@ -271,6 +271,7 @@ pub(super) fn run(
     };
     let mut buf = [0u8; 512];
     let mut next_cycle = Instant::now() + cycle;
+    let mut last_command = Instant::now();
     let mut faults;
     while !shared.stop.load(Ordering::SeqCst) {
         {
@@ -313,6 +314,7 @@ pub(super) fn run(
                     let was_open = robot.stage() == SyncStage::Open;
                     let mut closed = false;
                     decoder.decode(&buf[..n], |p| {
+                        last_command = now;
                         robot.handle(p, now, &mut out);
                         closed |= was_open && robot.stage() == SyncStage::NoSync;
                     });
@@ -326,6 +328,13 @@ pub(super) fn run(
             }
         }
         let now = Instant::now();
+        if let Some(w) = config.watchdog
+            && robot.stage() == SyncStage::Open
+            && now.saturating_duration_since(last_command) >= w
+        {
+            robot.reset_connection();
+            wire.stats.watchdog_trips += 1;
+        }
         robot.advance(now, &mut out);
         if now >= next_cycle {
             robot.cycle(now, &mut out);

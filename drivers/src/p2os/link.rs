@@ -117,6 +117,7 @@ pub struct Link {
     packets_out: u64,
     malformed: u64,
     last_send: Option<Instant>,
+    last_receive: Option<Instant>,
     write_timeout: Duration,
 }
 
@@ -140,6 +141,7 @@ impl Link {
             packets_out: 0,
             malformed: 0,
             last_send: None,
+            last_receive: None,
             write_timeout: DEFAULT_WRITE_TIMEOUT,
         }
     }
@@ -271,6 +273,11 @@ impl Link {
         self.last_send
     }
 
+    /// When bytes were last received (to tell a fresh link from a stale one).
+    pub fn last_receive(&self) -> Option<Instant> {
+        self.last_receive
+    }
+
     /// Counters.
     pub fn stats(&self) -> LinkStats {
         LinkStats {
@@ -293,7 +300,11 @@ impl Link {
             let _ = p.clear(ClearBuffer::Input);
         }
         let mut scratch = [0u8; 256];
-        while wait_readable(&[self.as_raw_fd()], Duration::ZERO)? != 0 {
+        // Bounded: a robot that streams faster than we drain cannot hold us.
+        for _ in 0..64 {
+            if wait_readable(&[self.as_raw_fd()], Duration::ZERO)? == 0 {
+                break;
+            }
             match self.raw_read(&mut scratch) {
                 Ok(0) => return Err(LinkError::Closed),
                 Ok(_) => {}
@@ -326,7 +337,10 @@ impl Link {
         };
         match r {
             Ok(0) => Err(LinkError::Closed),
-            Ok(_) => Ok(true),
+            Ok(_) => {
+                self.last_receive = Some(Instant::now());
+                Ok(true)
+            }
             Err(e)
                 if matches!(
                     e.kind(),
