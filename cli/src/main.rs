@@ -4,6 +4,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod demo;
 mod device;
 mod echo;
 mod layout;
@@ -25,6 +26,10 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// The main job: start the Pioneer emulator and driver in this process and run the
+    /// paper's pick-a-block program on it, step by step with the live joint and gripper
+    /// state, then a summary.
+    Demo(demo::DemoArgs),
     /// Print the wire contract: every message struct with its type name, size and fields.
     ///
     /// Without a flag, a readable catalogue. `--json` prints the layout manifest that the
@@ -62,6 +67,7 @@ fn main() -> ExitCode {
         set_domain_env(d);
     }
     let result = match cli.command {
+        Command::Demo(args) => demo::run(args),
         Command::Layout(args) => layout::run(args),
         Command::List(args) => list::run(args),
         Command::Echo(args) => echo::run(args),

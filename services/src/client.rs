@@ -320,6 +320,8 @@ impl<I: Interface> Client<I> {
             .event()
             .open_with_attributes(&layout)
             .map_err(|e| map("notify", format!("{e:?}")))?;
+        // Wake the driver so that it hands this new subscriber the latest state at once.
+        let _ = wake.notify_with_custom_event_id(EventId::new(qos::EVENT_HELLO));
         Ok(Client {
             ctx: ctx.clone(),
             device: device.clone(),

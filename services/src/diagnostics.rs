@@ -53,7 +53,9 @@ pub struct StatsPublisher {
 
 impl core::fmt::Debug for StatsPublisher {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("StatsPublisher").field("seq", &self.seq).finish()
+        f.debug_struct("StatsPublisher")
+            .field("seq", &self.seq)
+            .finish()
     }
 }
 

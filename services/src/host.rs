@@ -546,6 +546,10 @@ impl<I: Interface> DeviceHost<I> {
                 .notify
                 .notify_with_custom_event_id(EventId::new(qos::EVENT_REPLY));
         }
+        // What a request changed (power, ...) is visible in the state at once.
+        if n > 0 && self.publish_each_outcome {
+            self.publish()?;
+        }
         Ok(n)
     }
 

@@ -10,8 +10,10 @@ pub const MAX_CLIENTS: usize = 64;
 pub const MAX_NODES: usize = 80;
 /// Publishers of `data`: the driver, plus one dead driver not yet cleaned up.
 pub const DATA_PUBLISHERS: usize = 2;
-/// Samples buffered per `data` subscriber (history 1; the newest wins).
-pub const DATA_BUFFER: usize = 2;
+/// Samples buffered per `data` subscriber (history 1; when full the oldest is replaced).
+/// Deep enough that a client sees its own command's outcome even when a few other
+/// commands were applied since.
+pub const DATA_BUFFER: usize = 16;
 /// Samples a `data` subscriber may hold at once (the client keeps the latest one).
 pub const DATA_BORROWED: usize = 2;
 /// Commands buffered per client for the driver: a burst this long is never lost.
@@ -31,6 +33,8 @@ pub const NOTIFY_NOTIFIERS: usize = 4;
 pub const EVENT_COMMAND: usize = 1;
 /// Event id on `wake`: a request was sent.
 pub const EVENT_REQUEST: usize = 2;
+/// Event id on `wake`: a client connected (the driver hands it the latest state).
+pub const EVENT_HELLO: usize = 3;
 /// Event id on `notify`: a state sample was published.
 pub const EVENT_STATE: usize = 1;
 /// Event id on `notify`: a reply was sent.

@@ -1,0 +1,302 @@
+//! `limber demo`: the main job. Starts a robot (the Pioneer emulator and driver, or the
+//! simulated arm) in this process and runs the paper's pick-a-block program against it,
+//! showing each step with the live joint and gripper state.
+
+use std::io::{IsTerminal, Write};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use clap::{Args, ValueEnum};
+use limber_examples::pick_block::{self, Devices, Event, PickParams, Step};
+use limber_interfaces::diagnostics::get_text;
+use limber_services::diagnostics::StatsReader;
+use limber_services::prelude::*;
+use limber_services::{Domain, Role};
+
+use crate::{CliError, exit};
+
+/// Which robot the demo drives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Robot {
+    /// The Pioneer 5-DOF arm: the built-in P2OS emulator on a pty, driven by the real
+    /// Pioneer driver.
+    Pioneer,
+}
+
+/// Arguments of `limber demo`.
+#[derive(Debug, Args)]
+pub struct DemoArgs {
+    /// The robot to run the very same client program on.
+    #[arg(long, value_enum, default_value_t = Robot::Pioneer)]
+    on: Robot,
+    /// Block position x y (m, robot frame); default depends on the robot.
+    #[arg(long, num_args = 2, allow_negative_numbers = true, value_names = ["X", "Y"])]
+    block: Option<Vec<f64>>,
+    /// Drop position x y (m, robot frame); default depends on the robot.
+    #[arg(long, num_args = 2, allow_negative_numbers = true, value_names = ["X", "Y"])]
+    drop: Option<Vec<f64>>,
+    /// Run the joints at their fastest (for tests); the default speed is watchable.
+    #[arg(long)]
+    fast: bool,
+}
+
+/// A robot running on threads of this process, stopped when dropped.
+struct Running {
+    stop: Arc<AtomicBool>,
+    thread: Option<JoinHandle<()>>,
+    limb: String,
+    gripper: String,
+    arm: String,
+    robot: String,
+    params: PickParams,
+}
+
+impl Drop for Running {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+fn start_pioneer(domain: &Domain) -> Result<Running, CliError> {
+    use limber_drivers::emulator::{Emulator, EmulatorConfig};
+    use limber_drivers::pioneer::{PioneerConfig, PioneerDriver, RunOptions};
+    let stop = Arc::new(AtomicBool::new(false));
+    let (tx, rx) = mpsc::channel::<Result<String, String>>();
+    let d = domain.clone();
+    let s = Arc::clone(&stop);
+    let thread = std::thread::Builder::new()
+        .name("pioneer-driver".into())
+        .spawn(move || {
+            let emu = match Emulator::start_pty(EmulatorConfig::default()) {
+                Ok(e) => e,
+                Err(e) => {
+                    let _ = tx.send(Err(format!("cannot start the emulator: {e}")));
+                    return;
+                }
+            };
+            let path = emu
+                .pty_path()
+                .map(|p| p.display().to_string())
+                .unwrap_or_default();
+            let ctx = match Context::new(&d, Role::Driver, "pioneer") {
+                Ok(c) => c,
+                Err(e) => {
+                    let _ = tx.send(Err(e.to_string()));
+                    return;
+                }
+            };
+            let cfg = PioneerConfig {
+                port: path.clone(),
+                ..PioneerConfig::default()
+            };
+            let mut driver = match PioneerDriver::start(&ctx, cfg, emu.link_target()) {
+                Ok(d) => d,
+                Err(e) => {
+                    let _ = tx.send(Err(e.to_string()));
+                    return;
+                }
+            };
+            let _ = tx.send(Ok(path));
+            let _ = driver.run_until(RunOptions::default(), || s.load(Ordering::Relaxed));
+            drop(driver);
+            let _ = emu.stop();
+        })
+        .map_err(|e| CliError::new(exit::FAILURE, e.to_string()))?;
+    match rx.recv_timeout(Duration::from_secs(30)) {
+        Ok(Ok(path)) => println!("started the Pioneer emulator on {path} and the Pioneer driver"),
+        Ok(Err(e)) => return Err(CliError::new(exit::FAILURE, e)),
+        Err(_) => {
+            return Err(CliError::new(
+                exit::TIMEOUT,
+                "the Pioneer driver did not start within 30 s",
+            ));
+        }
+    }
+    Ok(Running {
+        stop,
+        thread: Some(thread),
+        limb: "pioneer/limb/0".into(),
+        gripper: "pioneer/gripper/1".into(),
+        arm: "pioneer/actarray/0".into(),
+        robot: "pioneer".into(),
+        params: PickParams::default(),
+    })
+}
+
+fn fmt_v(v: Vec3) -> String {
+    format!("({:+.3}, {:+.3}, {:+.3})", v.x, v.y, v.z)
+}
+
+fn gripper_name(g: &GripperData) -> &'static str {
+    match g.gripper_state() {
+        Ok(GripperState::Open) => "open",
+        Ok(GripperState::Closed) => "closed",
+        Ok(GripperState::Moving) => "moving",
+        _ => "error",
+    }
+}
+
+fn step_name(s: &Step) -> String {
+    match s {
+        Step::Home => "home".into(),
+        Step::OpenGripper => "open the gripper".into(),
+        Step::Approach(x) => format!(
+            "approach 5 cm above the block at ({:.2}, {:.2}, {:.2})",
+            x[0], x[1], x[2]
+        ),
+        Step::Descend(x) => format!("descend to the grasp height {:.2} m", x[2]),
+        Step::Grip => "grip the block".into(),
+        Step::Lift(_) => "lift it".into(),
+        Step::Carry(x) => format!("carry it above ({:.2}, {:.2})", x[0], x[1]),
+        Step::PutDown(_) => "put it down".into(),
+        Step::Release => "release it".into(),
+        Step::Retreat(_) => "move up and away".into(),
+        Step::HomeAgain => "home again".into(),
+    }
+}
+
+/// Runs `limber demo`.
+pub fn run(a: DemoArgs) -> Result<(), CliError> {
+    let domain = crate::domain()?;
+    println!(
+        "limber demo: the paper's pick-a-block program on the {} (domain {}; watch it with `limber monitor` in another terminal)",
+        match a.on {
+            Robot::Pioneer => "Pioneer arm (emulated)",
+        },
+        domain.name()
+    );
+    let running = match a.on {
+        Robot::Pioneer => start_pioneer(&domain)?,
+    };
+    let ctx = Context::new(&domain, Role::Client, "demo")
+        .map_err(|e| CliError::new(exit::FAILURE, e.to_string()))?;
+    let mut params = running.params;
+    if let Some(b) = &a.block {
+        params.block = [b[0], b[1]];
+    }
+    if let Some(d) = &a.drop {
+        params.drop = [d[0], d[1]];
+    }
+    let mut arm = ActArrayClient::connect_timeout(&ctx, &running.arm, Duration::from_secs(5))
+        .map_err(crate::device::connect_err)?;
+    if a.fast {
+        let n = arm.geometry().map(|g| g.actuators_count).unwrap_or(0) as usize;
+        for j in 0..n {
+            let _ = arm.set_speed_config(j, 50.0);
+        }
+    }
+    let mut dev = Devices::connect(
+        &ctx,
+        &running.limb,
+        &running.gripper,
+        Duration::from_secs(5),
+    )
+    .map_err(crate::device::connect_err)?;
+    println!(
+        "devices: {} (joints), {} (end effector), {} (gripper)\n",
+        running.arm, running.limb, running.gripper
+    );
+
+    let tty = std::io::stdout().is_terminal();
+    let start = Instant::now();
+    let mut step_start = Instant::now();
+    let mut last_line = Instant::now();
+    let mut n = 0;
+    let result = pick_block::run(&mut dev, &params, &mut |ev| match ev {
+        Event::Start(s) => {
+            n += 1;
+            step_start = Instant::now();
+            println!("[{n:>2}/11] {} ...", step_name(&s));
+        }
+        Event::Progress(l, g) => {
+            if tty {
+                if let Some(s) = arm.state() {
+                    let joints: Vec<String> = s
+                        .actuators()
+                        .iter()
+                        .map(|a| format!("{:+.2}", a.position))
+                        .collect();
+                    print!(
+                        "\r        joints [{}] gripper {:<7} end effector {}   ",
+                        joints.join(" "),
+                        gripper_name(g),
+                        fmt_v(l.position)
+                    );
+                    let _ = std::io::stdout().flush();
+                }
+            } else if last_line.elapsed() > Duration::from_secs(1) {
+                last_line = Instant::now();
+                println!(
+                    "        moving: end effector {} gripper {}",
+                    fmt_v(l.position),
+                    gripper_name(g)
+                );
+            }
+        }
+        Event::Done(_, l, g) => {
+            if tty {
+                print!("\r{:<100}\r", "");
+            }
+            let joints: Vec<String> = arm
+                .state()
+                .map(|s| {
+                    s.actuators()
+                        .iter()
+                        .map(|a| format!("{:+.3}", a.position))
+                        .collect()
+                })
+                .unwrap_or_default();
+            println!(
+                "        done in {:.1} s: end effector {} approach {}; gripper {}; joints [{}]",
+                step_start.elapsed().as_secs_f64(),
+                fmt_v(l.position),
+                fmt_v(l.approach),
+                gripper_name(g),
+                joints.join(" ")
+            );
+        }
+    });
+    match result {
+        Ok(s) => {
+            println!(
+                "\npicked the block at ({:.2}, {:.2}) and put it down at ({:.2}, {:.2}): {} steps in {:.1} s",
+                params.block[0],
+                params.block[1],
+                params.drop[0],
+                params.drop[1],
+                s.steps,
+                start.elapsed().as_secs_f64()
+            );
+            if let Ok(mut stats) = StatsReader::open(&ctx, &running.robot)
+                && let Ok(st) = stats.wait(Duration::from_millis(1500))
+            {
+                println!(
+                    "driver: {} {} {}; loop period p50 {:.2} ms p99 {:.2} ms; command to wire p50 {:.1} µs; {:.1} SIPs/s; {} commands, {} refused, {} requests; {} bad checksums",
+                    get_text(&st.robot_name).unwrap_or("?"),
+                    get_text(&st.robot_class).unwrap_or(""),
+                    get_text(&st.robot_subclass).unwrap_or(""),
+                    st.period_p50_ns as f64 / 1e6,
+                    st.period_p99_ns as f64 / 1e6,
+                    st.cmd_to_wire_p50_ns as f64 / 1e3,
+                    st.sips_per_s,
+                    st.commands,
+                    st.refused,
+                    st.requests,
+                    st.bad_checksums
+                );
+            }
+            println!("done.");
+            Ok(())
+        }
+        Err(e) => Err(CliError::new(
+            exit::FAILURE,
+            format!("the program stopped: {e}"),
+        )),
+    }
+}
