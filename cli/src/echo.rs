@@ -209,7 +209,9 @@ where
             }
             Err(e) => return Err(wait_err(e)),
         }
-        let s = c.last_state().expect("a state was received");
+        let Some(s) = c.last_state() else {
+            continue;
+        };
         if a.json {
             let mut v = s.json();
             v["device"] = json!(a.device);

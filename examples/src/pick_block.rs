@@ -222,8 +222,9 @@ pub fn run(
         if let Some(ticket) = sent {
             wait_limb(dev, step, ticket, p.motion_timeout, observe)?;
         }
-        let l = *dev.limb.state().expect("limb state seen");
-        let g = *dev.gripper.state().expect("gripper state seen");
+        let wait = |source| PickError::Wait { step, source };
+        let l = *dev.limb.current(p.motion_timeout).map_err(wait)?;
+        let g = *dev.gripper.current(p.motion_timeout).map_err(wait)?;
         if matches!(step, Step::Grip | Step::Lift(_) | Step::Carry(_)) && g.beams != 0 {
             block_seen = true;
         }
@@ -299,7 +300,10 @@ fn wait_limb(
     // The state published with the outcome already reflects the command (moving, or
     // idle when there was nothing to do); wait until it is no longer moving.
     loop {
-        let l = *dev.limb.state().expect("a state arrived with the outcome");
+        let l = *dev
+            .limb
+            .current(timeout)
+            .map_err(|source| PickError::Wait { step, source })?;
         match l.limb_state() {
             Ok(LimbState::Idle) | Ok(LimbState::Braked) => return Ok(()),
             Ok(LimbState::OutOfReach) => return Err(PickError::OutOfReach { step }),
@@ -340,8 +344,8 @@ fn wait_gripper(
     loop {
         let g = *dev
             .gripper
-            .state()
-            .expect("a state arrived with the outcome");
+            .current(timeout)
+            .map_err(|source| PickError::Wait { step, source })?;
         if g.gripper_state() == Ok(want) {
             return Ok(());
         }

@@ -403,6 +403,15 @@ impl<I: Interface> Client<I> {
         self.latest.as_deref()
     }
 
+    /// The latest state, waiting up to `timeout` for a first one if none arrived yet.
+    pub fn current(&mut self, timeout: Duration) -> Result<&I::Data, WaitError> {
+        self.refresh()?;
+        if self.latest.is_none() {
+            self.wait_state(timeout)?;
+        }
+        self.latest.as_deref().ok_or(WaitError::Timeout(timeout))
+    }
+
     /// The latest state already taken, without looking for a newer one.
     pub fn last_state(&self) -> Option<&I::Data> {
         self.latest.as_deref()
