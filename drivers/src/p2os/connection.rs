@@ -4,6 +4,7 @@ use super::command::{ArmStatusMode, Command};
 use super::convert::ArmCalibration;
 use super::link::{Link, LinkError, LinkTarget, OpenError};
 use super::packet::{ArmPacket, GripperPacket, RobotIdentity, RobotPacket, Sip};
+use std::os::fd::{AsRawFd, RawFd};
 use std::time::{Duration, Instant};
 use thiserror::Error;
 
@@ -361,6 +362,24 @@ impl Connection {
         Ok(p)
     }
 
+    /// Nonblocking, for an event loop woken by the fd ([`AsRawFd`]): the
+    /// next packet if one is complete (at most one read), with its state
+    /// recorded. Does not send keep-alives: call [`Connection::keep_alive`]
+    /// from the loop's timer.
+    pub fn poll(&mut self) -> Result<Option<RobotPacket<'_>>, LinkError> {
+        let p = self.link.poll_packet()?;
+        if let Some(p) = &p {
+            Self::record(
+                p,
+                &mut self.last_sip,
+                &mut self.last_arm,
+                &mut self.arm,
+                &mut self.last_gripper,
+            );
+        }
+        Ok(p)
+    }
+
     /// Receives packets until `pred` accepts one, at most `timeout` in all
     /// ([`LinkError::Timeout`] otherwise). Keeps the connection alive.
     pub fn wait_until(
@@ -397,5 +416,11 @@ impl Connection {
         self.link.send(&Command::Stop)?;
         self.link.send(&Command::Close)?;
         Ok(())
+    }
+}
+
+impl AsRawFd for Connection {
+    fn as_raw_fd(&self) -> RawFd {
+        self.link.as_raw_fd()
     }
 }
