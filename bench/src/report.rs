@@ -1,0 +1,464 @@
+//! The report of a run: the terminal table, ratios against the floor and the peers with
+//! the goals, and the JSON file.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::machine::Machine;
+use crate::scenario::ScenarioOutcome;
+use crate::stats::{Measurement, Metric, Strategy, Summary, fmt_ns};
+use crate::{BenchArgs, BenchError};
+
+/// The jitter definition, stated in every report.
+pub const JITTER: &str = "jitter = p99 - p50";
+
+/// Which percentile a ratio compares.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Pct {
+    /// Median.
+    P50,
+    /// 99th percentile.
+    P99,
+}
+
+impl Pct {
+    fn of(self, s: &Summary) -> u64 {
+        match self {
+            Pct::P50 => s.p50_ns,
+            Pct::P99 => s.p99_ns,
+        }
+    }
+    fn name(self) -> &'static str {
+        match self {
+            Pct::P50 => "p50",
+            Pct::P99 => "p99",
+        }
+    }
+}
+
+/// A goal on a ratio.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Goal {
+    /// The ratio must be at most this.
+    AtMost(f64),
+    /// The ratio must be at least this.
+    AtLeast(f64),
+}
+
+/// A ratio of two measurements of the same run.
+#[derive(Debug, Clone, Copy)]
+pub struct RatioDef {
+    /// What it says.
+    pub label: &'static str,
+    /// Numerator measurement id.
+    pub num: &'static str,
+    /// Denominator measurement id.
+    pub den: &'static str,
+    /// The percentile compared.
+    pub pct: Pct,
+    /// The goal, if any.
+    pub goal: Option<Goal>,
+}
+
+/// The ratios reported, like with like (spin with spin, blocking with blocking).
+pub const RATIOS: &[RatioDef] = &[
+    RatioDef {
+        label: "command spin one-way / floor spin one-way",
+        num: "command.spin.oneway",
+        den: "floor.spin.oneway",
+        pct: Pct::P50,
+        goal: Some(Goal::AtMost(1.5)),
+    },
+    RatioDef {
+        label: "command spin one-way / floor spin one-way",
+        num: "command.spin.oneway",
+        den: "floor.spin.oneway",
+        pct: Pct::P99,
+        goal: Some(Goal::AtMost(2.0)),
+    },
+    RatioDef {
+        label: "command spin round trip / floor spin round trip",
+        num: "command.spin.rtt",
+        den: "floor.spin.rtt",
+        pct: Pct::P50,
+        goal: None,
+    },
+    RatioDef {
+        label: "command event round trip / floor event round trip",
+        num: "command.event.rtt",
+        den: "floor.event.rtt",
+        pct: Pct::P50,
+        goal: Some(Goal::AtMost(1.2)),
+    },
+    RatioDef {
+        label: "command event round trip / floor WaitSet-echo round trip",
+        num: "command.event.rtt",
+        den: "floor.waitset.rtt",
+        pct: Pct::P50,
+        goal: None,
+    },
+    RatioDef {
+        label: "floor WaitSet-echo round trip / floor event round trip",
+        num: "floor.waitset.rtt",
+        den: "floor.event.rtt",
+        pct: Pct::P50,
+        goal: None,
+    },
+    RatioDef {
+        label: "command event one-way / floor event one-way",
+        num: "command.event.oneway",
+        den: "floor.event.oneway",
+        pct: Pct::P50,
+        goal: None,
+    },
+    RatioDef {
+        label: "TCP spin round trip / command spin round trip",
+        num: "peers.tcp.spin.rtt",
+        den: "command.spin.rtt",
+        pct: Pct::P50,
+        goal: Some(Goal::AtLeast(10.0)),
+    },
+    RatioDef {
+        label: "UDS spin round trip / command spin round trip",
+        num: "peers.uds.spin.rtt",
+        den: "command.spin.rtt",
+        pct: Pct::P50,
+        goal: Some(Goal::AtLeast(5.0)),
+    },
+    RatioDef {
+        label: "TCP blocking round trip / command event round trip",
+        num: "peers.tcp.blocking.rtt",
+        den: "command.event.rtt",
+        pct: Pct::P50,
+        goal: Some(Goal::AtLeast(10.0)),
+    },
+    RatioDef {
+        label: "UDS blocking round trip / command event round trip",
+        num: "peers.uds.blocking.rtt",
+        den: "command.event.rtt",
+        pct: Pct::P50,
+        goal: Some(Goal::AtLeast(5.0)),
+    },
+    RatioDef {
+        label: "Pioneer GET_GEOM request / command event round trip",
+        num: "request.pioneer.rtt",
+        den: "command.event.rtt",
+        pct: Pct::P50,
+        goal: None,
+    },
+    RatioDef {
+        label: "floor event round trip / floor spin round trip (cost of blocking)",
+        num: "floor.event.rtt",
+        den: "floor.spin.rtt",
+        pct: Pct::P50,
+        goal: None,
+    },
+    RatioDef {
+        label: "state to 16 subscribers / to 1 subscriber",
+        num: "state.16.oneway",
+        den: "state.1.oneway",
+        pct: Pct::P50,
+        goal: None,
+    },
+];
+
+/// One point of a percentile curve.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct CurvePoint {
+    /// Percentile, 0 to 100.
+    pub percentile: f64,
+    /// Latency at it, ns.
+    pub ns: u64,
+}
+
+/// A measurement as reported.
+#[derive(Debug, Clone, Serialize)]
+pub struct Row {
+    /// The scenario.
+    pub scenario: &'static str,
+    /// The stable id.
+    pub id: String,
+    /// The label.
+    pub label: String,
+    /// `spin`, `blocking` or `compute`.
+    pub strategy: Strategy,
+    /// `round_trip`, `one_way` or `solve`.
+    pub metric: Metric,
+    /// Bytes out, if an exchange.
+    pub bytes_out: Option<usize>,
+    /// Bytes back, if an exchange.
+    pub bytes_back: Option<usize>,
+    /// Percentiles etc., ns.
+    pub summary: Summary,
+    /// The floor this row is compared with in the table (same strategy and metric).
+    pub floor_id: Option<String>,
+    /// p50 of this row / p50 of its floor.
+    pub x_floor_p50: Option<f64>,
+    /// The percentile curve (for plots).
+    pub curve: Vec<CurvePoint>,
+}
+
+/// A computed ratio.
+#[derive(Debug, Clone, Serialize)]
+pub struct Ratio {
+    /// What it says.
+    pub label: String,
+    /// Numerator id.
+    pub num: &'static str,
+    /// Denominator id.
+    pub den: &'static str,
+    /// The percentile compared.
+    pub pct: Pct,
+    /// The strategy of the numerator and denominator.
+    pub strategy: String,
+    /// The value.
+    pub value: f64,
+    /// The goal.
+    pub goal: Option<Goal>,
+    /// Whether the goal was met (None without a goal).
+    pub met: Option<bool>,
+}
+
+/// A whole report.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    /// The machine.
+    pub machine: Machine,
+    /// How jitter is defined.
+    pub jitter_definition: &'static str,
+    /// How every scenario ended.
+    pub scenarios: Vec<ScenarioOutcome>,
+    /// Every measurement.
+    pub measurements: Vec<Row>,
+    /// Ratios against the floor and the peers, with goals.
+    pub ratios: Vec<Ratio>,
+}
+
+fn floor_of(m: &Measurement) -> Option<String> {
+    if m.scenario == "floor" {
+        return None;
+    }
+    let k = match m.strategy {
+        Strategy::Spin => "spin",
+        Strategy::Blocking => "event",
+        Strategy::Compute => return None,
+    };
+    let what = match m.metric {
+        Metric::RoundTrip => "rtt",
+        Metric::OneWay if m.id.ends_with(".back") => "back",
+        Metric::OneWay => "oneway",
+        Metric::Solve => return None,
+    };
+    Some(format!("floor.{k}.{what}"))
+}
+
+/// The percentiles of a curve: 0 to 99.999 on a "nines" scale.
+pub const CURVE_NINES: &[f64] = &[
+    0.0, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.3, 1.5, 1.7, 2.0, 2.3, 2.5, 2.7, 3.0, 3.3, 3.5, 3.7, 4.0,
+    4.5, 5.0,
+];
+
+fn curve(m: &Measurement) -> Vec<CurvePoint> {
+    let n = m.hist.len();
+    if n == 0 {
+        return Vec::new();
+    }
+    let max_nines = (n as f64).log10();
+    CURVE_NINES
+        .iter()
+        .filter(|x| **x <= max_nines)
+        .map(|x| {
+            let q = 1.0 - 10f64.powf(-x);
+            CurvePoint {
+                percentile: q * 100.0,
+                ns: m.hist.value_at_quantile(q),
+            }
+        })
+        .chain(std::iter::once(CurvePoint {
+            percentile: 100.0,
+            ns: m.hist.max(),
+        }))
+        .collect()
+}
+
+impl Report {
+    /// Builds the report of a run.
+    pub fn new(
+        machine: Machine,
+        _args: &BenchArgs,
+        scenarios: Vec<ScenarioOutcome>,
+        measurements: Vec<Measurement>,
+    ) -> Self {
+        let find = |id: &str| measurements.iter().find(|m| m.id == id);
+        let rows: Vec<Row> = measurements
+            .iter()
+            .map(|m| {
+                let s = Summary::of(&m.hist);
+                let floor_id = floor_of(m).filter(|f| find(f).is_some());
+                let x_floor_p50 = floor_id.as_deref().and_then(find).and_then(|f| {
+                    let fp = Summary::of(&f.hist).p50_ns;
+                    (fp > 0).then(|| s.p50_ns as f64 / fp as f64)
+                });
+                Row {
+                    scenario: m.scenario,
+                    id: m.id.clone(),
+                    label: m.label.clone(),
+                    strategy: m.strategy,
+                    metric: m.metric,
+                    bytes_out: m.bytes.map(|b| b.0),
+                    bytes_back: m.bytes.map(|b| b.1),
+                    summary: s,
+                    floor_id,
+                    x_floor_p50,
+                    curve: curve(m),
+                }
+            })
+            .collect();
+        let ratios = RATIOS
+            .iter()
+            .filter_map(|r| {
+                let (a, b) = (find(r.num)?, find(r.den)?);
+                let (sa, sb) = (Summary::of(&a.hist), Summary::of(&b.hist));
+                let den = r.pct.of(&sb);
+                if den == 0 || sa.count == 0 {
+                    return None;
+                }
+                let value = r.pct.of(&sa) as f64 / den as f64;
+                let met = r.goal.map(|g| match g {
+                    Goal::AtMost(x) => value <= x,
+                    Goal::AtLeast(x) => value >= x,
+                });
+                let strategy = if a.strategy == b.strategy {
+                    a.strategy.name().to_string()
+                } else {
+                    format!("{} / {}", a.strategy.name(), b.strategy.name())
+                };
+                Some(Ratio {
+                    label: format!("{} ({})", r.label, r.pct.name()),
+                    num: r.num,
+                    den: r.den,
+                    pct: r.pct,
+                    strategy,
+                    value,
+                    goal: r.goal,
+                    met,
+                })
+            })
+            .collect();
+        Report {
+            machine,
+            jitter_definition: JITTER,
+            scenarios,
+            measurements: rows,
+            ratios,
+        }
+    }
+
+    /// Scenarios that failed.
+    pub fn failed(&self) -> usize {
+        self.scenarios
+            .iter()
+            .filter(|s| s.status == "failed")
+            .count()
+    }
+
+    /// The terminal table.
+    pub fn table(&self) -> String {
+        let mut t = String::new();
+        let _ = writeln!(t);
+        t.push_str(&self.machine.header());
+        let _ = writeln!(
+            t,
+            "{JITTER}; x floor = p50 / p50 of the iceoryx2 floor with the same strategy and metric\n"
+        );
+        let _ = writeln!(
+            t,
+            "{:<8} {:<34} {:<8} {:<10} {:>7} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>7}",
+            "scenario",
+            "series",
+            "strategy",
+            "metric",
+            "count",
+            "p50",
+            "p90",
+            "p99",
+            "p99.9",
+            "max",
+            "jitter",
+            "x floor"
+        );
+        for r in &self.measurements {
+            let s = &r.summary;
+            let _ = writeln!(
+                t,
+                "{:<8} {:<34} {:<8} {:<10} {:>7} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>7}",
+                r.scenario,
+                r.label,
+                r.strategy.name(),
+                r.metric.name(),
+                s.count,
+                fmt_ns(s.p50_ns),
+                fmt_ns(s.p90_ns),
+                fmt_ns(s.p99_ns),
+                fmt_ns(s.p999_ns),
+                fmt_ns(s.max_ns),
+                fmt_ns(s.jitter_ns),
+                r.x_floor_p50
+                    .map(|x| format!("{x:.2}"))
+                    .unwrap_or_else(|| "-".into()),
+            );
+        }
+        let others: Vec<&ScenarioOutcome> =
+            self.scenarios.iter().filter(|s| s.status != "ok").collect();
+        let notes: Vec<&ScenarioOutcome> = self
+            .scenarios
+            .iter()
+            .filter(|s| s.status == "ok" && !s.detail.is_empty())
+            .collect();
+        if !others.is_empty() || !notes.is_empty() {
+            let _ = writeln!(t);
+        }
+        for s in others {
+            let status = match s.status {
+                "not_available" => "not yet available",
+                other => other,
+            };
+            let _ = writeln!(t, "{:<8} {status}: {}", s.name, s.detail);
+        }
+        for s in notes {
+            let _ = writeln!(t, "{:<8} note: {}", s.name, s.detail);
+        }
+        if !self.ratios.is_empty() {
+            let _ = writeln!(t, "\nratios (same run):");
+            for r in &self.ratios {
+                let goal = match (r.goal, r.met) {
+                    (Some(Goal::AtMost(x)), Some(m)) => {
+                        format!("goal <= {x}: {}", if m { "met" } else { "NOT met" })
+                    }
+                    (Some(Goal::AtLeast(x)), Some(m)) => {
+                        format!("goal >= {x}: {}", if m { "met" } else { "NOT met" })
+                    }
+                    _ => String::new(),
+                };
+                let value = if r.value < 0.1 {
+                    format!("{:.4}", r.value)
+                } else {
+                    format!("{:.2}", r.value)
+                };
+                let _ = writeln!(t, "  {:<72} {:<15} {value:>8}  {goal}", r.label, r.strategy);
+            }
+        }
+        t
+    }
+
+    /// Writes the JSON file.
+    pub fn write_json(&self, path: &Path) -> Result<(), BenchError> {
+        let text = serde_json::to_string_pretty(self)
+            .map_err(|e| BenchError::io(path.display().to_string(), std::io::Error::other(e)))?;
+        std::fs::write(path, text).map_err(|e| BenchError::io(path.display().to_string(), e))
+    }
+}

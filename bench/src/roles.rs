@@ -1,0 +1,119 @@
+//! The child side: what this executable does when started with the hidden `--role`.
+//!
+//! | role | scenario | what it does |
+//! |---|---|---|
+//! | `pubsub-echo` | floor | raw iceoryx2: spins on the ping topic, answers on the pong topic |
+//! | `event-echo` | floor | the same, blocking on an event listener, notifying back |
+//! | `waitset-echo` | floor | the same, blocking in a WaitSet with the listener attached |
+//! | `state-pub` | state | a `DeviceHost` publishing the arm state at 1 kHz after `go` |
+//! | `state-sub` | state | an `ActArrayClient` blocking in `wait_state`, recording one-way latency |
+//! | `cmd-driver-spin` / `cmd-driver-event` | command | a `DeviceHost` driver, busy-polling or in `event_loop::run` |
+//! | `pioneer-driver` | request | the emulator on a pty and the Pioneer driver on it |
+//! | `{uds,tcp}-echo-{spin,blocking}` | peers | a socket echo with the same bytes |
+
+use std::io::Write;
+use std::time::{Duration, Instant};
+
+use iceoryx2::prelude::*;
+use limber_services::Domain;
+
+use crate::scenario::{command, floor, peers, state};
+use crate::{BenchArgs, BenchError};
+
+/// Runs `role`; on failure prints `error: <why>` on stdout for the parent, and returns it.
+pub fn run_role(role: &str, args: &BenchArgs) -> Result<(), BenchError> {
+    if let Some(cpu) = args.cpu {
+        pin_to(cpu);
+    }
+    let r = match role {
+        "pubsub-echo" => floor::echo_role(args, floor::Echo::Spin),
+        "event-echo" => floor::echo_role(args, floor::Echo::Listener),
+        "waitset-echo" => floor::echo_role(args, floor::Echo::WaitSet),
+        "state-pub" => state::publisher_role(args),
+        "state-sub" => state::subscriber_role(args),
+        "pioneer-driver" => crate::scenario::request::driver_role(args),
+        "cmd-driver-spin" => command::driver_role(args, true),
+        "cmd-driver-event" => command::driver_role(args, false),
+        "uds-echo-spin" => peers::echo_role(args, peers::Transport::Uds, true),
+        "uds-echo-blocking" => peers::echo_role(args, peers::Transport::Uds, false),
+        "tcp-echo-spin" => peers::echo_role(args, peers::Transport::Tcp, true),
+        "tcp-echo-blocking" => peers::echo_role(args, peers::Transport::Tcp, false),
+        other => Err(BenchError::Args(format!("unknown role {other:?}"))),
+    };
+    if let Err(e) = &r {
+        announce(&format!("error: {e}"));
+    }
+    r
+}
+
+/// Pins the calling thread to core `cpu` (ignored if impossible).
+pub fn pin_to(cpu: usize) {
+    if let Some(id) =
+        core_affinity::get_core_ids().and_then(|ids| ids.into_iter().find(|c| c.id == cpu))
+    {
+        let _ = core_affinity::set_for_current(id);
+    }
+}
+
+/// Prints a line for the parent and flushes.
+pub fn announce(line: &str) {
+    let mut out = std::io::stdout().lock();
+    let _ = writeln!(out, "{line}");
+    let _ = out.flush();
+}
+
+/// The child's domain.
+pub fn child_domain(args: &BenchArgs) -> Result<Domain, BenchError> {
+    let name = args
+        .domain
+        .as_deref()
+        .ok_or_else(|| BenchError::Args("--domain is required for this role".into()))?;
+    Domain::new(name).map_err(|e| BenchError::Args(e.to_string()))
+}
+
+/// The child's deadline, from now.
+pub fn child_deadline(args: &BenchArgs) -> Instant {
+    Instant::now() + Duration::from_millis(args.deadline_ms)
+}
+
+/// Writes the child's histogram where the parent expects it.
+pub fn write_histogram(
+    args: &BenchArgs,
+    h: &hdrhistogram::Histogram<u64>,
+) -> Result<(), BenchError> {
+    let path = args
+        .out
+        .as_ref()
+        .ok_or_else(|| BenchError::Args("--out is required for this role".into()))?;
+    let bytes = crate::stats::serialize(h)?;
+    std::fs::write(path, bytes).map_err(|e| BenchError::io(path.display().to_string(), e))
+}
+
+/// A raw iceoryx2 node in `domain` (no signal handling: the parent kills children).
+pub fn raw_node(domain: &Domain) -> Result<Node<ipc::Service>, BenchError> {
+    set_log_level_from_env_or(LogLevel::Error);
+    NodeBuilder::new()
+        .config(domain.config())
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<ipc::Service>()
+        .map_err(|e| BenchError::transport("creating an iceoryx2 node", e))
+}
+
+/// Lines from stdin, read by a thread (so that waiting for them has a timeout).
+pub fn stdin_lines() -> std::sync::mpsc::Receiver<String> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        use std::io::BufRead;
+        for l in std::io::stdin().lock().lines() {
+            match l {
+                Ok(l) => {
+                    if tx.send(l).is_err() {
+                        break;
+                    }
+                }
+                Err(_) => break,
+            }
+        }
+    });
+    rx
+}

@@ -1,0 +1,279 @@
+//! `command`: a limber-services client sends an actarray POS command, a driver process
+//! (`DeviceHost` with a handler that moves at once) receives it and publishes its
+//! outcome, the client sees the outcome in the next state sample
+//! (`Client::move_to` + `Client::wait_outcome`).
+//!
+//! * spin: the driver busy-polls `DeviceHost::process`; the client spins
+//!   (`WaitMode::Spin`, no wake-up events): the driver's `--spin` mode.
+//! * blocking: the driver waits in `event_loop::run` (WaitSet on the wake listener); the
+//!   client blocks on the notify listener (`WaitMode::Event`, the default).
+//!
+//! Round trip: client clock before `move_to` to after `wait_outcome`. One-way
+//! client→driver: `MsgMeta.stamp_ns` (set in `Client::send`) against the driver's clock
+//! at the top of the handler. One-way driver→client: the state stamp (set in the handler)
+//! against the client's clock when `wait_outcome` returned.
+
+use std::ops::ControlFlow;
+use std::time::{Duration, Instant};
+
+use limber_interfaces::prelude::*;
+use limber_services::event_loop;
+use limber_services::prelude::*;
+use limber_services::{Role, WaitMode, monotonic_ns};
+
+use super::floor::BYTES;
+use super::{READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario};
+use crate::child::{ChildProc, ChildSpec, read_histogram};
+use crate::progress::Progress;
+use crate::roles;
+use crate::stats::{Measurement, Metric, Strategy, new_histogram};
+use crate::{BenchArgs, BenchError};
+
+/// The device the benchmark driver offers.
+pub const DEVICE: &str = "bench/actarray/0";
+
+/// The `command` scenario.
+#[derive(Debug, Clone, Copy)]
+pub struct Command;
+
+impl Scenario for Command {
+    fn name(&self) -> &'static str {
+        "command"
+    }
+    fn description(&self) -> &'static str {
+        "limber-services command -> driver -> published outcome seen by the client (DeviceHost/Client), spin and event-driven"
+    }
+    fn run(&self, ctx: &mut RunCtx) -> Result<(), BenchError> {
+        if ctx.spin_enabled() {
+            run_mode(ctx, true)?;
+        }
+        if ctx.blocking_enabled() {
+            run_mode(ctx, false)?;
+        }
+        Ok(())
+    }
+}
+
+fn ctx_err(what: &str) -> impl Fn(String) -> BenchError + '_ {
+    move |reason| BenchError::Transport {
+        context: what.to_string(),
+        reason,
+    }
+}
+
+fn run_mode(ctx: &mut RunCtx, spin: bool) -> Result<(), BenchError> {
+    let domain = ctx.domain();
+    let (warm, n) = if spin {
+        (ctx.count(5_000, 1_000), ctx.count(100_000, 10_000))
+    } else {
+        (ctx.count(500, 100), ctx.count(5_000, 1_000))
+    };
+    let key = if spin { "spin" } else { "event" };
+    let out = ctx.tmp_file(&format!("command-{key}.hdr"));
+    let mut child = ChildProc::spawn(&ChildSpec {
+        role: format!("cmd-driver-{}", if spin { "spin" } else { "event" }),
+        domain: Some(domain.name().to_string()),
+        out: Some(out.clone()),
+        cpu: ctx.child_cpu(),
+        warmup: warm,
+        deadline: ctx.deadline_for(warm + n, Duration::from_micros(100)),
+        ..Default::default()
+    })?;
+    child.expect("ready", READY_TIMEOUT)?;
+
+    let cctx = Context::new(&domain, Role::Client, "bench-client")
+        .map_err(|e| ctx_err("client context")(e.to_string()))?;
+    let mut client = ActArrayClient::connect_timeout(&cctx, DEVICE, READY_TIMEOUT)
+        .map_err(|e| ctx_err("connect")(e.to_string()))?;
+    if spin {
+        client.set_wait_mode(WaitMode::Spin);
+        client.set_wake_driver(false);
+    }
+
+    let mut rtt = new_histogram()?;
+    let mut back = new_histogram()?;
+    let progress = Progress::new(ctx.progress, &format!("command {key}"), warm + n);
+    for i in 1..=warm + n {
+        let target = if i % 2 == 0 { 0.25 } else { -0.25 };
+        let t0 = monotonic_ns();
+        let ticket = client
+            .move_to(0, target)
+            .map_err(|e| ctx_err("move_to")(e.to_string()))?;
+        let status = client
+            .wait_outcome(ticket, SAMPLE_TIMEOUT)
+            .map_err(|e| match e {
+                limber_services::WaitError::Timeout(t) => BenchError::Timeout {
+                    what: format!("outcome of command {i}"),
+                    timeout: t,
+                },
+                other => ctx_err("wait_outcome")(other.to_string()),
+            })?;
+        let t1 = monotonic_ns();
+        if status != Status::Ok {
+            return Err(ctx_err("command")(format!("refused: {status}")));
+        }
+        if i > warm {
+            rtt.saturating_record(t1.saturating_sub(t0));
+            if let Some(s) = client.last_state() {
+                back.saturating_record(t1.saturating_sub(s.header.stamp_ns));
+            }
+        }
+        progress.tick(i);
+    }
+    progress.finish();
+    // HOME all joints stops the driver.
+    let _ = client.home(None);
+    child.finish(Duration::from_secs(10))?;
+    let oneway = read_histogram(&out)?;
+
+    let strategy = if spin {
+        Strategy::Spin
+    } else {
+        Strategy::Blocking
+    };
+    ctx.push(Measurement {
+        scenario: "command",
+        id: format!("command.{key}.rtt"),
+        label: "command→outcome".into(),
+        strategy,
+        metric: Metric::RoundTrip,
+        bytes: Some(BYTES),
+        hist: rtt,
+    });
+    ctx.push(Measurement {
+        scenario: "command",
+        id: format!("command.{key}.oneway"),
+        label: "command client→driver".into(),
+        strategy,
+        metric: Metric::OneWay,
+        bytes: Some(BYTES),
+        hist: oneway,
+    });
+    ctx.push(Measurement {
+        scenario: "command",
+        id: format!("command.{key}.back"),
+        label: "outcome driver→client".into(),
+        strategy,
+        metric: Metric::OneWay,
+        bytes: Some(BYTES),
+        hist: back,
+    });
+    Ok(())
+}
+
+/// The benchmark arm: 6 joints that move at once; records the one-way latency of every
+/// command after the warm-up; HOME (all joints) asks the driver to stop.
+struct BenchArm {
+    oneway: hdrhistogram::Histogram<u64>,
+    warmup: u64,
+    stop: bool,
+}
+
+impl DeviceHandler<ActArray> for BenchArm {
+    fn command(
+        &mut self,
+        cmd: &ActArrayCommand,
+        from: &Origin,
+        state: &mut ActArrayData,
+    ) -> Status {
+        let now = monotonic_ns();
+        let status = match *cmd {
+            ActArrayCommand::Position { joint, position } => {
+                if from.seq > self.warmup {
+                    self.oneway
+                        .saturating_record(now.saturating_sub(from.sent_ns));
+                }
+                match state.actuators.get_mut(joint as usize) {
+                    Some(a) => {
+                        a.position = position;
+                        Status::Ok
+                    }
+                    None => Status::UnknownJoint,
+                }
+            }
+            ActArrayCommand::Home(_) => {
+                self.stop = true;
+                Status::Ok
+            }
+            _ => Status::Unsupported,
+        };
+        // The state is "acquired" now: its stamp is the start of the driver→client leg.
+        state.header.stamp_ns = monotonic_ns();
+        status
+    }
+
+    fn request(
+        &mut self,
+        _req: &ActArrayRequest,
+        _from: &Origin,
+        _state: &mut ActArrayData,
+    ) -> Result<ActArrayReply, Status> {
+        Err(Status::Unsupported)
+    }
+}
+
+/// The driver child (`cmd-driver-spin`, `cmd-driver-event`).
+pub fn driver_role(args: &BenchArgs, spin: bool) -> Result<(), BenchError> {
+    let domain = roles::child_domain(args)?;
+    let deadline = roles::child_deadline(args);
+    let ctx = Context::new(&domain, Role::Driver, "bench-driver")
+        .map_err(|e| ctx_err("driver context")(e.to_string()))?;
+    let device: DeviceName = DEVICE
+        .parse()
+        .map_err(|e: limber_services::NameError| ctx_err("device")(e.to_string()))?;
+    let mut host = DeviceHost::<ActArray>::new(&ctx, &device, "bench")
+        .map_err(|e| ctx_err("driver host")(e.to_string()))?;
+    host.state_mut().actuators_count = 6;
+    host.publish()
+        .map_err(|e| ctx_err("publish")(e.to_string()))?;
+    let mut arm = BenchArm {
+        oneway: new_histogram()?,
+        warmup: args.warmup,
+        stop: false,
+    };
+    if spin {
+        roles::announce("ready");
+        let mut i = 0u32;
+        loop {
+            let a = host
+                .process(&mut arm)
+                .map_err(|e| ctx_err("process")(e.to_string()))?;
+            if arm.stop {
+                break;
+            }
+            if a.commands == 0 {
+                i = i.wrapping_add(1);
+                if i & 0xffff == 0 && Instant::now() > deadline {
+                    return Err(ctx_err("driver")("deadline passed".into()));
+                }
+                core::hint::spin_loop();
+            }
+        }
+    } else {
+        let wake = host
+            .take_wake_listener()
+            .ok_or_else(|| ctx_err("driver")("no wake listener".into()))?;
+        let listeners = [wake];
+        roles::announce("ready");
+        let mut failure = None;
+        event_loop::run(&listeners, Duration::from_millis(50), None, |_wake| {
+            if let Err(e) = host.process(&mut arm) {
+                failure = Some(e.to_string());
+                return ControlFlow::Break(());
+            }
+            if arm.stop || Instant::now() > deadline {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        })
+        .map_err(|e| ctx_err("event loop")(e.to_string()))?;
+        if let Some(f) = failure {
+            return Err(ctx_err("process")(f));
+        }
+        if !arm.stop {
+            return Err(ctx_err("driver")("deadline passed".into()));
+        }
+    }
+    roles::write_histogram(args, &arm.oneway)
+}

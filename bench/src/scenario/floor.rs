@@ -1,0 +1,473 @@
+//! `floor`: raw iceoryx2 between two processes, with the payloads of the command path
+//! (a 296 B `ActArrayCmdMsg` out, a 1336 B `ActArrayData` back), no limber-services.
+//!
+//! * spin: both sides busy-poll `receive()`; the floor of the driver's `--spin` mode.
+//! * blocking (`event`): each message is followed by a `notify()` on an event service and
+//!   the other side blocks in `Listener::timed_wait`; the floor of the event-driven mode.
+//! * blocking (`waitset`): the same, but the echo blocks in a WaitSet with its listener
+//!   attached (as a driver's `event_loop::run` does) while the pinger blocks in
+//!   `Listener::timed_wait` (as a client does): separates the WaitSet's cost from the
+//!   services layer's.
+//!
+//! Round trip is measured by the pinging parent; one-way ping→echo by the echo child
+//! (the parent's `CLOCK_MONOTONIC` stamp in `meta.stamp_ns` against its clock on
+//! receipt), one-way echo→ping by the parent (the echo's stamp in `header.stamp_ns`).
+
+use std::time::{Duration, Instant};
+
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::*;
+use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PsFactory;
+use limber_interfaces::prelude::*;
+use limber_services::monotonic_ns;
+
+use super::{READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario};
+use crate::child::{ChildProc, ChildSpec, read_histogram};
+use crate::progress::Progress;
+use crate::roles;
+use crate::stats::{Measurement, Metric, Strategy, new_histogram};
+use crate::{BenchArgs, BenchError};
+
+/// `meta.kind` of the message that stops an echo.
+pub const STOP_KIND: u32 = u32::MAX;
+/// Command and state sizes, bytes.
+pub const BYTES: (usize, usize) = (
+    core::mem::size_of::<ActArrayCmdMsg>(),
+    core::mem::size_of::<ActArrayData>(),
+);
+
+/// The `floor` scenario.
+#[derive(Debug, Clone, Copy)]
+pub struct Floor;
+
+impl Scenario for Floor {
+    fn name(&self) -> &'static str {
+        "floor"
+    }
+    fn description(&self) -> &'static str {
+        "raw iceoryx2 ping-pong, 296 B out / 1336 B back, 2 processes: spinning, and event wake-up (notify -> blocking listener, or WaitSet on the echo side)"
+    }
+    fn run(&self, ctx: &mut RunCtx) -> Result<(), BenchError> {
+        if ctx.spin_enabled() {
+            ping_pong(ctx, Echo::Spin)?;
+        }
+        if ctx.blocking_enabled() {
+            ping_pong(ctx, Echo::Listener)?;
+            ping_pong(ctx, Echo::WaitSet)?;
+        }
+        Ok(())
+    }
+}
+
+/// How the echo side waits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Echo {
+    /// Busy-polls `receive()` (the pinger spins too).
+    Spin,
+    /// Blocks in `Listener::timed_wait` (the pinger too).
+    Listener,
+    /// Blocks in a WaitSet with the listener attached, like a driver's event loop (the
+    /// pinger blocks in `Listener::timed_wait`, like a client).
+    WaitSet,
+}
+
+impl Echo {
+    fn key(self) -> &'static str {
+        match self {
+            Echo::Spin => "spin",
+            Echo::Listener => "event",
+            Echo::WaitSet => "waitset",
+        }
+    }
+    /// The child role.
+    pub fn role(self) -> &'static str {
+        match self {
+            Echo::Spin => "pubsub-echo",
+            Echo::Listener => "event-echo",
+            Echo::WaitSet => "waitset-echo",
+        }
+    }
+}
+
+type Ping = Publisher<ipc::Service, ActArrayCmdMsg, ()>;
+type Pong = Subscriber<ipc::Service, ActArrayData, ()>;
+
+struct Services {
+    a2b: PsFactory<ipc::Service, ActArrayCmdMsg, ()>,
+    b2a: PsFactory<ipc::Service, ActArrayData, ()>,
+    ev_a2b: iceoryx2::service::port_factory::event::PortFactory<ipc::Service>,
+    ev_b2a: iceoryx2::service::port_factory::event::PortFactory<ipc::Service>,
+}
+
+fn services(node: &Node<ipc::Service>, tag: &str) -> Result<Services, BenchError> {
+    let name = |ch: &str| -> Result<ServiceName, BenchError> {
+        ServiceName::new(&format!("limber-bench/{tag}/{ch}"))
+            .map_err(|e| BenchError::transport("service name", e))
+    };
+    let a2b = node
+        .service_builder(&name("a2b")?)
+        .publish_subscribe::<ActArrayCmdMsg>()
+        .max_publishers(1)
+        .max_subscribers(1)
+        .history_size(0)
+        .subscriber_max_buffer_size(4)
+        .open_or_create()
+        .map_err(|e| BenchError::transport("floor a2b service", e))?;
+    let b2a = node
+        .service_builder(&name("b2a")?)
+        .publish_subscribe::<ActArrayData>()
+        .max_publishers(1)
+        .max_subscribers(1)
+        .history_size(0)
+        .subscriber_max_buffer_size(4)
+        .open_or_create()
+        .map_err(|e| BenchError::transport("floor b2a service", e))?;
+    let ev_a2b = node
+        .service_builder(&name("ev_a2b")?)
+        .event()
+        .open_or_create()
+        .map_err(|e| BenchError::transport("floor ev_a2b service", e))?;
+    let ev_b2a = node
+        .service_builder(&name("ev_b2a")?)
+        .event()
+        .open_or_create()
+        .map_err(|e| BenchError::transport("floor ev_b2a service", e))?;
+    Ok(Services {
+        a2b,
+        b2a,
+        ev_a2b,
+        ev_b2a,
+    })
+}
+
+fn send_ping(p: &Ping, seq: u64, kind: u32) -> Result<(), BenchError> {
+    let loan = p
+        .loan_uninit()
+        .map_err(|e| BenchError::transport("loan ping", e))?;
+    let mut s = loan.write_payload(ActArrayCmdMsg::default());
+    let m = &mut s.payload_mut().meta;
+    m.seq = seq;
+    m.kind = kind;
+    m.stamp_ns = monotonic_ns();
+    s.send()
+        .map_err(|e| BenchError::transport("send ping", e))?;
+    Ok(())
+}
+
+/// Waits for the pong of `seq`: returns (receipt time, the echo's stamp).
+fn recv_pong(
+    sub: &Pong,
+    listener: Option<&Listener<ipc::Service>>,
+    seq: u64,
+    timeout: Duration,
+) -> Result<(u64, u64), BenchError> {
+    let mut spins = 0u32;
+    let mut deadline: Option<Instant> = None;
+    loop {
+        while let Some(s) = sub
+            .receive()
+            .map_err(|e| BenchError::transport("receive pong", e))?
+        {
+            let t1 = monotonic_ns();
+            if s.header.seq == seq {
+                return Ok((t1, s.header.stamp_ns));
+            }
+        }
+        match listener {
+            Some(l) => {
+                let d = *deadline.get_or_insert_with(|| Instant::now() + timeout);
+                let left = d.saturating_duration_since(Instant::now());
+                if left.is_zero() {
+                    return Err(BenchError::Timeout {
+                        what: format!("floor pong {seq}"),
+                        timeout,
+                    });
+                }
+                l.timed_wait(|_| {}, left)
+                    .map_err(|e| BenchError::transport("wait for pong", e))?;
+            }
+            None => {
+                spins = spins.wrapping_add(1);
+                if spins & 0x3fff == 0 {
+                    let d = *deadline.get_or_insert_with(|| Instant::now() + timeout);
+                    if Instant::now() >= d {
+                        return Err(BenchError::Timeout {
+                            what: format!("floor pong {seq}"),
+                            timeout,
+                        });
+                    }
+                }
+                core::hint::spin_loop();
+            }
+        }
+    }
+}
+
+fn notify(n: Option<&Notifier<ipc::Service>>) -> Result<(), BenchError> {
+    if let Some(n) = n {
+        n.notify().map_err(|e| BenchError::transport("notify", e))?;
+    }
+    Ok(())
+}
+
+/// Sends ping 0 until its pong arrives: both sides are connected afterwards.
+fn sync(
+    p: &Ping,
+    sub: &Pong,
+    notifier: Option<&Notifier<ipc::Service>>,
+    listener: Option<&Listener<ipc::Service>>,
+) -> Result<(), BenchError> {
+    let deadline = Instant::now() + READY_TIMEOUT;
+    loop {
+        send_ping(p, 0, 0)?;
+        notify(notifier)?;
+        match recv_pong(sub, listener, 0, Duration::from_millis(10)) {
+            Ok(_) => return Ok(()),
+            Err(BenchError::Timeout { .. }) if Instant::now() < deadline => {}
+            Err(e) => return Err(e),
+        }
+    }
+}
+
+fn ping_pong(ctx: &mut RunCtx, echo: Echo) -> Result<(), BenchError> {
+    let event = echo != Echo::Spin;
+    let domain = ctx.domain();
+    let node = roles::raw_node(&domain)?;
+    let tag = format!("floor-{}", echo.key());
+    let tag = tag.as_str();
+    let svc = services(&node, tag)?;
+    let publisher = svc
+        .a2b
+        .publisher_builder()
+        .create()
+        .map_err(|e| BenchError::transport("floor publisher", e))?;
+    let subscriber = svc
+        .b2a
+        .subscriber_builder()
+        .create()
+        .map_err(|e| BenchError::transport("floor subscriber", e))?;
+    let (notifier, listener) = if event {
+        (
+            Some(
+                svc.ev_a2b
+                    .notifier_builder()
+                    .create()
+                    .map_err(|e| BenchError::transport("floor notifier", e))?,
+            ),
+            Some(
+                svc.ev_b2a
+                    .listener_builder()
+                    .create()
+                    .map_err(|e| BenchError::transport("floor listener", e))?,
+            ),
+        )
+    } else {
+        (None, None)
+    };
+    let (warm, n) = if event {
+        (ctx.count(500, 100), ctx.count(5_000, 1_000))
+    } else {
+        (ctx.count(5_000, 1_000), ctx.count(100_000, 10_000))
+    };
+    let out = ctx.tmp_file(&format!("{tag}.hdr"));
+    let mut child = ChildProc::spawn(&ChildSpec {
+        role: echo.role().into(),
+        domain: Some(domain.name().to_string()),
+        out: Some(out.clone()),
+        cpu: ctx.child_cpu(),
+        warmup: warm,
+        deadline: ctx.deadline_for(warm + n, Duration::from_micros(100)),
+        ..Default::default()
+    })?;
+    child.expect("ready", READY_TIMEOUT)?;
+    sync(
+        &publisher,
+        &subscriber,
+        notifier.as_ref(),
+        listener.as_ref(),
+    )?;
+
+    let mut rtt = new_histogram()?;
+    let mut back = new_histogram()?;
+    let label = format!("floor {}", echo.key());
+    let progress = Progress::new(ctx.progress, &label, warm + n);
+    for seq in 1..=warm + n {
+        let t0 = monotonic_ns();
+        send_ping(&publisher, seq, 0)?;
+        notify(notifier.as_ref())?;
+        let (t1, stamp) = recv_pong(&subscriber, listener.as_ref(), seq, SAMPLE_TIMEOUT)?;
+        if seq > warm {
+            rtt.saturating_record(t1.saturating_sub(t0));
+            back.saturating_record(t1.saturating_sub(stamp));
+        }
+        progress.tick(seq);
+    }
+    progress.finish();
+    send_ping(&publisher, warm + n + 1, STOP_KIND)?;
+    notify(notifier.as_ref())?;
+    child.finish(Duration::from_secs(10))?;
+    let oneway = read_histogram(&out)?;
+
+    let strategy = if event {
+        Strategy::Blocking
+    } else {
+        Strategy::Spin
+    };
+    let key = echo.key();
+    let via = if echo == Echo::WaitSet {
+        ", echo in WaitSet"
+    } else {
+        ""
+    };
+    ctx.push(Measurement {
+        scenario: "floor",
+        id: format!("floor.{key}.rtt"),
+        label: format!("iceoryx2 ping-pong{via}"),
+        strategy,
+        metric: Metric::RoundTrip,
+        bytes: Some(BYTES),
+        hist: rtt,
+    });
+    ctx.push(Measurement {
+        scenario: "floor",
+        id: format!("floor.{key}.oneway"),
+        label: format!("iceoryx2 ping→echo{via}"),
+        strategy,
+        metric: Metric::OneWay,
+        bytes: Some(BYTES),
+        hist: oneway,
+    });
+    ctx.push(Measurement {
+        scenario: "floor",
+        id: format!("floor.{key}.back"),
+        label: format!("iceoryx2 echo→ping{via}"),
+        strategy,
+        metric: Metric::OneWay,
+        bytes: Some(BYTES),
+        hist: back,
+    });
+    Ok(())
+}
+
+/// The echo child (`pubsub-echo`, `event-echo`, `waitset-echo`).
+pub fn echo_role(args: &BenchArgs, echo: Echo) -> Result<(), BenchError> {
+    let event = echo != Echo::Spin;
+    let domain = roles::child_domain(args)?;
+    let deadline = roles::child_deadline(args);
+    let node = roles::raw_node(&domain)?;
+    let svc = services(&node, &format!("floor-{}", echo.key()))?;
+    let sub = svc
+        .a2b
+        .subscriber_builder()
+        .create()
+        .map_err(|e| BenchError::transport("echo subscriber", e))?;
+    let publisher = svc
+        .b2a
+        .publisher_builder()
+        .create()
+        .map_err(|e| BenchError::transport("echo publisher", e))?;
+    let (listener, notifier) = if event {
+        (
+            Some(
+                svc.ev_a2b
+                    .listener_builder()
+                    .create()
+                    .map_err(|e| BenchError::transport("echo listener", e))?,
+            ),
+            Some(
+                svc.ev_b2a
+                    .notifier_builder()
+                    .create()
+                    .map_err(|e| BenchError::transport("echo notifier", e))?,
+            ),
+        )
+    } else {
+        (None, None)
+    };
+    let mut oneway = new_histogram()?;
+    let waitset = if echo == Echo::WaitSet {
+        Some(
+            WaitSetBuilder::new()
+                .create::<ipc::Service>()
+                .map_err(|e| BenchError::transport("echo waitset", e))?,
+        )
+    } else {
+        None
+    };
+    let guard = match (&waitset, &listener) {
+        (Some(ws), Some(l)) => Some(
+            ws.attach_notification(l)
+                .map_err(|e| BenchError::transport("echo waitset attach", e))?,
+        ),
+        _ => None,
+    };
+    roles::announce("ready");
+    let mut spins = 0u32;
+    loop {
+        while let Some(s) = sub
+            .receive()
+            .map_err(|e| BenchError::transport("echo receive", e))?
+        {
+            let now = monotonic_ns();
+            let meta = s.meta;
+            drop(s);
+            if meta.kind == STOP_KIND {
+                return roles::write_histogram(args, &oneway);
+            }
+            if meta.seq > args.warmup {
+                oneway.saturating_record(now.saturating_sub(meta.stamp_ns));
+            }
+            let loan = publisher
+                .loan_uninit()
+                .map_err(|e| BenchError::transport("echo loan", e))?;
+            let mut r = loan.write_payload(ActArrayData::default());
+            let h = &mut r.payload_mut().header;
+            h.seq = meta.seq;
+            h.stamp_ns = monotonic_ns();
+            r.send()
+                .map_err(|e| BenchError::transport("echo send", e))?;
+            notify(notifier.as_ref())?;
+        }
+        match &listener {
+            Some(l) => {
+                match (&waitset, &guard) {
+                    (Some(ws), Some(g)) => {
+                        ws.wait_and_process_once_with_timeout(
+                            |id| {
+                                if id.has_event_from(g) {
+                                    let _ = l.try_wait(|_| {});
+                                }
+                                CallbackProgression::Continue
+                            },
+                            Duration::from_millis(50),
+                        )
+                        .map_err(|e| BenchError::transport("echo waitset wait", e))?;
+                    }
+                    _ => {
+                        l.timed_wait(|_| {}, Duration::from_millis(50))
+                            .map_err(|e| BenchError::transport("echo wait", e))?;
+                    }
+                }
+                if Instant::now() > deadline {
+                    return Err(BenchError::Timeout {
+                        what: "echo: the ping side stopped".into(),
+                        timeout: Duration::from_millis(args.deadline_ms),
+                    });
+                }
+            }
+            None => {
+                spins = spins.wrapping_add(1);
+                if spins & 0xffff == 0 && Instant::now() > deadline {
+                    return Err(BenchError::Timeout {
+                        what: "echo: the ping side stopped".into(),
+                        timeout: Duration::from_millis(args.deadline_ms),
+                    });
+                }
+                core::hint::spin_loop();
+            }
+        }
+    }
+}

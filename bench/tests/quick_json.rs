@@ -1,0 +1,110 @@
+//! End to end: the quick mode of cheap scenarios (floor, ik, and the `loop` placeholder) with
+//! small counts, through the real binary and its child processes; checks the structure
+//! of the JSON report and of the SVG plot. Asserts structure, never speed.
+
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+use serde_json::Value;
+
+#[test]
+fn quick_run_writes_a_well_formed_report() {
+    let dir = std::env::temp_dir().join(format!("limber-bench-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let json = dir.join("report.json");
+    let svg = dir.join("report.svg");
+    let start = Instant::now();
+    let out = Command::new(env!("CARGO_BIN_EXE_limber-bench"))
+        .args(["--quick", "--scale", "0.1", "--no-progress", "--only"])
+        .arg("floor,ik,loop")
+        .arg("--json")
+        .arg(&json)
+        .arg("--plot")
+        .arg(&svg)
+        .output()
+        .expect("the benchmark binary runs");
+    assert!(
+        out.status.success(),
+        "limber-bench failed: {}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(start.elapsed() < Duration::from_secs(60));
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("machine:"), "{table}");
+    assert!(table.contains("not yet available"), "{table}");
+
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let machine = &v["machine"];
+    for k in ["cpu", "cores", "kernel", "load_avg", "pinning", "build"] {
+        assert!(!machine[k].is_null(), "machine.{k} missing: {machine}");
+    }
+    assert_eq!(v["jitter_definition"], "jitter = p99 - p50");
+
+    let scenarios = v["scenarios"].as_array().unwrap();
+    let status = |name: &str| {
+        scenarios
+            .iter()
+            .find(|s| s["name"] == name)
+            .map(|s| s["status"].as_str().unwrap().to_string())
+    };
+    assert_eq!(status("floor").as_deref(), Some("ok"));
+    assert_eq!(status("ik").as_deref(), Some("ok"));
+    assert_eq!(status("loop").as_deref(), Some("not_available"));
+
+    let ms = v["measurements"].as_array().unwrap();
+    let ids: Vec<&str> = ms.iter().map(|m| m["id"].as_str().unwrap()).collect();
+    for id in [
+        "floor.spin.rtt",
+        "floor.spin.oneway",
+        "floor.event.rtt",
+        "floor.event.oneway",
+        "ik.pioneer.pose",
+        "ik.chain6.pose",
+    ] {
+        assert!(ids.contains(&id), "{id} missing from {ids:?}");
+    }
+    for m in ms {
+        for k in ["scenario", "label", "strategy", "metric"] {
+            assert!(m[k].is_string(), "{k} in {m}");
+        }
+        let s = &m["summary"];
+        let get = |k: &str| s[k].as_u64().unwrap_or_else(|| panic!("{k} in {s}"));
+        assert!(get("count") > 0, "{m}");
+        assert!(get("p50_ns") <= get("p90_ns"));
+        assert!(get("p90_ns") <= get("p99_ns"));
+        assert!(get("p99_ns") <= get("p999_ns"));
+        assert!(get("p999_ns") <= get("max_ns"));
+        assert_eq!(get("jitter_ns"), get("p99_ns") - get("p50_ns"));
+        assert!(!m["curve"].as_array().unwrap().is_empty());
+    }
+    let strategies: Vec<&str> = ms.iter().map(|m| m["strategy"].as_str().unwrap()).collect();
+    assert!(strategies.contains(&"spin"));
+    assert!(strategies.contains(&"blocking"));
+    assert!(strategies.contains(&"compute"));
+    // The floor-only ratio is computed in the same run.
+    assert!(
+        v["ratios"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|r| r["num"] == "floor.event.rtt")
+    );
+
+    let svg_text = std::fs::read_to_string(&svg).unwrap();
+    assert!(svg_text.starts_with("<svg"), "not an SVG");
+    assert!(svg_text.contains("polyline") || svg_text.contains("path"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn unknown_scenario_is_an_error_not_a_panic() {
+    let out = Command::new(env!("CARGO_BIN_EXE_limber-bench"))
+        .args(["--only", "nosuch"])
+        .output()
+        .expect("the benchmark binary runs");
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("unknown scenario"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}
