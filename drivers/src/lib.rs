@@ -5,3 +5,4 @@ pub mod emulator;
 pub mod kinematics;
 pub mod p2os;
 pub mod pioneer;
+pub mod simarm;
