@@ -240,3 +240,36 @@ fn gripper_closes_on_the_object_and_carries_it() {
         Status::Unsupported
     );
 }
+
+#[test]
+fn a_refused_line_leaves_the_running_one_alone() {
+    let mut m = model(Chain::default_6dof());
+    let st = m.limb_command(
+        &LimbCommand::set_pose(
+            Vec3::new(0.4, 0.0, 0.2),
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::new(1.0, 0.0, 0.0),
+        )
+        .unwrap(),
+    );
+    assert_eq!(st, Status::Ok);
+    run_until_idle(&mut m);
+    let st = m.limb_command(&LimbCommand::vec_move(Vec3::new(0.0, 1.0, 0.0), 0.1).unwrap());
+    assert_eq!(st, Status::Ok);
+    m.advance(0.02);
+    assert!(m.limb_moving());
+    let st = m.limb_command(&LimbCommand::vec_move(Vec3::new(1.0, 0.0, 0.0), 2.0).unwrap());
+    assert_eq!(st, Status::OutOfReach);
+    run_until_idle(&mut m);
+    let p = m.tool_pose().position;
+    assert!((p - Vector3::new(0.4, 0.1, 0.2)).norm() < 1e-5, "{p:?}");
+    // Limb STOP stops a line at once.
+    let st = m.limb_command(&LimbCommand::vec_move(Vec3::new(0.0, -1.0, 0.0), 0.1).unwrap());
+    assert_eq!(st, Status::Ok);
+    m.advance(0.02);
+    assert_eq!(m.limb_command(&LimbCommand::Stop), Status::Ok);
+    assert!(!moving(&m));
+    let mut s = LimbData::default();
+    m.limb_state(&mut s);
+    assert_eq!(s.state, LimbState::Idle as u32);
+}

@@ -46,8 +46,8 @@ pub struct SimArmArgs {
     pub time_scale: f64,
     /// An object to grasp: x,y,z of its centre (m, robot frame) and its width (m),
     /// e.g. `--object 0.45,0.1,0.1,0.04`.
-    #[arg(long, value_name = "X,Y,Z,WIDTH", value_delimiter = ',', num_args = 4)]
-    pub object: Option<Vec<f64>>,
+    #[arg(long, value_name = "X,Y,Z,WIDTH", value_parser = parse_object)]
+    pub object: Option<SimObject>,
 }
 
 impl SimArmArgs {
@@ -66,13 +66,33 @@ impl SimArmArgs {
             robot: self.robot.clone(),
             tick: Duration::from_millis(self.tick_ms),
             time_scale: self.time_scale,
-            object: self.object.as_deref().and_then(|v| match v {
-                [x, y, z, w] => Some(SimObject::block([*x, *y, *z], *w)),
-                _ => None,
-            }),
+            object: self.object,
             ..SimArmOptions::default()
         }
     }
+}
+
+/// Parses `x,y,z,width` (metres) into a block captured within 2 cm.
+fn parse_object(s: &str) -> Result<SimObject, String> {
+    let mut v = [0.0; 4];
+    let mut n = 0;
+    for part in s.split(',') {
+        if n == 4 {
+            return Err("expected 4 numbers: x,y,z,width".into());
+        }
+        v[n] = part
+            .trim()
+            .parse::<f64>()
+            .map_err(|e| format!("{part:?}: {e}"))?;
+        n += 1;
+    }
+    if n != 4 {
+        return Err("expected 4 numbers: x,y,z,width".into());
+    }
+    if !(v.iter().all(|x| x.is_finite()) && v[3] > 0.0) {
+        return Err("values must be finite and the width > 0".into());
+    }
+    Ok(SimObject::block([v[0], v[1], v[2]], v[3]))
 }
 
 /// Runs `limber simarm` until SIGINT/SIGTERM: joins the domain of `LIMBER_DOMAIN`,

@@ -185,6 +185,9 @@ enum GripperCmd {
 #[derive(Debug)]
 struct VecMovePlan {
     waypoints: Vec<JointVec>,
+    /// Where a new line is solved, swapped with `waypoints` once every waypoint is
+    /// known, so a refused line leaves the running one untouched.
+    scratch: Vec<JointVec>,
     next: usize,
     /// Tool distance between waypoints, m.
     step: f64,
@@ -270,6 +273,7 @@ impl ArmModel {
             powered: true,
             vecmove: VecMovePlan {
                 waypoints: Vec::with_capacity(MAX_WAYPOINTS),
+                scratch: Vec::with_capacity(MAX_WAYPOINTS),
                 next: 0,
                 step: options.vecmove_step,
                 active: false,
@@ -861,9 +865,9 @@ impl ArmModel {
         if count > MAX_WAYPOINTS {
             return Err(Status::InvalidArgument);
         }
-        // Solve into a scratch copy of the plan so a refusal leaves the running one intact.
+        // Solve into the scratch buffer so a refusal leaves the running line intact.
         let mut seed = self.q();
-        let mut plan = core::mem::take(&mut self.vecmove.waypoints);
+        let mut plan = core::mem::take(&mut self.vecmove.scratch);
         plan.clear();
         let mut result = Ok(());
         for k in 1..=count {
@@ -888,15 +892,11 @@ impl ArmModel {
                 }
             }
         }
-        self.vecmove.waypoints = plan;
         if let Err(e) = result {
-            // The refused line does not disturb a line being streamed... which was
-            // overwritten: stop streaming rather than follow a half-planned line.
-            if self.vecmove.active {
-                self.stop_all_joints();
-            }
+            self.vecmove.scratch = plan;
             return Err(e);
         }
+        self.vecmove.scratch = core::mem::replace(&mut self.vecmove.waypoints, plan);
         self.vecmove.step = if count > 0 {
             length / count as f64
         } else {
