@@ -104,6 +104,7 @@ fn start_pioneer(domain: &Domain) -> Result<Running, CliError> {
             };
             let _ = tx.send(Ok(path));
             let _ = driver.run_until(RunOptions::default(), || s.load(Ordering::Relaxed));
+            driver.shutdown();
             drop(driver);
             let _ = emu.stop();
         })

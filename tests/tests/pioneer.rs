@@ -188,17 +188,25 @@ fn a_killed_link_is_detected_reported_and_recovered_without_restart() {
     assert!(wait_flag(&mut arm, true, T));
 
     emu.disconnect();
-    assert!(wait_flag(&mut arm, false, T), "link down not reported");
-    assert!(
-        wait_flag(&mut arm, true, Duration::from_secs(10)),
-        "link not recovered"
-    );
+    // The fault is detected and recovered from (a reconnect takes a fraction of a second,
+    // so the link-down samples may be superseded before this client reads them: the
+    // statistics count both).
+    let mut stats = StatsReader::open(&c, "pioneer").unwrap();
+    let deadline = Instant::now() + Duration::from_secs(15);
+    loop {
+        if let Ok(s) = stats.wait(Duration::from_secs(2))
+            && s.link_faults >= 1
+            && s.reconnects >= 1
+            && s.header.flags & limber_interfaces::device_flag::LINK_UP != 0
+        {
+            break;
+        }
+        assert!(Instant::now() < deadline, "link not recovered");
+    }
+    assert!(wait_flag(&mut arm, true, T));
     arm.power(true).unwrap();
     let t = arm.move_to(0, 0.3).unwrap();
     assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
-    let mut stats = StatsReader::open(&c, "pioneer").unwrap();
-    let s = stats.wait(Duration::from_secs(3)).unwrap();
-    assert!(s.reconnects >= 1 && s.link_faults >= 1, "{s:?}");
 }
 
 #[test]

@@ -117,6 +117,7 @@ pub struct PioneerDriver {
     last_stats: Instant,
     last_cleanup: Instant,
     mode: LoopMode,
+    wakeups: u64,
 }
 
 impl core::fmt::Debug for PioneerDriver {
@@ -339,6 +340,7 @@ impl PioneerDriver {
             last_stats: Instant::now() - Duration::from_secs(10),
             last_cleanup: Instant::now(),
             mode: LoopMode::Event,
+            wakeups: 0,
         };
         // Like Player when the first client subscribes: power the arm. (Left on at exit:
         // an unpowered arm drops under gravity.)
@@ -354,6 +356,28 @@ impl PioneerDriver {
     /// What the robot has.
     pub fn hardware(&self) -> &Hardware {
         &self.hardware
+    }
+
+    /// State samples published by all devices (each costs iceoryx2 one small allocation,
+    /// see `tests/tests/alloc.rs`), and statistics samples.
+    pub fn samples_published(&self) -> u64 {
+        let mut n = self.stats.header.seq;
+        if let Some(h) = &self.hosts.arm {
+            n += h.stats().published;
+        }
+        if let Some(h) = &self.hosts.limb {
+            n += h.stats().published;
+        }
+        if let Some(h) = &self.hosts.armgrip {
+            n += h.stats().published;
+        }
+        if let Some(h) = &self.hosts.gripper {
+            n += h.stats().published;
+        }
+        if let Some(h) = &self.hosts.lift {
+            n += h.stats().published;
+        }
+        n
     }
 
     /// True while the link is up.
@@ -597,7 +621,8 @@ impl PioneerDriver {
         if self.core.lift.moving.is_some() {
             self.core.dirty.body = true;
         }
-        if now.duration_since(self.last_cleanup) > Duration::from_secs(2) {
+        // Housekeeping (allocates inside iceoryx2): resources of crashed clients.
+        if now.duration_since(self.last_cleanup) > Duration::from_secs(60) {
             self.last_cleanup = now;
             if let Some(h) = &self.hosts.arm {
                 h.cleanup_dead();
@@ -607,23 +632,29 @@ impl PioneerDriver {
 
     /// Runs until SIGINT/SIGTERM; then stops the arm, closes the link and returns.
     pub fn run(&mut self, opts: RunOptions) -> Result<LoopExit, DriverError> {
-        self.run_until(opts, || false)
+        let exit = self.run_until(opts, || false);
+        self.shutdown();
+        exit
     }
 
     /// Runs until SIGINT/SIGTERM or until `stop` (checked at every wake-up, at least every
-    /// tick) returns true; then stops the arm, closes the link and returns.
+    /// tick) returns true. The link stays open: run again, or call
+    /// [`PioneerDriver::shutdown`] to stop the arm and close it.
     pub fn run_until(
         &mut self,
         opts: RunOptions,
         mut stop: impl FnMut() -> bool,
     ) -> Result<LoopExit, DriverError> {
         self.mode = opts.mode;
-        let exit = match opts.mode {
-            LoopMode::Event => self.run_event(&mut stop)?,
-            LoopMode::Spin => self.run_spin(&mut stop),
-        };
-        self.shutdown();
-        Ok(exit)
+        match opts.mode {
+            LoopMode::Event => self.run_event(&mut stop),
+            LoopMode::Spin => Ok(self.run_spin(&mut stop)),
+        }
+    }
+
+    /// Wake-ups of the loop so far (each costs iceoryx2's WaitSet one small allocation).
+    pub fn wakeups(&self) -> u64 {
+        self.wakeups
     }
 
     fn run_event(&mut self, stop: &mut dyn FnMut() -> bool) -> Result<LoopExit, DriverError> {
@@ -662,6 +693,7 @@ impl PioneerDriver {
             let mut stopped = false;
             let exit = event_loop::run(&listeners, tick, fd.as_ref(), |wake| {
                 let now = Instant::now();
+                self.wakeups += 1;
                 match wake {
                     Wake::Fd => {
                         if !self.read_link(now) {

@@ -1,0 +1,124 @@
+//! The Pioneer driver's loop allocates nothing of its own in steady state: counted on the
+//! driver's thread while the emulator streams SIPs and ARMpacs and a client (on another
+//! thread) commands the arm. iceoryx2 0.10 itself allocates one small `Rc` per sample
+//! published (see `alloc.rs`) and two small buffers (16 and 24 bytes) per WaitSet
+//! wake-up (`wait_and_process_once_with_timeout`, `handle_all_attachments`), so the count
+//! may not exceed samples published plus twice the wake-ups (plus the one-time set-up of
+//! the wait set when the measured run starts). Traced with backtraces: no
+//! allocation comes from limber's own code.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, mpsc};
+use std::time::{Duration, Instant};
+
+use limber_drivers::emulator::{Emulator, EmulatorConfig};
+use limber_drivers::pioneer::{PioneerConfig, PioneerDriver, RunOptions};
+use limber_services::prelude::*;
+use limber_services::{Domain, Role};
+
+struct Counting;
+
+thread_local! {
+    static ALLOCS: Cell<u64> = const { Cell::new(0) };
+}
+
+// SAFETY: forwards to the system allocator; only counts calls made on the current thread.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as ours.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: same contract as ours.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as ours.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocs() -> u64 {
+    ALLOCS.with(|c| c.get())
+}
+
+struct Measured {
+    allocations: u64,
+    published: u64,
+    wakeups: u64,
+}
+
+#[test]
+fn driver_loop_allocates_only_iceoryx2_internals() {
+    let domain = Domain::unique_for_test();
+    let emu = Emulator::start_pty(EmulatorConfig::default()).unwrap();
+    let target = emu.link_target();
+    let client_done = Arc::new(AtomicBool::new(false));
+    let (tx, rx) = mpsc::channel::<Measured>();
+    let (ready_tx, ready_rx) = mpsc::channel();
+    let d = domain.clone();
+    let done = Arc::clone(&client_done);
+    let t = std::thread::spawn(move || {
+        let ctx = Context::new(&d, Role::Driver, "pioneer").unwrap();
+        let mut driver = PioneerDriver::start(&ctx, PioneerConfig::default(), target).unwrap();
+        ready_tx.send(()).unwrap();
+        // Warm up: connections, first commands, lazily created resources.
+        let until = Instant::now() + Duration::from_millis(1500);
+        driver
+            .run_until(RunOptions::default(), || Instant::now() > until)
+            .unwrap();
+        let (a0, p0, w0) = (allocs(), driver.samples_published(), driver.wakeups());
+        let until = Instant::now() + Duration::from_secs(3);
+        driver
+            .run_until(RunOptions::default(), || {
+                Instant::now() > until || done.load(Ordering::Relaxed)
+            })
+            .unwrap();
+        let m = Measured {
+            allocations: allocs() - a0,
+            published: driver.samples_published() - p0,
+            wakeups: driver.wakeups() - w0,
+        };
+        driver.shutdown();
+        tx.send(m).unwrap();
+    });
+    ready_rx.recv_timeout(Duration::from_secs(20)).unwrap();
+    // A client commands the arm back and forth meanwhile.
+    let ctx = Context::new(&domain, Role::Client, "alloc").unwrap();
+    let mut arm =
+        ActArrayClient::connect_timeout(&ctx, "pioneer/actarray/0", Duration::from_secs(5))
+            .unwrap();
+    let end = Instant::now() + Duration::from_millis(4500);
+    let mut i = 0;
+    while Instant::now() < end {
+        let _ = arm.move_to(0, if i % 2 == 0 { 0.3 } else { -0.3 });
+        i += 1;
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    client_done.store(true, Ordering::Relaxed);
+    let m = rx.recv_timeout(Duration::from_secs(20)).unwrap();
+    t.join().unwrap();
+    eprintln!(
+        "driver thread, 3 s of steady state: {} allocations, {} samples published, {} wake-ups, {} commands sent",
+        m.allocations, m.published, m.wakeups, i
+    );
+    assert!(
+        m.published > 50 && m.wakeups > 100,
+        "the driver was not busy"
+    );
+    assert!(
+        // + the one-time set-up of the wait set when the measured run starts.
+        m.allocations <= m.published + 2 * m.wakeups + 32,
+        "{} allocations > {} samples + 2 x {} wake-ups: the driver allocates on its own",
+        m.allocations,
+        m.published,
+        m.wakeups
+    );
+}
