@@ -315,3 +315,39 @@ fn a_robot_without_an_arm_is_served_for_what_it_has() {
     ));
     let _ = (RequestError::Timeout(T), WaitError::Timeout(T));
 }
+
+#[test]
+fn spin_mode_with_pinning_serves_and_stops_cleanly() {
+    let domain = Domain::unique_for_test();
+    let emu = Emulator::start_pty(EmulatorConfig::default()).unwrap();
+    let port = emu.pty_path().unwrap().display().to_string();
+    let cfg = config_file("spin");
+    let mut d = Proc::spawn(
+        PIONEER,
+        domain.name(),
+        &[
+            "--port",
+            &port,
+            "--config",
+            cfg.to_str().unwrap(),
+            "--spin",
+            "--cpu",
+            "0",
+        ],
+    );
+    assert!(
+        d.read_until(|l| l.ends_with("ready")).is_some(),
+        "driver did not start"
+    );
+    let c = ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
+    arm.set_wake_driver(false); // a spinning driver needs no wake-up
+    assert_eq!(arm.geometry().unwrap().actuators_count, 6);
+    let t = arm.move_to(3, 0.4).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
+    let mut stats = StatsReader::open(&c, "pioneer").unwrap();
+    let s = stats.wait(Duration::from_secs(3)).unwrap();
+    assert_eq!(s.loop_mode, limber_interfaces::diagnostics::loop_mode::SPIN);
+    d.signal(libc::SIGTERM);
+    assert_eq!(d.wait_timeout(T), Some(0));
+}
