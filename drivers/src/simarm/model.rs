@@ -357,9 +357,10 @@ impl ArmModel {
         }
         let dt = real_dt * self.options.time_scale;
         self.time += dt;
-        // Sub-steps so the last VECMOVE segments do not each wait a whole tick.
+        // Sub-steps so each VECMOVE waypoint starts the moment the previous one is
+        // reached (a tick may span many short segments at a large time scale).
         let mut left = dt;
-        for _ in 0..16 {
+        for _ in 0..MAX_WAYPOINTS + 2 {
             if left <= 0.0 {
                 break;
             }
