@@ -24,6 +24,8 @@ pub enum Robot {
     /// The Pioneer 5-DOF arm: the built-in P2OS emulator on a pty, driven by the real
     /// Pioneer driver.
     Pioneer,
+    /// The simulated 6-joint arm (simarm) with its parallel gripper.
+    Simarm,
 }
 
 /// Arguments of `limber demo`.
@@ -130,6 +132,67 @@ fn start_pioneer(domain: &Domain) -> Result<Running, CliError> {
     })
 }
 
+fn start_simarm(domain: &Domain) -> Result<Running, CliError> {
+    use limber_drivers::kinematics::chain::Chain;
+    use limber_drivers::simarm::{SimArm, SimArmOptions, SimObject};
+    let stop = Arc::new(AtomicBool::new(false));
+    let (tx, rx) = mpsc::channel::<Result<(), String>>();
+    let d = domain.clone();
+    let s = Arc::clone(&stop);
+    let thread = std::thread::Builder::new()
+        .name("simarm".into())
+        .spawn(move || {
+            let ctx = match Context::new(&d, Role::Driver, "simarm") {
+                Ok(c) => c,
+                Err(e) => {
+                    let _ = tx.send(Err(e.to_string()));
+                    return;
+                }
+            };
+            // A 4 cm block where the program will look for it, so the gripper's beam sees it.
+            let opts = SimArmOptions {
+                object: Some(SimObject::block([0.45, 0.10, 0.15], 0.04)),
+                ..SimArmOptions::default()
+            };
+            let mut arm = match SimArm::new(&ctx, Chain::default_6dof(), opts) {
+                Ok(a) => a,
+                Err(e) => {
+                    let _ = tx.send(Err(e.to_string()));
+                    return;
+                }
+            };
+            let _ = tx.send(Ok(()));
+            let _ = arm.run(|| s.load(Ordering::Relaxed));
+        })
+        .map_err(|e| CliError::new(exit::FAILURE, e.to_string()))?;
+    match rx.recv_timeout(Duration::from_secs(30)) {
+        Ok(Ok(())) => {
+            println!("started simarm: the built-in 6-joint chain with its parallel gripper")
+        }
+        Ok(Err(e)) => return Err(CliError::new(exit::FAILURE, e)),
+        Err(_) => {
+            return Err(CliError::new(
+                exit::TIMEOUT,
+                "simarm did not start within 30 s",
+            ));
+        }
+    }
+    Ok(Running {
+        stop,
+        thread: Some(thread),
+        limb: "simarm/limb/0".into(),
+        gripper: "simarm/gripper/0".into(),
+        arm: "simarm/actarray/0".into(),
+        robot: "simarm".into(),
+        params: PickParams {
+            block: [0.45, 0.10],
+            drop: [0.45, -0.10],
+            grasp_height: 0.15,
+            ..PickParams::default()
+        },
+    })
+}
+
 fn fmt_v(v: Vec3) -> String {
     format!("({:+.3}, {:+.3}, {:+.3})", v.x, v.y, v.z)
 }
@@ -169,11 +232,13 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
         "limber demo: the paper's pick-a-block program on the {} (domain {}; watch it with `limber monitor` in another terminal)",
         match a.on {
             Robot::Pioneer => "Pioneer arm (emulated)",
+            Robot::Simarm => "simulated 6-joint arm",
         },
         domain.name()
     );
     let running = match a.on {
         Robot::Pioneer => start_pioneer(&domain)?,
+        Robot::Simarm => start_simarm(&domain)?,
     };
     let ctx = Context::new(&domain, Role::Client, "demo")
         .map_err(|e| CliError::new(exit::FAILURE, e.to_string()))?;
@@ -266,15 +331,21 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
     match result {
         Ok(s) => {
             println!(
-                "\npicked the block at ({:.2}, {:.2}) and put it down at ({:.2}, {:.2}): {} steps in {:.1} s",
+                "\npicked the block at ({:.2}, {:.2}) and put it down at ({:.2}, {:.2}): {} steps in {:.1} s{}",
                 params.block[0],
                 params.block[1],
                 params.drop[0],
                 params.drop[1],
                 s.steps,
-                start.elapsed().as_secs_f64()
+                start.elapsed().as_secs_f64(),
+                if s.block_seen {
+                    "; the gripper's beam saw the block while it was held"
+                } else {
+                    ""
+                }
             );
-            if let Ok(mut stats) = StatsReader::open(&ctx, &running.robot)
+            if a.on == Robot::Pioneer
+                && let Ok(mut stats) = StatsReader::open(&ctx, &running.robot)
                 && let Ok(st) = stats.wait(Duration::from_millis(1500))
             {
                 println!(

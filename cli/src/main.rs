@@ -28,7 +28,7 @@ struct Cli {
 enum Command {
     /// The main job: start the Pioneer emulator and driver in this process and run the
     /// paper's pick-a-block program on it, step by step with the live joint and gripper
-    /// state, then a summary.
+    /// state, then a summary. `--on simarm` runs the very same program on the simulated arm.
     Demo(demo::DemoArgs),
     /// Print the wire contract: every message struct with its type name, size and fields.
     ///
@@ -59,6 +59,12 @@ enum Command {
     Pioneer(limber_drivers::pioneer::PioneerArgs),
     /// Run a Pioneer controller emulator on a pty (prints its path) or on TCP.
     Emulator(limber_drivers::emulator::EmulatorArgs),
+    /// Run the simulated arm: actarray, limb and gripper for any serial chain (default the
+    /// built-in 6-joint arm; --builtin 7dof, or --chain FILE), robot name "simarm".
+    Simarm(limber_drivers::simarm::SimArmArgs),
+    /// Measure latency: the command and state paths, requests, the loop through the
+    /// emulator and IK, beside raw iceoryx2 (the floor) and Unix/TCP sockets (the peers).
+    Bench(limber_bench::BenchArgs),
 }
 
 fn main() -> ExitCode {
@@ -78,6 +84,11 @@ fn main() -> ExitCode {
             .map_err(|e| CliError::new(exit::FAILURE, e.to_string())),
         Command::Emulator(args) => limber_drivers::emulator::run_cli(args)
             .map_err(|e| CliError::new(exit::FAILURE, e.to_string())),
+        Command::Simarm(args) => limber_drivers::simarm::run_cli(args)
+            .map_err(|e| CliError::new(exit::FAILURE, e.to_string())),
+        Command::Bench(args) => {
+            limber_bench::run_cli(args).map_err(|e| CliError::new(exit::FAILURE, e.to_string()))
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -32,3 +32,14 @@ fn demo_reports_an_unreachable_block_and_fails() {
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("out of reach"), "{}", stderr(&o));
 }
+
+#[test]
+fn the_same_program_runs_on_simarm() {
+    let d = Domain::unique_for_test();
+    let o = limber(d.name(), &["demo", "--on", "simarm", "--fast"]);
+    let out = stdout(&o);
+    assert!(o.status.success(), "{out}\n{}", stderr(&o));
+    assert!(out.contains("started simarm"), "{out}");
+    assert!(out.contains("[11/11] home again"), "{out}");
+    assert!(out.contains("11 steps"), "{out}");
+}
