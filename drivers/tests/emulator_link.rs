@@ -624,4 +624,6 @@ fn event_loop_style_polling() {
     }
     assert_eq!(sips, 5);
     assert!(c.last_sip().is_some());
+    // "No limit" does not overflow.
+    assert!(c.recv(Duration::MAX).is_ok());
 }

@@ -291,7 +291,7 @@ impl Emulator {
         timeout: Duration,
         mut pred: impl FnMut(&EmulatorState) -> bool,
     ) -> (bool, EmulatorState) {
-        let deadline = Instant::now() + timeout;
+        let deadline = crate::p2os::sys::deadline(timeout);
         loop {
             let s = self.state();
             if pred(&s) {

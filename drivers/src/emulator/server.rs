@@ -262,7 +262,9 @@ pub(super) fn run(
     mut robot: Robot,
     shared: Arc<Shared>,
 ) -> Result<(), EmulatorError> {
-    let cycle = config.cycle.max(Duration::from_millis(1));
+    let cycle = config
+        .cycle
+        .clamp(Duration::from_millis(1), Duration::from_secs(86_400));
     let mut decoder = Decoder::new();
     let mut out: Vec<Frame> = Vec::with_capacity(16);
     let mut wire = Wire {

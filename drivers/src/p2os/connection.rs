@@ -114,7 +114,7 @@ fn wait_sync(
     timeout: Duration,
     ignore_running: bool,
 ) -> Result<SyncWait, LinkError> {
-    let deadline = Instant::now() + timeout;
+    let deadline = crate::p2os::sys::deadline(timeout);
     loop {
         let left = deadline.saturating_duration_since(Instant::now());
         let p = match link.recv(left) {
@@ -387,7 +387,7 @@ impl Connection {
         timeout: Duration,
         mut pred: impl FnMut(&RobotPacket<'_>) -> bool,
     ) -> Result<(), LinkError> {
-        let deadline = Instant::now() + timeout;
+        let deadline = crate::p2os::sys::deadline(timeout);
         loop {
             let now = Instant::now();
             if now >= deadline {

@@ -368,7 +368,7 @@ impl Link {
 
     /// Waits up to `timeout` for the next payload (type byte first).
     pub fn recv_payload(&mut self, timeout: Duration) -> Result<&[u8], LinkError> {
-        let deadline = Instant::now() + timeout;
+        let deadline = crate::p2os::sys::deadline(timeout);
         loop {
             if self.decoder.has_packet() {
                 break;
@@ -404,7 +404,7 @@ impl Link {
     /// Waits up to `timeout` for the next parsed packet (malformed ones are
     /// counted and skipped).
     pub fn recv(&mut self, timeout: Duration) -> Result<RobotPacket<'_>, LinkError> {
-        let deadline = Instant::now() + timeout;
+        let deadline = crate::p2os::sys::deadline(timeout);
         loop {
             if self.decoder.has_packet() {
                 if self.parse_next_ok() {

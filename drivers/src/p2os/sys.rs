@@ -38,3 +38,12 @@ pub(crate) fn wait_readable(fds: &[RawFd], timeout: Duration) -> io::Result<u8> 
     }
     Ok(mask)
 }
+
+/// `now + timeout`, saturating far in the future instead of overflowing
+/// (a caller may pass `Duration::MAX` for "no limit").
+pub(crate) fn deadline(timeout: Duration) -> std::time::Instant {
+    let now = std::time::Instant::now();
+    now.checked_add(timeout)
+        .or_else(|| now.checked_add(Duration::from_secs(100 * 365 * 86_400)))
+        .unwrap_or(now)
+}
