@@ -115,17 +115,37 @@ pub(crate) const GROUPS: &[ConstantGroup] = &[
         name: "HARDWARE",
         doc: "DriverStats.hardware bits",
         constants: &[
-            Constant { name: "ARM", value: 1, doc: "5-DOF arm present" },
-            Constant { name: "GRIPPER", value: 2, doc: "body gripper present" },
-            Constant { name: "LIFT", value: 4, doc: "gripper lift present" },
+            Constant {
+                name: "ARM",
+                value: 1,
+                doc: "5-DOF arm present",
+            },
+            Constant {
+                name: "GRIPPER",
+                value: 2,
+                doc: "body gripper present",
+            },
+            Constant {
+                name: "LIFT",
+                value: 4,
+                doc: "gripper lift present",
+            },
         ],
     },
     ConstantGroup {
         name: "LOOP_MODE",
         doc: "DriverStats.loop_mode",
         constants: &[
-            Constant { name: "EVENT", value: 1, doc: "event-driven" },
-            Constant { name: "SPIN", value: 2, doc: "busy-polling" },
+            Constant {
+                name: "EVENT",
+                value: 1,
+                doc: "event-driven",
+            },
+            Constant {
+                name: "SPIN",
+                value: 2,
+                doc: "busy-polling",
+            },
         ],
     },
 ];

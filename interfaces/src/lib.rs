@@ -67,11 +67,11 @@ pub mod prelude {
         ActArrayReplyMsg, ActArrayReqMsg, ActArrayRequest, ActuatorFlags, ActuatorGeom,
         ActuatorKind, ActuatorState, JointSel, JointValues,
     };
-    pub use crate::diagnostics::DriverStats;
     pub use crate::common::{
         Bbox3, CmdOutcome, MAX_ACTUATORS, MsgMeta, Orientation3, Pose3, ReplyMeta, StateHeader,
         Status, Vec3, device_flag,
     };
+    pub use crate::diagnostics::DriverStats;
     pub use crate::error::{DecodeError, ValueError};
     pub use crate::gripper::{
         GripperCmdMsg, GripperCommand, GripperData, GripperGeom, GripperReply, GripperReplyMsg,
