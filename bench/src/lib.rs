@@ -8,8 +8,8 @@
 //!
 //! * [`BenchArgs`] / [`run_cli`]: the command line (wired by the `limber` CLI as
 //!   `limber bench`).
-//! * [`scenario`]: the [`scenario::Scenario`] trait and the registry; `request` and `loop`
-//!   are registered as not yet available until the Pioneer driver and emulator exist.
+//! * [`scenario`]: the [`scenario::Scenario`] trait and the registry; `loop` is registered
+//!   as not yet available until the Pioneer driver and the emulator expose per-stage stamps.
 //! * [`stats`]: what a measurement is and how it is summarised (jitter = p99 − p50).
 //! * [`report`]: the terminal table, the ratios and goals, the JSON file; [`plot`]: the SVG.
 //!
