@@ -9,6 +9,7 @@ mod device;
 mod echo;
 mod layout;
 mod list;
+mod monitor;
 
 /// limber: Player's generic limb interfaces (actarray, limb, gripper) over zero-copy
 /// shared memory, with a real-time driver for the Pioneer arm.
@@ -40,6 +41,12 @@ enum Command {
     List(list::ListArgs),
     /// Print the live state of a device (one line per sample; --json for scripts).
     Echo(echo::EchoArgs),
+    /// A live terminal view of every device of the domain, like Player's playerv: joints
+    /// against their limits, states, limb pose, grippers, lift, drivers' link statistics.
+    ///
+    /// Keys: up/down (j/k) select a device, h home, s stop, o open, c close, q quit.
+    /// `--once` (or a stdout that is not a terminal) prints one frame as text.
+    Monitor(monitor::MonitorArgs),
     /// Command an actuator array: pos, multipos, speed, multispeed, home, current,
     /// multicurrent; requests power, brakes, geom, speedcfg, accel.
     ///
@@ -77,6 +84,7 @@ fn main() -> ExitCode {
         Command::Layout(args) => layout::run(args),
         Command::List(args) => list::run(args),
         Command::Echo(args) => echo::run(args),
+        Command::Monitor(args) => monitor::run(args),
         Command::Actarray(args) => device::actarray(args),
         Command::Limb(args) => device::limb(args),
         Command::Gripper(args) => device::gripper(args),
