@@ -436,6 +436,39 @@ struct Trig {
     c5: f64,
 }
 
+/// One shoulder-and-elbow solution with the sines and cosines the FK check needs.
+#[derive(Clone, Copy)]
+struct Arm {
+    elbow: Elbow,
+    t2: f64,
+    t3: f64,
+    s2: f64,
+    c2: f64,
+    s23: f64,
+    c23: f64,
+}
+
+impl Default for Arm {
+    fn default() -> Self {
+        Self {
+            elbow: Elbow::Down,
+            t2: 0.0,
+            t3: 0.0,
+            s2: 0.0,
+            c2: 1.0,
+            s23: 0.0,
+            c23: 1.0,
+        }
+    }
+}
+
+/// (sin, cos) of `atan2(y, x)` by normalisation; (0, 1) for the zero vector, as
+/// `atan2(0, 0) = 0`.
+fn unit(y: f64, x: f64) -> (f64, f64) {
+    let h = y.hypot(x);
+    if h > 0.0 { (y / h, x / h) } else { (0.0, 1.0) }
+}
+
 /// Which wrist solution to compute.
 #[derive(Clone, Copy)]
 enum WristGoal<'a> {
@@ -966,12 +999,33 @@ impl PioneerGeometry {
             let one_minus = (dmax - d).max(0.0) * (dmax + d);
             let one_plus = (d - dmin).max(0.0) * (d + dmin);
             let g = 2.0 * one_minus.sqrt().atan2(one_plus.sqrt());
-            let mut arms = [(Elbow::Down, 0.0, 0.0); 4];
+            // sin and cos of g from the same half-angle quantities (no transcendental).
+            let pm = one_plus + one_minus;
+            let (sg, cg) = if pm > 0.0 {
+                (
+                    2.0 * (one_minus * one_plus).sqrt() / pm,
+                    (one_plus - one_minus) / pm,
+                )
+            } else {
+                g.sin_cos()
+            };
+            let (sa, ca) = unit(z, r);
+            let mut arms = [Arm::default(); 4];
             let mut n_arms = 0;
-            for (elbow, t3) in [(Elbow::Down, g), (Elbow::Up, -g)] {
-                let (s3, c3) = t3.sin_cos();
-                let t2 = wrap_pi(z.atan2(r) - (self.l4 * s3).atan2(self.l2 + self.l4 * c3));
-                arms[n_arms] = (elbow, t2, t3);
+            for (elbow, t3, s3, c3) in [(Elbow::Down, g, sg, cg), (Elbow::Up, -g, -sg, cg)] {
+                // θ2 = atan2(z, r) − atan2(L4·s3, L2 + L4·c3), by the difference formulas.
+                let (sb, cb) = unit(self.l4 * s3, self.l2 + self.l4 * c3);
+                let (s2, c2) = (sa * cb - ca * sb, ca * cb + sa * sb);
+                let t2 = s2.atan2(c2);
+                arms[n_arms] = Arm {
+                    elbow,
+                    t2,
+                    t3,
+                    s2,
+                    c2,
+                    s23: s2 * c3 + c2 * s3,
+                    c23: c2 * c3 - s2 * s3,
+                };
                 n_arms += 1;
                 // Near a straight (or folded) elbow the position fixes θ2+θ3 only to
                 // about √ε; a full frame fixes it better whenever the wrist rolls
@@ -986,88 +1040,105 @@ impl PioneerGeometry {
                             t23 = wrap_pi(t23 + PI);
                         }
                         let (s23, c23) = t23.sin_cos();
-                        let t2b = (z - self.l4 * s23).atan2(r - self.l4 * c23);
-                        arms[n_arms] = (elbow, t2b, wrap_pi(t23 - t2b));
+                        let (s2, c2) = unit(z - self.l4 * s23, r - self.l4 * c23);
+                        let t2 = s2.atan2(c2);
+                        arms[n_arms] = Arm {
+                            elbow,
+                            t2,
+                            t3: wrap_pi(t23 - t2),
+                            s2,
+                            c2,
+                            s23,
+                            c23,
+                        };
                         n_arms += 1;
                     }
                 }
             }
-            for &(elbow, t2, t3) in &arms[..n_arms] {
-                let (s23, c23) = (t2 + t3).sin_cos();
+            for arm in &arms[..n_arms] {
+                let Arm {
+                    elbow,
+                    t2,
+                    t3,
+                    s2,
+                    c2,
+                    s23,
+                    c23,
+                } = *arm;
                 // Columns of R0 = Rz(θ1)·Ry(−θ23).
                 let fx = Vector3::new(c1 * c23, s1 * c23, s23);
                 let fy = Vector3::new(-s1, c1, 0.0);
                 let fz = Vector3::new(-c1 * s23, -s1 * s23, c23);
                 let local = |v: &Vector3<f64>| Vector3::new(fx.dot(v), fy.dot(v), fz.dot(v));
                 let al = local(&a);
-                let (s2, c2) = t2.sin_cos();
-                let mut push = |t4: f64, t5: f64, wrist: Wrist| {
-                    let mut theta = [t1, t2, t3, wrap_pi(t4), wrap_pi(t5)];
-                    let mut within = true;
-                    for i in 0..PIONEER_DOF {
-                        let l = self.limits[i];
-                        match fit_angle_to_limits(
-                            theta[i],
-                            l.min,
-                            l.max,
-                            current[i],
-                            LIMIT_TOLERANCE,
-                        ) {
-                            Some(v) => theta[i] = v,
-                            None => within = false,
+                let mut push =
+                    |t4: f64, (s4, c4): (f64, f64), t5: f64, (s5, c5): (f64, f64), wrist| {
+                        let mut theta = [t1, t2, t3, wrap_pi(t4), wrap_pi(t5)];
+                        let mut within = true;
+                        for i in 0..PIONEER_DOF {
+                            let l = self.limits[i];
+                            match fit_angle_to_limits(
+                                theta[i],
+                                l.min,
+                                l.max,
+                                current[i],
+                                LIMIT_TOLERANCE,
+                            ) {
+                                Some(v) => theta[i] = v,
+                                None => within = false,
+                            }
                         }
-                    }
-                    let (s4, c4) = t4.sin_cos();
-                    let (s5, c5) = t5.sin_cos();
-                    let fk = self.fk_trig(&Trig {
-                        s1,
-                        c1,
-                        s2,
-                        c2,
-                        s23,
-                        c23,
-                        s4,
-                        c4,
-                        s5,
-                        c5,
-                    });
-                    let position_error = (fk.position - p).norm();
-                    let orientation_error = match goal {
-                        WristGoal::Frame(pose) => fk.orientation_error(pose),
-                        WristGoal::Approach(a) => vector_angle(&fk.approach(), a),
+                        let fk = self.fk_trig(&Trig {
+                            s1,
+                            c1,
+                            s2,
+                            c2,
+                            s23,
+                            c23,
+                            s4,
+                            c4,
+                            s5,
+                            c5,
+                        });
+                        let position_error = (fk.position - p).norm();
+                        let orientation_error = match goal {
+                            WristGoal::Frame(pose) => fk.orientation_error(pose),
+                            WristGoal::Approach(a) => vector_angle(&fk.approach(), a),
+                        };
+                        let ok = |v: f64| if v.is_finite() { v } else { f64::INFINITY };
+                        out.push(IkCandidate {
+                            theta,
+                            branch: Branch {
+                                shoulder,
+                                elbow,
+                                wrist,
+                            },
+                            within_limits: within,
+                            position_error: ok(position_error),
+                            orientation_error: ok(orientation_error),
+                        });
                     };
-                    let ok = |v: f64| if v.is_finite() { v } else { f64::INFINITY };
-                    out.push(IkCandidate {
-                        theta,
-                        branch: Branch {
-                            shoulder,
-                            elbow,
-                            wrist,
-                        },
-                        within_limits: within,
-                        position_error: ok(position_error),
-                        orientation_error: ok(orientation_error),
-                    });
-                };
                 match goal {
                     WristGoal::Frame(pose) => {
                         let nl = local(&pose.normal());
                         let t4 = nl.z.atan2(nl.y);
-                        let (s4, c4) = t4.sin_cos();
+                        let (s4, c4) = unit(nl.z, nl.y);
                         // v = Rx(θ4)ᵀ·a_local = (c5, 0, s5) for a consistent frame.
                         let vx = al.x;
                         let vz = -s4 * al.y + c4 * al.z;
-                        push(t4, vz.atan2(vx), Wrist::Normal);
+                        push(t4, (s4, c4), vz.atan2(vx), unit(vz, vx), Wrist::Normal);
                     }
                     WristGoal::Approach(_) => {
                         let s5 = al.y.hypot(al.z);
-                        let (t4, t5) = if s5 < 1e-12 {
-                            (current[3], s5.atan2(al.x))
+                        let t5 = s5.atan2(al.x);
+                        let (t4, (s4, c4)) = if s5 < 1e-12 {
+                            (current[3], current[3].sin_cos())
                         } else {
-                            ((-al.y).atan2(al.z), s5.atan2(al.x))
+                            ((-al.y).atan2(al.z), (-al.y / s5, al.z / s5))
                         };
-                        push(t4, t5, Wrist::Normal);
-                        push(t4 + PI, -t5, Wrist::Flipped);
+                        let (ss5, cs5) = unit(s5, al.x);
+                        push(t4, (s4, c4), t5, (ss5, cs5), Wrist::Normal);
+                        push(t4 + PI, (-s4, -c4), -t5, (-ss5, cs5), Wrist::Flipped);
                     }
                 }
             }
