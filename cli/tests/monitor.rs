@@ -332,7 +332,7 @@ fn a_pioneer_driver_shows_its_statistics_lift_and_grippers_and_its_death() {
         assert!(text.contains(s), "{s} in\n{text}");
     }
     assert!(
-        line_with(&text, "hardware:").contains("arm gripper lift"),
+        line_with(&text, "hw: ").contains("arm gripper lift"),
         "{text}"
     );
     // The lift: one linear actuator, in m.

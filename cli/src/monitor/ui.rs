@@ -46,7 +46,7 @@ fn device_lines(d: &Device) -> u16 {
                 .unwrap_or(0);
             1 + n.max(1) as u16
         }
-        Ok(Conn::Limb { .. }) => 2,
+        Ok(Conn::Limb { .. }) => 3,
         Ok(Conn::Gripper { .. }) => 1,
         Err(_) => 1,
     }
@@ -55,7 +55,7 @@ fn device_lines(d: &Device) -> u16 {
 fn panels(app: &App) -> Vec<Panel<'_>> {
     let mut out = Vec::new();
     for (name, robot) in &app.robots {
-        let lines = if robot.latest().is_some() { 5 } else { 1 };
+        let lines = if robot.latest().is_some() { 6 } else { 1 };
         out.push(Panel {
             kind: PanelKind::Driver(name, robot),
             height: lines + 2,
@@ -93,14 +93,25 @@ pub fn draw(frame: &mut Frame, app: &App) {
             Style::new().add_modifier(Modifier::BOLD | Modifier::REVERSED),
         ),
         Span::raw(format!(
-            " domain {} · {} devices, {} alive · ",
+            " domain {} · {} devices, {} alive",
             app.domain(),
             app.devices.len(),
             alive
         )),
-        Span::styled(KEYS, Style::new().fg(Color::Cyan)),
     ]);
-    frame.render_widget(Paragraph::new(title), top);
+    // The keys at the right of the top line, when there is room.
+    let keys_w = KEYS.chars().count() as u16 + 1;
+    if top.width >= title.width() as u16 + keys_w + 2 {
+        let [left, right] =
+            Layout::horizontal([Constraint::Min(0), Constraint::Length(keys_w)]).areas(top);
+        frame.render_widget(Paragraph::new(title), left);
+        frame.render_widget(
+            Paragraph::new(Span::styled(KEYS, Style::new().fg(Color::Cyan))),
+            right,
+        );
+    } else {
+        frame.render_widget(Paragraph::new(title), top);
+    }
 
     let panels = panels(app);
     if panels.is_empty() {
@@ -140,7 +151,7 @@ pub fn draw(frame: &mut Frame, app: &App) {
 
     let status = match &app.status {
         None => Line::from(Span::styled(
-            " select a device with ↑↓, then h/s/o/c",
+            " keys: ↑↓/jk select · h home · s stop · o open · c close · q quit",
             Style::new().fg(Color::DarkGray),
         )),
         Some(s) => {
@@ -258,9 +269,10 @@ fn stats_lines(s: &DriverStats) -> Vec<Line<'static>> {
             Style::new()
         }
     };
+    // Six short lines (at most ~78 columns): readable in an 80-column terminal.
     vec![
         Line::from(format!(
-            "robot {} ({} {}) · hardware: {} · loop: {mode}",
+            "robot {} ({} {}) · hw: {} · {mode} loop",
             text(&s.robot_name),
             text(&s.robot_class),
             text(&s.robot_subclass),
@@ -270,31 +282,31 @@ fn stats_lines(s: &DriverStats) -> Vec<Line<'static>> {
                 hw.join(" ")
             },
         )),
+        Line::from(format!(
+            "period p50 {} p99 {} max {} · jitter p99 {}",
+            fmt_ns(s.period_p50_ns),
+            fmt_ns(s.period_p99_ns),
+            fmt_ns(s.period_max_ns),
+            fmt_ns(s.jitter_p99_ns),
+        )),
         Line::from(vec![
-            Span::raw(format!(
-                "loop  {} cycles · period p50 {} p99 {} max {} · jitter p99 {} · ",
-                s.cycles,
-                fmt_ns(s.period_p50_ns),
-                fmt_ns(s.period_p99_ns),
-                fmt_ns(s.period_max_ns),
-                fmt_ns(s.jitter_p99_ns),
-            )),
+            Span::raw(format!("cycles {} · ", s.cycles)),
             Span::styled(format!("overruns {}", s.overruns), warn(s.overruns)),
+            Span::raw(format!(
+                " · cmd→wire p50 {} p99 {} max {}",
+                fmt_ns(s.cmd_to_wire_p50_ns),
+                fmt_ns(s.cmd_to_wire_p99_ns),
+                fmt_ns(s.cmd_to_wire_max_ns),
+            )),
         ]),
         Line::from(format!(
-            "cmd→wire p50 {} p99 {} max {} · SIPs {:.1}/s",
-            fmt_ns(s.cmd_to_wire_p50_ns),
-            fmt_ns(s.cmd_to_wire_p99_ns),
-            fmt_ns(s.cmd_to_wire_max_ns),
+            "link in {} ({} packets) · out {} · SIPs {:.1}/s",
+            fmt_bytes(s.bytes_in),
+            s.packets_in,
+            fmt_bytes(s.bytes_out),
             s.sips_per_s,
         )),
         Line::from(vec![
-            Span::raw(format!(
-                "link  in {} ({} packets) · out {} · ",
-                fmt_bytes(s.bytes_in),
-                s.packets_in,
-                fmt_bytes(s.bytes_out),
-            )),
             Span::styled(
                 format!("bad checksums {}", s.bad_checksums),
                 warn(s.bad_checksums),
@@ -317,7 +329,7 @@ fn stats_lines(s: &DriverStats) -> Vec<Line<'static>> {
             Span::styled(format!("refused {}", s.refused), warn(s.refused)),
             Span::raw(format!(" · requests {} · ", s.requests)),
             Span::styled(
-                format!("overflows {}", s.cmd_overflows),
+                format!("command overflows {}", s.cmd_overflows),
                 warn(s.cmd_overflows),
             ),
         ]),
@@ -329,7 +341,7 @@ fn header_spans(h: &StateHeader, age: Option<std::time::Duration>) -> Vec<Span<'
     if let Some(a) = age {
         // Fixed width, so that the title does not jitter.
         out.push(Span::raw(format!(
-            " · {:5.1} ms old",
+            " · age {:5.1} ms",
             a.as_secs_f64() * 1e3
         )));
     }
@@ -535,12 +547,8 @@ fn limb_lines(s: Option<&LimbData>) -> Vec<Line<'static>> {
             ),
             Span::raw(format!(" position {} m", v3(&s.position))),
         ]),
-        Line::from(format!(
-            "{:<12} approach {}  orientation {}",
-            "",
-            v3(&s.approach),
-            v3(&s.orientation)
-        )),
+        Line::from(format!("{:<12} approach {}", "", v3(&s.approach))),
+        Line::from(format!("{:<12} orientation {}", "", v3(&s.orientation))),
     ]
 }
 
