@@ -22,8 +22,10 @@ use crate::{BenchArgs, BenchError};
 
 /// Runs `role`; on failure prints `error: <why>` on stdout for the parent, and returns it.
 pub fn run_role(role: &str, args: &BenchArgs) -> Result<(), BenchError> {
-    if let Some(cpu) = args.cpu {
-        pin_to(cpu);
+    match args.cpu {
+        Some(cpu) => pin_to(cpu),
+        // A pinned parent's affinity is inherited: give unpinned children every core.
+        None => unpin(),
     }
     let r = match role {
         "pubsub-echo" => floor::echo_role(args, floor::Echo::Spin),
@@ -52,6 +54,21 @@ pub fn pin_to(cpu: usize) {
         core_affinity::get_core_ids().and_then(|ids| ids.into_iter().find(|c| c.id == cpu))
     {
         let _ = core_affinity::set_for_current(id);
+    }
+}
+
+/// Allows the calling thread to run on every online core.
+pub fn unpin() {
+    // SAFETY: a zeroed cpu_set_t is a valid empty set; CPU_SET writes inside it for
+    // indices below CPU_SETSIZE; sched_setaffinity reads it.
+    unsafe {
+        let n = libc::sysconf(libc::_SC_NPROCESSORS_ONLN)
+            .clamp(1, libc::CPU_SETSIZE as libc::c_long) as usize;
+        let mut set: libc::cpu_set_t = core::mem::zeroed();
+        for cpu in 0..n {
+            libc::CPU_SET(cpu, &mut set);
+        }
+        let _ = libc::sched_setaffinity(0, core::mem::size_of::<libc::cpu_set_t>(), &set);
     }
 }
 

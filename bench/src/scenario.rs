@@ -142,13 +142,15 @@ impl RunCtx {
     /// Prepares a run: probes the machine, pins this process when asked, makes the
     /// scratch directory.
     pub fn new(args: &BenchArgs) -> Result<Self, BenchError> {
+        // Probe before pinning: the core count is read from this process's affinity.
+        let mut machine = Machine::probe(String::new(), String::new());
         let mut pin = false;
         let pinning = if args.pin {
             match core_affinity::get_core_ids() {
                 Some(ids) if ids.len() >= 2 && core_affinity::set_for_current(ids[0]) => {
                     pin = true;
                     format!(
-                        "client/publisher side on core {}, driver/echo child on core {}",
+                        "client/publisher side on core {}, driver/echo child on core {}, state subscribers unpinned",
                         ids[0].id, ids[1].id
                     )
                 }
@@ -168,8 +170,10 @@ impl RunCtx {
             limber_services::monotonic_ns()
         ));
         std::fs::create_dir_all(&tmp).map_err(|e| BenchError::io(tmp.display().to_string(), e))?;
+        machine.pinning = pinning;
+        machine.mode = mode;
         Ok(RunCtx {
-            machine: Machine::probe(pinning, mode),
+            machine,
             quick: args.quick,
             scale: args.scale,
             strategy: args.strategy(),
