@@ -198,6 +198,7 @@ pub struct Client<I: Interface> {
     cmd_seq: u64,
     req_seq: u64,
     outcomes: [(u64, u32); OUTCOME_SLOTS],
+    max_seen_seq: u64,
     wake_driver: bool,
     wait_mode: WaitMode,
     request_timeout: Duration,
@@ -337,6 +338,7 @@ impl<I: Interface> Client<I> {
             cmd_seq: 0,
             req_seq: 0,
             outcomes: [(0, 0); OUTCOME_SLOTS],
+            max_seen_seq: 0,
             wake_driver: true,
             wait_mode: WaitMode::Event,
             request_timeout: DEFAULT_REQUEST_TIMEOUT,
@@ -387,6 +389,7 @@ impl<I: Interface> Client<I> {
                     if h.last_cmd.client_id == self.client_id {
                         let slot = (h.last_cmd.cmd_seq as usize) % OUTCOME_SLOTS;
                         self.outcomes[slot] = (h.last_cmd.cmd_seq, h.last_cmd.status);
+                        self.max_seen_seq = self.max_seen_seq.max(h.last_cmd.cmd_seq);
                     }
                     self.latest = Some(s);
                     got = true;
@@ -470,13 +473,12 @@ impl<I: Interface> Client<I> {
             if seq == ticket.seq {
                 return Ok(Status::try_from(status).unwrap_or(Status::InvalidArgument));
             }
-            if let Some(d) = self.latest.as_deref() {
-                let h = d.header();
-                if h.last_cmd.client_id == self.client_id && h.last_cmd.cmd_seq > ticket.seq {
-                    return Err(WaitError::Missed {
-                        newer_seq: h.last_cmd.cmd_seq,
-                    });
-                }
+            // Commands of one client are applied in order: an outcome of a later one
+            // means this one was applied too, its sample overwritten before it was read.
+            if self.max_seen_seq > ticket.seq {
+                return Err(WaitError::Missed {
+                    newer_seq: self.max_seen_seq,
+                });
             }
             let now = Instant::now();
             if now >= deadline {

@@ -236,7 +236,7 @@ pub fn driver_role(args: &BenchArgs, spin: bool) -> Result<(), BenchError> {
         let mut i = 0u32;
         loop {
             let a = host
-                .process(&mut arm)
+                .process_spin(&mut arm)
                 .map_err(|e| ctx_err("process")(e.to_string()))?;
             if arm.stop {
                 break;

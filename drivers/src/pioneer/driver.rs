@@ -501,6 +501,26 @@ impl PioneerDriver {
         let _ = self.stats_pub.publish(s);
     }
 
+    /// Spin mode: commands on every call, requests on every 16th.
+    fn process_clients_spin(&mut self) {
+        let core = &mut self.core;
+        if let Some(h) = self.hosts.arm.as_mut() {
+            let _ = h.process_spin(&mut ArmH(core));
+        }
+        if let Some(h) = self.hosts.limb.as_mut() {
+            let _ = h.process_spin(&mut LimbH(core));
+        }
+        if let Some(h) = self.hosts.armgrip.as_mut() {
+            let _ = h.process_spin(&mut ArmGripH(core));
+        }
+        if let Some(h) = self.hosts.gripper.as_mut() {
+            let _ = h.process_spin(&mut GripperH(core));
+        }
+        if let Some(h) = self.hosts.lift.as_mut() {
+            let _ = h.process_spin(&mut LiftH(core));
+        }
+    }
+
     /// Handles every pending command and request of every device.
     fn process_clients(&mut self) {
         let core = &mut self.core;
@@ -742,7 +762,7 @@ impl PioneerDriver {
             if self.core.conn.is_some() && !self.read_link(now) {
                 self.link_failed("read failed");
             }
-            self.process_clients();
+            self.process_clients_spin();
             if now >= next_tick {
                 let missed = (now.duration_since(next_tick).as_nanos() as u64) / nominal.max(1);
                 self.core.stats.tick(now, nominal, 1 + missed);

@@ -32,15 +32,11 @@ fn main() {
                 arm.move_to((i % 6) as usize, (i as f64) * 1e-3)
                     .expect("send");
             }
-            // Stay until the driver has applied the last one.
-            let last = limber_services::Ticket {
-                seq: a.n,
-                receivers: 1,
-            };
-            match arm.wait_outcome(last, Duration::from_secs(5)) {
-                Ok(_) | Err(WaitError::Missed { .. }) => println!("sent {}", a.n),
-                Err(e) => panic!("last outcome: {e}"),
-            }
+            // Stay until the driver has applied every one: it drains a client's commands
+            // before answering its requests, so a reply is a barrier. (The last outcome
+            // itself may be overwritten by the other client's outcomes before it is read.)
+            arm.geometry().expect("barrier request");
+            println!("sent {}", a.n);
         }
         "basic" => {
             let g = arm.geometry().expect("geometry");
