@@ -83,3 +83,36 @@ impl Drop for Proc {
         let _ = self.child.wait();
     }
 }
+
+/// A global allocator that counts the allocations made on each thread, for the tests that
+/// prove a hot loop allocates nothing. Declare it in a test binary with
+/// `#[global_allocator] static GLOBAL: limber_tests::Counting = limber_tests::Counting;`.
+#[derive(Debug)]
+pub struct Counting;
+
+thread_local! {
+    static ALLOCS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+// SAFETY: forwards to the system allocator; only counts calls made on the current thread.
+unsafe impl std::alloc::GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
+        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as ours.
+        unsafe { std::alloc::System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: std::alloc::Layout) {
+        // SAFETY: same contract as ours.
+        unsafe { std::alloc::System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: std::alloc::Layout, new_size: usize) -> *mut u8 {
+        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as ours.
+        unsafe { std::alloc::System.realloc(ptr, layout, new_size) }
+    }
+}
+
+/// Allocations made so far on this thread (when [`Counting`] is the global allocator).
+pub fn allocations() -> u64 {
+    ALLOCS.with(|c| c.get())
+}
