@@ -1,0 +1,121 @@
+//! The driver verbs as a user runs them: `limber emulator` in one process, `limber pioneer`
+//! on its pty in another, `limber simarm`; the shell verbs against them; SIGTERM ends
+//! each with exit 0.
+
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use limber_services::Domain;
+
+mod common;
+use common::{LIMBER, limber, stderr, stdout};
+
+struct Bg(Child);
+
+impl Bg {
+    fn spawn(domain: &str, args: &[&str]) -> Bg {
+        Bg(Command::new(LIMBER)
+            .args(args)
+            .env("LIMBER_DOMAIN", domain)
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .unwrap())
+    }
+
+    /// The first stdout line satisfying `pred`.
+    fn line(&mut self, pred: impl Fn(&str) -> bool) -> String {
+        let out = self.0.stdout.as_mut().unwrap();
+        let mut r = BufReader::new(out);
+        let mut l = String::new();
+        loop {
+            l.clear();
+            assert!(
+                r.read_line(&mut l).unwrap() > 0,
+                "process ended before the expected line"
+            );
+            if pred(l.trim_end()) {
+                return l.trim_end().to_string();
+            }
+        }
+    }
+
+    fn term(&mut self) -> Option<i32> {
+        // SAFETY: kill(2) on our own child; no memory is involved.
+        unsafe { libc::kill(self.0.id() as i32, libc::SIGTERM) };
+        let deadline = Instant::now() + Duration::from_secs(10);
+        while Instant::now() < deadline {
+            if let Ok(Some(s)) = self.0.try_wait() {
+                return s.code();
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        None
+    }
+}
+
+impl Drop for Bg {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+#[test]
+fn emulator_and_pioneer_as_separate_commands() {
+    let d = Domain::unique_for_test();
+    let mut emu = Bg::spawn(d.name(), &["emulator", "--pty", "--ignore-stdin"]);
+    let pty = emu.line(|l| l.starts_with("/dev/"));
+    let mut drv = Bg::spawn(d.name(), &["pioneer", "--port", &pty]);
+    drv.line(|l| l.ends_with("ready"));
+    let o = limber(d.name(), &["list"]);
+    let text = stdout(&o);
+    for dev in [
+        "pioneer/actarray/0",
+        "pioneer/actarray/1",
+        "pioneer/limb/0",
+        "pioneer/gripper/0",
+        "pioneer/gripper/1",
+    ] {
+        assert!(text.contains(dev), "{text}");
+    }
+    let o = limber(
+        d.name(),
+        &["actarray", "pioneer/actarray/0", "pos", "2", "0.5"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = limber(
+        d.name(),
+        &["echo", "pioneer/driver", "--count", "1", "--json"],
+    );
+    assert!(
+        stdout(&o).contains(r#""name":"limber-emulator""#),
+        "{}",
+        stdout(&o)
+    );
+    assert_eq!(drv.term(), Some(0));
+    assert_eq!(emu.term(), Some(0));
+}
+
+#[test]
+fn simarm_serves_and_stops_on_sigterm() {
+    let d = Domain::unique_for_test();
+    let mut sim = Bg::spawn(d.name(), &["simarm", "--builtin", "7dof"]);
+    sim.line(|l| l.ends_with("ready"));
+    let o = limber(d.name(), &["actarray", "simarm/actarray/0", "geom"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        stdout(&o).lines().filter(|l| l.contains("rotary")).count(),
+        7,
+        "{}",
+        stdout(&o)
+    );
+    let o = limber(
+        d.name(),
+        &["limb", "simarm/limb/0", "setposition", "0.5", "0.1", "0.3"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(sim.term(), Some(0));
+}
