@@ -3,7 +3,6 @@
 //! of the JSON report and of the SVG plot. Asserts structure, never speed.
 
 use std::process::Command;
-use std::time::{Duration, Instant};
 
 use serde_json::Value;
 
@@ -13,7 +12,6 @@ fn quick_run_writes_a_well_formed_report() {
     std::fs::create_dir_all(&dir).unwrap();
     let json = dir.join("report.json");
     let svg = dir.join("report.svg");
-    let start = Instant::now();
     let out = Command::new(env!("CARGO_BIN_EXE_limber-bench"))
         .args(["--quick", "--scale", "0.1", "--no-progress", "--only"])
         .arg("floor,ik,loop")
@@ -29,7 +27,6 @@ fn quick_run_writes_a_well_formed_report() {
         String::from_utf8_lossy(&out.stdout),
         String::from_utf8_lossy(&out.stderr)
     );
-    assert!(start.elapsed() < Duration::from_secs(60));
     let table = String::from_utf8_lossy(&out.stdout);
     assert!(table.contains("machine:"), "{table}");
     assert!(table.contains("not yet available"), "{table}");

@@ -501,44 +501,26 @@ impl PioneerDriver {
         let _ = self.stats_pub.publish(s);
     }
 
-    /// Spin mode: commands on every call, requests on every 16th.
-    fn process_clients_spin(&mut self) {
+    /// Handles the pending commands and requests of every device. Spinning: commands on
+    /// every call, requests on every 16th ([`DeviceHost::process_spin`]).
+    fn process_clients(&mut self, spin: bool) {
+        macro_rules! serve {
+            ($host:expr, $handler:expr) => {
+                if let Some(h) = $host.as_mut() {
+                    let _ = if spin {
+                        h.process_spin(&mut $handler)
+                    } else {
+                        h.process(&mut $handler)
+                    };
+                }
+            };
+        }
         let core = &mut self.core;
-        if let Some(h) = self.hosts.arm.as_mut() {
-            let _ = h.process_spin(&mut ArmH(core));
-        }
-        if let Some(h) = self.hosts.limb.as_mut() {
-            let _ = h.process_spin(&mut LimbH(core));
-        }
-        if let Some(h) = self.hosts.armgrip.as_mut() {
-            let _ = h.process_spin(&mut ArmGripH(core));
-        }
-        if let Some(h) = self.hosts.gripper.as_mut() {
-            let _ = h.process_spin(&mut GripperH(core));
-        }
-        if let Some(h) = self.hosts.lift.as_mut() {
-            let _ = h.process_spin(&mut LiftH(core));
-        }
-    }
-
-    /// Handles every pending command and request of every device.
-    fn process_clients(&mut self) {
-        let core = &mut self.core;
-        if let Some(h) = self.hosts.arm.as_mut() {
-            let _ = h.process(&mut ArmH(core));
-        }
-        if let Some(h) = self.hosts.limb.as_mut() {
-            let _ = h.process(&mut LimbH(core));
-        }
-        if let Some(h) = self.hosts.armgrip.as_mut() {
-            let _ = h.process(&mut ArmGripH(core));
-        }
-        if let Some(h) = self.hosts.gripper.as_mut() {
-            let _ = h.process(&mut GripperH(core));
-        }
-        if let Some(h) = self.hosts.lift.as_mut() {
-            let _ = h.process(&mut LiftH(core));
-        }
+        serve!(self.hosts.arm, ArmH(core));
+        serve!(self.hosts.limb, LimbH(core));
+        serve!(self.hosts.armgrip, ArmGripH(core));
+        serve!(self.hosts.gripper, GripperH(core));
+        serve!(self.hosts.lift, LiftH(core));
     }
 
     /// Reads every packet the link has; returns false when the link failed.
@@ -720,7 +702,7 @@ impl PioneerDriver {
                             self.link_failed("read failed");
                         }
                     }
-                    Wake::Clients => self.process_clients(),
+                    Wake::Clients => self.process_clients(false),
                     Wake::Tick(n) => {
                         self.core.stats.tick(now, nominal, n);
                         // A packet may be sitting in the decoder after a send.
@@ -762,7 +744,7 @@ impl PioneerDriver {
             if self.core.conn.is_some() && !self.read_link(now) {
                 self.link_failed("read failed");
             }
-            self.process_clients_spin();
+            self.process_clients(true);
             if now >= next_tick {
                 let missed = (now.duration_since(next_tick).as_nanos() as u64) / nominal.max(1);
                 self.core.stats.tick(now, nominal, 1 + missed);
