@@ -8,8 +8,9 @@
 //!
 //! * [`BenchArgs`] / [`run_cli`]: the command line (wired by the `limber` CLI as
 //!   `limber bench`).
-//! * [`scenario`]: the [`scenario::Scenario`] trait and the registry; `loop` is registered
-//!   as not yet available until the Pioneer driver and the emulator expose per-stage stamps.
+//! * [`scenario`]: the [`scenario::Scenario`] trait and the registry; `loop` goes through
+//!   the emulator and is split by stage with the stamps on the way (client send, the
+//!   driver's read of the robot's reply, client receipt).
 //! * [`stats`]: what a measurement is and how it is summarised (jitter = p99 − p50).
 //! * [`report`]: the terminal table, the ratios and goals, the JSON file; [`plot`]: the SVG.
 //!

@@ -29,7 +29,10 @@ fn quick_run_writes_a_well_formed_report() {
     );
     let table = String::from_utf8_lossy(&out.stdout);
     assert!(table.contains("machine:"), "{table}");
-    assert!(table.contains("not yet available"), "{table}");
+    assert!(
+        table.contains("command → state, through the emulator"),
+        "{table}"
+    );
 
     let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let machine = &v["machine"];
@@ -47,7 +50,7 @@ fn quick_run_writes_a_well_formed_report() {
     };
     assert_eq!(status("floor").as_deref(), Some("ok"));
     assert_eq!(status("ik").as_deref(), Some("ok"));
-    assert_eq!(status("loop").as_deref(), Some("not_available"));
+    assert_eq!(status("loop").as_deref(), Some("ok"));
 
     let ms = v["measurements"].as_array().unwrap();
     let ids: Vec<&str> = ms.iter().map(|m| m["id"].as_str().unwrap()).collect();
@@ -58,6 +61,9 @@ fn quick_run_writes_a_well_formed_report() {
         "floor.event.oneway",
         "ik.pioneer.pose",
         "ik.chain6.pose",
+        "loop.to_robot",
+        "loop.to_client",
+        "loop.total",
     ] {
         assert!(ids.contains(&id), "{id} missing from {ids:?}");
     }

@@ -1,30 +1,138 @@
-//! Scenarios that wait for parts being built: registered so that they are listed (as
-//! "not yet available") and so that adding them means filling in `run`.
+//! `loop`: the full control loop through the emulator over a pty. A client moves joint 0
+//! of the Pioneer arm (driver and emulator in the `pioneer-driver` child process,
+//! event-driven); the command goes to the driver, out as P2OS bytes on the pty, the
+//! emulator acts on it and answers with an ARMpac at once, the driver reads it and
+//! publishes the arm state, and the client sees it. Split by stage with the stamps on
+//! the way:
 //!
-//! * `loop`: the full loop client → driver → P2OS over a pty → emulator → ARMpac →
-//!   driver → published state → client, split by stage (driver receive, serial write,
-//!   emulator reply, driver publish, client receive) from the stamps each stage records.
+//! * `command → robot reply read by the driver`: the client's send stamp to the state's
+//!   acquisition stamp (`StateHeader::stamp_ns` = when the driver read the ARMpac):
+//!   client → driver, validation, the serial write, the emulator, the ARMpac back;
+//! * `reply read → client sees the state`: acquisition stamp to the client's receipt
+//!   (driver publish, notify, client wake-up);
+//! * the total, client send → client receipt.
+//!
+//! The driver's own command-to-wire latency is in its statistics (`limber echo
+//! pioneer/driver`).
 
+use std::time::{Duration, Instant};
+
+use limber_interfaces::prelude::*;
+use limber_services::prelude::*;
+use limber_services::{Role, monotonic_ns};
+
+use super::request::{DEVICE, START_TIMEOUT};
 use super::{RunCtx, Scenario};
 use crate::BenchError;
+use crate::child::{ChildProc, ChildSpec};
+use crate::progress::Progress;
+use crate::stats::{Measurement, Metric, Strategy, new_histogram};
 
-const WHY: &str = "needs per-stage stamps from the Pioneer driver and the emulator (serial write, controller reply, packet received), which they do not expose yet";
-
-/// The `loop` scenario (placeholder).
+/// The `loop` scenario.
 #[derive(Debug, Clone, Copy)]
 pub struct Loop;
+
+fn err(what: &str, reason: String) -> BenchError {
+    BenchError::Transport {
+        context: what.to_string(),
+        reason,
+    }
+}
 
 impl Scenario for Loop {
     fn name(&self) -> &'static str {
         "loop"
     }
     fn description(&self) -> &'static str {
-        "full loop through the emulator over a pty, split by stage"
+        "full loop through the emulator over a pty (command → P2OS → emulator → ARMpac → state), split by stage"
     }
-    fn availability(&self) -> Result<(), String> {
-        Err(WHY.into())
-    }
-    fn run(&self, _ctx: &mut RunCtx) -> Result<(), BenchError> {
-        Err(BenchError::Args(format!("loop: {WHY}")))
+    fn run(&self, ctx: &mut RunCtx) -> Result<(), BenchError> {
+        if !ctx.blocking_enabled() {
+            ctx.notes
+                .push("loop runs the event-driven driver only; skipped by --strategy spin".into());
+            return Ok(());
+        }
+        let domain = ctx.domain();
+        let (warm, n) = (ctx.count(50, 20), ctx.count(1_000, 200));
+        let mut child = ChildProc::spawn(&ChildSpec {
+            role: "pioneer-driver".into(),
+            domain: Some(domain.name().to_string()),
+            cpu: ctx.child_cpu(),
+            deadline: ctx.deadline_for(warm + n, Duration::from_millis(20)),
+            ..Default::default()
+        })?;
+        child.expect("ready", START_TIMEOUT)?;
+        let cctx = Context::new(&domain, Role::Client, "bench-loop")
+            .map_err(|e| err("client context", e.to_string()))?;
+        let mut arm = ActArrayClient::connect_timeout(&cctx, DEVICE, START_TIMEOUT)
+            .map_err(|e| err("connect", e.to_string()))?;
+        arm.set_request_timeout(super::SAMPLE_TIMEOUT);
+        arm.power(true).map_err(|e| err("power", e.to_string()))?;
+        let (mut to_robot, mut to_client, mut total) =
+            (new_histogram()?, new_histogram()?, new_histogram()?);
+        let progress = Progress::new(ctx.progress, "loop through the emulator", warm + n);
+        for i in 1..=warm + n {
+            let target = if i % 2 == 0 { 0.15 } else { -0.15 };
+            let t0 = monotonic_ns();
+            arm.move_to(0, target)
+                .map_err(|e| err("command", e.to_string()))?;
+            // The first state acquired after the command was sent: the emulator's prompt
+            // ARMpac, read by the driver.
+            let deadline = Instant::now() + super::SAMPLE_TIMEOUT;
+            let (stamp, seen) = loop {
+                let s = arm
+                    .wait_state(deadline.saturating_duration_since(Instant::now()))
+                    .map_err(|e| err("state", e.to_string()))?;
+                let stamp = s.header.stamp_ns;
+                if stamp > t0 {
+                    break (stamp, monotonic_ns());
+                }
+            };
+            if i > warm {
+                to_robot.saturating_record(stamp.saturating_sub(t0));
+                to_client.saturating_record(seen.saturating_sub(stamp));
+                total.saturating_record(seen.saturating_sub(t0));
+            }
+            progress.tick(i);
+        }
+        progress.finish();
+        drop(arm);
+        let _ = child.send_line("quit");
+        child.finish(Duration::from_secs(10))?;
+        let bytes = Some((
+            core::mem::size_of::<ActArrayCmdMsg>(),
+            core::mem::size_of::<ActArrayData>(),
+        ));
+        for (id, label, metric, hist) in [
+            (
+                "loop.to_robot",
+                "command → robot reply read by the driver",
+                Metric::OneWay,
+                to_robot,
+            ),
+            (
+                "loop.to_client",
+                "reply read → client sees the state",
+                Metric::OneWay,
+                to_client,
+            ),
+            (
+                "loop.total",
+                "command → state, through the emulator",
+                Metric::RoundTrip,
+                total,
+            ),
+        ] {
+            ctx.push(Measurement {
+                scenario: "loop",
+                id: id.into(),
+                label: label.into(),
+                strategy: Strategy::Blocking,
+                metric,
+                bytes,
+                hist,
+            });
+        }
+        Ok(())
     }
 }
