@@ -607,11 +607,7 @@ impl<I: Interface> Client<I> {
         loop {
             match pending.receive() {
                 Ok(Some(resp)) => {
-                    return match I::Reply::read(resp.payload()) {
-                        Ok(Ok(reply)) => Ok(reply),
-                        Ok(Err(status)) => Err(RequestError::Nack(status)),
-                        Err(e) => Err(RequestError::Decode(e)),
-                    };
+                    return decode_reply::<I>(resp.payload());
                 }
                 Ok(None) => {}
                 Err(e) => return Err(RequestError::Transport(format!("{e:?}"))),
@@ -619,11 +615,7 @@ impl<I: Interface> Client<I> {
             if !pending.is_connected() {
                 // The server may have answered and closed in between: look once more.
                 if let Ok(Some(resp)) = pending.receive() {
-                    return match I::Reply::read(resp.payload()) {
-                        Ok(Ok(reply)) => Ok(reply),
-                        Ok(Err(status)) => Err(RequestError::Nack(status)),
-                        Err(e) => Err(RequestError::Decode(e)),
-                    };
+                    return decode_reply::<I>(resp.payload());
                 }
                 return Err(RequestError::DriverGone);
             }
@@ -640,6 +632,15 @@ impl<I: Interface> Client<I> {
             self.pause(deadline.min(next_check))
                 .map_err(|e| RequestError::Transport(e.to_string()))?;
         }
+    }
+}
+
+/// A reply as the caller sees it: the ACK's payload, or the NACK's reason.
+fn decode_reply<I: Interface>(raw: &I::ReplyMsg) -> Result<I::Reply, RequestError> {
+    match I::Reply::read(raw) {
+        Ok(Ok(reply)) => Ok(reply),
+        Ok(Err(status)) => Err(RequestError::Nack(status)),
+        Err(e) => Err(RequestError::Decode(e)),
     }
 }
 
