@@ -103,7 +103,6 @@ pub fn run(
     let geom = arm.geometry()?;
     let mut rng = Rng::new(p.seed);
     for round in 0..p.rounds {
-        let mut last = None;
         for (joint, g) in geom.actuators().iter().enumerate() {
             // The geometry reports min <= max; stay a margin inside, as the paper's
             // program stays clear of the limits.
@@ -133,9 +132,7 @@ pub fn run(
                 }
                 Err(e) => return Err(e.into()),
             }
-            last = Some(t);
         }
-        let _ = last;
         wait_settled(arm, round, p.round_timeout)?;
         if let Some(s) = arm.state() {
             observe(None, s);
