@@ -66,8 +66,8 @@ impl Drop for Running {
 }
 
 fn start_pioneer(domain: &Domain) -> Result<Running, CliError> {
-    use limber_drivers::emulator::{Emulator, EmulatorConfig};
-    use limber_drivers::pioneer::{PioneerConfig, PioneerDriver, RunOptions};
+    use limber_emulator::{Emulator, EmulatorConfig};
+    use limber_pioneer::{PioneerConfig, PioneerDriver, RunOptions};
     let stop = Arc::new(AtomicBool::new(false));
     let (tx, rx) = mpsc::channel::<Result<String, String>>();
     let d = domain.clone();
@@ -133,8 +133,8 @@ fn start_pioneer(domain: &Domain) -> Result<Running, CliError> {
 }
 
 fn start_simarm(domain: &Domain) -> Result<Running, CliError> {
-    use limber_drivers::kinematics::chain::Chain;
-    use limber_drivers::simarm::{SimArm, SimArmOptions, SimObject};
+    use limber_kinematics::chain::Chain;
+    use limber_simarm::{SimArm, SimArmOptions, SimObject};
     let stop = Arc::new(AtomicBool::new(false));
     let (tx, rx) = mpsc::channel::<Result<(), String>>();
     let d = domain.clone();

@@ -262,7 +262,7 @@ pub(crate) fn wait_err(e: WaitError) -> CliError {
 }
 
 fn connect<I: Interface>(device: &str, timeout: Duration) -> Result<Client<I>, CliError> {
-    let ctx = Context::client_from_env().map_err(connect_err)?;
+    let ctx = crate::client_context()?;
     let mut c = Client::<I>::connect_timeout(&ctx, device, timeout.min(Duration::from_millis(500)))
         .map_err(connect_err)?;
     c.set_request_timeout(timeout);

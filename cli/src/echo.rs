@@ -182,7 +182,7 @@ fn echo<I: Interface>(a: &EchoArgs) -> Result<(), CliError>
 where
     I::Data: Show,
 {
-    let ctx = Context::client_from_env().map_err(connect_err)?;
+    let ctx = crate::client_context()?;
     let mut c = Client::<I>::connect_timeout(&ctx, &a.device, Duration::from_millis(500))
         .map_err(connect_err)?;
     let timeout = Duration::from_secs_f64(a.timeout.clamp(0.01, 3600.0));
@@ -291,7 +291,7 @@ fn stats_human(s: &DriverStats) -> String {
 
 fn echo_driver(robot: &str, a: &EchoArgs) -> Result<(), CliError> {
     use limber_services::diagnostics::{DiagnosticsError, StatsReader};
-    let ctx = Context::client_from_env().map_err(connect_err)?;
+    let ctx = crate::client_context()?;
     let mut r = StatsReader::open(&ctx, robot).map_err(|e| match e {
         DiagnosticsError::NoDriver(_) => CliError::new(exit::NO_DRIVER, e.to_string()),
         DiagnosticsError::Name(_) => CliError::new(exit::USAGE, e.to_string()),

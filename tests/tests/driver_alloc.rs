@@ -11,8 +11,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, mpsc};
 use std::time::{Duration, Instant};
 
-use limber_drivers::emulator::{Emulator, EmulatorConfig};
-use limber_drivers::pioneer::{PioneerConfig, PioneerDriver, RunOptions};
+use limber_emulator::{Emulator, EmulatorConfig};
+use limber_pioneer::{PioneerConfig, PioneerDriver, RunOptions};
 use limber_services::prelude::*;
 use limber_services::{Domain, Role};
 

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use limber_drivers::emulator::{Emulator, EmulatorConfig, Faults, ModelConfig};
+use limber_emulator::{Emulator, EmulatorConfig, Faults, ModelConfig};
 use limber_examples::pick_block::{self, Devices, PickParams, Step};
 use limber_examples::random_moves::{self, RandomParams};
 use limber_interfaces::diagnostics::hardware;
@@ -125,7 +125,7 @@ fn the_papers_programs_run_on_the_emulated_pioneer() {
     );
     // And the emulated servos are where the driver says.
     let st = emu.state();
-    let home = limber_drivers::emulator::default_arm_info();
+    let home = limber_emulator::default_arm_info();
     for j in 0..5 {
         assert_eq!(
             st.robot.servo_ticks[j], home.joints[j].home,
@@ -254,9 +254,9 @@ fn silence_and_garbage_are_detected_and_survived() {
     // The refused command was not replayed after recovery.
     std::thread::sleep(Duration::from_millis(300));
     let target_tick = emu.state().robot.servo_targets[1];
-    let cal = limber_drivers::emulator::default_arm_info();
-    let refused_tick = limber_drivers::p2os::ArmCalibration::from(cal)
-        .radians_to_ticks(limber_drivers::p2os::ArmJoint::new(2).unwrap(), 0.2)
+    let cal = limber_emulator::default_arm_info();
+    let refused_tick = limber_p2os::ArmCalibration::from(cal)
+        .radians_to_ticks(limber_p2os::ArmJoint::new(2).unwrap(), 0.2)
         .unwrap()
         .tick;
     assert_ne!(target_tick, refused_tick, "a refused command was replayed");
@@ -274,9 +274,7 @@ fn sigterm_stops_the_arm_closes_the_link_and_exits_zero() {
     assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
     driver.signal(libc::SIGTERM);
     assert_eq!(driver.wait_timeout(T), Some(0));
-    let (closed, st) = emu.wait_for(T, |s| {
-        s.robot.stage == limber_drivers::emulator::SyncStage::NoSync
-    });
+    let (closed, st) = emu.wait_for(T, |s| s.robot.stage == limber_emulator::SyncStage::NoSync);
     assert!(closed, "no CLOSE: {:?}", st.robot.stage);
     // The arm was stopped where it was, not left running to the old target.
     assert_eq!(st.robot.servo_targets[0], st.robot.servo_ticks[0]);

@@ -6,11 +6,11 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use limber_drivers::emulator::{
+use limber_emulator::{
     Emulator, EmulatorConfig, EmulatorState, Faults, ModelConfig, ObjectPlacement, default_arm_info,
 };
-use limber_drivers::p2os::{ArmCalibration, ArmJoint, Command, GripperCommand as P2Grip};
 use limber_interfaces::actarray::{self, ActArrayMultiPositionCmd};
+use limber_p2os::{ArmCalibration, ArmJoint, Command, GripperCommand as P2Grip};
 use limber_services::prelude::*;
 use limber_services::{ConnectError, Domain, RequestError, Role};
 use limber_tests::Proc;

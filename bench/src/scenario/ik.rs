@@ -1,18 +1,16 @@
 //! `ik`: inverse kinematics solve times, in this process (pinned with `--pin`).
 //!
 //! The same solvers and deterministic targets as
-//! `limber_drivers::kinematics::bench::ik_solve_times` (FK of random configurations
+//! `the kinematics tests (FK of random configurations
 //! inside the limits, so every target is reachable), but every solve is recorded into a
 //! histogram: Pioneer closed form (SETPOSE full pose; SETPOSITION keeping the current
 //! approach) and the numeric IK of the generic 6- and 7-joint chains.
 
 use std::hint::black_box;
 
-use limber_drivers::kinematics::Pose;
-use limber_drivers::kinematics::chain::{Chain, DeterministicRng, IkTarget, NumericIkOptions};
-use limber_drivers::kinematics::pioneer::{
-    ApproachPreference, PioneerGeometry, PioneerIkOptions, Theta,
-};
+use limber_kinematics::Pose;
+use limber_kinematics::chain::{Chain, DeterministicRng, IkTarget, NumericIkOptions};
+use limber_kinematics::pioneer::{ApproachPreference, PioneerGeometry, PioneerIkOptions, Theta};
 use limber_services::monotonic_ns;
 
 use super::{RunCtx, Scenario};

@@ -1,14 +1,14 @@
 //! `request`: the GET_GEOM request round trip (`ActArrayClient::geometry`) against the
-//! Pioneer driver (`limber_drivers::pioneer::PioneerDriver`, event-driven loop) talking
+//! Pioneer driver (`limber_pioneer::PioneerDriver`, event-driven loop) talking
 //! P2OS over a pty to the built-in emulator, both in one child process. The driver
 //! answers requests from its own state: the round trip is client → driver → client,
 //! and the serial link only adds load to the driver's loop (SIPs every 100 ms).
 
 use std::time::{Duration, Instant};
 
-use limber_drivers::emulator::{Emulator, EmulatorConfig};
-use limber_drivers::pioneer::{LoopMode, PioneerConfig, PioneerDriver, RunOptions};
+use limber_emulator::{Emulator, EmulatorConfig};
 use limber_interfaces::prelude::*;
+use limber_pioneer::{LoopMode, PioneerConfig, PioneerDriver, RunOptions};
 use limber_services::prelude::*;
 use limber_services::{Role, monotonic_ns};
 

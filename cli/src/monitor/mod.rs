@@ -15,9 +15,7 @@ use std::time::{Duration, Instant};
 
 use clap::Args;
 use crossterm::event::{self, Event, KeyCode, KeyEventKind, KeyModifiers};
-use limber_services::Context;
 
-use crate::device::connect_err;
 use crate::{CliError, exit};
 use app::App;
 
@@ -41,7 +39,7 @@ const SETTLE: Duration = Duration::from_millis(1500);
 
 /// Runs `limber monitor`.
 pub fn run(args: MonitorArgs) -> Result<(), CliError> {
-    let ctx = Context::client_from_env().map_err(connect_err)?;
+    let ctx = crate::client_context()?;
     let mut app = App::new(ctx);
     let tty = std::io::stdout().is_terminal();
     if args.once || !tty {

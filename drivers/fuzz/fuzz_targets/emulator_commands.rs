@@ -3,8 +3,8 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use limber_drivers::emulator::{ModelConfig, Robot};
-use limber_drivers::p2os::{Command, Decoder};
+use limber_emulator::{ModelConfig, Robot};
+use limber_p2os::{Command, Decoder};
 use std::time::{Duration, Instant};
 
 fuzz_target!(|data: &[u8]| {

@@ -4,7 +4,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use limber_drivers::p2os::{Decoder, ReceivedCommand, RobotPacket};
+use limber_p2os::{Decoder, ReceivedCommand, RobotPacket};
 
 fuzz_target!(|data: &[u8]| {
     let Some((&chunk, stream)) = data.split_first() else {

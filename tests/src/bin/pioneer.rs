@@ -1,20 +1,8 @@
 //! `limber pioneer` as a test binary (the CLI crate's binary is not visible to this
-//! package's tests): the same arguments, the same behaviour.
-
-use clap::Parser;
-
-#[derive(Parser)]
-struct Args {
-    #[command(flatten)]
-    inner: limber_drivers::pioneer::PioneerArgs,
-}
+//! package's tests): the very same code as the `limber` binary, with `pioneer` inserted.
 
 fn main() -> std::process::ExitCode {
-    match limber_drivers::pioneer::run_cli(Args::parse().inner) {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("limber pioneer: {e}");
-            std::process::ExitCode::FAILURE
-        }
-    }
+    let mut args: Vec<std::ffi::OsString> = std::env::args_os().collect();
+    args.insert(1, "pioneer".into());
+    limber_cli::run_from(args)
 }

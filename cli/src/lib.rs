@@ -1,0 +1,215 @@
+//! `limber`: the command-line tool of the limber middleware. Every command-line parser of
+//! the workspace lives here; the library crates take plain configuration structs.
+//!
+//! The binary is a one-line `main` over [`run`]; the library form lets test binaries run
+//! a verb exactly as the `limber` binary does.
+
+use std::process::ExitCode;
+use std::sync::OnceLock;
+
+use clap::{Parser, Subcommand};
+use limber_services::{Context, Domain, Role};
+
+mod demo;
+mod device;
+mod echo;
+pub mod emulator;
+mod layout;
+mod list;
+mod logging;
+mod monitor;
+pub mod pioneer;
+pub mod simarm;
+
+/// limber: Player's generic limb interfaces (actarray, limb, gripper) over zero-copy
+/// shared memory, with a real-time driver for the Pioneer arm.
+#[derive(Debug, Parser)]
+#[command(name = "limber", version, about, long_about = None, propagate_version = true)]
+struct Cli {
+    /// The domain to work in (default: $LIMBER_DOMAIN, or "limber"). Robots and tests in
+    /// different domains never see each other.
+    #[arg(long, global = true, value_name = "NAME", env = limber_services::naming::DOMAIN_ENV,
+          value_parser = parse_domain)]
+    domain: Option<Domain>,
+
+    /// More log output on stderr (-v info, -vv debug, -vvv trace); RUST_LOG overrides.
+    #[arg(short, long, global = true, action = clap::ArgAction::Count)]
+    verbose: u8,
+
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// The main job: start the Pioneer emulator and driver in this process and run the
+    /// paper's pick-a-block program on it, step by step with the live joint and gripper
+    /// state, then a summary. `--on simarm` runs the very same program on the simulated arm.
+    Demo(demo::DemoArgs),
+    /// Print the wire contract: every message struct with its type name, size and fields.
+    ///
+    /// Without a flag, a readable catalogue. `--json` prints the layout manifest that the
+    /// C header and the Python classes are generated from.
+    Layout(layout::LayoutArgs),
+    /// List every device of the domain by its name robot/interface/index, with its driver
+    /// and whether the driver is alive.
+    List(list::ListArgs),
+    /// Print the live state of a device (one line per sample; --json for scripts).
+    Echo(echo::EchoArgs),
+    /// A live terminal view of every device of the domain, like Player's playerv: joints
+    /// against their limits, states, limb pose, grippers, lift, drivers' link statistics.
+    ///
+    /// Keys: up/down (j/k) select a device, h home, s stop, o open, c close, q quit.
+    /// `--once` (or a stdout that is not a terminal) prints one frame as text.
+    Monitor(monitor::MonitorArgs),
+    /// Command an actuator array: pos, multipos, speed, multispeed, home, current,
+    /// multicurrent; requests power, brakes, geom, speedcfg, accel.
+    ///
+    /// Example: limber actarray pioneer/actarray/0 pos 2 0.5
+    Actarray(device::ActArrayArgs),
+    /// Command a limb: home, stop, setpose, setposition, vecmove; requests power, brakes,
+    /// geom, speed.
+    ///
+    /// Example: limber limb pioneer/limb/0 setpose 0.3 0 0.2 --approach 0 0 -1 --orient 1 0 0
+    Limb(device::LimbArgs),
+    /// Command a gripper: open, close, stop, store, retrieve; request geom.
+    ///
+    /// Example: limber gripper pioneer/gripper/0 open
+    Gripper(device::GripperArgs),
+    /// Run the Pioneer driver: the arm, limb, grippers and lift over P2OS (serial, pty or
+    /// tcp://host:port). `--emulated` drives the built-in emulator.
+    Pioneer(pioneer::PioneerArgs),
+    /// Run a Pioneer controller emulator on a pty (prints its path) or on TCP.
+    Emulator(emulator::EmulatorArgs),
+    /// Run the simulated arm: actarray, limb and gripper for any serial chain (default the
+    /// built-in 6-joint arm; --builtin 7dof, or --chain FILE), robot name "simarm".
+    Simarm(simarm::SimArmArgs),
+    /// Measure latency: the command and state paths, requests, the loop through the
+    /// emulator and IK, beside raw iceoryx2 (the floor) and Unix/TCP sockets (the peers).
+    Bench(limber_bench::BenchArgs),
+}
+
+/// Runs the `limber` command line with the process's arguments.
+pub fn run() -> ExitCode {
+    run_from(std::env::args_os())
+}
+
+/// Runs the `limber` command line with `args` (the first is the program name).
+pub fn run_from<I, T>(args: I) -> ExitCode
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    let cli = Cli::parse_from(args);
+    logging::init(cli.verbose);
+    let domain = match cli.domain {
+        Some(d) => d,
+        None => match Domain::new(limber_services::naming::DEFAULT_DOMAIN) {
+            Ok(d) => d,
+            Err(e) => {
+                eprintln!("limber: {e}");
+                return ExitCode::from(exit::USAGE);
+            }
+        },
+    };
+    if DOMAIN.set(domain).is_err() {
+        tracing::debug!("the domain was already chosen in this process");
+    }
+    let result = match cli.command {
+        Command::Demo(args) => demo::run(args),
+        Command::Layout(args) => layout::run(args),
+        Command::List(args) => list::run(args),
+        Command::Echo(args) => echo::run(args),
+        Command::Monitor(args) => monitor::run(args),
+        Command::Actarray(args) => device::actarray(args),
+        Command::Limb(args) => device::limb(args),
+        Command::Gripper(args) => device::gripper(args),
+        Command::Pioneer(args) => pioneer::run(args),
+        Command::Emulator(args) => emulator::run(args),
+        Command::Simarm(args) => simarm::run(args),
+        Command::Bench(args) => {
+            limber_bench::run_cli(args).map_err(|e| CliError::new(exit::FAILURE, e.to_string()))
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("limber: {e}");
+            ExitCode::from(e.exit_code())
+        }
+    }
+}
+
+static DOMAIN: OnceLock<Domain> = OnceLock::new();
+
+/// `--domain` / `LIMBER_DOMAIN`: a valid domain name; an empty one is an error, not the
+/// default.
+fn parse_domain(s: &str) -> Result<Domain, String> {
+    if s.is_empty() {
+        return Err("the domain name is empty (unset LIMBER_DOMAIN or name a domain)".into());
+    }
+    Domain::new(s).map_err(|e| e.to_string())
+}
+
+/// The domain selected by `--domain` or `LIMBER_DOMAIN` (default `limber`).
+pub fn domain() -> Result<Domain, CliError> {
+    match DOMAIN.get() {
+        Some(d) => Ok(d.clone()),
+        None => Domain::new(limber_services::naming::DEFAULT_DOMAIN)
+            .map_err(|e| CliError::new(exit::USAGE, e.to_string())),
+    }
+}
+
+/// A client context in the selected domain, named after the verb's program.
+pub(crate) fn client_context() -> Result<Context, CliError> {
+    let domain = domain()?;
+    Context::new(&domain, Role::Client, "limber").map_err(|e| {
+        CliError::new(
+            exit::FAILURE,
+            format!("cannot join domain {}: {e}", domain.name()),
+        )
+    })
+}
+
+/// Exit codes of the `limber` command.
+pub mod exit {
+    /// Bad arguments (as clap uses).
+    pub const USAGE: u8 = 2;
+    /// No driver offers the device.
+    pub const NO_DRIVER: u8 = 3;
+    /// The driver died.
+    pub const DRIVER_GONE: u8 = 4;
+    /// The driver refused the command or request (the reason is printed).
+    pub const REFUSED: u8 = 5;
+    /// No answer in time.
+    pub const TIMEOUT: u8 = 6;
+    /// Anything else (I/O, shared memory).
+    pub const FAILURE: u8 = 1;
+}
+
+/// An error of a verb, with the exit code it maps to.
+#[derive(Debug)]
+pub struct CliError {
+    message: String,
+    code: u8,
+}
+
+impl CliError {
+    /// An error with exit code `code`.
+    pub fn new(code: u8, message: impl Into<String>) -> Self {
+        CliError {
+            message: message.into(),
+            code,
+        }
+    }
+
+    fn exit_code(&self) -> u8 {
+        self.code
+    }
+}
+
+impl std::fmt::Display for CliError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}

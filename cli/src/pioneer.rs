@@ -1,0 +1,158 @@
+//! `limber pioneer`: the driver as a command.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use limber_emulator::{Emulator, EmulatorConfig};
+use limber_p2os::LinkTarget;
+use limber_pioneer::{
+    ConfigError, DriverError, LoopMode, PioneerConfig, PioneerDriver, RunOptions, apply_realtime,
+};
+use limber_services::{Context, Role};
+
+use crate::{CliError, exit};
+
+/// Arguments of `limber pioneer`.
+#[derive(Debug, Clone, Args)]
+pub struct PioneerArgs {
+    /// Configuration file (TOML); see `--print-config` for every key and its default.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// The link: a serial device (/dev/ttyS0), a pty, or tcp://host:port (simulator: 8101).
+    #[arg(long)]
+    pub port: Option<String>,
+    /// Serial baud rate (default: try 9600, 38400, 19200, 115200, 57600).
+    #[arg(long)]
+    pub baud: Option<u32>,
+    /// Robot name in the device names (default "pioneer").
+    #[arg(long)]
+    pub robot: Option<String>,
+    /// Start the built-in Pioneer emulator on a pty and drive it.
+    #[arg(long)]
+    pub emulated: bool,
+    /// Busy-poll instead of waiting on events (lowest latency; takes a whole core).
+    #[arg(long)]
+    pub spin: bool,
+    /// Pin the driver thread to this CPU core.
+    #[arg(long, value_name = "N")]
+    pub cpu: Option<usize>,
+    /// Real-time: SCHED_FIFO priority 80 and locked memory (needs CAP_SYS_NICE /
+    /// CAP_IPC_LOCK; a warning says so when not permitted).
+    #[arg(long)]
+    pub rt: bool,
+    /// Print the configuration (defaults merged with --config) as TOML and exit.
+    #[arg(long)]
+    pub print_config: bool,
+}
+
+/// `limber pioneer` failed.
+#[derive(Debug, thiserror::Error)]
+pub enum PioneerCliError {
+    /// The configuration is invalid.
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    /// The domain or context could not be set up.
+    #[error("{0}")]
+    Setup(String),
+    /// The emulator could not start.
+    #[error("cannot start the emulator: {0}")]
+    Emulator(#[from] limber_emulator::EmulatorError),
+    /// The driver failed.
+    #[error(transparent)]
+    Driver(#[from] DriverError),
+}
+
+/// The configuration from `--config` and the flags.
+pub fn config_from(args: &PioneerArgs) -> Result<PioneerConfig, PioneerCliError> {
+    let mut cfg = match &args.config {
+        Some(p) => PioneerConfig::from_file(p)?,
+        None => PioneerConfig::default(),
+    };
+    if let Some(p) = &args.port {
+        cfg.port = p.clone();
+    }
+    if let Some(b) = args.baud {
+        cfg.baud = Some(b);
+    }
+    if let Some(r) = &args.robot {
+        cfg.robot = r.clone();
+    }
+    cfg.validate()?;
+    Ok(cfg)
+}
+
+/// Runs `limber pioneer` until SIGINT/SIGTERM.
+pub fn run(args: PioneerArgs) -> Result<(), CliError> {
+    let domain = crate::domain()?;
+    serve(args, &domain).map_err(|e| {
+        let code = match e {
+            PioneerCliError::Config(_) => exit::USAGE,
+            _ => exit::FAILURE,
+        };
+        CliError::new(code, e.to_string())
+    })
+}
+
+fn serve(args: PioneerArgs, domain: &limber_services::Domain) -> Result<(), PioneerCliError> {
+    let cfg = config_from(&args)?;
+    if args.print_config {
+        print!("{}", cfg.to_toml());
+        return Ok(());
+    }
+    let ctx = Context::new(domain, Role::Driver, "pioneer").map_err(|e| {
+        PioneerCliError::Setup(format!("cannot join domain {}: {e}", domain.name()))
+    })?;
+    let emulator = if args.emulated {
+        let emu = Emulator::start_pty(EmulatorConfig::default())?;
+        eprintln!(
+            "limber pioneer: emulator on {}",
+            emu.pty_path()
+                .map(|p| p.display().to_string())
+                .unwrap_or_default()
+        );
+        Some(emu)
+    } else {
+        None
+    };
+    let target = match &emulator {
+        Some(e) => e.link_target(),
+        None => LinkTarget::parse(&cfg.port),
+    };
+    // Each warning is logged where it arises.
+    let _warnings = apply_realtime(args.cpu, args.rt);
+    let mut driver = PioneerDriver::start(&ctx, cfg.clone(), target)?;
+    let hw = driver.hardware().clone();
+    eprintln!(
+        "limber pioneer: connected to {:?} class {:?} subclass {:?}; domain {}",
+        hw.identity.name,
+        hw.identity.class,
+        hw.identity.subclass,
+        domain.name()
+    );
+    let r = &cfg.robot;
+    if hw.arm {
+        println!("serving {r}/actarray/0 (arm), {r}/limb/0, {r}/gripper/1 (arm gripper)");
+    } else {
+        println!(
+            "no arm: the robot did not answer ARM_INFO; not serving {r}/actarray/0, {r}/limb/0, {r}/gripper/1"
+        );
+    }
+    if hw.gripper {
+        println!("serving {r}/gripper/0 (body gripper), {r}/actarray/1 (lift)");
+    }
+    println!("serving {r}/driver/0 (statistics); ready");
+    let mode = if args.spin {
+        LoopMode::Spin
+    } else {
+        LoopMode::Event
+    };
+    driver.run(RunOptions { mode })?;
+    eprintln!("limber pioneer: stopped the arm and closed the link");
+    drop(driver);
+    if let Some(e) = emulator
+        && let Err(err) = e.stop()
+    {
+        tracing::warn!("stopping the emulator: {err}");
+    }
+    Ok(())
+}

@@ -1,0 +1,128 @@
+//! `limber simarm`: the simulated arm as a command.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use clap::{Args, ValueEnum};
+use limber_kinematics::chain::Chain;
+use limber_services::event_loop::LoopExit;
+use limber_services::{Context, Role};
+use limber_simarm::{SimArm, SimArmError, SimArmOptions, SimObject};
+
+use crate::{CliError, exit};
+
+/// A built-in chain.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Builtin {
+    /// The 6-joint UR5-like arm (`drivers/kinematics/chains/arm6.toml`).
+    #[value(name = "6dof")]
+    Arm6,
+    /// The 7-joint Panda-like arm (`drivers/kinematics/chains/arm7.toml`).
+    #[value(name = "7dof")]
+    Arm7,
+}
+
+/// Arguments of `limber simarm`.
+#[derive(Debug, Clone, Args)]
+pub struct SimArmArgs {
+    /// Chain file (TOML, see `drivers/kinematics/chains/`); default: the built-in 6-joint arm.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["builtin", "chain_7dof"])]
+    pub chain: Option<PathBuf>,
+    /// A built-in chain instead of a file.
+    #[arg(long, value_enum, conflicts_with = "chain_7dof")]
+    pub builtin: Option<Builtin>,
+    /// Shorthand for `--builtin 7dof`.
+    #[arg(long)]
+    pub chain_7dof: bool,
+    /// Robot name in the device names.
+    #[arg(long, default_value = "simarm")]
+    pub robot: String,
+    /// Simulation and publishing period, ms (1 to 1000).
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    pub tick_ms: u64,
+    /// Simulated seconds per real second (2.0 = twice as fast).
+    #[arg(long, default_value_t = 1.0)]
+    pub time_scale: f64,
+    /// An object to grasp: x,y,z of its centre (m, robot frame) and its width (m),
+    /// e.g. `--object 0.45,0.1,0.1,0.04`.
+    #[arg(long, value_name = "X,Y,Z,WIDTH", value_parser = parse_object)]
+    pub object: Option<SimObject>,
+}
+
+impl SimArmArgs {
+    /// The chain the arguments select.
+    pub fn chain(&self) -> Result<Chain, SimArmError> {
+        Ok(match (&self.chain, self.builtin, self.chain_7dof) {
+            (Some(p), _, _) => Chain::from_file(p)?,
+            (None, Some(Builtin::Arm7), _) | (None, None, true) => Chain::default_7dof(),
+            _ => Chain::default_6dof(),
+        })
+    }
+
+    /// The options the arguments select.
+    pub fn options(&self) -> SimArmOptions {
+        SimArmOptions {
+            robot: self.robot.clone(),
+            tick: Duration::from_millis(self.tick_ms),
+            time_scale: self.time_scale,
+            object: self.object,
+            ..SimArmOptions::default()
+        }
+    }
+}
+
+/// Parses `x,y,z,width` (metres) into a block captured within 2 cm.
+fn parse_object(s: &str) -> Result<SimObject, String> {
+    let mut v = [0.0; 4];
+    let mut n = 0;
+    for part in s.split(',') {
+        if n == 4 {
+            return Err("expected 4 numbers: x,y,z,width".into());
+        }
+        v[n] = part
+            .trim()
+            .parse::<f64>()
+            .map_err(|e| format!("{part:?}: {e}"))?;
+        n += 1;
+    }
+    if n != 4 {
+        return Err("expected 4 numbers: x,y,z,width".into());
+    }
+    if !(v.iter().all(|x| x.is_finite()) && v[3] > 0.0) {
+        return Err("values must be finite and the width > 0".into());
+    }
+    Ok(SimObject::block([v[0], v[1], v[2]], v[3]))
+}
+
+/// Runs `limber simarm` until SIGINT/SIGTERM: joins the domain of `LIMBER_DOMAIN`,
+/// prints `serving <robot>/actarray/0, <robot>/limb/0, <robot>/gripper/0; ready` and
+/// serves.
+pub fn run(args: SimArmArgs) -> Result<(), CliError> {
+    let fail = |e: SimArmError| CliError::new(exit::FAILURE, e.to_string());
+    let chain = args
+        .chain()
+        .map_err(|e| CliError::new(exit::USAGE, e.to_string()))?;
+    let options = args.options();
+    let domain = crate::domain()?;
+    let ctx = Context::new(&domain, Role::Driver, "simarm").map_err(|e| {
+        CliError::new(
+            exit::FAILURE,
+            format!("cannot join domain {}: {e}", domain.name()),
+        )
+    })?;
+    let robot = options.robot.clone();
+    let mut arm = SimArm::new(&ctx, chain, options).map_err(fail)?;
+    eprintln!(
+        "limber simarm: chain {:?}, {} joints + gripper, time scale {}; domain {}",
+        arm.model().chain().name(),
+        arm.model().chain().dof(),
+        args.time_scale,
+        domain.name()
+    );
+    println!("serving {robot}/actarray/0, {robot}/limb/0, {robot}/gripper/0; ready");
+    let ended = arm.run(|| false).map_err(fail)?;
+    if ended == LoopExit::Signal {
+        eprintln!("limber simarm: stopped");
+    }
+    Ok(())
+}

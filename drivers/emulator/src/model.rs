@@ -1,0 +1,666 @@
+//! The emulated controller's state and behaviour, independent of I/O: it
+//! takes command payloads and the time, and produces packets.
+
+use limber_p2os::vendor_conventions as vc;
+use limber_p2os::{
+    ArmInfo, ArmPacket, Frame, GripperCommand, GripperPacket, GripperSwitchFacts, GripperSwitches,
+    JointCalibration, ReceivedCommand, RobotIdentity, Sip, SonarReading, num,
+};
+use std::time::{Duration, Instant};
+
+/// Where a simulated object sits in front of the gripper (at floor level,
+/// between the paddles).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ObjectPlacement {
+    /// Between the paddle tips: breaks the outer beam only.
+    Outer,
+    /// Fully between the paddles: breaks both beams.
+    Inner,
+}
+
+/// The sync/connection stage of the emulated controller.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SyncStage {
+    /// Waiting for SYNC0.
+    NoSync,
+    /// SYNC0 answered.
+    AfterSync0,
+    /// SYNC1 answered.
+    AfterSync1,
+    /// SYNC2 answered; waiting for OPEN.
+    Synced,
+    /// OPEN received: streaming SIPs.
+    Open,
+}
+
+/// The default arm calibration: 6 joints including the gripper.
+pub fn default_arm_info() -> ArmInfo {
+    let j = |speed, home, min, centre, max, ticks_per_90| JointCalibration {
+        speed,
+        home,
+        min,
+        centre,
+        max,
+        ticks_per_90,
+    };
+    ArmInfo::new(
+        "limber-emulator P2ARM 1.0",
+        &[
+            j(20, 128, 28, 128, 228, 80),
+            j(20, 200, 40, 120, 220, 85),
+            j(20, 40, 30, 128, 225, 90),
+            j(20, 128, 10, 128, 245, 85),
+            j(20, 128, 40, 128, 215, 80),
+            j(10, 160, 100, 128, 200, 80),
+        ],
+    )
+}
+
+/// Physical parameters of the emulated robot.
+#[derive(Debug, Clone)]
+pub struct ModelConfig {
+    /// The SYNC2 identity.
+    pub identity: RobotIdentity,
+    /// The arm and its calibration; `None` = no arm (arm commands are
+    /// ignored silently, like a simulator without an arm).
+    pub arm: Option<ArmInfo>,
+    /// A body gripper with lift is fitted.
+    pub gripper: bool,
+    /// Time of a full lift stroke (the reference: 3.5 s).
+    pub lift_stroke: Duration,
+    /// Time for the paddles to go from closed to open.
+    pub paddle_stroke: Duration,
+    /// Paddle opening at which they close on an object (0 closed, 1 open).
+    pub object_width: f64,
+}
+
+impl Default for ModelConfig {
+    fn default() -> Self {
+        ModelConfig {
+            identity: RobotIdentity {
+                name: "limber-emulator".into(),
+                class: "Pioneer".into(),
+                subclass: "p3dx".into(),
+            },
+            arm: Some(default_arm_info()),
+            gripper: true,
+            lift_stroke: Duration::from_millis(3500),
+            paddle_stroke: Duration::from_millis(1500),
+            object_width: 0.35,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Servo {
+    tick: u8,
+    target: u8,
+    ms: u8,
+    next_step: Option<Instant>,
+}
+
+/// A linear actuator moving at a constant rate (paddles, lift), 0..1.
+#[derive(Debug, Clone, Copy)]
+struct Axis {
+    pos: f64,
+    target: f64,
+    last: Instant,
+}
+
+impl Axis {
+    fn moving(&self) -> bool {
+        (self.pos - self.target).abs() > 1e-9
+    }
+
+    fn advance(&mut self, now: Instant, stroke: Duration) {
+        let dt = now.saturating_duration_since(self.last).as_secs_f64();
+        self.last = now;
+        let step = dt / stroke.as_secs_f64().max(1e-6);
+        if self.pos < self.target {
+            self.pos = (self.pos + step).min(self.target);
+        } else if self.pos > self.target {
+            self.pos = (self.pos - step).max(self.target);
+        }
+    }
+
+    fn set_target(&mut self, t: f64, now: Instant) {
+        if !self.moving() {
+            self.last = now;
+        }
+        self.target = t.clamp(0.0, 1.0);
+    }
+
+    fn stop(&mut self) {
+        self.target = self.pos;
+    }
+}
+
+const LIFT_FLOOR: f64 = 0.05;
+
+/// A snapshot of the emulated robot, for tests and tools.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RobotState {
+    /// Connection stage.
+    pub stage: SyncStage,
+    /// An arm is fitted.
+    pub has_arm: bool,
+    /// Arm servo power.
+    pub arm_powered: bool,
+    /// Current tick of joints 1..6.
+    pub servo_ticks: [u8; 6],
+    /// Target tick of joints 1..6.
+    pub servo_targets: [u8; 6],
+    /// Speed (ms per step) of joints 1..6.
+    pub ms_per_step: [u8; 6],
+    /// ARMpac stream mode (0 off, 2 continuous).
+    pub arm_status_mode: u8,
+    /// The arm is homing.
+    pub homing: bool,
+    /// Paddle opening, 0 closed .. 1 open.
+    pub paddles: f64,
+    /// Paddles moving.
+    pub paddles_moving: bool,
+    /// Lift position, 0 down .. 1 up.
+    pub lift: f64,
+    /// Lift moving.
+    pub lift_moving: bool,
+    /// The simulated object in front of the gripper.
+    pub object: Option<ObjectPlacement>,
+    /// The object is held between the paddles.
+    pub object_in_gripper: bool,
+    /// The gripper switch byte as sent.
+    pub switches: GripperSwitches,
+    /// Sonar on.
+    pub sonar: bool,
+    /// Valid commands received.
+    pub commands: u64,
+}
+
+/// The emulated controller.
+#[derive(Debug, Clone)]
+pub struct Robot {
+    cfg: ModelConfig,
+    stage: SyncStage,
+    arm_powered: bool,
+    homing: bool,
+    parking: bool,
+    servos: [Servo; 6],
+    arm_status: u8,
+    paddles: Axis,
+    lift: Axis,
+    object: Option<ObjectPlacement>,
+    gripped: bool,
+    pending_carry: bool,
+    gripper_pac: u8,
+    sonar: bool,
+    commands: u64,
+    last_moving: u8,
+    wants_arm_pac: bool,
+}
+
+impl Robot {
+    /// A robot at rest: arm unpowered at its home ticks, paddles closed,
+    /// lift down.
+    pub fn new(cfg: ModelConfig, now: Instant) -> Robot {
+        let mut servos = [Servo {
+            tick: 128,
+            target: 128,
+            ms: 20,
+            next_step: None,
+        }; 6];
+        if let Some(info) = &cfg.arm {
+            for (s, c) in servos.iter_mut().zip(info.calibrations()) {
+                s.tick = c.home;
+                s.target = c.home;
+                s.ms = c.speed;
+            }
+        }
+        let axis = |pos| Axis {
+            pos,
+            target: pos,
+            last: now,
+        };
+        Robot {
+            cfg,
+            stage: SyncStage::NoSync,
+            arm_powered: false,
+            homing: false,
+            parking: false,
+            servos,
+            arm_status: 0,
+            paddles: axis(0.0),
+            lift: axis(0.0),
+            object: None,
+            gripped: false,
+            pending_carry: false,
+            gripper_pac: 0,
+            sonar: false,
+            commands: 0,
+            last_moving: 0,
+            wants_arm_pac: false,
+        }
+    }
+
+    /// The connection stage.
+    pub fn stage(&self) -> SyncStage {
+        self.stage
+    }
+
+    /// Forgets the client (a new TCP connection, or after CLOSE): back to
+    /// NO_SYNC, streams off. The physical state stays.
+    pub fn reset_connection(&mut self) {
+        self.stage = SyncStage::NoSync;
+        self.arm_status = 0;
+        self.gripper_pac = 0;
+        self.sonar = false;
+    }
+
+    /// Places or removes the simulated object.
+    pub fn set_object(&mut self, o: Option<ObjectPlacement>) {
+        self.object = o;
+        if o.is_none() {
+            self.gripped = false;
+        }
+    }
+
+    fn has_arm(&self) -> bool {
+        self.cfg.arm.is_some()
+    }
+
+    fn calib(&self, idx: usize) -> Option<JointCalibration> {
+        self.cfg.arm.as_ref()?.calibrations().get(idx).copied()
+    }
+
+    fn joints(&self, arg: i32) -> std::ops::Range<usize> {
+        let n = self.cfg.arm.as_ref().map_or(0, |a| a.calibrations().len());
+        match u8::try_from(arg) {
+            Ok(vc::ARM_ALL_JOINTS) => 0..n,
+            Ok(j @ 1..=6) if usize::from(j) <= n => usize::from(j) - 1..usize::from(j),
+            _ => 0..0,
+        }
+    }
+
+    fn set_servo_target(&mut self, idx: usize, target: u8, now: Instant) {
+        let Some(c) = self.calib(idx) else { return };
+        let target = target.clamp(c.min.min(c.max), c.max.max(c.min));
+        let s = &mut self.servos[idx];
+        s.target = target;
+        if s.next_step.is_none() && s.tick != target {
+            s.next_step = Some(now + step_time(s.ms));
+        }
+    }
+
+    /// Handles one command payload; replies (and an ARMpac when the command
+    /// changed the arm's state and the stream is on) go to `out` at once.
+    pub fn handle(&mut self, payload: &[u8], now: Instant, out: &mut Vec<Frame>) {
+        let Some(cmd) = ReceivedCommand::parse(payload) else {
+            return;
+        };
+        self.advance(now, out);
+        self.commands += 1;
+        let arg = cmd.int();
+        let open = self.stage == SyncStage::Open;
+        match cmd.number {
+            num::SYNC0 if !open => {
+                self.stage = SyncStage::AfterSync0;
+                push(out, Frame::new(&[0]));
+            }
+            num::SYNC1 if !open => {
+                if self.stage == SyncStage::Synced {
+                    self.stage = SyncStage::Open;
+                } else {
+                    self.stage = SyncStage::AfterSync1;
+                    push(out, Frame::new(&[1]));
+                }
+            }
+            num::SYNC2 if !open && self.stage == SyncStage::AfterSync1 => {
+                self.stage = SyncStage::Synced;
+                push(out, self.cfg.identity.encode_sync2());
+            }
+            num::SYNC2 if !open => {}
+            num::PULSE => {}
+            num::CLOSE => self.reset_connection(),
+            _ if !open => {}
+            num::SONAR => self.sonar = arg.unwrap_or(0) != 0,
+            num::GRIPPER if self.cfg.gripper => {
+                if let Some(g) = arg.and_then(|a| u8::try_from(a & 0xFF).ok()) {
+                    self.gripper_command(g, now);
+                }
+            }
+            num::GRIPPERVAL if self.cfg.gripper && self.pending_carry => {
+                self.pending_carry = false;
+                let v = f64::from(arg.unwrap_or(0));
+                let travel = v * 0.020 / self.cfg.lift_stroke.as_secs_f64().max(1e-6);
+                let t = self.lift.pos + travel;
+                self.lift.set_target(t, now);
+            }
+            num::GRIPPERPACREQUEST if self.cfg.gripper => {
+                let a = arg.unwrap_or(0);
+                if a == 1 {
+                    push(out, self.gripper_packet().encode());
+                } else {
+                    self.gripper_pac = u8::from(a == 2);
+                }
+            }
+            n if self.has_arm() && (num::ARM_INFO..=num::ARM_GRIPPARK).contains(&n) => {
+                self.arm_command(n, arg, now, out);
+            }
+            _ => {}
+        }
+    }
+
+    fn gripper_command(&mut self, g: u8, now: Instant) {
+        let Some(g) = GripperCommand::from_u8(g) else {
+            return;
+        };
+        self.pending_carry = false;
+        match g {
+            GripperCommand::Open => self.paddles.set_target(1.0, now),
+            GripperCommand::Close | GripperCommand::Press => self.paddles.set_target(0.0, now),
+            GripperCommand::Stop => self.paddles.stop(),
+            GripperCommand::LiftUp => self.lift.set_target(1.0, now),
+            GripperCommand::LiftDown => self.lift.set_target(0.0, now),
+            GripperCommand::LiftStop => self.lift.stop(),
+            GripperCommand::Store => {
+                self.paddles.set_target(0.0, now);
+                self.lift.set_target(1.0, now);
+            }
+            GripperCommand::Deploy => {
+                self.paddles.set_target(1.0, now);
+                self.lift.set_target(0.0, now);
+            }
+            GripperCommand::Halt => {
+                self.paddles.stop();
+                self.lift.stop();
+            }
+            GripperCommand::LiftCarry => self.pending_carry = true,
+        }
+    }
+
+    fn arm_command(&mut self, n: u8, arg: Option<i32>, now: Instant, out: &mut Vec<Frame>) {
+        let a = arg.unwrap_or(0);
+        let [lsb, msb] = (a.clamp(0, 0xFFFF) as u16).to_le_bytes();
+        match n {
+            num::ARM_INFO => {
+                if let Some(info) = &self.cfg.arm {
+                    push(out, info.encode());
+                }
+                return;
+            }
+            num::ARM_STATUS => {
+                match a {
+                    1 => push(out, self.arm_packet().encode()),
+                    2 => {
+                        self.arm_status = 2;
+                        push(out, self.arm_packet().encode());
+                    }
+                    _ => self.arm_status = 0,
+                }
+                return;
+            }
+            num::ARM_POWER => {
+                self.arm_powered = a != 0;
+                if !self.arm_powered {
+                    for s in &mut self.servos {
+                        s.target = s.tick;
+                        s.next_step = None;
+                    }
+                    self.homing = false;
+                    self.parking = false;
+                }
+            }
+            num::ARM_HOME | num::ARM_PARK if self.arm_powered => {
+                let js = if n == num::ARM_PARK {
+                    self.joints(i32::from(vc::ARM_ALL_JOINTS))
+                } else {
+                    self.joints(a)
+                };
+                for j in js {
+                    if let Some(c) = self.calib(j) {
+                        self.set_servo_target(j, c.home, now);
+                    }
+                }
+                self.homing = true;
+                self.parking = n == num::ARM_PARK;
+            }
+            num::ARM_POS if self.arm_powered => {
+                for j in self.joints(i32::from(msb)) {
+                    self.set_servo_target(j, lsb, now);
+                }
+            }
+            num::ARM_SPEED => {
+                for j in self.joints(i32::from(msb)) {
+                    self.servos[j].ms = lsb;
+                }
+            }
+            num::ARM_STOP => {
+                for j in self.joints(a) {
+                    let s = &mut self.servos[j];
+                    s.target = s.tick;
+                    s.next_step = None;
+                }
+            }
+            _ => return,
+        }
+        self.wants_arm_pac = true;
+        self.flush_arm_pac(out);
+    }
+
+    fn flush_arm_pac(&mut self, out: &mut Vec<Frame>) {
+        if self.wants_arm_pac && self.arm_status == 2 && self.stage == SyncStage::Open {
+            push(out, self.arm_packet().encode());
+            // The client now knows which joints move.
+            self.last_moving = self.moving_mask();
+        }
+        self.wants_arm_pac = false;
+    }
+
+    fn moving_mask(&self) -> u8 {
+        let mut m = 0u8;
+        for (i, s) in self.servos.iter().enumerate() {
+            if s.tick != s.target {
+                m |= 1 << i;
+            }
+        }
+        m
+    }
+
+    /// Advances the servos, paddles and lift to `now`. When a joint stops
+    /// and the ARMpac stream is on, an ARMpac goes to `out` at once.
+    pub fn advance(&mut self, now: Instant, out: &mut Vec<Frame>) {
+        if self.arm_powered {
+            for s in &mut self.servos {
+                while s.tick != s.target {
+                    let Some(due) = s.next_step else {
+                        s.next_step = Some(now + step_time(s.ms));
+                        break;
+                    };
+                    if now < due {
+                        break;
+                    }
+                    s.tick = if s.tick < s.target {
+                        s.tick + 1
+                    } else {
+                        s.tick - 1
+                    };
+                    s.next_step = Some(due + step_time(s.ms));
+                }
+                if s.tick == s.target {
+                    s.next_step = None;
+                }
+            }
+        }
+        let moving = self.moving_mask();
+        if moving == 0 && (self.homing || self.parking) {
+            self.homing = false;
+            if self.parking {
+                self.parking = false;
+                self.arm_powered = false;
+            }
+            self.wants_arm_pac = true;
+        }
+        if moving != self.last_moving {
+            // A joint started or finished: tell the client now.
+            self.wants_arm_pac = true;
+            self.last_moving = moving;
+        }
+        self.flush_arm_pac(out);
+
+        let was_closing = self.paddles.target < self.paddles.pos;
+        self.paddles.advance(now, self.cfg.paddle_stroke);
+        self.lift.advance(now, self.cfg.lift_stroke);
+        let visible = self.object_visible();
+        if was_closing && visible && !self.gripped && self.paddles.pos <= self.cfg.object_width {
+            self.paddles.pos = self.cfg.object_width;
+            self.paddles.stop();
+            self.gripped = true;
+        }
+        if self.gripped && self.paddles.pos > self.cfg.object_width + 1e-9 {
+            // Opened: the object is released (and falls if lifted).
+            self.gripped = false;
+        }
+    }
+
+    fn object_visible(&self) -> bool {
+        self.gripped || (self.object.is_some() && self.lift.pos <= LIFT_FLOOR)
+    }
+
+    /// The earliest time something changes by itself, for the I/O loop's
+    /// wait (`None`: nothing moves).
+    pub fn next_event(&self, now: Instant) -> Option<Instant> {
+        let servo = self
+            .servos
+            .iter()
+            .filter(|s| self.arm_powered && s.tick != s.target)
+            .filter_map(|s| s.next_step)
+            .min();
+        let axes =
+            (self.paddles.moving() || self.lift.moving()).then(|| now + Duration::from_millis(5));
+        match (servo, axes) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
+    }
+
+    /// The packets of one controller cycle (SIP, and the ARMpac and gripper
+    /// packet when streaming). Nothing before OPEN.
+    pub fn cycle(&mut self, now: Instant, out: &mut Vec<Frame>) {
+        self.advance(now, out);
+        if self.stage != SyncStage::Open {
+            return;
+        }
+        push(out, self.sip().encode());
+        if self.arm_status == 2 && self.has_arm() {
+            push(out, self.arm_packet().encode());
+        }
+        if self.gripper_pac == 1 {
+            push(out, self.gripper_packet().encode());
+        }
+    }
+
+    fn switch_facts(&self) -> GripperSwitchFacts {
+        let closed = self.paddles.pos <= 1e-9 || self.gripped;
+        let visible = self.object_visible();
+        GripperSwitchFacts {
+            paddles_open: self.paddles.pos >= 1.0 - 1e-9,
+            left_contact: closed,
+            right_contact: closed,
+            paddles_moving: self.paddles.moving(),
+            lift_at_limit: !self.lift.moving()
+                && (self.lift.pos <= 1e-9 || self.lift.pos >= 1.0 - 1e-9),
+            lift_moving: self.lift.moving(),
+            outer_beam: visible,
+            inner_beam: visible && (self.gripped || self.object == Some(ObjectPlacement::Inner)),
+        }
+    }
+
+    fn switches(&self) -> GripperSwitches {
+        if self.cfg.gripper {
+            GripperSwitches::from_facts(self.switch_facts())
+        } else {
+            GripperSwitches(0)
+        }
+    }
+
+    /// The current standard SIP.
+    pub fn sip(&self) -> Sip {
+        let mut sip = Sip::default();
+        sip.timer = u16::from(self.switches().0) << 8;
+        if self.sonar {
+            let readings: [SonarReading; 8] = std::array::from_fn(|i| SonarReading {
+                index: i as u8,
+                range: 5000,
+            });
+            sip.set_sonars(&readings);
+        }
+        sip
+    }
+
+    /// The current ARMpac.
+    pub fn arm_packet(&self) -> ArmPacket {
+        let mut status = u16::from(self.moving_mask()) & vc::ARM_STATUS_MOVING_MASK;
+        status |= vc::ARM_STATUS_GOOD | vc::ARM_STATUS_INITED;
+        if self.arm_powered {
+            status |= vc::ARM_STATUS_POWERED;
+        }
+        if self.homing {
+            status |= vc::ARM_STATUS_HOMING;
+        }
+        let mut ticks = [0u8; 6];
+        for (t, s) in ticks.iter_mut().zip(&self.servos) {
+            *t = s.tick;
+        }
+        ArmPacket { status, ticks }
+    }
+
+    /// The current 0xE0 gripper packet.
+    pub fn gripper_packet(&self) -> GripperPacket {
+        GripperPacket {
+            gripper_type: if self.cfg.gripper { 2 } else { 0 },
+            switches: self.switches(),
+            grasp_time: 10,
+        }
+    }
+
+    /// A snapshot of the state.
+    pub fn state(&self) -> RobotState {
+        let mut ticks = [0u8; 6];
+        let mut targets = [0u8; 6];
+        let mut ms = [0u8; 6];
+        for (i, s) in self.servos.iter().enumerate() {
+            ticks[i] = s.tick;
+            targets[i] = s.target;
+            ms[i] = s.ms;
+        }
+        RobotState {
+            stage: self.stage,
+            has_arm: self.has_arm(),
+            arm_powered: self.arm_powered,
+            servo_ticks: ticks,
+            servo_targets: targets,
+            ms_per_step: ms,
+            arm_status_mode: self.arm_status,
+            homing: self.homing,
+            paddles: self.paddles.pos,
+            paddles_moving: self.paddles.moving(),
+            lift: self.lift.pos,
+            lift_moving: self.lift.moving(),
+            object: self.object,
+            object_in_gripper: self.gripped,
+            switches: self.switches(),
+            sonar: self.sonar,
+            commands: self.commands,
+        }
+    }
+}
+
+fn step_time(ms: u8) -> Duration {
+    Duration::from_millis(u64::from(ms.max(1)))
+}
+
+fn push(out: &mut Vec<Frame>, f: Result<Frame, limber_p2os::EncodeError>) {
+    // Every frame the model builds is far below the size limit.
+    if let Ok(f) = f {
+        out.push(f);
+    }
+}

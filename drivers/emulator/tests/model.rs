@@ -1,0 +1,338 @@
+//! The emulated controller's behaviour on simulated time (no I/O, no sleeps).
+
+use limber_emulator::{ModelConfig, ObjectPlacement, Robot, SyncStage, default_arm_info};
+use limber_p2os::*;
+use std::time::{Duration, Instant};
+
+fn ms(n: u64) -> Duration {
+    Duration::from_millis(n)
+}
+
+struct Sim {
+    robot: Robot,
+    t0: Instant,
+    out: Vec<Frame>,
+}
+
+impl Sim {
+    fn new(cfg: ModelConfig) -> Sim {
+        let t0 = Instant::now();
+        Sim {
+            robot: Robot::new(cfg, t0),
+            t0,
+            out: Vec::new(),
+        }
+    }
+
+    /// Sends a command at `at` after the start; returns the replies' payloads.
+    fn cmd(&mut self, at: u64, c: Command) -> Vec<Vec<u8>> {
+        self.out.clear();
+        let f = c.encode().unwrap();
+        self.robot
+            .handle(f.payload(), self.t0 + ms(at), &mut self.out);
+        self.out.iter().map(|f| f.payload().to_vec()).collect()
+    }
+
+    fn advance(&mut self, at: u64) -> Vec<Vec<u8>> {
+        self.out.clear();
+        self.robot.advance(self.t0 + ms(at), &mut self.out);
+        self.out.iter().map(|f| f.payload().to_vec()).collect()
+    }
+
+    fn cycle(&mut self, at: u64) -> Vec<Vec<u8>> {
+        self.out.clear();
+        self.robot.cycle(self.t0 + ms(at), &mut self.out);
+        self.out.iter().map(|f| f.payload().to_vec()).collect()
+    }
+
+    fn open(&mut self) {
+        assert_eq!(self.cmd(0, Command::Sync0), vec![vec![0]]);
+        assert_eq!(
+            self.cmd(0, Command::Sync0),
+            vec![vec![0]],
+            "duplicate SYNC0"
+        );
+        assert_eq!(self.cmd(0, Command::Sync1), vec![vec![1]]);
+        let r = self.cmd(0, Command::Sync2);
+        assert_eq!(r.len(), 1);
+        assert_eq!(
+            RobotIdentity::parse(&r[0][1..]),
+            ModelConfig::default().identity
+        );
+        assert_eq!(self.robot.stage(), SyncStage::Synced);
+        assert!(self.cmd(0, Command::Open).is_empty());
+        assert_eq!(self.robot.stage(), SyncStage::Open);
+    }
+}
+
+fn j(n: u8) -> ArmJoint {
+    ArmJoint::new(n).unwrap()
+}
+
+#[test]
+fn handshake_and_nothing_before_open() {
+    let mut s = Sim::new(ModelConfig::default());
+    assert!(s.cmd(0, Command::ArmInfo).is_empty());
+    assert!(s.cycle(100).is_empty(), "no SIP before OPEN");
+    assert!(s.cmd(0, Command::Sync2).is_empty(), "SYNC2 out of order");
+    s.open();
+    let c = s.cycle(100);
+    assert_eq!(c.len(), 1);
+    assert!(matches!(RobotPacket::parse(&c[0]), Ok(RobotPacket::Sip(_))));
+    // CLOSE: back to NO_SYNC, silent.
+    s.cmd(150, Command::Close);
+    assert_eq!(s.robot.stage(), SyncStage::NoSync);
+    assert!(s.cycle(200).is_empty());
+}
+
+#[test]
+fn servos_step_one_tick_per_ms_per_step() {
+    let mut s = Sim::new(ModelConfig::default());
+    s.open();
+    let r = s.cmd(0, Command::ArmInfo);
+    match RobotPacket::parse(&r[0]) {
+        Ok(RobotPacket::ArmInfo(i)) => assert_eq!(i, default_arm_info()),
+        other => panic!("{other:?}"),
+    }
+    // Unpowered: position commands are ignored.
+    s.cmd(
+        0,
+        Command::ArmPos {
+            joint: j(1),
+            tick: 138,
+        },
+    );
+    s.advance(500);
+    assert_eq!(s.robot.state().servo_ticks[0], 128);
+    s.cmd(1000, Command::ArmPower(true));
+    s.cmd(
+        1000,
+        Command::ArmSpeed {
+            joint: j(1),
+            ms_per_step: 10,
+        },
+    );
+    s.cmd(
+        1000,
+        Command::ArmPos {
+            joint: j(1),
+            tick: 138,
+        },
+    );
+    s.advance(1055);
+    assert_eq!(s.robot.state().servo_ticks[0], 133);
+    assert_eq!(s.robot.arm_packet().moving_mask(), 1);
+    s.advance(1099);
+    assert_eq!(s.robot.state().servo_ticks[0], 137);
+    // Reaching the target sends no ARMpac unless the stream is on.
+    assert!(s.advance(1100).is_empty());
+    assert_eq!(s.robot.state().servo_ticks[0], 138);
+    assert_eq!(s.robot.arm_packet().moving_mask(), 0);
+
+    // With the stream on, commands and arrivals produce an ARMpac at once.
+    assert_eq!(
+        s.cmd(1200, Command::ArmStatus(ArmStatusMode::Continuous))
+            .len(),
+        1
+    );
+    let r = s.cmd(
+        1200,
+        Command::ArmPos {
+            joint: j(1),
+            tick: 136,
+        },
+    );
+    assert_eq!(r.len(), 1);
+    assert!(s.advance(1205).is_empty());
+    let r = s.advance(1220);
+    match RobotPacket::parse(&r[0]) {
+        Ok(RobotPacket::Arm(a)) => {
+            assert_eq!(a.tick(j(1)), 136);
+            assert_eq!(a.moving_mask(), 0);
+            assert!(a.is_powered());
+        }
+        other => panic!("{other:?}"),
+    }
+    // Every cycle: SIP and ARMpac.
+    assert_eq!(s.cycle(1300).len(), 2);
+    // Targets are clamped to the calibrated range; bad joints are ignored.
+    s.cmd(
+        1300,
+        Command::ArmPos {
+            joint: j(1),
+            tick: 255,
+        },
+    );
+    assert_eq!(s.robot.state().servo_targets[0], 228);
+    s.cmd(
+        1300,
+        Command::Custom {
+            number: num::ARM_POS,
+            arg: Some(0x0905),
+        },
+    );
+    s.cmd(
+        1300,
+        Command::Custom {
+            number: num::ARM_POS,
+            arg: Some(-5),
+        },
+    );
+    s.cmd(
+        1300,
+        Command::Custom {
+            number: num::ARM_POS,
+            arg: None,
+        },
+    );
+    assert_eq!(s.robot.state().servo_targets[1], 200);
+}
+
+#[test]
+fn park_homes_then_powers_off() {
+    let mut s = Sim::new(ModelConfig::default());
+    s.open();
+    s.cmd(0, Command::ArmPower(true));
+    for joint in ArmJoint::all() {
+        s.cmd(
+            0,
+            Command::ArmSpeed {
+                joint,
+                ms_per_step: 1,
+            },
+        );
+    }
+    s.cmd(
+        0,
+        Command::ArmPos {
+            joint: j(2),
+            tick: 100,
+        },
+    );
+    s.cmd(
+        0,
+        Command::ArmPos {
+            joint: j(6),
+            tick: 110,
+        },
+    );
+    s.advance(1000);
+    assert_eq!(s.robot.state().servo_ticks[1], 100);
+    s.cmd(1000, Command::ArmPark);
+    assert!(s.robot.arm_packet().is_homing());
+    s.advance(1050);
+    s.advance(2000);
+    let st = s.robot.state();
+    let homes: Vec<u8> = default_arm_info()
+        .calibrations()
+        .iter()
+        .map(|c| c.home)
+        .collect();
+    assert_eq!(st.servo_ticks.to_vec(), homes);
+    assert!(!st.arm_powered && !st.homing);
+}
+
+#[test]
+fn lift_takes_three_and_a_half_seconds_per_stroke() {
+    let mut s = Sim::new(ModelConfig::default());
+    s.open();
+    s.cmd(0, Command::Gripper(GripperCommand::LiftUp));
+    s.advance(1750);
+    let st = s.robot.state();
+    assert!((st.lift - 0.5).abs() < 1e-9 && st.lift_moving);
+    assert!(st.switches.lift_moving() && !st.switches.lift_at_limit());
+    s.advance(3500);
+    let st = s.robot.state();
+    assert_eq!(st.lift, 1.0);
+    assert!(!st.lift_moving && st.switches.lift_at_limit());
+    // Stop half way down: not at a limit.
+    s.cmd(3500, Command::Gripper(GripperCommand::LiftDown));
+    s.cmd(4375, Command::Gripper(GripperCommand::LiftStop));
+    let st = s.robot.state();
+    assert!((st.lift - 0.75).abs() < 1e-9);
+    assert!(!st.switches.lift_at_limit() && !st.switches.lift_moving());
+}
+
+#[test]
+fn breakbeams_follow_the_object() {
+    let mut s = Sim::new(ModelConfig::default());
+    s.open();
+    s.cmd(0, Command::Gripper(GripperCommand::Open));
+    s.advance(2000);
+    assert_eq!(s.robot.state().switches.paddles(), PaddleState::Open);
+    s.robot.set_object(Some(ObjectPlacement::Outer));
+    let sw = s.robot.sip().gripper_switches();
+    assert!(sw.outer_beam() && !sw.inner_beam());
+    s.robot.set_object(Some(ObjectPlacement::Inner));
+    let sw = s.robot.sip().gripper_switches();
+    assert!(sw.outer_beam() && sw.inner_beam());
+    s.cmd(2000, Command::Gripper(GripperCommand::Close));
+    s.advance(2500);
+    assert_eq!(s.robot.state().switches.paddles(), PaddleState::Moving);
+    s.advance(4000);
+    let st = s.robot.state();
+    assert!(st.object_in_gripper);
+    assert_eq!(st.switches.paddles(), PaddleState::Closed);
+    assert!((st.paddles - 0.35).abs() < 1e-9, "stopped on the object");
+    // Lifted with the paddles open, the object stays on the floor.
+    s.cmd(4000, Command::Gripper(GripperCommand::Open));
+    s.cmd(4000, Command::Gripper(GripperCommand::LiftUp));
+    s.advance(8000);
+    let st = s.robot.state();
+    assert!(!st.object_in_gripper);
+    assert!(!st.switches.outer_beam() && !st.switches.inner_beam());
+}
+
+#[test]
+fn a_robot_without_arm_or_gripper_ignores_their_commands() {
+    let cfg = ModelConfig {
+        arm: None,
+        gripper: false,
+        ..ModelConfig::default()
+    };
+    let mut s = Sim::new(cfg);
+    s.open();
+    assert!(s.cmd(0, Command::ArmInfo).is_empty());
+    assert!(s.cmd(0, Command::ArmStatus(ArmStatusMode::Once)).is_empty());
+    s.cmd(0, Command::Gripper(GripperCommand::LiftUp));
+    s.advance(5000);
+    assert_eq!(s.robot.state().lift, 0.0);
+    assert_eq!(s.cycle(5000).len(), 1);
+    assert!(!s.robot.state().has_arm);
+}
+
+#[test]
+fn gripper_packet_on_request_and_sonar() {
+    let mut s = Sim::new(ModelConfig::default());
+    s.open();
+    let r = s.cmd(0, Command::GripperPacketRequest(1));
+    assert!(
+        matches!(RobotPacket::parse(&r[0]), Ok(RobotPacket::Gripper(g)) if g.gripper_type == 2)
+    );
+    s.cmd(0, Command::Sonar(true));
+    let c = s.cycle(100);
+    match RobotPacket::parse(&c[0]) {
+        Ok(RobotPacket::Sip(sip)) => assert_eq!(sip.sonars().len(), 8),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn garbage_commands_do_not_panic() {
+    let mut s = Sim::new(ModelConfig::default());
+    s.open();
+    let mut out = Vec::new();
+    for n in 0..=255u8 {
+        for payload in [
+            vec![n],
+            vec![n, 0x3B],
+            vec![n, 0x1B, 0xFF, 0xFF],
+            vec![n, 0x3B, 0xFF, 0xFF],
+            vec![n, 0x2B, 3, b'a'],
+        ] {
+            s.robot.handle(&payload, s.t0 + ms(10), &mut out);
+        }
+    }
+    s.robot.handle(&[], s.t0, &mut out);
+    s.robot.advance(s.t0 + ms(10_000), &mut out);
+}

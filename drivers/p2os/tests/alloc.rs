@@ -1,0 +1,86 @@
+//! The decoder and the link's receive path allocate nothing per packet.
+//! (One test in this file: the counting allocator sees only this thread's
+//! work while it runs.)
+
+use limber_p2os::*;
+use serialport::TTYPort;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::io::Write;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Duration;
+
+struct Counting;
+
+static ALLOCS: AtomicU64 = AtomicU64::new(0);
+
+// SAFETY: forwards to the system allocator unchanged; only counts calls.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: same contract as our caller's.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: same contract as our caller's.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: same contract as our caller's.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn decoding_and_receiving_do_not_allocate() {
+    let arm = ArmPacket {
+        status: 0x0503,
+        ticks: [1, 2, 3, 4, 5, 6],
+    }
+    .encode()
+    .unwrap();
+    let mut sip = Sip::default();
+    sip.set_sonars(&[SonarReading::default(); 16]);
+    let sip = sip.encode().unwrap();
+    let mut stream = Vec::new();
+    for i in 0..200 {
+        stream.extend_from_slice(arm.as_bytes());
+        stream.extend_from_slice(&[0x00, 0xFA, i as u8]);
+        stream.extend_from_slice(sip.as_bytes());
+    }
+    let mut d = Decoder::new();
+
+    let before = ALLOCS.load(Ordering::SeqCst);
+    let mut n = 0;
+    for chunk in stream.chunks(37) {
+        d.decode(chunk, |p| {
+            if RobotPacket::parse(p).is_ok() {
+                n += 1;
+            }
+        });
+    }
+    assert_eq!(ALLOCS.load(Ordering::SeqCst), before, "decoder allocated");
+    assert_eq!(n, 400);
+
+    // The link's receive path over a pty.
+    let (mut master, slave) = TTYPort::pair().unwrap();
+    let mut link = Link::from_serial_port(slave);
+    let frames: Vec<u8> = [arm.as_bytes(), sip.as_bytes()].concat();
+    let mut got = 0;
+    let before = ALLOCS.load(Ordering::SeqCst);
+    for _ in 0..50 {
+        master.write_all(&frames).unwrap();
+        for _ in 0..2 {
+            match link.recv(Duration::from_secs(5)) {
+                Ok(RobotPacket::Arm(_)) | Ok(RobotPacket::Sip(_)) => got += 1,
+                other => panic!("{other:?}"),
+            }
+        }
+        link.send(&Command::Pulse).unwrap();
+    }
+    assert_eq!(ALLOCS.load(Ordering::SeqCst), before, "link allocated");
+    assert_eq!(got, 100);
+}

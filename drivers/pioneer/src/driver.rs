@@ -1,0 +1,867 @@
+//! The driver process: one thread that owns the link, serves the devices and recovers from
+//! link faults.
+
+use core::ops::ControlFlow;
+use std::time::{Duration, Instant};
+
+use limber_interfaces::diagnostics::{self, DriverStats, hardware, loop_mode};
+use limber_interfaces::prelude::*;
+use limber_services::diagnostics::StatsPublisher;
+use limber_services::event_loop::{self, FdSource, LoopExit, Wake};
+use limber_services::{
+    Context, DeviceHandler, DeviceHost, DeviceName, HostError, Origin, monotonic_ns,
+};
+use thiserror::Error;
+
+use limber_p2os::{
+    ArmStatusMode, Command, ConnectOptions, Connection, LinkError, LinkTarget, RobotIdentity,
+    RobotPacket,
+};
+
+use super::config::PioneerConfig;
+use crate::robot::RobotModel;
+
+/// The driver could not start or failed.
+#[derive(Debug, Error)]
+pub enum DriverError {
+    /// The first connection to the robot failed (nothing is served).
+    #[error("cannot connect to the robot at {port}: {source}")]
+    Connect {
+        /// The port.
+        port: String,
+        /// The cause.
+        source: limber_p2os::ConnectError,
+    },
+    /// A device could not be offered.
+    #[error(transparent)]
+    Host(#[from] HostError),
+    /// The statistics channel could not be offered.
+    #[error("cannot offer the driver statistics: {0}")]
+    Stats(String),
+    /// The event loop failed.
+    #[error("event loop: {0}")]
+    Loop(String),
+}
+
+/// How the loop waits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LoopMode {
+    /// Event-driven: a WaitSet on the link, the clients and a timer.
+    #[default]
+    Event,
+    /// Busy-polling (take a whole core; pin it with `--cpu`).
+    Spin,
+}
+
+/// Options of a driver run.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RunOptions {
+    /// How the loop waits.
+    pub mode: LoopMode,
+}
+
+/// What the robot turned out to have.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Hardware {
+    /// The robot's identity (SYNC2).
+    pub identity: RobotIdentity,
+    /// ARM_INFO was answered.
+    pub arm: bool,
+    /// The body gripper and lift are served (not detectable over P2OS; from the config).
+    pub gripper: bool,
+}
+
+fn origin_internal() -> Origin {
+    Origin {
+        client_id: 0,
+        seq: 0,
+        sent_ns: 0,
+    }
+}
+
+fn options(cfg: &PioneerConfig, target: &LinkTarget) -> ConnectOptions {
+    let mut o = ConnectOptions {
+        arm_info_timeout: Duration::from_millis(cfg.arm_info_timeout_ms),
+        pulse_interval: Duration::from_millis(cfg.pulse_interval_ms),
+        arm_status: ArmStatusMode::Continuous,
+        ..ConnectOptions::default()
+    };
+    if let (Some(b), LinkTarget::Serial(_)) = (cfg.baud, target) {
+        o.baud_rates = vec![b];
+    }
+    o
+}
+
+struct Hosts {
+    arm: Option<DeviceHost<ActArray>>,
+    limb: Option<DeviceHost<Limb>>,
+    armgrip: Option<DeviceHost<Gripper>>,
+    gripper: Option<DeviceHost<Gripper>>,
+    lift: Option<DeviceHost<ActArray>>,
+}
+
+/// The Pioneer driver: serves `<robot>/actarray/0` (arm), `<robot>/limb/0`,
+/// `<robot>/gripper/0` (body gripper), `<robot>/gripper/1` (arm gripper) and
+/// `<robot>/actarray/1` (lift), and `<robot>/driver/0` (statistics).
+pub struct PioneerDriver {
+    ctx: Context,
+    target: LinkTarget,
+    robot: RobotModel,
+    hosts: Hosts,
+    stats_pub: StatsPublisher,
+    stats: DriverStats,
+    hardware: Hardware,
+    reconnects: u64,
+    link_faults: u64,
+    next_reconnect: Instant,
+    last_stats: Instant,
+    last_cleanup: Instant,
+    mode: LoopMode,
+    wakeups: u64,
+    failures: Failures,
+}
+
+/// A failure the loop survives (it is retried on the next cycle or the next event).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Failure {
+    /// Publishing a state or the statistics.
+    Publish,
+    /// Receiving a device's commands or requests.
+    Process,
+    /// Writing the next VECMOVE waypoint.
+    VecMove,
+    /// A reconnection attempt.
+    Reconnect,
+}
+
+/// Counts the failures the loop survives and logs them: each kind at its first
+/// occurrence and then at powers of two, so a persistent fault is visible without
+/// flooding the log.
+#[derive(Debug, Default)]
+struct Failures {
+    counts: [u64; 4],
+}
+
+impl Failures {
+    fn note(&mut self, kind: Failure, cause: &dyn std::fmt::Display) {
+        let n = &mut self.counts[kind as usize];
+        *n += 1;
+        if n.is_power_of_two() {
+            tracing::warn!("{kind:?} failed ({} so far): {cause}", *n);
+        }
+    }
+}
+
+impl core::fmt::Debug for PioneerDriver {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("PioneerDriver")
+            .field("hardware", &self.hardware)
+            .finish()
+    }
+}
+
+// One handler per device: each borrows the robot model for the duration of a `process` call.
+struct ArmH<'a>(&'a mut RobotModel);
+struct LimbH<'a>(&'a mut RobotModel);
+struct ArmGripH<'a>(&'a mut RobotModel);
+struct GripperH<'a>(&'a mut RobotModel);
+struct LiftH<'a>(&'a mut RobotModel);
+
+impl DeviceHandler<ActArray> for ArmH<'_> {
+    fn command(&mut self, cmd: &ActArrayCommand, from: &Origin, _s: &mut ActArrayData) -> Status {
+        self.0.arm_command(cmd, from)
+    }
+    fn request(
+        &mut self,
+        req: &ActArrayRequest,
+        from: &Origin,
+        _s: &mut ActArrayData,
+    ) -> Result<ActArrayReply, Status> {
+        self.0.arm_request(req, from)
+    }
+}
+impl DeviceHandler<Limb> for LimbH<'_> {
+    fn command(&mut self, cmd: &LimbCommand, from: &Origin, s: &mut LimbData) -> Status {
+        let st = self.0.limb_command(cmd, from);
+        self.0.limb_state(s, Instant::now());
+        st
+    }
+    fn request(
+        &mut self,
+        req: &LimbRequest,
+        from: &Origin,
+        _s: &mut LimbData,
+    ) -> Result<LimbReply, Status> {
+        self.0.limb_request(req, from)
+    }
+}
+impl DeviceHandler<Gripper> for ArmGripH<'_> {
+    fn command(&mut self, cmd: &GripperCommand, from: &Origin, _s: &mut GripperData) -> Status {
+        self.0.armgrip_command(cmd, from)
+    }
+    fn request(
+        &mut self,
+        _req: &GripperRequest,
+        _from: &Origin,
+        _s: &mut GripperData,
+    ) -> Result<GripperReply, Status> {
+        let g = &self.0.cfg.arm_gripper;
+        Ok(GripperReply::Geom(gripper_geom(g, 0)))
+    }
+}
+impl DeviceHandler<Gripper> for GripperH<'_> {
+    fn command(&mut self, cmd: &GripperCommand, from: &Origin, _s: &mut GripperData) -> Status {
+        self.0.gripper_command(cmd, from)
+    }
+    fn request(
+        &mut self,
+        _req: &GripperRequest,
+        _from: &Origin,
+        _s: &mut GripperData,
+    ) -> Result<GripperReply, Status> {
+        let g = &self.0.cfg.gripper;
+        Ok(GripperReply::Geom(gripper_geom(g, 2)))
+    }
+}
+impl DeviceHandler<ActArray> for LiftH<'_> {
+    fn command(&mut self, cmd: &ActArrayCommand, from: &Origin, s: &mut ActArrayData) -> Status {
+        let st = self.0.lift_command(cmd, from);
+        self.0.lift_state(s);
+        st
+    }
+    fn request(
+        &mut self,
+        req: &ActArrayRequest,
+        _from: &Origin,
+        _s: &mut ActArrayData,
+    ) -> Result<ActArrayReply, Status> {
+        self.0.lift_request(req)
+    }
+}
+
+fn gripper_geom(g: &super::config::GripperGeometry, beams: u32) -> GripperGeom {
+    GripperGeom {
+        pose: Pose3 {
+            position: Vec3::new(g.pose[0], g.pose[1], g.pose[2]),
+            orientation: Orientation3 {
+                roll: g.pose[3],
+                pitch: g.pose[4],
+                yaw: g.pose[5],
+            },
+        },
+        outer_size: Bbox3 {
+            width: g.outer[0],
+            length: g.outer[1],
+            height: g.outer[2],
+        },
+        inner_size: Bbox3 {
+            width: g.inner[0],
+            length: g.inner[1],
+            height: g.inner[2],
+        },
+        num_beams: beams,
+        capacity: 0,
+    }
+}
+
+impl PioneerDriver {
+    /// Connects to the robot (the handshake, the arm calibration; no arm within the
+    /// timeout means no arm), then offers the devices the robot has.
+    pub fn start(
+        ctx: &Context,
+        cfg: PioneerConfig,
+        target: LinkTarget,
+    ) -> Result<Self, DriverError> {
+        let conn = Connection::open(&target, &options(&cfg, &target)).map_err(|source| {
+            DriverError::Connect {
+                port: cfg.port.clone(),
+                source,
+            }
+        })?;
+        let mut model = RobotModel::new(cfg.clone());
+        let hardware = Hardware {
+            identity: conn.identity().clone(),
+            arm: conn.arm_calibration().is_some(),
+            gripper: true,
+        };
+        if let Some(cal) = conn.arm_calibration() {
+            model.set_calibration(*cal);
+        }
+        if let Some(sip) = conn.last_sip() {
+            model.sip = Some(*sip);
+        }
+        model.conn = Some(conn);
+        model.link_up_since_ns = monotonic_ns();
+        model.last_rx = Instant::now();
+
+        let robot = cfg.robot.as_str();
+        let name =
+            |i, n| DeviceName::new(robot, i, n).map_err(|e| DriverError::Stats(e.to_string()));
+        let driver = "pioneer";
+        let hosts = Hosts {
+            arm: if hardware.arm {
+                Some(DeviceHost::new(
+                    ctx,
+                    &name(InterfaceKind::ActArray, 0)?,
+                    driver,
+                )?)
+            } else {
+                None
+            },
+            limb: if hardware.arm {
+                Some(DeviceHost::new(
+                    ctx,
+                    &name(InterfaceKind::Limb, 0)?,
+                    driver,
+                )?)
+            } else {
+                None
+            },
+            armgrip: if hardware.arm {
+                Some(DeviceHost::new(
+                    ctx,
+                    &name(InterfaceKind::Gripper, 1)?,
+                    driver,
+                )?)
+            } else {
+                None
+            },
+            gripper: if hardware.gripper {
+                Some(DeviceHost::new(
+                    ctx,
+                    &name(InterfaceKind::Gripper, 0)?,
+                    driver,
+                )?)
+            } else {
+                None
+            },
+            lift: if hardware.gripper {
+                Some(DeviceHost::new(
+                    ctx,
+                    &name(InterfaceKind::ActArray, 1)?,
+                    driver,
+                )?)
+            } else {
+                None
+            },
+        };
+        let stats_pub =
+            StatsPublisher::new(ctx, robot).map_err(|e| DriverError::Stats(e.to_string()))?;
+        let mut stats = DriverStats::default();
+        diagnostics::put_text(&mut stats.driver, driver);
+        diagnostics::put_text(&mut stats.robot_name, &hardware.identity.name);
+        diagnostics::put_text(&mut stats.robot_class, &hardware.identity.class);
+        diagnostics::put_text(&mut stats.robot_subclass, &hardware.identity.subclass);
+        stats.hardware = if hardware.arm { hardware::ARM } else { 0 }
+            | if hardware.gripper {
+                hardware::GRIPPER | hardware::LIFT
+            } else {
+                0
+            };
+        let mut d = PioneerDriver {
+            ctx: ctx.clone(),
+            target,
+            robot: model,
+            hosts,
+            stats_pub,
+            stats,
+            hardware,
+            reconnects: 0,
+            link_faults: 0,
+            next_reconnect: Instant::now(),
+            last_stats: Instant::now() - Duration::from_secs(10),
+            last_cleanup: Instant::now(),
+            mode: LoopMode::Event,
+            wakeups: 0,
+            failures: Failures::default(),
+        };
+        // Like Player when the first client subscribes: power the arm. (Left on at exit:
+        // an unpowered arm drops under gravity.)
+        if d.hardware.arm
+            && let Err(status) = d.robot.send(&Command::ArmPower(true), &origin_internal())
+        {
+            tracing::warn!("cannot power the arm at start: {status}");
+        }
+        d.robot.dirty.arm = true;
+        d.robot.dirty.body = true;
+        d.publish_all(Instant::now());
+        Ok(d)
+    }
+
+    /// What the robot has.
+    pub fn hardware(&self) -> &Hardware {
+        &self.hardware
+    }
+
+    /// State samples published by all devices (each costs iceoryx2 one small allocation,
+    /// see `tests/tests/alloc.rs`), and statistics samples.
+    pub fn samples_published(&self) -> u64 {
+        let mut n = self.stats.header.seq;
+        if let Some(h) = &self.hosts.arm {
+            n += h.stats().published;
+        }
+        if let Some(h) = &self.hosts.limb {
+            n += h.stats().published;
+        }
+        if let Some(h) = &self.hosts.armgrip {
+            n += h.stats().published;
+        }
+        if let Some(h) = &self.hosts.gripper {
+            n += h.stats().published;
+        }
+        if let Some(h) = &self.hosts.lift {
+            n += h.stats().published;
+        }
+        n
+    }
+
+    /// True while the link is up.
+    pub fn link_up(&self) -> bool {
+        self.robot.conn.is_some()
+    }
+
+    fn flags(&self) -> u32 {
+        let mut f = 0;
+        if self.robot.conn.is_some() {
+            f |= device_flag::LINK_UP;
+        }
+        if self.robot.cal.is_some() {
+            f |= device_flag::CALIBRATED;
+        }
+        f
+    }
+
+    /// Publishes the devices whose state changed, and the statistics once a second.
+    fn publish_all(&mut self, now: Instant) {
+        let flags = self.flags();
+        let robot = &mut self.robot;
+        let failures = &mut self.failures;
+        if robot.dirty.arm {
+            if let Some(h) = self.hosts.arm.as_mut() {
+                h.set_flags(flags);
+                robot.arm_state(h.state_mut(), now);
+                if let Err(e) = h.publish() {
+                    failures.note(Failure::Publish, &e);
+                }
+            }
+            if let Some(h) = self.hosts.limb.as_mut() {
+                h.set_flags(flags);
+                robot.limb_state(h.state_mut(), now);
+                if let Err(e) = h.publish() {
+                    failures.note(Failure::Publish, &e);
+                }
+            }
+            if let Some(h) = self.hosts.armgrip.as_mut() {
+                h.set_flags(flags);
+                robot.armgrip_state(h.state_mut(), now);
+                if let Err(e) = h.publish() {
+                    failures.note(Failure::Publish, &e);
+                }
+            }
+            robot.dirty.arm = false;
+        }
+        if robot.dirty.body {
+            robot.lift_from_sip(now);
+            if let Some(h) = self.hosts.gripper.as_mut() {
+                h.set_flags(flags & device_flag::LINK_UP);
+                robot.gripper_state(h.state_mut());
+                h.state_mut().header.stamp_ns = monotonic_ns();
+                if let Err(e) = h.publish() {
+                    failures.note(Failure::Publish, &e);
+                }
+            }
+            if let Some(h) = self.hosts.lift.as_mut() {
+                h.set_flags(flags & device_flag::LINK_UP);
+                robot.lift_state(h.state_mut());
+                h.state_mut().header.stamp_ns = monotonic_ns();
+                if let Err(e) = h.publish() {
+                    failures.note(Failure::Publish, &e);
+                }
+            }
+            robot.dirty.body = false;
+        }
+        if now.duration_since(self.last_stats) >= Duration::from_secs(1) {
+            self.last_stats = now;
+            self.publish_stats();
+        }
+    }
+
+    fn publish_stats(&mut self) {
+        let s = &mut self.stats;
+        let ls = &self.robot.stats;
+        s.header.flags = if self.robot.conn.is_some() {
+            device_flag::LINK_UP
+        } else {
+            0
+        };
+        s.loop_mode = match self.mode {
+            LoopMode::Event => loop_mode::EVENT,
+            LoopMode::Spin => loop_mode::SPIN,
+        };
+        s.cycles = ls.cycles;
+        s.overruns = ls.overruns;
+        (s.period_p50_ns, s.period_p99_ns, s.period_max_ns) = ls.period.summary();
+        s.jitter_p99_ns = ls.jitter.summary().1;
+        (
+            s.cmd_to_wire_p50_ns,
+            s.cmd_to_wire_p99_ns,
+            s.cmd_to_wire_max_ns,
+        ) = ls.cmd_to_wire.summary();
+        s.sips_per_s = ls.sips_per_s;
+        if let Some(c) = self.robot.conn.as_ref() {
+            let st = c.link().stats();
+            s.bytes_in = st.decoder.bytes_in;
+            s.bytes_out = st.bytes_out;
+            s.packets_in = st.decoder.packets_ok;
+            s.bad_checksums = st.decoder.bad_checksums;
+            s.resync_bytes = st.decoder.garbage_bytes;
+        }
+        s.reconnects = self.reconnects;
+        s.link_faults = self.link_faults;
+        let (mut c, mut r, mut q, mut o) = (0, 0, 0, 0);
+        let mut add = |st: limber_services::HostStats| {
+            c += st.commands;
+            r += st.refused;
+            q += st.requests;
+            o += st.overflows;
+        };
+        if let Some(h) = &self.hosts.arm {
+            add(h.stats())
+        }
+        if let Some(h) = &self.hosts.limb {
+            add(h.stats())
+        }
+        if let Some(h) = &self.hosts.armgrip {
+            add(h.stats())
+        }
+        if let Some(h) = &self.hosts.gripper {
+            add(h.stats())
+        }
+        if let Some(h) = &self.hosts.lift {
+            add(h.stats())
+        }
+        s.commands = c;
+        s.refused = r;
+        s.requests = q;
+        s.cmd_overflows = o;
+        if let Err(e) = self.stats_pub.publish(s) {
+            self.failures.note(Failure::Publish, &e);
+        }
+    }
+
+    /// Handles the pending commands and requests of every device. Spinning: commands on
+    /// every call, requests on every 16th ([`DeviceHost::process_spin`]).
+    fn process_clients(&mut self, spin: bool) {
+        macro_rules! serve {
+            ($failures:expr, $host:expr, $handler:expr) => {
+                if let Some(h) = $host.as_mut() {
+                    let r = if spin {
+                        h.process_spin(&mut $handler)
+                    } else {
+                        h.process(&mut $handler)
+                    };
+                    if let Err(e) = r {
+                        $failures.note(Failure::Process, &e);
+                    }
+                }
+            };
+        }
+        let robot = &mut self.robot;
+        let failures = &mut self.failures;
+        serve!(failures, self.hosts.arm, ArmH(robot));
+        serve!(failures, self.hosts.limb, LimbH(robot));
+        serve!(failures, self.hosts.armgrip, ArmGripH(robot));
+        serve!(failures, self.hosts.gripper, GripperH(robot));
+        serve!(failures, self.hosts.lift, LiftH(robot));
+    }
+
+    /// Reads every packet the link has; returns false when the link failed.
+    fn read_link(&mut self, now: Instant) -> bool {
+        let robot = &mut self.robot;
+        let failures = &mut self.failures;
+        loop {
+            let Some(conn) = robot.conn.as_mut() else {
+                return false;
+            };
+            let pkt = match conn.link_mut().poll_packet() {
+                Ok(Some(p)) => Owned::from(&p),
+                Ok(None) => return true,
+                Err(LinkError::Timeout(_)) => return true,
+                Err(e) => {
+                    tracing::warn!("reading the link failed: {e}");
+                    return false;
+                }
+            };
+            robot.last_rx = now;
+            match pkt {
+                Owned::Sip(s) => {
+                    robot.sip = Some(s);
+                    robot.dirty.body = true;
+                    robot.stats.sips_this_second += 1;
+                }
+                Owned::Arm(a) => {
+                    robot.arm.update(&a, now);
+                    robot.dirty.arm = true;
+                    if let Err(status) = robot.stream_vecmove(&origin_internal()) {
+                        // The next waypoint could not be written (the link is failing):
+                        // the line is abandoned, never resumed on a later link.
+                        robot.vecmove = None;
+                        failures.note(Failure::VecMove, &status);
+                    }
+                }
+                Owned::ArmInfo(i) => robot.set_calibration(limber_p2os::ArmCalibration::from(i)),
+                Owned::Other => {}
+            }
+        }
+    }
+
+    fn link_failed(&mut self, why: &str) {
+        if let Some(conn) = self.robot.conn.take() {
+            tracing::warn!("link down ({why}); reconnecting");
+            drop(conn);
+            self.link_faults += 1;
+        }
+        self.robot.vecmove = None;
+        self.robot.dirty.arm = true;
+        self.robot.dirty.body = true;
+        self.next_reconnect = Instant::now();
+    }
+
+    /// One reconnection attempt (bounded by the handshake's timeouts).
+    fn try_reconnect(&mut self) {
+        let now = Instant::now();
+        if now < self.next_reconnect {
+            return;
+        }
+        self.next_reconnect = now + Duration::from_millis(self.robot.cfg.reconnect_interval_ms);
+        let mut opts = options(&self.robot.cfg, &self.target);
+        opts.sync_attempts = 2;
+        opts.arm = self.hardware.arm;
+        match Connection::open(&self.target, &opts) {
+            Ok(conn) => {
+                if let Some(cal) = conn.arm_calibration() {
+                    self.robot.set_calibration(*cal);
+                }
+                if let Some(sip) = conn.last_sip() {
+                    self.robot.sip = Some(*sip);
+                }
+                self.robot.conn = Some(conn);
+                // Commands sent before this instant were sent to a dead link: refused.
+                self.robot.link_up_since_ns = monotonic_ns();
+                self.robot.last_rx = Instant::now();
+                // Whatever was commanded before is void; hold where the arm is.
+                self.robot.arm.target = [None; 6];
+                self.reconnects += 1;
+                self.robot.dirty.arm = true;
+                self.robot.dirty.body = true;
+                tracing::info!("link up again (reconnect #{})", self.reconnects);
+            }
+            Err(e) => {
+                // Logged at the first failure and then at powers of two: a robot that
+                // stays away does not flood the log.
+                self.failures.note(Failure::Reconnect, &e);
+            }
+        }
+    }
+
+    /// Timer work: silence detection, keep-alive, estimates, housekeeping.
+    fn tick(&mut self, now: Instant) {
+        if self.robot.conn.is_some() {
+            if now.duration_since(self.robot.last_rx)
+                > Duration::from_millis(self.robot.cfg.link_timeout_ms)
+            {
+                self.link_failed("silent");
+            } else if let Some(c) = self.robot.conn.as_mut()
+                && c.keep_alive().is_err()
+            {
+                self.link_failed("write failed");
+            }
+        } else {
+            self.try_reconnect();
+        }
+        // Time-based lift estimate and stall detection move without packets.
+        if self.robot.lift.moving.is_some() {
+            self.robot.dirty.body = true;
+        }
+        // Housekeeping (allocates inside iceoryx2): resources of crashed clients.
+        if now.duration_since(self.last_cleanup) > Duration::from_secs(60) {
+            self.last_cleanup = now;
+            if let Some(h) = &self.hosts.arm {
+                h.cleanup_dead();
+            }
+        }
+    }
+
+    /// Runs until SIGINT/SIGTERM; then stops the arm, closes the link and returns.
+    pub fn run(&mut self, opts: RunOptions) -> Result<LoopExit, DriverError> {
+        let exit = self.run_until(opts, || false);
+        self.shutdown();
+        exit
+    }
+
+    /// Runs until SIGINT/SIGTERM or until `stop` (checked at every wake-up, at least every
+    /// tick) returns true. The link stays open: run again, or call
+    /// [`PioneerDriver::shutdown`] to stop the arm and close it.
+    pub fn run_until(
+        &mut self,
+        opts: RunOptions,
+        mut stop: impl FnMut() -> bool,
+    ) -> Result<LoopExit, DriverError> {
+        self.mode = opts.mode;
+        match opts.mode {
+            LoopMode::Event => self.run_event(&mut stop),
+            LoopMode::Spin => Ok(self.run_spin(&mut stop)),
+        }
+    }
+
+    /// Wake-ups of the loop so far (each costs iceoryx2's WaitSet one small allocation).
+    pub fn wakeups(&self) -> u64 {
+        self.wakeups
+    }
+
+    fn run_event(&mut self, stop: &mut dyn FnMut() -> bool) -> Result<LoopExit, DriverError> {
+        let listeners: Vec<_> = [
+            self.hosts.arm.as_mut().and_then(|h| h.take_wake_listener()),
+            self.hosts
+                .limb
+                .as_mut()
+                .and_then(|h| h.take_wake_listener()),
+            self.hosts
+                .armgrip
+                .as_mut()
+                .and_then(|h| h.take_wake_listener()),
+            self.hosts
+                .gripper
+                .as_mut()
+                .and_then(|h| h.take_wake_listener()),
+            self.hosts
+                .lift
+                .as_mut()
+                .and_then(|h| h.take_wake_listener()),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        let tick = self.robot.cfg.tick();
+        let nominal = tick.as_nanos() as u64;
+        loop {
+            // (Re)attach the link's fd: it changes when the link is re-established.
+            let fd = self
+                .robot
+                .conn
+                .as_ref()
+                .and_then(|c| FdSource::new(c.link()));
+            let had_link = fd.is_some();
+            let mut stopped = false;
+            let exit = event_loop::run(&listeners, tick, fd.as_ref(), |wake| {
+                let now = Instant::now();
+                self.wakeups += 1;
+                match wake {
+                    Wake::Fd => {
+                        if !self.read_link(now) {
+                            self.link_failed("read failed");
+                        }
+                    }
+                    Wake::Clients => self.process_clients(false),
+                    Wake::Tick(n) => {
+                        self.robot.stats.tick(now, nominal, n);
+                        // A packet may be sitting in the decoder after a send.
+                        if !self.read_link(now) && self.robot.conn.is_some() {
+                            self.link_failed("read failed");
+                        }
+                        self.tick(now);
+                    }
+                }
+                self.publish_all(now);
+                if stop() {
+                    stopped = true;
+                    return ControlFlow::Break(());
+                }
+                // Leave the wait to re-attach when the link went down or came up.
+                if self.robot.conn.is_some() != had_link {
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
+                }
+            })
+            .map_err(|e| DriverError::Loop(e.to_string()))?;
+            if exit == LoopExit::Signal {
+                return Ok(LoopExit::Signal);
+            }
+            if stopped {
+                return Ok(LoopExit::Stopped);
+            }
+        }
+    }
+
+    fn run_spin(&mut self, stop: &mut dyn FnMut() -> bool) -> LoopExit {
+        let tick = self.robot.cfg.tick();
+        let nominal = tick.as_nanos() as u64;
+        let mut next_tick = Instant::now() + tick;
+        let mut n: u64 = 0;
+        loop {
+            let now = Instant::now();
+            if self.robot.conn.is_some() && !self.read_link(now) {
+                self.link_failed("read failed");
+            }
+            self.process_clients(true);
+            if now >= next_tick {
+                let missed = (now.duration_since(next_tick).as_nanos() as u64) / nominal.max(1);
+                self.robot.stats.tick(now, nominal, 1 + missed);
+                next_tick += tick * (1 + missed as u32);
+                self.tick(now);
+            }
+            self.publish_all(now);
+            n += 1;
+            if n.is_multiple_of(1024) {
+                if self.ctx.termination_requested() {
+                    return LoopExit::Signal;
+                }
+                if stop() {
+                    return LoopExit::Stopped;
+                }
+            }
+            core::hint::spin_loop();
+        }
+    }
+
+    /// Stops the arm, stops the ARMpac stream and closes the link (STOP, CLOSE).
+    pub fn shutdown(&mut self) {
+        let o = origin_internal();
+        if self.hardware.arm
+            && let Err(status) = self
+                .robot
+                .send(&Command::ArmStop(limber_p2os::JointSelection::All), &o)
+        {
+            tracing::warn!("cannot stop the arm at shutdown: {status}");
+        }
+        if let Some(conn) = self.robot.conn.take()
+            && let Err(e) = conn.close()
+        {
+            tracing::warn!("closing the link: {e}");
+        }
+        self.robot.dirty.arm = true;
+        self.robot.dirty.body = true;
+        self.publish_all(Instant::now());
+        self.publish_stats();
+    }
+}
+
+/// An owned copy of the packets the driver uses.
+enum Owned {
+    Sip(limber_p2os::Sip),
+    Arm(limber_p2os::ArmPacket),
+    ArmInfo(limber_p2os::ArmInfo),
+    Other,
+}
+
+impl From<&RobotPacket<'_>> for Owned {
+    fn from(p: &RobotPacket<'_>) -> Self {
+        match p {
+            RobotPacket::Sip(s) => Owned::Sip(*s),
+            RobotPacket::Arm(a) => Owned::Arm(*a),
+            RobotPacket::ArmInfo(i) => Owned::ArmInfo(*i),
+            _ => Owned::Other,
+        }
+    }
+}

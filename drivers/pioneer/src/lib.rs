@@ -1,0 +1,28 @@
+//! The Pioneer driver: one real-time process that owns the P2OS link and serves the arm,
+//! the limb (inverse kinematics inside), the body gripper, the arm gripper and the lift.
+//!
+//! Devices (robot name `pioneer` by default):
+//!
+//! | device | what |
+//! |---|---|
+//! | `pioneer/actarray/0` | the arm: 6 actuators (5 joints and the gripper joint), rad |
+//! | `pioneer/limb/0` | the end effector: HOME, STOP, SETPOSE, SETPOSITION, VECMOVE |
+//! | `pioneer/gripper/0` | the body gripper (paddles, two break beams) |
+//! | `pioneer/gripper/1` | the arm gripper (joint 6) |
+//! | `pioneer/actarray/1` | the lift: one linear actuator, 0 (down) to 0.07 m (up) |
+//! | `pioneer/driver/0` | loop, link and robot statistics ([`limber_interfaces::diagnostics`]) |
+//!
+//! Every command is validated (finite, known joint, inside the limits, calibration
+//! present, link up) before a byte is written; a refused command reaches its sender as the
+//! status of the next state sample. Requests are answered as soon as they arrive.
+
+mod config;
+mod driver;
+mod realtime;
+mod robot;
+mod stats;
+
+pub use config::{ConfigError, GripperGeometry, PioneerConfig};
+pub use driver::{DriverError, Hardware, LoopMode, PioneerDriver, RunOptions};
+pub use realtime::{RealtimeWarning, apply_realtime};
+pub use stats::{LoopStats, Ring};

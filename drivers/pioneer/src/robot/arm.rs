@@ -1,0 +1,239 @@
+//! The arm actarray (`<robot>/actarray/0`): joint commands, requests, geometry, state.
+
+use std::time::{Duration, Instant};
+
+use limber_interfaces::prelude::*;
+use limber_services::Origin;
+
+use limber_p2os::{ArmJoint, Command, JointSelection};
+
+use super::*;
+
+impl RobotModel {
+    /// An arm actarray command.
+    pub fn arm_command(&mut self, cmd: &ActArrayCommand, from: &Origin) -> Status {
+        let r = match *cmd {
+            ActArrayCommand::Position { joint, position } => {
+                self.vecmove = None;
+                self.move_joint(joint as usize, position, from)
+            }
+            ActArrayCommand::MultiPosition(v) => {
+                self.vecmove = None;
+                // Validate every joint before sending any.
+                let mut ticks = [0u8; ARM_JOINTS];
+                let r = v.as_slice().iter().enumerate().try_for_each(|(j, p)| {
+                    ticks[j] = self.joint_tick(j, *p)?;
+                    Ok(())
+                });
+                r.and_then(|()| {
+                    for (j, &tick) in ticks.iter().enumerate().take(v.len()) {
+                        let joint = ArmJoint::from_index(j).map_err(|_| Status::UnknownJoint)?;
+                        self.send(&Command::ArmPos { joint, tick }, from)?;
+                        self.arm.set_target(j, tick);
+                    }
+                    Ok(())
+                })
+            }
+            ActArrayCommand::Speed { joint, speed } => {
+                self.move_at_speed(joint as usize, speed, from)
+            }
+            ActArrayCommand::MultiSpeed(v) => {
+                let r = v.as_slice().iter().enumerate().try_for_each(|(j, _)| {
+                    self.joint_tick(j, 0.0).map(|_| ()).or_else(|e| {
+                        if e == Status::BeyondLimits {
+                            Ok(())
+                        } else {
+                            Err(e)
+                        }
+                    })
+                });
+                r.and_then(|()| {
+                    v.as_slice()
+                        .iter()
+                        .enumerate()
+                        .try_for_each(|(j, s)| self.move_at_speed(j, *s, from))
+                })
+            }
+            ActArrayCommand::Home(sel) => self.home(sel, from),
+            ActArrayCommand::Current { .. } | ActArrayCommand::MultiCurrent(_) => {
+                Err(Status::Unsupported)
+            }
+        };
+        r.err().unwrap_or(Status::Ok)
+    }
+
+    pub(super) fn move_at_speed(
+        &mut self,
+        j: usize,
+        speed: f64,
+        from: &Origin,
+    ) -> Result<(), Status> {
+        let cal = self.calibration()?;
+        if j >= cal.num_joints().min(ARM_JOINTS) {
+            return Err(Status::UnknownJoint);
+        }
+        let joint = ArmJoint::from_index(j).map_err(|_| Status::UnknownJoint)?;
+        if !speed.is_finite() {
+            return Err(Status::NotFinite);
+        }
+        if speed == 0.0 {
+            self.send(&Command::ArmStop(JointSelection::One(joint)), from)?;
+            self.arm.target[j] = None;
+            return Ok(());
+        }
+        let ms = cal
+            .speed_to_ms_per_step(joint, speed.abs())
+            .map_err(|_| Status::InvalidArgument)?;
+        let [a, _, b, _] = cal
+            .limits_radians(joint)
+            .map_err(|_| Status::NotCalibrated)?;
+        let end = if speed > 0.0 { a.max(b) } else { a.min(b) };
+        let tick = self.joint_tick(j, end)?;
+        self.send(
+            &Command::ArmSpeed {
+                joint,
+                ms_per_step: ms,
+            },
+            from,
+        )?;
+        self.send(&Command::ArmPos { joint, tick }, from)?;
+        self.arm.set_target(j, tick);
+        Ok(())
+    }
+
+    pub(super) fn home(&mut self, sel: JointSel, from: &Origin) -> Result<(), Status> {
+        let cal = *self.calibration()?;
+        self.vecmove = None;
+        match sel {
+            JointSel::All => {
+                self.send(&Command::ArmHome(JointSelection::All), from)?;
+                for j in 0..cal.num_joints().min(ARM_JOINTS) {
+                    if let Ok(c) =
+                        cal.joint(ArmJoint::from_index(j).map_err(|_| Status::UnknownJoint)?)
+                    {
+                        self.arm.set_target(j, c.home);
+                    }
+                }
+            }
+            JointSel::One(j) => {
+                let j = j as usize;
+                if j >= cal.num_joints().min(ARM_JOINTS) {
+                    return Err(Status::UnknownJoint);
+                }
+                let joint = ArmJoint::from_index(j).map_err(|_| Status::UnknownJoint)?;
+                self.send(&Command::ArmHome(JointSelection::One(joint)), from)?;
+                if let Ok(c) = cal.joint(joint) {
+                    self.arm.set_target(j, c.home);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// An arm actarray request.
+    pub fn arm_request(
+        &mut self,
+        req: &ActArrayRequest,
+        from: &Origin,
+    ) -> Result<ActArrayReply, Status> {
+        match *req {
+            ActArrayRequest::Power(on) => {
+                self.calibration()?;
+                self.send(&Command::ArmPower(on), from)?;
+                Ok(ActArrayReply::Done)
+            }
+            ActArrayRequest::GetGeom => Ok(ActArrayReply::Geom(self.arm_geometry()?)),
+            ActArrayRequest::Speed { joint, speed } => {
+                let cal = self.calibration()?;
+                let j = joint as usize;
+                if j >= cal.num_joints().min(ARM_JOINTS) {
+                    return Err(Status::UnknownJoint);
+                }
+                if !(speed.is_finite() && speed > 0.0) {
+                    return Err(if speed.is_finite() {
+                        Status::InvalidArgument
+                    } else {
+                        Status::NotFinite
+                    });
+                }
+                // This joint's own calibration (Player used joint j+1's).
+                let aj = ArmJoint::from_index(j).map_err(|_| Status::UnknownJoint)?;
+                let ms = cal
+                    .speed_to_ms_per_step(aj, speed)
+                    .map_err(|_| Status::InvalidArgument)?;
+                self.send(
+                    &Command::ArmSpeed {
+                        joint: aj,
+                        ms_per_step: ms,
+                    },
+                    from,
+                )?;
+                Ok(ActArrayReply::Done)
+            }
+            ActArrayRequest::Brakes(_) | ActArrayRequest::Accel { .. } => Err(Status::Unsupported),
+        }
+    }
+
+    /// The arm geometry from the calibration.
+    pub fn arm_geometry(&self) -> Result<ActArrayGeom, Status> {
+        let cal = self
+            .cal
+            .as_ref()
+            .ok_or(if self.has_arm || self.conn.is_none() {
+                Status::NotCalibrated
+            } else {
+                Status::Unsupported
+            })?;
+        let mut g = ActArrayGeom {
+            actuators_count: cal.num_joints().min(ARM_JOINTS) as u32,
+            base_pos: Vec3::from(self.cfg.arm_base),
+            ..Default::default()
+        };
+        #[allow(clippy::needless_range_loop)]
+        for j in 0..g.actuators_count as usize {
+            let joint = ArmJoint::from_index(j).map_err(|_| Status::UnknownJoint)?;
+            let [a, c, b, h] = cal
+                .limits_radians(joint)
+                .map_err(|_| Status::NotCalibrated)?;
+            let jc = cal.joint(joint).map_err(|_| Status::NotCalibrated)?;
+            let speed = cal.ms_per_step_to_speed(joint, jc.speed).unwrap_or(0.0);
+            g.actuators[j] = ActuatorGeom {
+                kind: ActuatorKind::Rotary as u32,
+                has_brakes: 0,
+                length: self.cfg.arm_geometry_lengths[j],
+                orientation: Orientation3::default(),
+                axis: Vec3::from(AXES[j]),
+                min: a.min(b),
+                centre: c,
+                max: a.max(b),
+                home: h,
+                config_speed: speed,
+            };
+        }
+        Ok(g)
+    }
+
+    /// Fills the arm actarray state.
+    pub fn arm_state(&self, s: &mut ActArrayData, now: Instant) {
+        let n = self
+            .cal
+            .as_ref()
+            .map(|c| c.num_joints().min(ARM_JOINTS))
+            .unwrap_or(ARM_JOINTS);
+        s.actuators_count = n as u32;
+        s.motor_state = self.arm.powered as u32;
+        let q = self.joint_angles();
+        for j in 0..n {
+            let a = &mut s.actuators[j];
+            a.position = q.map(|q| q[j]).unwrap_or(0.0);
+            a.speed = 0.0;
+            a.acceleration = -1.0;
+            a.current = -1.0;
+            a.state = self
+                .arm
+                .flags(j, now, Duration::from_millis(self.cfg.stall_timeout_ms))
+                .bits();
+        }
+        s.header.stamp_ns = self.arm.stamp_ns;
+    }
+}

@@ -1,0 +1,344 @@
+//! The driver's model of the robot and its command handling: what every device does with a
+//! command or request, validated before anything is written to the link.
+//!
+//! [`RobotModel`] holds the link, the calibration and what was commanded; its methods are
+//! split by device: [`arm`] (the arm actarray), [`limb`] (the end effector and its IK),
+//! [`grippers`] (the arm gripper and the body gripper) and [`lift`].
+
+mod arm;
+mod grippers;
+mod lift;
+mod limb;
+
+pub use lift::LiftModel;
+
+use std::time::{Duration, Instant};
+
+use limber_interfaces::prelude::*;
+use limber_services::Origin;
+use limber_services::monotonic_ns;
+use nalgebra::Vector3;
+
+use limber_kinematics::pioneer::{
+    DriverAngleMap, PIONEER_DOF, PioneerGeometry, PioneerIkError, PioneerIkOptions, Theta,
+};
+use limber_p2os::{ArmCalibration, ArmJoint, ArmPacket, Command, Connection, Sip};
+
+use crate::config::PioneerConfig;
+use crate::stats::LoopStats;
+
+/// Joints of the arm actarray: 5 arm joints and the gripper.
+pub const ARM_JOINTS: usize = 6;
+/// Waypoints a VECMOVE may have (2 cm apart at most: several metres).
+pub const MAX_WAYPOINTS: usize = 256;
+/// Rotation axes of the arm joints in the geometry (Player's aa_axes).
+const AXES: [[f64; 3]; ARM_JOINTS] = [
+    [0.0, 0.0, -1.0],
+    [0.0, -1.0, 0.0],
+    [0.0, -1.0, 0.0],
+    [1.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, 0.0, 1.0],
+];
+
+/// The arm as the last ARMpac described it, and what was commanded.
+#[derive(Debug, Clone)]
+pub struct ArmModel {
+    /// Latest ticks.
+    pub ticks: [u8; ARM_JOINTS],
+    /// An ARMpac arrived.
+    pub seen: bool,
+    /// Moving bits (joint i = bit i).
+    pub moving: u8,
+    /// Powered, per the status word.
+    pub powered: bool,
+    /// Commanded target tick per joint (None: hold wherever it is).
+    pub target: [Option<u8>; ARM_JOINTS],
+    /// Since when a joint has been still but short of its target.
+    pub short_since: [Option<Instant>; ARM_JOINTS],
+    /// When the last ARMpac arrived (`CLOCK_MONOTONIC` ns).
+    pub stamp_ns: u64,
+}
+
+impl Default for ArmModel {
+    fn default() -> Self {
+        ArmModel {
+            ticks: [0; ARM_JOINTS],
+            seen: false,
+            moving: 0,
+            powered: false,
+            target: [None; ARM_JOINTS],
+            short_since: [None; ARM_JOINTS],
+            stamp_ns: 0,
+        }
+    }
+}
+
+impl ArmModel {
+    /// Honest per-joint state: MOVING while the controller says so (or a fresh target is
+    /// not yet reached), IDLE at the target, STALLED when still and short of it for longer
+    /// than `stall`.
+    pub fn flags(&self, j: usize, now: Instant, stall: Duration) -> ActuatorFlags {
+        if self.moving & (1 << j) != 0 {
+            return ActuatorFlags::MOVING;
+        }
+        match self.target[j] {
+            None => ActuatorFlags::IDLE,
+            Some(t) if t == self.ticks[j] => ActuatorFlags::IDLE,
+            Some(_) => match self.short_since[j] {
+                Some(since) if now.duration_since(since) >= stall => ActuatorFlags::STALLED,
+                _ => ActuatorFlags::MOVING,
+            },
+        }
+    }
+
+    /// Applies an ARMpac.
+    pub fn update(&mut self, p: &ArmPacket, now: Instant) {
+        self.ticks = p.ticks;
+        self.moving = p.moving_mask();
+        self.powered = p.is_powered();
+        self.seen = true;
+        self.stamp_ns = monotonic_ns();
+        for j in 0..ARM_JOINTS {
+            let short =
+                self.moving & (1 << j) == 0 && self.target[j].is_some_and(|t| t != self.ticks[j]);
+            if !short {
+                self.short_since[j] = None;
+            } else if self.short_since[j].is_none() {
+                self.short_since[j] = Some(now);
+            }
+        }
+    }
+
+    pub(super) fn set_target(&mut self, j: usize, tick: u8) {
+        self.target[j] = Some(tick);
+        self.short_since[j] = None;
+    }
+}
+
+/// What happened on the link, for the loop.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Dirty {
+    /// The arm state changed: publish arm, limb and arm gripper.
+    pub arm: bool,
+    /// A SIP arrived: publish body gripper and lift.
+    pub body: bool,
+}
+
+/// A VECMOVE in progress: precomputed waypoints streamed one after another.
+#[derive(Debug, Clone)]
+pub struct VecMovePlan {
+    waypoints: [[u8; PIONEER_DOF]; MAX_WAYPOINTS],
+    len: usize,
+    next: usize,
+}
+
+/// The driver's state and the link.
+pub struct RobotModel {
+    /// The configuration.
+    pub cfg: PioneerConfig,
+    /// The connection while the link is up.
+    pub conn: Option<Connection>,
+    /// When the link came up (commands sent earlier are refused: never replayed).
+    pub link_up_since_ns: u64,
+    /// When the last packet arrived.
+    pub last_rx: Instant,
+    /// Calibration from ARMINFO.
+    pub cal: Option<ArmCalibration>,
+    /// The robot answered ARM_INFO.
+    pub has_arm: bool,
+    /// Arm kinematics.
+    pub geom: PioneerGeometry,
+    /// Driver ↔ kinematic angles.
+    pub map: DriverAngleMap,
+    /// IK options.
+    pub ik: PioneerIkOptions,
+    /// The arm.
+    pub arm: ArmModel,
+    /// The last limb target was out of reach (cleared by the next valid limb command).
+    pub limb_oor: bool,
+    /// A VECMOVE being streamed.
+    pub vecmove: Option<Box<VecMovePlan>>,
+    /// End-effector speed for limb motions, m/s.
+    pub limb_speed: f64,
+    /// The lift.
+    pub lift: LiftModel,
+    /// The latest SIP.
+    pub sip: Option<Sip>,
+    /// The last body-gripper command (OPEN/CLOSE/STOP).
+    pub gripper_cmd: Option<GripperCommand>,
+    /// The last arm-gripper command.
+    pub armgrip_cmd: Option<GripperCommand>,
+    /// What changed on the link since the last publish.
+    pub dirty: Dirty,
+    /// Loop statistics.
+    pub stats: LoopStats,
+}
+
+impl core::fmt::Debug for RobotModel {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("RobotModel")
+            .field("link_up", &self.conn.is_some())
+            .field("has_arm", &self.has_arm)
+            .finish()
+    }
+}
+
+fn ik_status(e: &PioneerIkError) -> Status {
+    match e {
+        PioneerIkError::NonFinite => Status::NotFinite,
+        e if e.is_out_of_reach() => Status::OutOfReach,
+        _ => Status::OutOfReach,
+    }
+}
+
+impl RobotModel {
+    /// The model for `cfg`, link down.
+    pub fn new(cfg: PioneerConfig) -> Self {
+        let mut geom = PioneerGeometry::default();
+        let [l1, l2, l4, l5] = cfg.arm_links;
+        geom.l1 = l1;
+        geom.l2 = l2;
+        geom.l4 = l4;
+        geom.l5 = l5;
+        geom.base_offset = Vector3::from(cfg.arm_base);
+        let map = DriverAngleMap {
+            offsets: cfg.limb_offsets,
+        };
+        let lift = LiftModel::new(cfg.lift_stroke);
+        let limb_speed = cfg.limb_speed;
+        RobotModel {
+            cfg,
+            conn: None,
+            link_up_since_ns: 0,
+            last_rx: Instant::now(),
+            cal: None,
+            has_arm: false,
+            geom,
+            map,
+            ik: PioneerIkOptions {
+                // Tick quantisation makes the achieved pose differ by millimetres; the
+                // solver itself is exact, so requested poses are checked tightly.
+                position_tolerance: 1e-6,
+                orientation_tolerance: 0.02,
+                ..PioneerIkOptions::default()
+            },
+            arm: ArmModel::default(),
+            limb_oor: false,
+            vecmove: None,
+            limb_speed,
+            lift,
+            sip: None,
+            gripper_cmd: None,
+            armgrip_cmd: None,
+            dirty: Dirty::default(),
+            stats: LoopStats::default(),
+        }
+    }
+
+    /// Takes the calibration: sets the IK joint limits (in θ, from the driver-convention
+    /// limits) and marks the arm present.
+    pub fn set_calibration(&mut self, cal: ArmCalibration) {
+        let mut min = [0.0; PIONEER_DOF];
+        let mut max = [0.0; PIONEER_DOF];
+        for j in 0..PIONEER_DOF {
+            if let Ok(joint) = ArmJoint::from_index(j)
+                && let Ok([a, _, b, _]) = cal.limits_radians(joint)
+            {
+                min[j] = a.min(b);
+                max[j] = a.max(b);
+            }
+        }
+        self.geom.limits = self.map.limits_from_driver(&min, &max);
+        self.cal = Some(cal);
+        self.has_arm = true;
+        self.dirty.arm = true;
+    }
+
+    /// Writes a command to the link. Refused (LinkDown) when the link is down, or when
+    /// the client sent it before the link came up (never replayed after a fault).
+    pub fn send(&mut self, cmd: &Command, from: &Origin) -> Result<(), Status> {
+        if from.sent_ns != 0 && from.sent_ns < self.link_up_since_ns {
+            return Err(Status::LinkDown);
+        }
+        let conn = self.conn.as_mut().ok_or(Status::LinkDown)?;
+        match conn.send(cmd) {
+            Ok(()) => {
+                if from.sent_ns != 0 {
+                    self.stats
+                        .cmd_to_wire
+                        .push(monotonic_ns().saturating_sub(from.sent_ns));
+                }
+                Ok(())
+            }
+            Err(_) => {
+                // The loop notices the dead link (read error or silence) and reconnects.
+                Err(Status::LinkDown)
+            }
+        }
+    }
+
+    pub(super) fn calibration(&self) -> Result<&ArmCalibration, Status> {
+        if self.conn.is_none() {
+            return Err(Status::LinkDown);
+        }
+        if !self.has_arm {
+            return Err(Status::Unsupported);
+        }
+        self.cal.as_ref().ok_or(Status::NotCalibrated)
+    }
+
+    /// Joint `j`'s limits in radians (min <= max) and its tick for `rad`, validated.
+    pub(super) fn joint_tick(&self, j: usize, rad: f64) -> Result<u8, Status> {
+        if !rad.is_finite() {
+            return Err(Status::NotFinite);
+        }
+        let cal = self.calibration()?;
+        if j >= cal.num_joints().min(ARM_JOINTS) {
+            return Err(Status::UnknownJoint);
+        }
+        let joint = ArmJoint::from_index(j).map_err(|_| Status::UnknownJoint)?;
+        let [a, _, b, _] = cal
+            .limits_radians(joint)
+            .map_err(|_| Status::NotCalibrated)?;
+        let (lo, hi) = (a.min(b), a.max(b));
+        // Half a tick of slack for angles that round-trip through ticks.
+        let slack = 0.5 * (hi - lo) / 255.0;
+        if rad < lo - slack || rad > hi + slack {
+            return Err(Status::BeyondLimits);
+        }
+        let t = cal
+            .radians_to_ticks(joint, rad.clamp(lo, hi))
+            .map_err(|_| Status::BeyondLimits)?;
+        Ok(t.tick)
+    }
+
+    /// Current joint angles (driver convention), when calibrated.
+    pub fn joint_angles(&self) -> Option<[f64; ARM_JOINTS]> {
+        let cal = self.cal.as_ref()?;
+        let mut out = [0.0; ARM_JOINTS];
+        for (j, o) in out
+            .iter_mut()
+            .enumerate()
+            .take(cal.num_joints().min(ARM_JOINTS))
+        {
+            let joint = ArmJoint::from_index(j).ok()?;
+            *o = cal.ticks_to_radians(joint, self.arm.ticks[j]).ok()?;
+        }
+        Some(out)
+    }
+
+    /// Current kinematic θ.
+    pub fn theta(&self) -> Option<Theta> {
+        let q = self.joint_angles()?;
+        Some(self.map.theta_from_driver(&[q[0], q[1], q[2], q[3], q[4]]))
+    }
+
+    pub(super) fn move_joint(&mut self, j: usize, rad: f64, from: &Origin) -> Result<(), Status> {
+        let tick = self.joint_tick(j, rad)?;
+        let joint = ArmJoint::from_index(j).map_err(|_| Status::UnknownJoint)?;
+        self.send(&Command::ArmPos { joint, tick }, from)?;
+        self.arm.set_target(j, tick);
+        Ok(())
+    }
+}
