@@ -88,25 +88,11 @@ impl Machine {
 }
 
 fn uname() -> String {
-    // SAFETY: `uname` fills a zeroed, properly sized struct; the fields are NUL-terminated.
-    unsafe {
-        let mut u: libc::utsname = core::mem::zeroed();
-        if libc::uname(&mut u) != 0 {
-            return "unknown".into();
-        }
-        let field = |f: &[libc::c_char]| {
-            let bytes: Vec<u8> = f
-                .iter()
-                .take_while(|c| **c != 0)
-                .map(|c| *c as u8)
-                .collect();
-            String::from_utf8_lossy(&bytes).into_owned()
-        };
-        format!(
-            "{} {} {}",
-            field(&u.sysname),
-            field(&u.release),
-            field(&u.machine)
-        )
-    }
+    let u = rustix::system::uname();
+    format!(
+        "{} {} {}",
+        u.sysname().to_string_lossy(),
+        u.release().to_string_lossy(),
+        u.machine().to_string_lossy()
+    )
 }

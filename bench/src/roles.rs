@@ -53,22 +53,24 @@ pub fn pin_to(cpu: usize) {
     if let Some(id) =
         core_affinity::get_core_ids().and_then(|ids| ids.into_iter().find(|c| c.id == cpu))
     {
-        let _ = core_affinity::set_for_current(id);
+        if !core_affinity::set_for_current(id) {
+            tracing::warn!("cannot pin to CPU {cpu}: running unpinned");
+        }
+    } else {
+        tracing::warn!("no CPU {cpu}: running unpinned");
     }
 }
 
 /// Allows the calling thread to run on every online core.
 pub fn unpin() {
-    // SAFETY: a zeroed cpu_set_t is a valid empty set; CPU_SET writes inside it for
-    // indices below CPU_SETSIZE; sched_setaffinity reads it.
-    unsafe {
-        let n = libc::sysconf(libc::_SC_NPROCESSORS_ONLN)
-            .clamp(1, libc::CPU_SETSIZE as libc::c_long) as usize;
-        let mut set: libc::cpu_set_t = core::mem::zeroed();
-        for cpu in 0..n {
-            libc::CPU_SET(cpu, &mut set);
-        }
-        let _ = libc::sched_setaffinity(0, core::mem::size_of::<libc::cpu_set_t>(), &set);
+    // Every CPU the set can name: the kernel ignores those that are not online (and
+    // `available_parallelism` would count only the CPUs this thread is pinned to).
+    let mut set = rustix::thread::CpuSet::new();
+    for cpu in 0..rustix::thread::CpuSet::MAX_CPU {
+        set.set(cpu);
+    }
+    if let Err(e) = rustix::thread::sched_setaffinity(None, &set) {
+        tracing::warn!("cannot unpin this process: {e}");
     }
 }
 

@@ -14,6 +14,13 @@ struct Cli {
 }
 
 fn main() -> ExitCode {
+    // Warnings (pinning not permitted, ...) on stderr; RUST_LOG overrides the level.
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn"));
+    tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .init();
     match run_cli(Cli::parse().args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -20,7 +20,7 @@ pub enum ConfigError {
     },
     /// The TOML is malformed or has unknown keys.
     #[error("invalid configuration: {0}")]
-    Parse(String),
+    Parse(#[source] toml::de::Error),
     /// A value is out of range.
     #[error("invalid configuration: {0}")]
     Invalid(String),
@@ -129,8 +129,7 @@ impl PioneerConfig {
 
     /// Parses TOML text.
     pub fn from_toml(text: &str) -> Result<Self, ConfigError> {
-        let c: PioneerConfig =
-            toml::from_str(text).map_err(|e| ConfigError::Parse(e.to_string()))?;
+        let c: PioneerConfig = toml::from_str(text).map_err(ConfigError::Parse)?;
         c.validate()?;
         Ok(c)
     }

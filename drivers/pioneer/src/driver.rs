@@ -35,12 +35,20 @@ pub enum DriverError {
     /// A device could not be offered.
     #[error(transparent)]
     Host(#[from] HostError),
+    /// The configured robot name does not make valid device names.
+    #[error("invalid robot name {robot:?}: {source}")]
+    RobotName {
+        /// The name from the configuration.
+        robot: String,
+        /// Why it is invalid.
+        source: limber_services::NameError,
+    },
     /// The statistics channel could not be offered.
     #[error("cannot offer the driver statistics: {0}")]
-    Stats(String),
+    Stats(#[source] limber_services::diagnostics::DiagnosticsError),
     /// The event loop failed.
     #[error("event loop: {0}")]
-    Loop(String),
+    Loop(#[source] limber_services::event_loop::LoopError),
 }
 
 /// How the loop waits.
@@ -295,8 +303,12 @@ impl PioneerDriver {
         model.last_rx = Instant::now();
 
         let robot = cfg.robot.as_str();
-        let name =
-            |i, n| DeviceName::new(robot, i, n).map_err(|e| DriverError::Stats(e.to_string()));
+        let name = |i, n| {
+            DeviceName::new(robot, i, n).map_err(|source| DriverError::RobotName {
+                robot: robot.to_string(),
+                source,
+            })
+        };
         let driver = "pioneer";
         let hosts = Hosts {
             arm: if hardware.arm {
@@ -345,8 +357,7 @@ impl PioneerDriver {
                 None
             },
         };
-        let stats_pub =
-            StatsPublisher::new(ctx, robot).map_err(|e| DriverError::Stats(e.to_string()))?;
+        let stats_pub = StatsPublisher::new(ctx, robot).map_err(DriverError::Stats)?;
         let mut stats = DriverStats::default();
         diagnostics::put_text(&mut stats.driver, driver);
         diagnostics::put_text(&mut stats.robot_name, &hardware.identity.name);
@@ -784,7 +795,7 @@ impl PioneerDriver {
                     ControlFlow::Continue(())
                 }
             })
-            .map_err(|e| DriverError::Loop(e.to_string()))?;
+            .map_err(DriverError::Loop)?;
             if exit == LoopExit::Signal {
                 return Ok(LoopExit::Signal);
             }
