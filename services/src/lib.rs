@@ -52,7 +52,7 @@
 //! let ctx = Context::client_from_env()?;
 //! let mut arm = ActArrayClient::connect(&ctx, "pioneer/actarray/0")?;
 //! let geom = arm.geometry()?;                       // a request: typed reply or typed error
-//! let ticket = arm.move_to(2, geom.actuators[2].home)?; // a command: no allocation
+//! let ticket = arm.move_to(2, geom.actuators[2].home)?; // a command: no wait
 //! let status = arm.wait_outcome(ticket, Duration::from_secs(1))?;
 //! println!("{status}; joint 2 at {:.3} rad", arm.state().unwrap().actuators[2].position);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
