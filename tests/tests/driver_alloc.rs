@@ -17,10 +17,10 @@ use limber_services::prelude::*;
 use limber_services::{Domain, Role};
 
 #[global_allocator]
-static GLOBAL: limber_tests::Counting = limber_tests::Counting;
+static GLOBAL: limber_counting_alloc::Counting = limber_counting_alloc::Counting;
 
 fn allocs() -> u64 {
-    limber_tests::allocations()
+    limber_counting_alloc::allocations()
 }
 
 struct Measured {
