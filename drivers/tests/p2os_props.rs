@@ -196,7 +196,7 @@ fn random_frame(r: &mut SmallRng) -> Vec<u8> {
             arg: if r.random_range(0..2) == 0 {
                 None
             } else {
-                Some(r.random_range(0..131071) as i32 - 65535)
+                Some(r.random_range(-65535..=65535))
             },
         }
         .encode()
