@@ -243,6 +243,9 @@ fn bug06_nothing_before_calibration() {
 fn bug07_moving_flags_cleared() {
     let r = Rig::new("b07");
     let mut a = r.arm();
+    // Slowly (about a second), so the motion is seen even on a loaded machine: at full
+    // speed it could end between two samples this test reads.
+    a.set_speed_config(0, 0.5).unwrap();
     ok!(a, a.move_to(0, 0.6).unwrap());
     let mut saw_moving = false;
     let deadline = Instant::now() + Duration::from_secs(10);
