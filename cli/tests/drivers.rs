@@ -4,6 +4,7 @@
 
 use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
 use limber_services::Domain;
@@ -11,33 +12,50 @@ use limber_services::Domain;
 mod common;
 use common::{LIMBER, limber, stderr, stdout};
 
-struct Bg(Child);
+/// A background `limber` process; its stdout lines arrive on a channel.
+struct Bg(Child, Receiver<String>);
 
 impl Bg {
     fn spawn(domain: &str, args: &[&str]) -> Bg {
-        Bg(Command::new(LIMBER)
+        let mut child = Command::new(LIMBER)
             .args(args)
             .env("LIMBER_DOMAIN", domain)
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
             .stderr(Stdio::inherit())
             .spawn()
-            .unwrap())
+            .unwrap();
+        let out = child.stdout.take().unwrap();
+        let (tx, rx) = mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(out).lines() {
+                let Ok(line) = line else { break };
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        Bg(child, rx)
     }
 
-    /// The first stdout line satisfying `pred`.
+    /// The first stdout line satisfying `pred`, within 30 s.
     fn line(&mut self, pred: impl Fn(&str) -> bool) -> String {
-        let out = self.0.stdout.as_mut().unwrap();
-        let mut r = BufReader::new(out);
-        let mut l = String::new();
+        let timeout = Duration::from_secs(30);
+        let deadline = Instant::now() + timeout;
+        let mut seen = Vec::new();
         loop {
-            l.clear();
-            assert!(
-                r.read_line(&mut l).unwrap() > 0,
-                "process ended before the expected line"
-            );
-            if pred(l.trim_end()) {
-                return l.trim_end().to_string();
+            match self
+                .1
+                .recv_timeout(deadline.saturating_duration_since(Instant::now()))
+            {
+                Ok(l) if pred(l.trim_end()) => return l.trim_end().to_string(),
+                Ok(l) => seen.push(l),
+                Err(RecvTimeoutError::Disconnected) => {
+                    panic!("process ended before the expected line; it printed {seen:?}")
+                }
+                Err(RecvTimeoutError::Timeout) => {
+                    panic!("no expected line within {timeout:?}; the process printed {seen:?}")
+                }
             }
         }
     }

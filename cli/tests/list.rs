@@ -11,10 +11,7 @@ use common::{LIMBER, driver};
 fn list_shows_devices_drivers_and_liveness() {
     let domain = Domain::unique_for_test();
     let _stop = driver(domain.name());
-    let out = Command::new(LIMBER)
-        .args(["list", "--domain", domain.name()])
-        .output()
-        .unwrap();
+    let out = common::output(Command::new(LIMBER).args(["list", "--domain", domain.name()]));
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
     for dev in ["cli/actarray/0", "cli/limb/0", "cli/gripper/0"] {
@@ -27,11 +24,11 @@ fn list_shows_devices_drivers_and_liveness() {
             "{line}"
         );
     }
-    let out = Command::new(LIMBER)
-        .args(["list", "--json"])
-        .env("LIMBER_DOMAIN", domain.name())
-        .output()
-        .unwrap();
+    let out = common::output(
+        Command::new(LIMBER)
+            .args(["list", "--json"])
+            .env("LIMBER_DOMAIN", domain.name()),
+    );
     let text = String::from_utf8(out.stdout).unwrap();
     assert_eq!(text.lines().count(), 3);
     assert!(text.contains(r#""device":"cli/limb/0""#), "{text}");
@@ -39,16 +36,14 @@ fn list_shows_devices_drivers_and_liveness() {
 
 #[test]
 fn list_of_an_empty_domain_says_so_and_bad_domains_are_refused() {
-    let out = Command::new(LIMBER)
-        .args(["list", "--domain", Domain::unique_for_test().name()])
-        .output()
-        .unwrap();
+    let out = common::output(Command::new(LIMBER).args([
+        "list",
+        "--domain",
+        Domain::unique_for_test().name(),
+    ]));
     assert!(out.status.success());
     assert!(String::from_utf8_lossy(&out.stdout).contains("no devices"));
-    let out = Command::new(LIMBER)
-        .args(["list", "--domain", "a b"])
-        .output()
-        .unwrap();
+    let out = common::output(Command::new(LIMBER).args(["list", "--domain", "a b"]));
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("invalid domain"));
 }

@@ -381,12 +381,12 @@ fn the_binary_prints_one_frame_with_once_or_when_stdout_is_not_a_terminal() {
     let domain = Domain::unique_for_test();
     let _stop = driver(domain.name());
     for args in [&["monitor", "--once"][..], &["monitor"][..]] {
-        let out = Command::new(LIMBER)
-            .args(args)
-            .env("LIMBER_DOMAIN", domain.name())
-            .stdin(Stdio::null())
-            .output()
-            .unwrap();
+        let out = common::output(
+            Command::new(LIMBER)
+                .args(args)
+                .env("LIMBER_DOMAIN", domain.name())
+                .stdin(Stdio::null()),
+        );
         assert!(out.status.success(), "{args:?}: {out:?}");
         let text = stdout(&out);
         for dev in ["cli/actarray/0", "cli/limb/0", "cli/gripper/0"] {
@@ -397,11 +397,11 @@ fn the_binary_prints_one_frame_with_once_or_when_stdout_is_not_a_terminal() {
         // Plain text: no escape sequences.
         assert!(!text.contains('\x1b'), "{text:?}");
     }
-    let out = Command::new(LIMBER)
-        .args(["monitor", "--once", "--width", "80"])
-        .env("LIMBER_DOMAIN", domain.name())
-        .output()
-        .unwrap();
+    let out = common::output(
+        Command::new(LIMBER)
+            .args(["monitor", "--once", "--width", "80"])
+            .env("LIMBER_DOMAIN", domain.name()),
+    );
     let text = stdout(&out);
     assert!(text.lines().all(|l| l.chars().count() <= 80), "{text}");
     assert!(text.contains("cli/gripper/0"), "{text}");

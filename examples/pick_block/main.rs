@@ -1,6 +1,6 @@
 //! Pick up a block and put it down elsewhere (the paper's Listing 2).
 //!
-//! `cargo run -p limber-examples --example pick_block -- --limb pioneer/limb/0 --gripper pioneer/gripper/1`
+//! `cargo run -p limber-examples --bin pick_block -- --limb pioneer/limb/0 --gripper pioneer/gripper/1`
 
 use std::process::ExitCode;
 use std::time::Duration;

@@ -1,6 +1,6 @@
 //! Move every joint of an arm to random positions within its limits (the paper's Listing 1).
 //!
-//! `cargo run -p limber-examples --example random_moves -- --arm pioneer/actarray/0 --rounds 3`
+//! `cargo run -p limber-examples --bin random_moves -- --arm pioneer/actarray/0 --rounds 3`
 
 use std::process::ExitCode;
 use std::time::Duration;

@@ -6,8 +6,8 @@
 //! * [`pick_block`] (Listing 2): pick up a block with the limb and gripper interfaces,
 //!   carry it and put it down.
 //!
-//! Each is a library function (the `limber demo` command runs the same code) and a cargo
-//! example with its own README: `cargo run -p limber-examples --example pick_block`.
+//! Each is a library function (the `limber demo` command runs the same code) and a
+//! binary with its own README: `cargo run -p limber-examples --bin pick_block`.
 
 #![warn(missing_docs)]
 

@@ -4,6 +4,8 @@
 use std::time::{Duration, Instant};
 
 use limber_services::prelude::*;
+use rand::rngs::SmallRng;
+use rand::{Rng as _, SeedableRng};
 use thiserror::Error;
 
 /// Parameters.
@@ -75,24 +77,6 @@ pub struct Move {
     pub limits: (f64, f64),
 }
 
-/// A small deterministic generator (xorshift64*), so runs are repeatable.
-#[derive(Debug, Clone)]
-pub struct Rng(u64);
-
-impl Rng {
-    /// Seeded.
-    pub fn new(seed: u64) -> Self {
-        Rng(seed.max(1))
-    }
-    /// Uniform in [0, 1).
-    pub fn next_f64(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
 /// Runs the program on `arm`; returns the final joint positions. `observe` sees each
 /// move as it is sent and, after each round, the state.
 pub fn run(
@@ -101,14 +85,15 @@ pub fn run(
     observe: &mut dyn FnMut(Option<Move>, &ActArrayData),
 ) -> Result<Vec<f64>, RandomError> {
     let geom = arm.geometry()?;
-    let mut rng = Rng::new(p.seed);
+    // Seeded, so runs are repeatable.
+    let mut rng = SmallRng::seed_from_u64(p.seed);
     for round in 0..p.rounds {
         for (joint, g) in geom.actuators().iter().enumerate() {
             // The geometry reports min <= max; stay a margin inside, as the paper's
             // program stays clear of the limits.
             let (lo, hi) = (g.min.min(g.max), g.min.max(g.max));
             let m = p.margin.min((hi - lo) / 4.0);
-            let target = lo + m + rng.next_f64() * (hi - lo - 2.0 * m);
+            let target = lo + m + rng.random::<f64>() * (hi - lo - 2.0 * m);
             let t = arm.move_to(joint, target)?;
             if let Some(s) = arm.state() {
                 observe(

@@ -1,28 +1,62 @@
 //! Helpers shared by the multi-process integration tests: spawning the test driver and
-//! test clients in a domain of their own, and stopping them.
+//! test clients in a domain of their own, and stopping them. Every wait is bounded.
 
-use std::io::{BufRead, BufReader};
-use std::process::{Child, Command, Stdio};
+use std::io::{BufRead, BufReader, Write};
+use std::process::{Child, ChildStdin, Command, Stdio};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
+
+/// How long [`Proc::read_until`] waits for a line before the test fails.
+pub const LINE_TIMEOUT: Duration = Duration::from_secs(30);
 
 /// A child process that is killed when dropped.
 #[derive(Debug)]
 pub struct Proc {
-    /// The child.
+    /// The child (its stdout is read by a thread of its own: see [`Proc::read_until`]).
     pub child: Child,
+    /// The child's stdout, line by line, from the reader thread (disconnected at EOF).
+    lines: Receiver<String>,
+    /// The child's stdin.
+    stdin: Option<ChildStdin>,
+    exe: String,
 }
 
 impl Proc {
-    /// Spawns `exe` with `args` in domain `domain`, stdout piped.
+    /// Spawns `exe` with `args` in domain `domain`, stdin and stdout piped.
     pub fn spawn(exe: &str, domain: &str, args: &[&str]) -> Proc {
-        let child = Command::new(exe)
+        let mut child = Command::new(exe)
             .args(args)
             .env("LIMBER_DOMAIN", domain)
+            .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::inherit())
             .spawn()
             .unwrap_or_else(|e| panic!("cannot start {exe}: {e}"));
-        Proc { child }
+        let out = child.stdout.take().expect("stdout is piped");
+        let (tx, lines) = mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(out).lines() {
+                let Ok(line) = line else { break };
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        let stdin = child.stdin.take();
+        Proc {
+            child,
+            lines,
+            stdin,
+            exe: exe.to_string(),
+        }
+    }
+
+    /// Writes `line` (and a newline) to the child's stdin.
+    pub fn write_line(&mut self, line: &str) {
+        let stdin = self.stdin.as_mut().expect("stdin is piped");
+        writeln!(stdin, "{line}")
+            .and_then(|()| stdin.flush())
+            .unwrap_or_else(|e| panic!("cannot write to {}: {e}", self.exe));
     }
 
     /// Sends a signal (SIGKILL, SIGTERM, ...).
@@ -50,30 +84,53 @@ impl Proc {
         }
     }
 
-    /// Reads stdout lines until one satisfies `pred` (or EOF); returns it.
+    /// Reads stdout lines until one satisfies `pred` and returns it; None if stdout ends
+    /// first. Fails the test if no such line comes within [`LINE_TIMEOUT`].
     pub fn read_until(&mut self, pred: impl Fn(&str) -> bool) -> Option<String> {
-        let out = self.child.stdout.as_mut()?;
-        let mut r = BufReader::new(out);
-        let mut line = String::new();
+        self.read_until_within(LINE_TIMEOUT, pred)
+    }
+
+    /// [`Proc::read_until`] with its own timeout.
+    pub fn read_until_within(
+        &mut self,
+        timeout: Duration,
+        pred: impl Fn(&str) -> bool,
+    ) -> Option<String> {
+        let deadline = Instant::now() + timeout;
+        let mut seen = Vec::new();
         loop {
-            line.clear();
-            if r.read_line(&mut line).ok()? == 0 {
-                return None;
-            }
-            if pred(line.trim_end()) {
-                return Some(line.trim_end().to_string());
+            let left = deadline.saturating_duration_since(Instant::now());
+            match self.lines.recv_timeout(left) {
+                Ok(line) if pred(line.trim_end()) => return Some(line.trim_end().to_string()),
+                Ok(line) => seen.push(line),
+                Err(RecvTimeoutError::Disconnected) => return None,
+                Err(RecvTimeoutError::Timeout) => panic!(
+                    "{}: no expected line within {timeout:?}; lines seen meanwhile: {seen:?}",
+                    self.exe
+                ),
             }
         }
     }
 
-    /// All remaining stdout (after the process ended).
+    /// All remaining stdout (after the process ended). Fails the test if stdout is still
+    /// open after [`LINE_TIMEOUT`] (a grandchild holding it, for example).
     pub fn rest_of_stdout(&mut self) -> String {
-        use std::io::Read;
+        let deadline = Instant::now() + LINE_TIMEOUT;
         let mut s = String::new();
-        if let Some(out) = self.child.stdout.as_mut() {
-            let _ = out.read_to_string(&mut s);
+        loop {
+            let left = deadline.saturating_duration_since(Instant::now());
+            match self.lines.recv_timeout(left) {
+                Ok(line) => {
+                    s.push_str(&line);
+                    s.push('\n');
+                }
+                Err(RecvTimeoutError::Disconnected) => return s,
+                Err(RecvTimeoutError::Timeout) => panic!(
+                    "{}: stdout still open {LINE_TIMEOUT:?} after the exit; read so far: {s}",
+                    self.exe
+                ),
+            }
         }
-        s
     }
 }
 
@@ -82,37 +139,4 @@ impl Drop for Proc {
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
-}
-
-/// A global allocator that counts the allocations made on each thread, for the tests that
-/// prove a hot loop allocates nothing. Declare it in a test binary with
-/// `#[global_allocator] static GLOBAL: limber_tests::Counting = limber_tests::Counting;`.
-#[derive(Debug)]
-pub struct Counting;
-
-thread_local! {
-    static ALLOCS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
-}
-
-// SAFETY: forwards to the system allocator; only counts calls made on the current thread.
-unsafe impl std::alloc::GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
-        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
-        // SAFETY: same contract as ours.
-        unsafe { std::alloc::System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: std::alloc::Layout) {
-        // SAFETY: same contract as ours.
-        unsafe { std::alloc::System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: std::alloc::Layout, new_size: usize) -> *mut u8 {
-        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
-        // SAFETY: same contract as ours.
-        unsafe { std::alloc::System.realloc(ptr, layout, new_size) }
-    }
-}
-
-/// Allocations made so far on this thread (when [`Counting`] is the global allocator).
-pub fn allocations() -> u64 {
-    ALLOCS.with(|c| c.get())
 }

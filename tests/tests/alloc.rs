@@ -7,18 +7,13 @@
 //!   including `send_copy`. The test therefore allows exactly one allocation per sample
 //!   sent and fails on anything more.
 
+use limber_counting_alloc::allocations_in;
 use limber_services::prelude::*;
 use limber_services::testing::TestDriver;
 use limber_services::{Domain, Role};
 
 #[global_allocator]
-static GLOBAL: limber_tests::Counting = limber_tests::Counting;
-
-fn allocations_in(f: impl FnOnce()) -> u64 {
-    let before = limber_tests::allocations();
-    f();
-    limber_tests::allocations() - before
-}
+static GLOBAL: limber_counting_alloc::Counting = limber_counting_alloc::Counting;
 
 struct Rig {
     driver: TestDriver,

@@ -7,8 +7,7 @@
 //! the wait set when the measured run starts). Traced with backtraces: no
 //! allocation comes from limber's own code.
 
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, mpsc};
+use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use limber_emulator::{Emulator, EmulatorConfig};
@@ -17,10 +16,10 @@ use limber_services::prelude::*;
 use limber_services::{Domain, Role};
 
 #[global_allocator]
-static GLOBAL: limber_tests::Counting = limber_tests::Counting;
+static GLOBAL: limber_counting_alloc::Counting = limber_counting_alloc::Counting;
 
 fn allocs() -> u64 {
-    limber_tests::allocations()
+    limber_counting_alloc::allocations()
 }
 
 struct Measured {
@@ -34,11 +33,9 @@ fn driver_loop_allocates_only_iceoryx2_internals() {
     let domain = Domain::unique_for_test();
     let emu = Emulator::start_pty(EmulatorConfig::default()).unwrap();
     let target = emu.link_target();
-    let client_done = Arc::new(AtomicBool::new(false));
     let (tx, rx) = mpsc::channel::<Measured>();
     let (ready_tx, ready_rx) = mpsc::channel();
     let d = domain.clone();
-    let done = Arc::clone(&client_done);
     let t = std::thread::spawn(move || {
         let ctx = Context::new(&d, Role::Driver, "pioneer").unwrap();
         let mut driver = PioneerDriver::start(&ctx, PioneerConfig::default(), target).unwrap();
@@ -51,9 +48,7 @@ fn driver_loop_allocates_only_iceoryx2_internals() {
         let (a0, p0, w0) = (allocs(), driver.samples_published(), driver.wakeups());
         let until = Instant::now() + Duration::from_secs(3);
         driver
-            .run_until(RunOptions::default(), || {
-                Instant::now() > until || done.load(Ordering::Relaxed)
-            })
+            .run_until(RunOptions::default(), || Instant::now() > until)
             .unwrap();
         let m = Measured {
             allocations: allocs() - a0,
@@ -69,15 +64,24 @@ fn driver_loop_allocates_only_iceoryx2_internals() {
     let mut arm =
         ActArrayClient::connect_timeout(&ctx, "pioneer/actarray/0", Duration::from_secs(5))
             .unwrap();
-    let end = Instant::now() + Duration::from_millis(4500);
+    // ... until the driver has finished measuring (warm-up and measured run alike).
+    let deadline = Instant::now() + Duration::from_secs(20);
     let mut i = 0;
-    while Instant::now() < end {
+    let m = loop {
+        match rx.try_recv() {
+            Ok(m) => break m,
+            Err(mpsc::TryRecvError::Empty) => {}
+            Err(mpsc::TryRecvError::Disconnected) => panic!("the driver thread failed"),
+        }
+        assert!(
+            Instant::now() < deadline,
+            "the driver never finished measuring"
+        );
         let _ = arm.move_to(0, if i % 2 == 0 { 0.3 } else { -0.3 });
         i += 1;
+        // Paces the commands.
         std::thread::sleep(Duration::from_millis(50));
-    }
-    client_done.store(true, Ordering::Relaxed);
-    let m = rx.recv_timeout(Duration::from_secs(20)).unwrap();
+    };
     t.join().unwrap();
     eprintln!(
         "driver thread, 3 s of steady state: {} allocations, {} samples published, {} wake-ups, {} commands sent",

@@ -8,6 +8,7 @@ use limber_emulator::{Emulator, EmulatorConfig, Faults, ModelConfig};
 use limber_examples::pick_block::{self, Devices, PickParams, Step};
 use limber_examples::random_moves::{self, RandomParams};
 use limber_interfaces::diagnostics::hardware;
+use limber_p2os::{ArmCalibration, ArmJoint, Command};
 use limber_services::diagnostics::StatsReader;
 use limber_services::prelude::*;
 use limber_services::{Domain, RequestError, Role, WaitError};
@@ -141,7 +142,35 @@ fn out_of_reach_is_reported_and_cleared_by_the_next_valid_command() {
     let _driver = start(&domain, &emu, "oor");
     let c = ctx(&domain);
     let mut limb = LimbClient::connect_timeout(&c, "pioneer/limb/0", T).unwrap();
-    let before = emu.state().stats.bytes_in;
+    // Barriers: a joint speed (ARM_SPEED) that the robot has taken; the link keeps the
+    // order, so everything sent before it has arrived.
+    let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
+    let cal = ArmCalibration::from(limber_emulator::default_arm_info());
+    let joint = ArmJoint::new(1).unwrap();
+    let mut barrier = |speed: f64| {
+        arm.set_speed_config(0, speed).unwrap();
+        let ms = cal.speed_to_ms_per_step(joint, speed).unwrap();
+        let (arrived, st) = emu.wait_for(T, |s| s.robot.ms_per_step[0] == ms);
+        assert!(
+            arrived,
+            "the barrier (speed {speed}) never reached the robot"
+        );
+        st
+    };
+    let speed_bytes = Command::ArmSpeed {
+        joint,
+        ms_per_step: 1,
+    }
+    .encode()
+    .unwrap()
+    .as_bytes()
+    .len() as u64;
+    let (slow, fast) = (0.3, 1.0);
+    assert_ne!(
+        cal.speed_to_ms_per_step(joint, slow).unwrap(),
+        cal.speed_to_ms_per_step(joint, fast).unwrap()
+    );
+    let st0 = barrier(slow);
     let t = limb
         .set_pose([1.5, 0.0, 0.3], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0])
         .unwrap();
@@ -151,11 +180,15 @@ fn out_of_reach_is_reported_and_cleared_by_the_next_valid_command() {
         LimbState::OutOfReach
     );
     // Nothing reached the robot for the refused pose (only keep-alives may have).
-    std::thread::sleep(Duration::from_millis(50));
-    let sent = emu.state().stats.bytes_in - before;
+    let st1 = barrier(fast);
+    let sent = st1.stats.bytes_in - st0.stats.bytes_in;
     assert!(
-        sent.is_multiple_of(6) && sent <= 6 * 3,
-        "{sent} bytes sent after a refused pose"
+        sent >= speed_bytes && (sent - speed_bytes).is_multiple_of(6),
+        "{sent} bytes (the barrier is {speed_bytes}) sent after a refused pose"
+    );
+    assert_eq!(
+        st1.robot.servo_targets, st0.robot.servo_targets,
+        "a refused pose moved the arm"
     );
     let t = limb.set_position([0.35, 0.0, 0.25]).unwrap();
     assert_eq!(limb.wait_outcome(t, T).unwrap(), Status::Ok);
@@ -224,9 +257,7 @@ fn silence_and_garbage_are_detected_and_survived() {
         bad_checksum_rate: 0.1,
         ..Faults::default()
     });
-    std::thread::sleep(Duration::from_millis(1500));
-    let t = arm.move_to(1, -0.5).unwrap();
-    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
+    // The driver sees the faults (counted), and the arm keeps working meanwhile.
     let mut stats = StatsReader::open(&c, "pioneer").unwrap();
     let deadline = Instant::now() + Duration::from_secs(5);
     loop {
@@ -236,6 +267,8 @@ fn silence_and_garbage_are_detected_and_survived() {
         }
         assert!(Instant::now() < deadline, "faults not counted: {s:?}");
     }
+    let t = arm.move_to(1, -0.5).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
 
     // Silence: the link is reported down, and recovered once the robot talks again.
     emu.set_faults(Faults {
@@ -251,15 +284,23 @@ fn silence_and_garbage_are_detected_and_survived() {
         wait_flag(&mut arm, true, Duration::from_secs(10)),
         "not recovered"
     );
-    // The refused command was not replayed after recovery.
-    std::thread::sleep(Duration::from_millis(300));
-    let target_tick = emu.state().robot.servo_targets[1];
-    let cal = limber_emulator::default_arm_info();
-    let refused_tick = limber_p2os::ArmCalibration::from(cal)
-        .radians_to_ticks(limber_p2os::ArmJoint::new(2).unwrap(), 0.2)
-        .unwrap()
-        .tick;
-    assert_ne!(target_tick, refused_tick, "a refused command was replayed");
+    // The refused command was not replayed after recovery. The barrier: a later command
+    // (joint 1 to 0.3) that the robot has carried out; a replay would have come before it.
+    let cal = limber_p2os::ArmCalibration::from(limber_emulator::default_arm_info());
+    let tick = |joint: u8, rad: f64| {
+        cal.radians_to_ticks(limber_p2os::ArmJoint::new(joint).unwrap(), rad)
+            .unwrap()
+            .tick
+    };
+    let t = arm.move_to(0, 0.3).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
+    let (arrived, st) = emu.wait_for(T, |s| s.robot.servo_targets[0] == tick(1, 0.3));
+    assert!(arrived, "the later command never reached the robot");
+    assert_ne!(
+        st.robot.servo_targets[1],
+        tick(2, 0.2),
+        "a refused command was replayed"
+    );
 }
 
 #[test]

@@ -122,18 +122,27 @@ fn no_driver_is_reported_at_once() {
 #[test]
 fn a_client_dying_mid_request_does_not_hurt_the_driver() {
     let domain = Domain::unique_for_test();
-    let _driver = start_driver(&domain, &["--reply-delay-ms", "300"]);
+    let mut driver = start_driver(&domain, &["--hold-first-request"]);
     let mut victim = Proc::spawn(CLIENT, domain.name(), &["hold-request"]);
-    assert!(victim.read_until(|l| l == "requesting").is_some());
-    std::thread::sleep(Duration::from_millis(100));
+    // The driver has the request in hand (and holds it): kill its sender now.
+    let held = driver.read_until(|l| l.starts_with("request "));
+    assert!(held.is_some(), "the driver never received the request");
     victim.signal(libc::SIGKILL);
-    let _ = victim.wait_timeout(T);
-    // The driver answers the dead client (undeliverable) and goes on serving.
+    assert_eq!(victim.wait_timeout(T), None, "the client was not killed");
+    // Let the driver answer the dead client (undeliverable); it goes on serving.
+    driver.write_line("go");
     let ctx = client_ctx(&domain);
     let mut arm = ActArrayClient::connect_timeout(&ctx, "test/actarray/0", T).unwrap();
     for _ in 0..3 {
         assert_eq!(arm.geometry().unwrap().actuators_count, 6);
     }
+    driver.signal(libc::SIGTERM);
+    assert_eq!(driver.wait_timeout(T), Some(0));
+    let out = driver.rest_of_stdout();
+    assert!(
+        out.contains("requests=4 "),
+        "the held request was not answered: {out}"
+    );
 }
 
 #[test]

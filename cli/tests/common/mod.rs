@@ -2,9 +2,10 @@
 
 #![allow(dead_code)]
 
-use std::process::{Command, Output};
+use std::io::Read;
+use std::process::{Command, Output, Stdio};
 use std::sync::mpsc;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use limber_services::testing::TestDriver;
 use limber_services::{Context, Domain, Role};
@@ -30,13 +31,55 @@ pub fn driver(domain: &str) -> mpsc::Sender<()> {
     tx
 }
 
+/// How long one `limber` verb may take before the test fails.
+pub const VERB_TIMEOUT: Duration = Duration::from_secs(60);
+
 /// Runs `limber <args>` in `domain`.
 pub fn limber(domain: &str, args: &[&str]) -> Output {
-    Command::new(LIMBER)
-        .args(args)
-        .env("LIMBER_DOMAIN", domain)
-        .output()
-        .expect("limber runs")
+    output(Command::new(LIMBER).args(args).env("LIMBER_DOMAIN", domain))
+}
+
+/// `cmd.output()` (stdin closed), but killed and failing the test after [`VERB_TIMEOUT`].
+pub fn output(cmd: &mut Command) -> Output {
+    let mut child = cmd
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("limber runs");
+    let drain = |mut r: Box<dyn Read + Send>| {
+        let (tx, rx) = mpsc::channel();
+        std::thread::spawn(move || {
+            let mut v = Vec::new();
+            let _ = r.read_to_end(&mut v);
+            let _ = tx.send(v);
+        });
+        rx
+    };
+    let out = drain(Box::new(child.stdout.take().unwrap()));
+    let err = drain(Box::new(child.stderr.take().unwrap()));
+    let deadline = Instant::now() + VERB_TIMEOUT;
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("wait for limber") {
+            break status;
+        }
+        if Instant::now() >= deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("{cmd:?} still running after {VERB_TIMEOUT:?}: killed");
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    // A process it left behind could hold the pipes open: bounded too.
+    let rest = |rx: mpsc::Receiver<Vec<u8>>| {
+        rx.recv_timeout(deadline.saturating_duration_since(Instant::now()))
+            .unwrap_or_else(|_| panic!("{cmd:?}: output still open after {VERB_TIMEOUT:?}"))
+    };
+    Output {
+        status,
+        stdout: rest(out),
+        stderr: rest(err),
+    }
 }
 
 /// Stdout as text.

@@ -4,6 +4,8 @@ use super::model::{Robot, SyncStage};
 use super::{Control, EmulatorConfig, EmulatorError, EmulatorStats, Faults, Shared, lock};
 use limber_p2os::sys::wait_readable;
 use limber_p2os::{Decoder, Frame, MAX_FRAME, ptype};
+use rand::rngs::SmallRng;
+use rand::{Rng as _, RngCore as _, SeedableRng};
 use serialport::{SerialPort, TTYPort};
 use std::io::{self, Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
@@ -182,21 +184,16 @@ fn is_transient(e: &io::Error) -> bool {
     )
 }
 
-/// xorshift64*: a small deterministic generator for fault injection.
-struct Rng(u64);
+/// The seeded generator of fault injection.
+struct Rng(SmallRng);
 
 impl Rng {
     fn next_u64(&mut self) -> u64 {
-        let mut x = self.0;
-        x ^= x >> 12;
-        x ^= x << 25;
-        x ^= x >> 27;
-        self.0 = x;
-        x.wrapping_mul(0x2545_F491_4F6C_DD1D)
+        self.0.next_u64()
     }
 
     fn chance(&mut self, p: f64) -> bool {
-        p > 0.0 && ((self.next_u64() >> 11) as f64 / (1u64 << 53) as f64) < p
+        p > 0.0 && self.0.random::<f64>() < p
     }
 }
 
@@ -268,7 +265,7 @@ pub(super) fn run(
     let mut decoder = Decoder::new();
     let mut out: Vec<Frame> = Vec::with_capacity(16);
     let mut wire = Wire {
-        rng: Rng(config.seed | 1),
+        rng: Rng(SmallRng::seed_from_u64(config.seed)),
         stats: EmulatorStats::default(),
     };
     let mut buf = [0u8; 512];

@@ -6,7 +6,7 @@ use limber_emulator::{
 };
 use limber_p2os::*;
 use std::net::SocketAddr;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 const WAIT: Duration = Duration::from_secs(5);
 
@@ -523,8 +523,12 @@ fn tcp_close_drops_the_connection_and_reconnect_works() {
     assert!(c.arm_calibration().is_some());
     // Keep-alive: PULSE goes out when nothing was sent for a while.
     let mut c = c;
-    std::thread::sleep(Duration::from_millis(250));
-    assert!(c.keep_alive().unwrap());
+    let deadline = Instant::now() + WAIT;
+    while !c.keep_alive().unwrap() {
+        assert!(Instant::now() < deadline, "no PULSE within {WAIT:?}");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    // Just sent: not due again at once.
     assert!(!c.keep_alive().unwrap());
     // An unroutable command is ignored by the robot; the link stays up.
     c.send(&Command::Custom {

@@ -44,6 +44,8 @@ use std::ops::{Deref, DerefMut};
 use std::path::Path;
 
 use nalgebra::{Rotation3, SMatrix, Unit, Vector3, Vector6};
+use rand::rngs::SmallRng;
+use rand::{Rng as _, RngCore as _, SeedableRng};
 use serde::Deserialize;
 
 use super::pose::{Pose, all_finite};
@@ -299,28 +301,25 @@ pub struct ChainSolution {
     pub restarts: u32,
 }
 
-/// A small deterministic generator (SplitMix64) for restarts, tests and benchmarks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct DeterministicRng(u64);
+/// A small deterministic generator (rand's `SmallRng`, seeded) for restarts, tests and
+/// benchmarks: the same seed gives the same sequence.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct DeterministicRng(SmallRng);
 
 impl DeterministicRng {
     /// A generator from a seed.
     pub fn new(seed: u64) -> Self {
-        Self(seed)
+        Self(SmallRng::seed_from_u64(seed))
     }
 
     /// The next 64 random bits.
     pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        self.0.next_u64()
     }
 
     /// Uniform in [0, 1).
     pub fn next_f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+        self.0.random()
     }
 
     /// Uniform in [lo, hi).

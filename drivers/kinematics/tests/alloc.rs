@@ -1,53 +1,16 @@
 //! The solvers do not allocate: a counting global allocator sees no allocation during
-//! Pioneer FK/IK/SETPOSITION/VECMOVE and chain FK/IK (success and failure). One test
-//! only, so nothing else allocates concurrently in this binary.
+//! Pioneer FK/IK/SETPOSITION/VECMOVE and chain FK/IK (success and failure), counted on
+//! the thread that solves.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-use std::sync::atomic::{AtomicUsize, Ordering};
-
+use limber_counting_alloc::{Counting, allocations_in};
 use limber_kinematics::chain::{Chain, IkTarget, NumericIkOptions};
 use limber_kinematics::pioneer::{
     ApproachPreference, PioneerGeometry, PioneerIkOptions, VecMoveOptions,
 };
 use nalgebra::Vector3;
 
-struct Counting;
-
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-thread_local! {
-    /// Counting is on for this thread only (the test harness's own threads may
-    /// allocate meanwhile).
-    static COUNTING: Cell<bool> = const { Cell::new(false) };
-}
-
-// SAFETY: forwards to the system allocator unchanged; only counts calls.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if COUNTING.with(Cell::get) {
-            ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        }
-        // SAFETY: forwarded unchanged to the system allocator.
-        unsafe { System.alloc(layout) }
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: forwarded unchanged to the system allocator.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
-
 #[global_allocator]
 static GLOBAL: Counting = Counting;
-
-fn allocations_during(f: impl FnOnce()) -> usize {
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
-    COUNTING.with(|c| c.set(true));
-    f();
-    COUNTING.with(|c| c.set(false));
-    ALLOCATIONS.load(Ordering::SeqCst) - before
-}
 
 #[test]
 fn solvers_do_not_allocate() {
@@ -61,7 +24,7 @@ fn solvers_do_not_allocate() {
     let h7 = c7.home();
     let t6 = c6.fk(&[0.3, -1.2, 1.1, -0.5, 0.7, 0.2]).unwrap();
     let t7 = c7.fk(&[0.3, 0.2, -0.4, -1.5, 0.2, 1.9, 0.4]).unwrap();
-    let n = allocations_during(|| {
+    let n = allocations_in(|| {
         let pose = g.fk(&theta).unwrap();
         assert!(g.solve_pose(&pose, &[0.0; 5], &o).is_ok());
         assert!(g.pose_candidates(&pose, &[0.0; 5], &o).is_ok());

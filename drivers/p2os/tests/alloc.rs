@@ -1,35 +1,11 @@
-//! The decoder and the link's receive path allocate nothing per packet.
-//! (One test in this file: the counting allocator sees only this thread's
-//! work while it runs.)
+//! The decoder and the link's receive path allocate nothing per packet (counted on this
+//! thread, which does all the decoding and receiving).
 
+use limber_counting_alloc::{Counting, allocations};
 use limber_p2os::*;
 use serialport::TTYPort;
-use std::alloc::{GlobalAlloc, Layout, System};
 use std::io::Write;
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Duration;
-
-struct Counting;
-
-static ALLOCS: AtomicU64 = AtomicU64::new(0);
-
-// SAFETY: forwards to the system allocator unchanged; only counts calls.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::Relaxed);
-        // SAFETY: same contract as our caller's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: same contract as our caller's.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::Relaxed);
-        // SAFETY: same contract as our caller's.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
@@ -53,7 +29,7 @@ fn decoding_and_receiving_do_not_allocate() {
     }
     let mut d = Decoder::new();
 
-    let before = ALLOCS.load(Ordering::SeqCst);
+    let before = allocations();
     let mut n = 0;
     for chunk in stream.chunks(37) {
         d.decode(chunk, |p| {
@@ -62,7 +38,7 @@ fn decoding_and_receiving_do_not_allocate() {
             }
         });
     }
-    assert_eq!(ALLOCS.load(Ordering::SeqCst), before, "decoder allocated");
+    assert_eq!(allocations(), before, "decoder allocated");
     assert_eq!(n, 400);
 
     // The link's receive path over a pty.
@@ -70,7 +46,7 @@ fn decoding_and_receiving_do_not_allocate() {
     let mut link = Link::from_serial_port(slave);
     let frames: Vec<u8> = [arm.as_bytes(), sip.as_bytes()].concat();
     let mut got = 0;
-    let before = ALLOCS.load(Ordering::SeqCst);
+    let before = allocations();
     for _ in 0..50 {
         master.write_all(&frames).unwrap();
         for _ in 0..2 {
@@ -81,6 +57,6 @@ fn decoding_and_receiving_do_not_allocate() {
         }
         link.send(&Command::Pulse).unwrap();
     }
-    assert_eq!(ALLOCS.load(Ordering::SeqCst), before, "link allocated");
+    assert_eq!(allocations(), before, "link allocated");
     assert_eq!(got, 100);
 }

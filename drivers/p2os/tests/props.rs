@@ -6,6 +6,8 @@
 
 use limber_p2os::*;
 use proptest::prelude::*;
+use rand::rngs::SmallRng;
+use rand::{Rng as _, SeedableRng};
 
 /// Feeds `stream` in chunks of the given sizes (cycled), collecting payloads
 /// and parsing each one as a robot packet and as a command: none may panic.
@@ -146,60 +148,41 @@ proptest! {
     }
 }
 
-/// splitmix64: a fixed-seed generator for the fuzz run.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n.max(1)
-    }
-    fn byte(&mut self) -> u8 {
-        self.next() as u8
-    }
-}
-
 /// A random frame: a typed robot packet, a typed command, or random bytes.
-fn random_frame(r: &mut Rng) -> Vec<u8> {
-    match r.below(6) {
+fn random_frame(r: &mut SmallRng) -> Vec<u8> {
+    match r.random_range(0..6) {
         0 => {
             let mut sip = Sip::default();
-            sip.x = r.next() as u16;
-            sip.timer = r.next() as u16;
-            let n = r.below(17) as usize;
+            sip.x = r.random::<u16>();
+            sip.timer = r.random::<u16>();
+            let n = r.random_range(0..17) as usize;
             let readings: Vec<SonarReading> = (0..n)
                 .map(|i| SonarReading {
                     index: i as u8,
-                    range: r.next() as u16,
+                    range: r.random::<u16>(),
                 })
                 .collect();
             sip.set_sonars(&readings);
             sip.encode().unwrap().as_bytes().to_vec()
         }
         1 => ArmPacket {
-            status: r.next() as u16,
-            ticks: [r.byte(), r.byte(), r.byte(), r.byte(), r.byte(), r.byte()],
+            status: r.random::<u16>(),
+            ticks: r.random(),
         }
         .encode()
         .unwrap()
         .as_bytes()
         .to_vec(),
         2 => {
-            let n = r.below(7) as usize;
+            let n = r.random_range(0..7) as usize;
             let joints: Vec<JointCalibration> = (0..n)
                 .map(|_| JointCalibration {
-                    speed: r.byte(),
-                    home: r.byte(),
-                    min: r.byte(),
-                    centre: r.byte(),
-                    max: r.byte(),
-                    ticks_per_90: r.byte(),
+                    speed: r.random::<u8>(),
+                    home: r.random::<u8>(),
+                    min: r.random::<u8>(),
+                    centre: r.random::<u8>(),
+                    max: r.random::<u8>(),
+                    ticks_per_90: r.random::<u8>(),
                 })
                 .collect();
             ArmInfo::new("fuzz", &joints)
@@ -209,11 +192,11 @@ fn random_frame(r: &mut Rng) -> Vec<u8> {
                 .to_vec()
         }
         3 => Command::Custom {
-            number: r.byte(),
-            arg: if r.below(2) == 0 {
+            number: r.random::<u8>(),
+            arg: if r.random_range(0..2) == 0 {
                 None
             } else {
-                Some(r.below(131071) as i32 - 65535)
+                Some(r.random_range(-65535..=65535))
             },
         }
         .encode()
@@ -221,11 +204,11 @@ fn random_frame(r: &mut Rng) -> Vec<u8> {
         .as_bytes()
         .to_vec(),
         _ => {
-            let n = 1 + r.below(MAX_PAYLOAD as u64) as usize;
-            let mut p: Vec<u8> = (0..n).map(|_| r.byte()).collect();
+            let n = 1 + r.random_range(0..MAX_PAYLOAD as u64) as usize;
+            let mut p: Vec<u8> = (0..n).map(|_| r.random::<u8>()).collect();
             // Often a known packet type, to reach the typed parsers.
-            if r.below(2) == 0 {
-                p[0] = [0x00, 0x02, 0x32, 0xA0, 0xA1, 0xE0][r.below(6) as usize];
+            if r.random_range(0..2) == 0 {
+                p[0] = [0x00, 0x02, 0x32, 0xA0, 0xA1, 0xE0][r.random_range(0..6) as usize];
             }
             frame(&p)
         }
@@ -234,23 +217,23 @@ fn random_frame(r: &mut Rng) -> Vec<u8> {
 
 /// Mutates a frame in place: bit flips, byte changes, inserts, deletes,
 /// truncation, a wrong length byte, or extra header bytes.
-fn mutate(r: &mut Rng, f: &mut Vec<u8>) {
-    for _ in 0..1 + r.below(3) {
+fn mutate(r: &mut SmallRng, f: &mut Vec<u8>) {
+    for _ in 0..1 + r.random_range(0..3) {
         if f.is_empty() {
-            f.push(r.byte());
+            f.push(r.random::<u8>());
         }
-        let i = r.below(f.len() as u64) as usize;
-        match r.below(7) {
-            0 => f[i] ^= 1 << r.below(8),
-            1 => f[i] = r.byte(),
-            2 => f.insert(i, r.byte()),
+        let i = r.random_range(0..f.len() as u64) as usize;
+        match r.random_range(0..7) {
+            0 => f[i] ^= 1 << r.random_range(0..8),
+            1 => f[i] = r.random::<u8>(),
+            2 => f.insert(i, r.random::<u8>()),
             3 => {
                 f.remove(i);
             }
             4 => f.truncate(i),
             5 => {
                 if f.len() > 2 {
-                    f[2] = r.byte();
+                    f[2] = r.random::<u8>();
                 }
             }
             _ => f.splice(i..i, [0xFA, 0xFB]).for_each(drop),
@@ -264,7 +247,8 @@ fn fuzz_random_and_mutated_frames() {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(20_000);
-    let mut r = Rng(0x00C0_FFEE_0000_2026);
+    // A fixed seed: every run fuzzes the same frames.
+    let mut r = SmallRng::seed_from_u64(0x00C0_FFEE_0000_2026);
     let mut d = Decoder::new();
     let mut fed = 0u64;
     let mut intact = 0u64;
@@ -277,19 +261,19 @@ fn fuzz_random_and_mutated_frames() {
         for _ in 0..64.min(count - frames) {
             frames += 1;
             let mut f = random_frame(&mut r);
-            match r.below(10) {
+            match r.random_range(0..10) {
                 0..=3 => intact += 1,
                 4..=8 => mutate(&mut r, &mut f),
                 _ => {
-                    let n = r.below(40) as usize;
-                    f = (0..n).map(|_| r.byte()).collect();
+                    let n = r.random_range(0..40) as usize;
+                    f = (0..n).map(|_| r.random::<u8>()).collect();
                 }
             }
             stream.extend_from_slice(&f);
         }
         let mut rest = &stream[..];
         while !rest.is_empty() {
-            let n = (1 + r.below(512) as usize).min(rest.len());
+            let n = (1 + r.random_range(0..512) as usize).min(rest.len());
             d.decode(&rest[..n], |p| {
                 delivered += 1;
                 let _ = RobotPacket::parse(p);
