@@ -35,7 +35,7 @@ fn main() {
     for (c, s, k) in &d.arm.log {
         println!("cmd {c} {s} {k}");
     }
-    let st = d.arm_host.stats();
+    let st = d.arm_host().stats();
     println!(
         "stats commands={} overflows={} requests={} undelivered={}",
         st.commands, st.overflows, st.requests, st.undelivered_replies
