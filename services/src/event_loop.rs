@@ -177,11 +177,11 @@ where
                 Wake::Fd
             } else {
                 for (l, g) in listeners.iter().zip(&guards) {
-                    if id.has_event_from(g) {
-                        if let Err(e) = l.try_wait(|_| {}) {
-                            // Unconsumed events wake the loop again at once: logged.
-                            tracing::warn!(error = %e, "cannot consume wake-up events");
-                        }
+                    // Unconsumed events wake the loop again at once: logged.
+                    if id.has_event_from(g)
+                        && let Err(e) = l.try_wait(|_| {})
+                    {
+                        tracing::warn!(error = %e, "cannot consume wake-up events");
                     }
                 }
                 Wake::Clients
