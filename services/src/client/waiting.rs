@@ -148,7 +148,11 @@ impl<I: Interface> Client<I> {
             self.refresh()?;
             let (seq, status) = self.outcomes[(ticket.seq as usize) % OUTCOME_SLOTS];
             if seq == ticket.seq {
-                return Ok(Status::try_from(status).unwrap_or(Status::InvalidArgument));
+                return Ok(Status::try_from(status).unwrap_or_else(|e| {
+                    // A driver of another build: the outcome is not one we know.
+                    tracing::warn!(device = %self.device, error = %e, "unknown outcome status");
+                    Status::InvalidArgument
+                }));
             }
             // Commands of one client are applied in order: an outcome of a later one
             // means this one was applied too, its sample overwritten before it was read.
