@@ -121,7 +121,7 @@ pub enum Iox2Error {
 
 impl Iox2Error {
     /// True when the service does not exist (nobody created it, or it was cleaned up).
-    pub fn is_does_not_exist(&self) -> bool {
+    pub fn is_missing_service(&self) -> bool {
         matches!(
             self,
             Iox2Error::PubSubOpen(PublishSubscribeOpenError::DoesNotExist)

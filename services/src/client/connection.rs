@@ -109,7 +109,7 @@ impl<I: Interface> Client<I> {
         let dev = device.to_string();
         let domain = ctx.domain().name().to_string();
         let map = |channel: &'static str, e: Iox2Error| -> ConnectError {
-            if e.is_does_not_exist() {
+            if e.is_missing_service() {
                 ConnectError::NoDriver {
                     device: dev.clone(),
                     domain: domain.clone(),
