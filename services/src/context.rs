@@ -33,12 +33,13 @@ pub enum ContextError {
     Name(String),
     /// iceoryx2 could not create the node (permissions on /tmp/iceoryx2 or /dev/shm,
     /// or a corrupted installation).
-    #[error("cannot join domain {domain}: {reason}")]
+    #[error("cannot join domain {domain}: {source}")]
     Node {
         /// The domain.
         domain: String,
-        /// iceoryx2's reason.
-        reason: String,
+        /// iceoryx2's error.
+        #[source]
+        source: NodeCreationFailure,
     },
 }
 
@@ -96,7 +97,7 @@ impl Context {
             .create::<ipc::Service>()
             .map_err(|e: NodeCreationFailure| ContextError::Node {
                 domain: domain.name().to_string(),
-                reason: format!("{e:?}"),
+                source: e,
             })?;
         Ok(Context {
             inner: Rc::new(Inner {

@@ -6,12 +6,15 @@ use std::time::Instant;
 
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::port::{ReceiveError, SendError};
 use iceoryx2::prelude::*;
 use iceoryx2::sample::Sample;
+use iceoryx2::service::builder::publish_subscribe::PublishSubscribeOpenError;
 use limber_interfaces::diagnostics::DriverStats;
 use thiserror::Error;
 
 use crate::context::{Context, monotonic_ns};
+use crate::error::Iox2Error;
 use crate::qos;
 
 /// The service name of a robot's driver statistics.
@@ -37,9 +40,30 @@ pub enum DiagnosticsError {
     /// No driver publishes statistics for this robot.
     #[error("no driver statistics for robot {0} (is its driver running?)")]
     NoDriver(String),
-    /// iceoryx2 failed.
-    #[error("driver statistics channel: {0}")]
-    Transport(String),
+    /// The statistics channel could not be offered (creating its service or publisher).
+    #[error("cannot offer the driver statistics of robot {robot}: {source}")]
+    Offer {
+        /// The robot.
+        robot: String,
+        /// iceoryx2's error.
+        #[source]
+        source: Iox2Error,
+    },
+    /// The statistics channel exists but could not be opened (or subscribed to).
+    #[error("cannot open the driver statistics of robot {robot}: {source}")]
+    Open {
+        /// The robot.
+        robot: String,
+        /// iceoryx2's error.
+        #[source]
+        source: Iox2Error,
+    },
+    /// A statistics sample could not be published.
+    #[error("cannot publish driver statistics: {0}")]
+    Publish(#[source] SendError),
+    /// Statistics could not be received.
+    #[error("cannot receive driver statistics: {0}")]
+    Receive(#[source] ReceiveError),
     /// Nothing new within the timeout.
     #[error("no new driver statistics within {0:?}")]
     Timeout(Duration),
@@ -62,6 +86,10 @@ impl core::fmt::Debug for StatsPublisher {
 impl StatsPublisher {
     /// Offers the statistics of `robot`'s driver.
     pub fn new(ctx: &Context, robot: &str) -> Result<Self, DiagnosticsError> {
+        let offer = |source: Iox2Error| DiagnosticsError::Offer {
+            robot: robot.to_string(),
+            source,
+        };
         let svc = ctx
             .node()
             .service_builder(&service_name(robot)?)
@@ -72,11 +100,11 @@ impl StatsPublisher {
             .max_subscribers(qos::MAX_CLIENTS)
             .max_nodes(qos::MAX_NODES)
             .open_or_create()
-            .map_err(|e| DiagnosticsError::Transport(format!("{e:?}")))?;
+            .map_err(|e| offer(e.into()))?;
         let publisher = svc
             .publisher_builder()
             .create()
-            .map_err(|e| DiagnosticsError::Transport(format!("{e:?}")))?;
+            .map_err(|e| offer(e.into()))?;
         Ok(StatsPublisher { publisher, seq: 0 })
     }
 
@@ -88,7 +116,7 @@ impl StatsPublisher {
         self.publisher
             .send_copy(*stats)
             .map(|_| ())
-            .map_err(|e| DiagnosticsError::Transport(format!("{e:?}")))
+            .map_err(DiagnosticsError::Publish)
     }
 }
 
@@ -112,18 +140,22 @@ impl StatsReader {
             .service_builder(&service_name(robot)?)
             .publish_subscribe::<DriverStats>()
             .open()
-            .map_err(|e| {
-                let e = format!("{e:?}");
-                if e.contains("DoesNotExist") {
+            .map_err(|e| match e {
+                PublishSubscribeOpenError::DoesNotExist => {
                     DiagnosticsError::NoDriver(robot.to_string())
-                } else {
-                    DiagnosticsError::Transport(e)
                 }
+                e => DiagnosticsError::Open {
+                    robot: robot.to_string(),
+                    source: e.into(),
+                },
             })?;
         let subscriber = svc
             .subscriber_builder()
             .create()
-            .map_err(|e| DiagnosticsError::Transport(format!("{e:?}")))?;
+            .map_err(|e| DiagnosticsError::Open {
+                robot: robot.to_string(),
+                source: e.into(),
+            })?;
         Ok(StatsReader {
             subscriber,
             latest: None,
@@ -136,7 +168,7 @@ impl StatsReader {
         while let Some(s) = self
             .subscriber
             .receive()
-            .map_err(|e| DiagnosticsError::Transport(format!("{e:?}")))?
+            .map_err(DiagnosticsError::Receive)?
         {
             self.latest = Some(s);
             got = true;

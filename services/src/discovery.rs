@@ -1,6 +1,7 @@
 //! Discovery: every device of a domain, with its driver and whether it is alive.
 
 use iceoryx2::prelude::*;
+use iceoryx2::service::ServiceListError;
 use iceoryx2::service::static_config::messaging_pattern::MessagingPattern as Pattern;
 use limber_interfaces::InterfaceKind;
 use thiserror::Error;
@@ -33,12 +34,13 @@ impl DeviceInfo {
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
 pub enum ListError {
     /// iceoryx2 could not read the service directory (permissions?).
-    #[error("cannot list the services of domain {domain}: {reason}")]
+    #[error("cannot list the services of domain {domain}: {source}")]
     Transport {
         /// The domain.
         domain: String,
-        /// iceoryx2's reason.
-        reason: String,
+        /// iceoryx2's error.
+        #[source]
+        source: ServiceListError,
     },
 }
 
@@ -91,7 +93,7 @@ pub fn list_devices(domain: &Domain) -> Result<Vec<DeviceInfo>, ListError> {
     })
     .map_err(|e| ListError::Transport {
         domain: domain.name().to_string(),
-        reason: format!("{e:?}"),
+        source: e,
     })?;
     out.sort();
     Ok(out)

@@ -8,19 +8,30 @@ use std::os::fd::{AsFd, AsRawFd, OwnedFd};
 
 use iceoryx2::port::listener::Listener;
 use iceoryx2::prelude::*;
-use iceoryx2::waitset::WaitSetRunResult;
+use iceoryx2::waitset::{WaitSetRunError, WaitSetRunResult};
 use rustix::time::{Itimerspec, TimerfdClockId, TimerfdFlags, TimerfdTimerFlags, Timespec};
 use thiserror::Error;
 
-/// The event loop failed.
-#[derive(Debug, Clone, PartialEq, Eq, Error)]
+use crate::error::Iox2Error;
+
+/// The event loop failed ([`run`], [`TimerFd::periodic`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
 pub enum LoopError {
-    /// The timer could not be created (period zero or too small?).
+    /// The timer period is zero.
+    #[error("cannot create the loop timer: period is zero")]
+    ZeroPeriod,
+    /// The timer could not be created or armed (too many fds?).
     #[error("cannot create the loop timer: {0}")]
-    Timer(String),
+    Timer(#[source] rustix::io::Errno),
+    /// The timer's file descriptor cannot be waited on.
+    #[error("cannot create the loop timer: invalid fd")]
+    TimerFd,
     /// The WaitSet could not be created or an attachment failed (too many fds?).
     #[error("cannot set up the wait set: {0}")]
-    WaitSet(String),
+    WaitSet(#[source] Iox2Error),
+    /// Waiting failed.
+    #[error("the wait set failed: {0}")]
+    Wait(#[source] WaitSetRunError),
 }
 
 /// Why the loop returned.
@@ -54,13 +65,13 @@ impl TimerFd {
     /// A timer that expires every `period`, first after one period.
     pub fn periodic(period: Duration) -> Result<Self, LoopError> {
         if period.is_zero() {
-            return Err(LoopError::Timer("period is zero".into()));
+            return Err(LoopError::ZeroPeriod);
         }
         let fd = rustix::time::timerfd_create(
             TimerfdClockId::Monotonic,
             TimerfdFlags::NONBLOCK | TimerfdFlags::CLOEXEC,
         )
-        .map_err(|e| LoopError::Timer(e.to_string()))?;
+        .map_err(LoopError::Timer)?;
         let ts = Timespec {
             tv_sec: period.as_secs() as _,
             tv_nsec: period.subsec_nanos() as _,
@@ -73,9 +84,8 @@ impl TimerFd {
                 it_value: ts,
             },
         )
-        .map_err(|e| LoopError::Timer(e.to_string()))?;
-        let handle = FileDescriptor::non_owning_new(fd.as_raw_fd())
-            .ok_or_else(|| LoopError::Timer("invalid fd".into()))?;
+        .map_err(LoopError::Timer)?;
+        let handle = FileDescriptor::non_owning_new(fd.as_raw_fd()).ok_or(LoopError::TimerFd)?;
         Ok(TimerFd { fd, handle })
     }
 
@@ -84,7 +94,17 @@ impl TimerFd {
         let mut buf = [0u8; 8];
         match rustix::io::read(self.fd.as_fd(), &mut buf) {
             Ok(8) => u64::from_ne_bytes(buf),
-            _ => 0,
+            // Not expired since the last read.
+            Err(rustix::io::Errno::AGAIN) => 0,
+            // A timerfd read is 8 bytes or an error; anything else is reported.
+            Ok(n) => {
+                tracing::warn!(bytes = n, "short read of the loop timer");
+                0
+            }
+            Err(e) => {
+                tracing::warn!(error = %e, "cannot read the loop timer");
+                0
+            }
         }
     }
 }
@@ -130,22 +150,22 @@ where
 {
     let ws = WaitSetBuilder::new()
         .create::<ipc::Service>()
-        .map_err(|e| LoopError::WaitSet(format!("{e:?}")))?;
+        .map_err(|e| LoopError::WaitSet(e.into()))?;
     let timer = TimerFd::periodic(period)?;
     let mut guards = Vec::with_capacity(listeners.len());
     for l in listeners {
         guards.push(
             ws.attach_notification(l)
-                .map_err(|e| LoopError::WaitSet(format!("{e:?}")))?,
+                .map_err(|e| LoopError::WaitSet(e.into()))?,
         );
     }
     let timer_guard = ws
         .attach_notification(&timer)
-        .map_err(|e| LoopError::WaitSet(format!("{e:?}")))?;
+        .map_err(|e| LoopError::WaitSet(e.into()))?;
     let extra_guard = match extra {
         Some(fd) => Some(
             ws.attach_notification(fd)
-                .map_err(|e| LoopError::WaitSet(format!("{e:?}")))?,
+                .map_err(|e| LoopError::WaitSet(e.into()))?,
         ),
         None => None,
     };
@@ -157,8 +177,11 @@ where
                 Wake::Fd
             } else {
                 for (l, g) in listeners.iter().zip(&guards) {
-                    if id.has_event_from(g) {
-                        let _ = l.try_wait(|_| {});
+                    // Unconsumed events wake the loop again at once: logged.
+                    if id.has_event_from(g)
+                        && let Err(e) = l.try_wait(|_| {})
+                    {
+                        tracing::warn!(error = %e, "cannot consume wake-up events");
                     }
                 }
                 Wake::Clients
@@ -169,7 +192,7 @@ where
                 CallbackProgression::Continue
             }
         })
-        .map_err(|e| LoopError::WaitSet(format!("{e:?}")))?;
+        .map_err(LoopError::Wait)?;
     Ok(match result {
         WaitSetRunResult::Interrupt | WaitSetRunResult::TerminationRequest => LoopExit::Signal,
         _ => LoopExit::Stopped,

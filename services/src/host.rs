@@ -10,13 +10,15 @@ use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::server::Server;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::port::update_connections::UpdateConnections;
+use iceoryx2::port::{LoanError, ReceiveError, SendError};
 use iceoryx2::prelude::*;
 use iceoryx2::service::attribute::{AttributeKey, AttributeValue};
 use limber_interfaces::prelude::*;
 use thiserror::Error;
 
 use crate::context::{Context, monotonic_ns};
-use crate::naming::{Channel, DeviceName, attr};
+use crate::error::Iox2Error;
+use crate::naming::{Channel, DeviceName, NameError, attr};
 use crate::qos;
 
 /// Who sent a command or request.
@@ -49,17 +51,29 @@ pub trait DeviceHandler<I: Interface> {
     ) -> Result<I::Reply, Status>;
 }
 
-/// Offering a device failed.
+/// Offering a device failed ([`DeviceHost::new`], [`crate::DeviceSet::new`]).
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
 pub enum HostError {
+    /// The device name is invalid (a robot name made of other characters, ...).
+    #[error(transparent)]
+    Name(#[from] NameError),
+    /// The device is of another interface than the host.
+    #[error("device {device} is not a {expected}")]
+    WrongInterface {
+        /// The device.
+        device: String,
+        /// The host's interface.
+        expected: InterfaceKind,
+    },
     /// A service of this device exists with other attributes or types: another driver
     /// (or another layout version) serves this name, or its clients still hold it.
-    #[error("{device}: the name is held by an incompatible service ({reason})")]
+    #[error("{device}: the name is held by an incompatible service ({source})")]
     Incompatible {
         /// The device.
         device: String,
-        /// iceoryx2's reason.
-        reason: String,
+        /// iceoryx2's error.
+        #[source]
+        source: Iox2Error,
     },
     /// A driver is already serving this device (its node is alive).
     #[error("{device}: already served by a running driver")]
@@ -68,36 +82,37 @@ pub enum HostError {
         device: String,
     },
     /// iceoryx2 failed to create a service or port.
-    #[error("{device}: cannot create the {channel} channel: {reason}")]
+    #[error("{device}: cannot create the {channel} channel: {source}")]
     Transport {
         /// The device.
         device: String,
-        /// The channel.
+        /// The channel (`data`, `cmd`, `req`, `wake`, `notify`, or `attributes`).
         channel: &'static str,
-        /// iceoryx2's reason.
-        reason: String,
+        /// iceoryx2's error.
+        #[source]
+        source: Iox2Error,
     },
 }
 
-/// Publishing the state failed.
-#[derive(Debug, Clone, PartialEq, Eq, Error)]
+/// Publishing the state failed ([`DeviceHost::publish`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
 pub enum PublishError {
     /// No shared-memory sample could be loaned (all held by slow readers: impossible with
     /// the QoS used, reported rather than hidden).
     #[error("cannot loan a state sample: {0}")]
-    Loan(String),
+    Loan(#[source] LoanError),
     /// The sample could not be delivered.
     #[error("cannot send the state sample: {0}")]
-    Send(String),
+    Send(#[source] SendError),
 }
 
-/// Receiving commands or requests failed.
-#[derive(Debug, Clone, PartialEq, Eq, Error)]
+/// Receiving commands or requests failed ([`DeviceHost::process`] and its variants).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
 pub enum ProcessError {
     /// Receiving from shared memory failed.
     #[error("cannot receive: {0}")]
-    Receive(String),
-    /// A reply could not be sent (the client is gone: not fatal, counted).
+    Receive(#[source] ReceiveError),
+    /// The state carrying a command's outcome could not be published.
     #[error("cannot publish the outcome: {0}")]
     Publish(#[from] PublishError),
 }
@@ -117,6 +132,39 @@ pub struct HostStats {
     pub undelivered_replies: u64,
     /// State samples published.
     pub published: u64,
+    /// Notifications to waiting clients that failed (new state or reply ready; a client
+    /// waiting with a timeout re-checks anyway, so each is a delay, not a loss).
+    pub failed_notifies: u64,
+    /// Failed attempts to connect the state publisher to new clients (retried at the
+    /// next publication or `process` call).
+    pub failed_connection_updates: u64,
+}
+
+impl core::ops::AddAssign for HostStats {
+    fn add_assign(&mut self, o: HostStats) {
+        self.commands += o.commands;
+        self.refused += o.refused;
+        self.overflows += o.overflows;
+        self.requests += o.requests;
+        self.undelivered_replies += o.undelivered_replies;
+        self.published += o.published;
+        self.failed_notifies += o.failed_notifies;
+        self.failed_connection_updates += o.failed_connection_updates;
+    }
+}
+
+impl core::ops::AddAssign for Activity {
+    fn add_assign(&mut self, o: Activity) {
+        self.commands += o.commands;
+        self.requests += o.requests;
+    }
+}
+
+impl Activity {
+    /// Commands plus requests.
+    pub fn total(&self) -> usize {
+        self.commands + self.requests
+    }
 }
 
 /// How many commands and requests one call of [`DeviceHost::process`] handled.
@@ -196,15 +244,15 @@ impl<I: Interface> core::fmt::Debug for DeviceHost<I> {
 }
 
 fn attribute_verifier(device: &DeviceName, driver: &str) -> Result<AttributeVerifier, HostError> {
-    let err = |reason: String| HostError::Transport {
+    let err = |e: Iox2Error| HostError::Transport {
         device: device.to_string(),
         channel: "attributes",
-        reason,
+        source: e,
     };
     let kv = |k: &str, v: &str| -> Result<(AttributeKey, AttributeValue), HostError> {
         Ok((
-            AttributeKey::new(k.as_bytes()).map_err(|e| err(format!("{e:?}")))?,
-            AttributeValue::new(v.as_bytes()).map_err(|e| err(format!("{e:?}")))?,
+            AttributeKey::new(k.as_bytes()).map_err(|e| err(e.into()))?,
+            AttributeValue::new(v.as_bytes()).map_err(|e| err(e.into()))?,
         ))
     };
     let mut v = AttributeVerifier::new();
@@ -216,7 +264,7 @@ fn attribute_verifier(device: &DeviceName, driver: &str) -> Result<AttributeVeri
         (attr::LAYOUT, limber_interfaces::LAYOUT_VERSION.to_string()),
     ] {
         let (k, val) = kv(k, &val)?;
-        v = v.require(&k, &val).map_err(|e| err(format!("{e:?}")))?;
+        v = v.require(&k, &val).map_err(|e| err(e.into()))?;
     }
     Ok(v)
 }
@@ -226,26 +274,26 @@ impl<I: Interface> DeviceHost<I> {
     /// `limber list`). The initial state is all zero: set it with [`DeviceHost::state_mut`]
     /// and [`DeviceHost::publish`] before clients act on it.
     pub fn new(ctx: &Context, device: &DeviceName, driver: &str) -> Result<Self, HostError> {
-        assert_eq!(
-            device.interface(),
-            I::KIND,
-            "device {device} is not a {}",
-            I::KIND
-        );
+        if device.interface() != I::KIND {
+            return Err(HostError::WrongInterface {
+                device: device.to_string(),
+                expected: I::KIND,
+            });
+        }
         let node = ctx.node();
         let dev = device.to_string();
         let verifier = attribute_verifier(device, driver)?;
-        let transport = |channel: &'static str, e: String| {
-            if e.contains("IncompatibleAttributes") || e.contains("IncompatibleTypes") {
+        let transport = |channel: &'static str, e: Iox2Error| {
+            if e.is_incompatible_attributes_or_types() {
                 HostError::Incompatible {
                     device: dev.clone(),
-                    reason: e,
+                    source: e,
                 }
             } else {
                 HostError::Transport {
                     device: dev.clone(),
                     channel,
-                    reason: e,
+                    source: e,
                 }
             }
         };
@@ -261,7 +309,7 @@ impl<I: Interface> DeviceHost<I> {
             .max_nodes(qos::MAX_NODES)
             .enable_safe_overflow(true)
             .open_or_create_with_attributes(&verifier)
-            .map_err(|e| transport("data", format!("{e:?}")))?;
+            .map_err(|e| transport("data", e.into()))?;
         // A live driver already publishing this device: refuse to serve it twice.
         if data_svc.dynamic_config().number_of_publishers() > 0 {
             data_svc.try_cleanup_dead_nodes();
@@ -273,7 +321,7 @@ impl<I: Interface> DeviceHost<I> {
             .publisher_builder()
             .max_loaned_samples(1)
             .create()
-            .map_err(|e| transport("data", format!("{e:?}")))?;
+            .map_err(|e| transport("data", e.into()))?;
 
         let cmd_svc = node
             .service_builder(&device.service_name(Channel::Cmd))
@@ -286,12 +334,12 @@ impl<I: Interface> DeviceHost<I> {
             .max_nodes(qos::MAX_NODES)
             .enable_safe_overflow(true)
             .open_or_create_with_attributes(&verifier)
-            .map_err(|e| transport("cmd", format!("{e:?}")))?;
+            .map_err(|e| transport("cmd", e.into()))?;
         let commands = cmd_svc
             .subscriber_builder()
             .buffer_size(qos::CMD_BUFFER)
             .create()
-            .map_err(|e| transport("cmd", format!("{e:?}")))?;
+            .map_err(|e| transport("cmd", e.into()))?;
 
         let req_svc = node
             .service_builder(&device.service_name(Channel::Req))
@@ -303,11 +351,11 @@ impl<I: Interface> DeviceHost<I> {
             .max_response_buffer_size(2)
             .enable_fire_and_forget_requests(false)
             .open_or_create_with_attributes(&verifier)
-            .map_err(|e| transport("req", format!("{e:?}")))?;
+            .map_err(|e| transport("req", e.into()))?;
         let server = req_svc
             .server_builder()
             .create()
-            .map_err(|e| transport("req", format!("{e:?}")))?;
+            .map_err(|e| transport("req", e.into()))?;
 
         let wake_svc = node
             .service_builder(&device.service_name(Channel::Wake))
@@ -316,11 +364,11 @@ impl<I: Interface> DeviceHost<I> {
             .max_notifiers(qos::MAX_CLIENTS)
             .max_nodes(qos::MAX_NODES)
             .open_or_create_with_attributes(&verifier)
-            .map_err(|e| transport("wake", format!("{e:?}")))?;
+            .map_err(|e| transport("wake", e.into()))?;
         let wake = wake_svc
             .listener_builder()
             .create()
-            .map_err(|e| transport("wake", format!("{e:?}")))?;
+            .map_err(|e| transport("wake", e.into()))?;
 
         let notify_svc = node
             .service_builder(&device.service_name(Channel::Notify))
@@ -329,11 +377,11 @@ impl<I: Interface> DeviceHost<I> {
             .max_notifiers(qos::NOTIFY_NOTIFIERS)
             .max_nodes(qos::MAX_NODES)
             .open_or_create_with_attributes(&verifier)
-            .map_err(|e| transport("notify", format!("{e:?}")))?;
+            .map_err(|e| transport("notify", e.into()))?;
         let notify = notify_svc
             .notifier_builder()
             .create()
-            .map_err(|e| transport("notify", format!("{e:?}")))?;
+            .map_err(|e| transport("notify", e.into()))?;
 
         Ok(DeviceHost {
             device: device.clone(),
@@ -407,10 +455,16 @@ impl<I: Interface> DeviceHost<I> {
     /// Consumes pending wake-up events (without blocking) while the host owns the
     /// listener; returns how many there were.
     pub fn consume_wakeups(&self) -> u64 {
-        self.wake
-            .as_ref()
-            .and_then(|w| w.try_wait(|_| {}).ok())
-            .unwrap_or(0)
+        let Some(w) = self.wake.as_ref() else {
+            return 0;
+        };
+        match w.try_wait(|_| {}) {
+            Ok(n) => n,
+            Err(e) => {
+                tracing::warn!(device = %self.device, error = %e, "cannot consume wake-ups");
+                0
+            }
+        }
     }
 
     /// Publishes the state acquired at `stamp_ns` (`CLOCK_MONOTONIC`).
@@ -431,20 +485,30 @@ impl<I: Interface> DeviceHost<I> {
         h.last_cmd = self.outcome;
         h.flags = self.flags;
         h.cmd_overflows = self.stats.overflows.min(u32::MAX as u64) as u32;
-        let sample = self
-            .publisher
-            .loan_uninit()
-            .map_err(|e| PublishError::Loan(format!("{e:?}")))?;
+        let sample = self.publisher.loan_uninit().map_err(PublishError::Loan)?;
         let sample = sample.write_payload(self.state);
-        sample
-            .send()
-            .map_err(|e| PublishError::Send(format!("{e:?}")))?;
+        sample.send().map_err(PublishError::Send)?;
         self.stats.published += 1;
-        // Best effort: a client that waits with a timeout re-checks anyway.
-        let _ = self
-            .notify
-            .notify_with_custom_event_id(EventId::new(qos::EVENT_STATE));
+        // A client that waits with a timeout re-checks anyway: counted, not fatal.
+        self.notify_clients(qos::EVENT_STATE);
         Ok(())
+    }
+
+    /// Notifies waiting clients; a failure is counted and logged.
+    fn notify_clients(&mut self, event: usize) {
+        if let Err(e) = self.notify.notify_with_custom_event_id(EventId::new(event)) {
+            self.stats.failed_notifies += 1;
+            tracing::debug!(device = %self.device, error = %e, "cannot notify clients");
+        }
+    }
+
+    /// Connects the state publisher to clients that came since the last call, so they
+    /// get the latest state (history 1) now; a failure is counted and logged.
+    fn update_connections(&mut self) {
+        if let Err(e) = self.publisher.update_connections() {
+            self.stats.failed_connection_updates += 1;
+            tracing::debug!(device = %self.device, error = %e, "cannot connect new clients");
+        }
     }
 
     /// Drains every pending command (in arrival order, per client in sending order) and
@@ -455,7 +519,7 @@ impl<I: Interface> DeviceHost<I> {
     ) -> Result<Activity, ProcessError> {
         // New clients get the latest state (history 1) now rather than at the next
         // publication; cheap when no client came or went.
-        let _ = self.publisher.update_connections();
+        self.update_connections();
         let commands = self.process_commands(handler)?;
         let requests = self.process_requests(handler)?;
         Ok(Activity { commands, requests })
@@ -471,7 +535,7 @@ impl<I: Interface> DeviceHost<I> {
         self.spin_calls = self.spin_calls.wrapping_add(1);
         let commands = self.process_commands(handler)?;
         let requests = if self.spin_calls.is_multiple_of(SPIN_REQUEST_EVERY) {
-            let _ = self.publisher.update_connections();
+            self.update_connections();
             self.process_requests(handler)?
         } else {
             0
@@ -490,7 +554,7 @@ impl<I: Interface> DeviceHost<I> {
             let sample = match self.commands.receive() {
                 Ok(Some(s)) => s,
                 Ok(None) => break,
-                Err(e) => return Err(ProcessError::Receive(format!("{e:?}"))),
+                Err(e) => return Err(ProcessError::Receive(e)),
             };
             let raw: &I::CmdMsg = &sample;
             let meta = *raw.meta();
@@ -537,7 +601,7 @@ impl<I: Interface> DeviceHost<I> {
                 match self.server.receive() {
                     Ok(Some(a)) => a,
                     Ok(None) => break,
-                    Err(e) => return Err(ProcessError::Receive(format!("{e:?}"))),
+                    Err(e) => return Err(ProcessError::Receive(e)),
                 };
             let raw: &I::ReqMsg = active.payload();
             let meta = *raw.meta();
@@ -559,19 +623,25 @@ impl<I: Interface> DeviceHost<I> {
                     m.client_id = meta.client_id;
                     m.seq = meta.seq;
                     m.stamp_ns = monotonic_ns();
-                    resp.send().is_ok()
+                    resp.send().map_err(Iox2Error::from)
                 }
-                Err(_) => false,
+                Err(e) => Err(e.into()),
             };
-            if !sent {
+            if let Err(e) = sent {
+                // The client is gone (or gave up): not fatal, counted.
                 self.stats.undelivered_replies += 1;
+                tracing::debug!(
+                    device = %self.device,
+                    client = meta.client_id,
+                    seq = meta.seq,
+                    error = %e,
+                    "reply not delivered"
+                );
             }
             drop(active);
             self.stats.requests += 1;
             n += 1;
-            let _ = self
-                .notify
-                .notify_with_custom_event_id(EventId::new(qos::EVENT_REPLY));
+            self.notify_clients(qos::EVENT_REPLY);
         }
         // What a request changed (power, ...) is visible in the state at once.
         if n > 0 && self.publish_each_outcome {

@@ -8,9 +8,16 @@
 //!   `robot/interface/index`, service names `limber/<robot>/<interface>/<index>/<channel>`.
 //! * [`host`]: [`DeviceHost`] offers a device; a driver implements [`DeviceHandler`] for
 //!   each interface it serves.
+//! * [`device_set`]: [`DeviceSet`], the hosts of one driver process as one group, served
+//!   through one [`DeviceSetHandler`].
 //! * [`client`]: [`ActArrayClient`], [`LimbClient`], [`GripperClient`], in the spirit of
 //!   Player's proxies, with typed errors and timeouts on every wait.
 //! * [`discovery`]: [`list_devices`], with liveness.
+//! * [`error`]: [`Iox2Error`], the iceoryx2 cause kept inside every transport error.
+//!
+//! Every fallible operation has its own error enum; none is flattened into text, and
+//! failures that do not end an operation (a notification that could not be sent, a reply
+//! to a client that left) are counted in [`HostStats`] or logged with `tracing`.
 //!
 //! ## A driver in 20 lines
 //!
@@ -62,8 +69,10 @@
 
 pub mod client;
 pub mod context;
+pub mod device_set;
 pub mod diagnostics;
 pub mod discovery;
+pub mod error;
 pub mod event_loop;
 pub mod host;
 pub mod naming;
@@ -72,10 +81,12 @@ pub mod testing;
 
 pub use client::{
     ActArrayClient, Client, CommandError, ConnectError, DriverStatus, Freshness, GripperClient,
-    LimbClient, RequestError, Ticket, WaitError, WaitMode,
+    Incompatibility, LimbClient, RequestError, Ticket, WaitError, WaitMode,
 };
 pub use context::{Context, ContextError, Role, monotonic_ns};
+pub use device_set::{DeviceError, DeviceSet, DeviceSetHandler};
 pub use discovery::{DeviceInfo, ListError, list_devices};
+pub use error::Iox2Error;
 pub use host::{
     Activity, DeviceHandler, DeviceHost, HostError, HostStats, Origin, ProcessError, PublishError,
 };
@@ -88,6 +99,7 @@ pub mod prelude {
         LimbClient, RequestError, Ticket, WaitError, WaitMode,
     };
     pub use crate::context::{Context, Role, monotonic_ns};
+    pub use crate::device_set::{DeviceSet, DeviceSetHandler};
     pub use crate::discovery::{DeviceInfo, list_devices};
     pub use crate::host::{DeviceHandler, DeviceHost, Origin};
     pub use crate::naming::{DeviceName, Domain};

@@ -6,11 +6,12 @@ use core::ops::ControlFlow;
 use core::time::Duration;
 
 use limber_interfaces::prelude::*;
+use thiserror::Error;
 
 use crate::context::{Context, monotonic_ns};
+use crate::device_set::{DeviceError, DeviceSet, DeviceSetHandler};
 use crate::event_loop::{self, LoopError, LoopExit, Wake};
-use crate::host::{DeviceHandler, DeviceHost, HostError, Origin, ProcessError};
-use crate::naming::DeviceName;
+use crate::host::{DeviceHandler, DeviceHost, HostError, Origin, ProcessError, PublishError};
 
 /// Joint limits of the test arm, rad.
 pub const JOINT_LIMIT: f64 = core::f64::consts::PI;
@@ -224,19 +225,79 @@ impl DeviceHandler<Gripper> for TestGripper {
     }
 }
 
+/// The test arm, limb and gripper as one [`DeviceSetHandler`] (each at index 0).
+struct Handlers<'a> {
+    arm: &'a mut TestArm,
+    limb: &'a mut TestLimb,
+    gripper: &'a mut TestGripper,
+}
+
+impl DeviceSetHandler for Handlers<'_> {
+    fn actarray_command(
+        &mut self,
+        _: u16,
+        cmd: &ActArrayCommand,
+        from: &Origin,
+        state: &mut ActArrayData,
+    ) -> Status {
+        self.arm.command(cmd, from, state)
+    }
+    fn actarray_request(
+        &mut self,
+        _: u16,
+        req: &ActArrayRequest,
+        from: &Origin,
+        state: &mut ActArrayData,
+    ) -> Result<ActArrayReply, Status> {
+        self.arm.request(req, from, state)
+    }
+    fn limb_command(
+        &mut self,
+        _: u16,
+        cmd: &LimbCommand,
+        from: &Origin,
+        state: &mut LimbData,
+    ) -> Status {
+        self.limb.command(cmd, from, state)
+    }
+    fn limb_request(
+        &mut self,
+        _: u16,
+        req: &LimbRequest,
+        from: &Origin,
+        state: &mut LimbData,
+    ) -> Result<LimbReply, Status> {
+        self.limb.request(req, from, state)
+    }
+    fn gripper_command(
+        &mut self,
+        _: u16,
+        cmd: &GripperCommand,
+        from: &Origin,
+        state: &mut GripperData,
+    ) -> Status {
+        self.gripper.command(cmd, from, state)
+    }
+    fn gripper_request(
+        &mut self,
+        _: u16,
+        req: &GripperRequest,
+        from: &Origin,
+        state: &mut GripperData,
+    ) -> Result<GripperReply, Status> {
+        self.gripper.request(req, from, state)
+    }
+}
+
 /// The three devices of the test driver, `<robot>/actarray/0`, `<robot>/limb/0`,
 /// `<robot>/gripper/0`.
 pub struct TestDriver {
-    /// The arm host.
-    pub arm_host: DeviceHost<ActArray>,
+    /// The hosts of the three devices.
+    pub hosts: DeviceSet,
     /// The arm.
     pub arm: TestArm,
-    /// The limb host.
-    pub limb_host: DeviceHost<Limb>,
     /// The limb.
     pub limb: TestLimb,
-    /// The gripper host.
-    pub gripper_host: DeviceHost<Gripper>,
     /// The gripper.
     pub gripper: TestGripper,
 }
@@ -249,79 +310,92 @@ impl core::fmt::Debug for TestDriver {
     }
 }
 
+/// Creating the test driver failed.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum TestDriverError {
+    /// A device could not be offered.
+    #[error(transparent)]
+    Host(#[from] HostError),
+    /// A first state could not be published.
+    #[error(transparent)]
+    Publish(#[from] DeviceError<PublishError>),
+}
+
 impl TestDriver {
     /// Offers the three devices of `robot` with an arm of `joints` joints, and publishes
     /// their initial states.
-    pub fn new(ctx: &Context, robot: &str, joints: usize) -> Result<Self, HostError> {
-        let name = |i: InterfaceKind| {
-            DeviceName::new(robot, i, 0).map_err(|e| HostError::Transport {
-                device: robot.to_string(),
-                channel: "name",
-                reason: e.to_string(),
-            })
-        };
+    pub fn new(ctx: &Context, robot: &str, joints: usize) -> Result<Self, TestDriverError> {
+        let mut hosts = DeviceSet::new(
+            ctx,
+            robot,
+            "testdriver",
+            &[
+                (InterfaceKind::ActArray, 0),
+                (InterfaceKind::Limb, 0),
+                (InterfaceKind::Gripper, 0),
+            ],
+        )?;
         let arm = TestArm::new(joints);
-        let mut arm_host =
-            DeviceHost::<ActArray>::new(ctx, &name(InterfaceKind::ActArray)?, "testdriver")?;
-        arm.initial_state(arm_host.state_mut());
-        let mut limb_host =
-            DeviceHost::<Limb>::new(ctx, &name(InterfaceKind::Limb)?, "testdriver")?;
-        limb_host.state_mut().state = LimbState::Idle as u32;
-        let mut gripper_host =
-            DeviceHost::<Gripper>::new(ctx, &name(InterfaceKind::Gripper)?, "testdriver")?;
-        gripper_host.state_mut().state = GripperState::Open as u32;
+        if let Some(h) = hosts.actarray_mut(0) {
+            arm.initial_state(h.state_mut());
+        }
+        if let Some(h) = hosts.limb_mut(0) {
+            h.state_mut().state = LimbState::Idle as u32;
+        }
+        if let Some(h) = hosts.gripper_mut(0) {
+            h.state_mut().state = GripperState::Open as u32;
+        }
         let mut d = TestDriver {
-            arm_host,
+            hosts,
             arm,
-            limb_host,
             limb: TestLimb,
-            gripper_host,
             gripper: TestGripper,
         };
-        d.publish_all().map_err(|e| HostError::Transport {
-            device: robot.to_string(),
-            channel: "data",
-            reason: e.to_string(),
-        })?;
+        d.publish_all()?;
         Ok(d)
     }
 
+    /// The arm's host.
+    pub fn arm_host(&self) -> &DeviceHost<ActArray> {
+        self.hosts
+            .actarray(0)
+            .expect("the test driver serves actarray/0")
+    }
+
     /// Publishes the state of all three devices.
-    pub fn publish_all(&mut self) -> Result<(), crate::host::PublishError> {
-        let now = monotonic_ns();
-        self.arm_host.publish_acquired(now)?;
-        self.limb_host.publish_acquired(now)?;
-        self.gripper_host.publish_acquired(now)
+    pub fn publish_all(&mut self) -> Result<(), DeviceError<PublishError>> {
+        self.hosts.publish_all(monotonic_ns())
     }
 
     /// Handles everything pending on the three devices; never blocks.
-    pub fn process(&mut self) -> Result<usize, ProcessError> {
-        let a = self.arm_host.process(&mut self.arm)?;
-        let l = self.limb_host.process(&mut self.limb)?;
-        let g = self.gripper_host.process(&mut self.gripper)?;
-        Ok(a.commands + a.requests + l.commands + l.requests + g.commands + g.requests)
+    pub fn process(&mut self) -> Result<usize, DeviceError<ProcessError>> {
+        let mut h = Handlers {
+            arm: &mut self.arm,
+            limb: &mut self.limb,
+            gripper: &mut self.gripper,
+        };
+        self.hosts.process(&mut h).map(|a| a.total())
     }
 
     /// Serves until SIGINT/SIGTERM (or `stop` returns true, checked at every wake-up),
     /// publishing every device's state each `period` and handling clients as they wake it.
+    /// A failure to publish or process is logged (by the [`DeviceSet`]) and retried at the
+    /// next wake-up.
     pub fn run(
         &mut self,
         period: Duration,
         mut stop: impl FnMut() -> bool,
     ) -> Result<LoopExit, LoopError> {
-        let listeners: Vec<_> = [
-            self.arm_host.take_wake_listener(),
-            self.limb_host.take_wake_listener(),
-            self.gripper_host.take_wake_listener(),
-        ]
-        .into_iter()
-        .flatten()
-        .collect();
+        let listeners = self.hosts.take_wake_listeners();
         event_loop::run(&listeners, period, None, |wake| {
-            if let Wake::Tick(_) = wake {
-                let _ = self.publish_all();
+            if let Wake::Tick(_) = wake
+                && let Err(e) = self.publish_all()
+            {
+                tracing::debug!(error = %e, "test driver: publication skipped");
             }
-            let _ = self.process();
+            if let Err(e) = self.process() {
+                tracing::debug!(error = %e, "test driver: processing skipped");
+            }
             if stop() {
                 ControlFlow::Break(())
             } else {

@@ -71,7 +71,11 @@ fn main() {
     if a.hold_first_request {
         // Until the first request has been held and answered; the loop below serves the rest.
         loop {
-            match d.arm_host.process(&mut Holding(&mut d.arm)) {
+            let host = d
+                .hosts
+                .actarray_mut(0)
+                .expect("the test driver serves actarray/0");
+            match host.process(&mut Holding(&mut d.arm)) {
                 Ok(n) if n.requests > 0 => break,
                 Ok(_) => std::thread::sleep(Duration::from_millis(2)),
                 Err(e) => {
@@ -85,7 +89,7 @@ fn main() {
     for (c, s, k) in &d.arm.log {
         println!("cmd {c} {s} {k}");
     }
-    let st = d.arm_host.stats();
+    let st = d.arm_host().stats();
     println!(
         "stats commands={} overflows={} requests={} undelivered={}",
         st.commands, st.overflows, st.requests, st.undelivered_replies

@@ -1,0 +1,236 @@
+//! The actarray wire structs: fixed layouts, versioned type names, envelopes.
+
+use crate::common::{MsgMeta, Orientation3, ReplyMeta, StateHeader, Vec3};
+use crate::message::{envelope, reply_envelope};
+#[allow(unused_imports)]
+use crate::wire::{ZeroCopySend, wire_struct};
+
+wire_struct! {
+    /// The state of one actuator.
+    pub struct ActuatorState : "limber.v1.ActuatorState", size = 40, align = 8 {
+        /// Position, rad or m.
+        pub position: f64,
+        /// Current speed, rad/s or m/s (NaN-free; 0 when unknown).
+        pub speed: f64,
+        /// Current acceleration (negative when unknown).
+        pub acceleration: f64,
+        /// Current in A (negative when unknown).
+        pub current: f64,
+        /// `ACTSTATE` bits.
+        pub state: u32,
+        /// Reserved, zero.
+        pub _pad: u32,
+    }
+}
+
+wire_struct! {
+    /// The state of an actuator array (channel `data`).
+    pub struct ActArrayData : "limber.v1.ActArrayData", size = 1336, align = 8 {
+        /// Common header.
+        pub header: StateHeader,
+        /// Number of valid entries in `actuators`.
+        pub actuators_count: u32,
+        /// Power state: 0 off, 1 on.
+        pub motor_state: u32,
+        /// The actuators.
+        pub actuators: [ActuatorState; 32],
+    }
+}
+
+wire_struct! {
+    /// CMD POS: move one joint to a position.
+    pub struct ActArrayPositionCmd : "limber.v1.ActArrayPositionCmd", size = 16, align = 8 {
+        /// Joint index (0-based).
+        pub joint: i32,
+        /// Reserved, zero.
+        pub _pad: u32,
+        /// Target position, rad or m.
+        pub position: f64,
+    }
+}
+
+wire_struct! {
+    /// CMD MULTI_POS: move every joint to a position.
+    pub struct ActArrayMultiPositionCmd : "limber.v1.ActArrayMultiPositionCmd", size = 264, align = 8 {
+        /// Number of valid entries.
+        pub count: u32,
+        /// Reserved, zero.
+        pub _pad: u32,
+        /// Targets, joint 0 first.
+        pub positions: [f64; 32],
+    }
+}
+
+wire_struct! {
+    /// CMD SPEED: move one joint at a speed.
+    pub struct ActArraySpeedCmd : "limber.v1.ActArraySpeedCmd", size = 16, align = 8 {
+        /// Joint index.
+        pub joint: i32,
+        /// Reserved, zero.
+        pub _pad: u32,
+        /// Speed, rad/s or m/s.
+        pub speed: f64,
+    }
+}
+
+wire_struct! {
+    /// CMD MULTI_SPEED: move every joint at a speed.
+    pub struct ActArrayMultiSpeedCmd : "limber.v1.ActArrayMultiSpeedCmd", size = 264, align = 8 {
+        /// Number of valid entries.
+        pub count: u32,
+        /// Reserved, zero.
+        pub _pad: u32,
+        /// Speeds, joint 0 first.
+        pub speeds: [f64; 32],
+    }
+}
+
+wire_struct! {
+    /// CMD HOME: home one joint, or all (`joint = -1`).
+    pub struct ActArrayHomeCmd : "limber.v1.ActArrayHomeCmd", size = 8, align = 4 {
+        /// Joint index, or -1 for all.
+        pub joint: i32,
+        /// Reserved, zero.
+        pub _pad: u32,
+    }
+}
+
+wire_struct! {
+    /// CMD CURRENT: drive one joint, or all (`joint = -1`), with a current.
+    pub struct ActArrayCurrentCmd : "limber.v1.ActArrayCurrentCmd", size = 16, align = 8 {
+        /// Joint index, or -1 for all.
+        pub joint: i32,
+        /// Reserved, zero.
+        pub _pad: u32,
+        /// Current in A.
+        pub current: f64,
+    }
+}
+
+wire_struct! {
+    /// CMD MULTI_CURRENT: drive every joint with a current.
+    pub struct ActArrayMultiCurrentCmd : "limber.v1.ActArrayMultiCurrentCmd", size = 264, align = 8 {
+        /// Number of valid entries.
+        pub count: u32,
+        /// Reserved, zero.
+        pub _pad: u32,
+        /// Currents in A, joint 0 first.
+        pub currents: [f64; 32],
+    }
+}
+
+wire_struct! {
+    /// The command envelope (channel `cmd`): `body` holds the struct `meta.kind` names.
+    pub struct ActArrayCmdMsg : "limber.v1.ActArrayCmdMsg", size = 296, align = 8 {
+        /// Sender, sequence, time, kind, body length.
+        pub meta: MsgMeta,
+        /// One of the `ActArray*Cmd` structs.
+        pub body: [u8; 264],
+    }
+}
+
+wire_struct! {
+    /// REQ POWER: power on (1) or off (0).
+    pub struct ActArrayPowerReq : "limber.v1.ActArrayPowerReq", size = 4, align = 4 {
+        /// 0 off, 1 on.
+        pub value: u32,
+    }
+}
+
+wire_struct! {
+    /// REQ BRAKES: brakes on (1) or off (0).
+    pub struct ActArrayBrakesReq : "limber.v1.ActArrayBrakesReq", size = 4, align = 4 {
+        /// 0 off, 1 on.
+        pub value: u32,
+    }
+}
+
+wire_struct! {
+    /// REQ SPEED: the speed of one joint for later moves.
+    pub struct ActArraySpeedReq : "limber.v1.ActArraySpeedReq", size = 16, align = 8 {
+        /// Joint index.
+        pub joint: i32,
+        /// Reserved, zero.
+        pub _pad: u32,
+        /// Speed, rad/s or m/s.
+        pub speed: f64,
+    }
+}
+
+wire_struct! {
+    /// REQ ACCEL: the acceleration of one joint for later moves.
+    pub struct ActArrayAccelReq : "limber.v1.ActArrayAccelReq", size = 16, align = 8 {
+        /// Joint index.
+        pub joint: i32,
+        /// Reserved, zero.
+        pub _pad: u32,
+        /// Acceleration, rad/s² or m/s².
+        pub accel: f64,
+    }
+}
+
+wire_struct! {
+    /// The request envelope (channel `req`). GET_GEOM has an empty body.
+    pub struct ActArrayReqMsg : "limber.v1.ActArrayReqMsg", size = 48, align = 8 {
+        /// Sender, sequence, time, kind, body length.
+        pub meta: MsgMeta,
+        /// One of the `ActArray*Req` structs.
+        pub body: [u8; 16],
+    }
+}
+
+wire_struct! {
+    /// The geometry of one actuator.
+    pub struct ActuatorGeom : "limber.v1.ActuatorGeom", size = 104, align = 8 {
+        /// `ACTUATOR_KIND`: 1 linear, 2 rotary.
+        pub kind: u32,
+        /// 1 when the actuator has brakes.
+        pub has_brakes: u32,
+        /// Length of the link to the next actuator, m (linear: the length at position 0).
+        pub length: f64,
+        /// Rest orientation (direction to the next actuator).
+        pub orientation: Orientation3,
+        /// Rotation or travel axis.
+        pub axis: Vec3,
+        /// Lower limit, rad or m (always `min <= max`).
+        pub min: f64,
+        /// Centre position.
+        pub centre: f64,
+        /// Upper limit.
+        pub max: f64,
+        /// Home position.
+        pub home: f64,
+        /// Configured speed for moves, rad/s or m/s.
+        pub config_speed: f64,
+    }
+}
+
+wire_struct! {
+    /// The geometry of the array (the GET_GEOM reply).
+    pub struct ActArrayGeom : "limber.v1.ActArrayGeom", size = 3384, align = 8 {
+        /// Number of valid entries.
+        pub actuators_count: u32,
+        /// Reserved, zero.
+        pub _pad: u32,
+        /// The actuators.
+        pub actuators: [ActuatorGeom; 32],
+        /// Position of the base in the robot frame, m.
+        pub base_pos: Vec3,
+        /// Orientation of the base in the robot frame.
+        pub base_orientation: Orientation3,
+    }
+}
+
+wire_struct! {
+    /// The reply envelope (channel `req`): an ACK carries the body of the request's reply.
+    pub struct ActArrayReplyMsg : "limber.v1.ActArrayReplyMsg", size = 3416, align = 8 {
+        /// Client, sequence, time, kind, status.
+        pub meta: ReplyMeta,
+        /// `ActArrayGeom` for GET_GEOM, empty otherwise.
+        pub body: [u8; 3384],
+    }
+}
+
+envelope!(ActArrayCmdMsg);
+envelope!(ActArrayReqMsg);
+reply_envelope!(ActArrayReplyMsg);

@@ -1,0 +1,59 @@
+//! Sending commands: not acknowledged, their outcome arrives in a later state sample.
+
+use iceoryx2::prelude::*;
+use limber_interfaces::prelude::*;
+
+use super::{Client, CommandError};
+use crate::context::monotonic_ns;
+use crate::qos;
+
+/// A command that was sent, to wait for its outcome.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Ticket {
+    /// The command's sequence number.
+    pub seq: u64,
+    /// How many driver processes received it (normally 1).
+    pub receivers: usize,
+}
+
+impl<I: Interface> Client<I> {
+    // ----- commands ---------------------------------------------------------------------
+
+    /// Sends a typed command. Returns at once (commands are not acknowledged; see
+    /// [`Client::wait_outcome`]).
+    pub fn send(&mut self, cmd: &I::Command) -> Result<Ticket, CommandError> {
+        let loan = self
+            .commands
+            .loan_uninit()
+            .map_err(|e| CommandError::Transport(e.into()))?;
+        let mut sample = loan.write_payload(I::CmdMsg::default());
+        let raw: &mut I::CmdMsg = sample.payload_mut();
+        cmd.write(raw);
+        self.cmd_seq += 1;
+        let m = raw.meta_mut();
+        m.client_id = self.client_id;
+        m.seq = self.cmd_seq;
+        m.stamp_ns = monotonic_ns();
+        let receivers = sample
+            .send()
+            .map_err(|e| CommandError::Transport(e.into()))?;
+        if self.wake_driver {
+            self.wake_driver_with(qos::EVENT_COMMAND);
+        }
+        if receivers == 0 {
+            return Err(CommandError::NoDriver);
+        }
+        Ok(Ticket {
+            seq: self.cmd_seq,
+            receivers,
+        })
+    }
+
+    /// Wakes the driver's loop. A failure delays the command or request until the
+    /// driver's next tick rather than losing it: logged, not fatal.
+    pub(super) fn wake_driver_with(&self, event: usize) {
+        if let Err(e) = self.wake.notify_with_custom_event_id(EventId::new(event)) {
+            tracing::debug!(device = %self.device, error = %e, "cannot wake the driver");
+        }
+    }
+}

@@ -1,0 +1,276 @@
+//! The connection to one device: the iceoryx2 ports of its five channels, opened by
+//! [`Client::connect`], and the driver's liveness.
+
+use core::time::Duration;
+use std::time::Instant;
+
+use iceoryx2::node::NodeView;
+use iceoryx2::port::client::Client as IoxClient;
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::*;
+use iceoryx2::sample::Sample;
+use iceoryx2::service::attribute::{AttributeKey, AttributeValue};
+use iceoryx2::service::port_factory::PortFactory;
+use limber_interfaces::prelude::*;
+
+use super::{ConnectError, DEFAULT_REQUEST_TIMEOUT, DriverStatus, Incompatibility, WaitMode};
+use crate::context::Context;
+use crate::error::Iox2Error;
+use crate::naming::{Channel, DRIVER_NODE_PREFIX, DeviceName, attr};
+use crate::qos;
+
+pub(super) const OUTCOME_SLOTS: usize = 16;
+
+type DataSvc<I> = iceoryx2::service::port_factory::publish_subscribe::PortFactory<
+    ipc::Service,
+    <I as Interface>::Data,
+    (),
+>;
+
+/// A connection to one device, for any interface `I`.
+///
+/// Reading the state and sending a command allocate nothing; requests allocate nothing
+/// either. Not `Send`: create it on the thread that uses it.
+pub struct Client<I: Interface> {
+    pub(super) ctx: Context,
+    pub(super) device: DeviceName,
+    pub(super) client_id: u64,
+    pub(super) data_svc: DataSvc<I>,
+    pub(super) states: Subscriber<ipc::Service, I::Data, ()>,
+    pub(super) latest: Option<Sample<ipc::Service, I::Data, ()>>,
+    pub(super) commands: Publisher<ipc::Service, I::CmdMsg, ()>,
+    pub(super) requests: IoxClient<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()>,
+    pub(super) wake: Notifier<ipc::Service>,
+    pub(super) notify_svc: iceoryx2::service::port_factory::event::PortFactory<ipc::Service>,
+    pub(super) notify: Option<Listener<ipc::Service>>,
+    pub(super) cmd_seq: u64,
+    pub(super) req_seq: u64,
+    pub(super) outcomes: [(u64, u32); OUTCOME_SLOTS],
+    pub(super) max_seen_seq: u64,
+    pub(super) wake_driver: bool,
+    pub(super) wait_mode: WaitMode,
+    pub(super) request_timeout: Duration,
+}
+
+impl<I: Interface> core::fmt::Debug for Client<I> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Client")
+            .field("device", &self.device.to_string())
+            .field("client_id", &self.client_id)
+            .finish()
+    }
+}
+
+/// A client of an actuator array.
+pub type ActArrayClient = Client<ActArray>;
+/// A client of a limb.
+pub type LimbClient = Client<Limb>;
+/// A client of a gripper.
+pub type GripperClient = Client<Gripper>;
+
+impl<I: Interface> Client<I> {
+    /// Connects to `device` ("robot/interface/index") in the context's domain. Fails with
+    /// [`ConnectError::NoDriver`] at once if nobody offers it.
+    pub fn connect(ctx: &Context, device: &str) -> Result<Self, ConnectError> {
+        let device: DeviceName = device.parse()?;
+        if device.interface() != I::KIND {
+            return Err(ConnectError::Incompatible {
+                device: device.to_string(),
+                reason: Incompatibility::Interface {
+                    actual: device.interface(),
+                    expected: I::KIND,
+                },
+            });
+        }
+        Self::open_device(ctx, &device)
+    }
+
+    /// Like [`Client::connect`], but waits up to `timeout` for a driver to offer the device.
+    pub fn connect_timeout(
+        ctx: &Context,
+        device: &str,
+        timeout: Duration,
+    ) -> Result<Self, ConnectError> {
+        let deadline = Instant::now() + timeout;
+        loop {
+            match Self::connect(ctx, device) {
+                Err(ConnectError::NoDriver { .. }) if Instant::now() < deadline => {
+                    std::thread::sleep(Duration::from_millis(20));
+                }
+                other => return other,
+            }
+        }
+    }
+
+    fn open_device(ctx: &Context, device: &DeviceName) -> Result<Self, ConnectError> {
+        let dev = device.to_string();
+        let domain = ctx.domain().name().to_string();
+        let map = |channel: &'static str, e: Iox2Error| -> ConnectError {
+            if e.is_missing_service() {
+                ConnectError::NoDriver {
+                    device: dev.clone(),
+                    domain: domain.clone(),
+                }
+            } else if e.is_incompatible() {
+                ConnectError::Incompatible {
+                    device: dev.clone(),
+                    reason: Incompatibility::Layout { channel, source: e },
+                }
+            } else {
+                ConnectError::Transport {
+                    device: dev.clone(),
+                    channel,
+                    source: e,
+                }
+            }
+        };
+        let attribute = |e: Iox2Error| map("attributes", e);
+        let layout = AttributeVerifier::new()
+            .require(
+                &AttributeKey::new(attr::LAYOUT.as_bytes()).map_err(|e| attribute(e.into()))?,
+                &AttributeValue::new(limber_interfaces::LAYOUT_VERSION.to_string().as_bytes())
+                    .map_err(|e| attribute(e.into()))?,
+            )
+            .map_err(|e| attribute(e.into()))?;
+        let node = ctx.node();
+        let data_svc = node
+            .service_builder(&device.service_name(Channel::Data))
+            .publish_subscribe::<I::Data>()
+            .open_with_attributes(&layout)
+            .map_err(|e| map("data", e.into()))?;
+        let states = data_svc
+            .subscriber_builder()
+            .create()
+            .map_err(|e| map("data", e.into()))?;
+        let commands = node
+            .service_builder(&device.service_name(Channel::Cmd))
+            .publish_subscribe::<I::CmdMsg>()
+            .open_with_attributes(&layout)
+            .map_err(|e| map("cmd", e.into()))?
+            .publisher_builder()
+            .max_loaned_samples(1)
+            .create()
+            .map_err(|e| map("cmd", e.into()))?;
+        let requests = node
+            .service_builder(&device.service_name(Channel::Req))
+            .request_response::<I::ReqMsg, I::ReplyMsg>()
+            .enable_fire_and_forget_requests(false)
+            .open_with_attributes(&layout)
+            .map_err(|e| map("req", e.into()))?
+            .client_builder()
+            .create()
+            .map_err(|e| map("req", e.into()))?;
+        let wake = node
+            .service_builder(&device.service_name(Channel::Wake))
+            .event()
+            .open_with_attributes(&layout)
+            .map_err(|e| map("wake", e.into()))?
+            .notifier_builder()
+            .create()
+            .map_err(|e| map("wake", e.into()))?;
+        let notify_svc = node
+            .service_builder(&device.service_name(Channel::Notify))
+            .event()
+            .open_with_attributes(&layout)
+            .map_err(|e| map("notify", e.into()))?;
+        // Wake the driver so that it hands this new subscriber the latest state at once
+        // (otherwise it does at its next publication: a delay, not a failure).
+        if let Err(e) = wake.notify_with_custom_event_id(EventId::new(qos::EVENT_HELLO)) {
+            tracing::debug!(device = %dev, error = %e, "cannot wake the driver");
+        }
+        Ok(Client {
+            ctx: ctx.clone(),
+            device: device.clone(),
+            client_id: ctx.new_client_id(),
+            data_svc,
+            states,
+            latest: None,
+            commands,
+            requests,
+            wake,
+            notify_svc,
+            notify: None,
+            cmd_seq: 0,
+            req_seq: 0,
+            outcomes: [(0, 0); OUTCOME_SLOTS],
+            max_seen_seq: 0,
+            wake_driver: true,
+            wait_mode: WaitMode::Event,
+            request_timeout: DEFAULT_REQUEST_TIMEOUT,
+        })
+    }
+
+    /// The device.
+    pub fn device(&self) -> &DeviceName {
+        &self.device
+    }
+
+    /// This client's id (carried in every command and request it sends).
+    pub fn client_id(&self) -> u64 {
+        self.client_id
+    }
+
+    /// The context.
+    pub fn context(&self) -> &Context {
+        &self.ctx
+    }
+
+    /// How to wait for states and replies (default [`WaitMode::Event`]).
+    pub fn set_wait_mode(&mut self, mode: WaitMode) {
+        self.wait_mode = mode;
+    }
+
+    /// Whether each command and request also wakes the driver with an event (default yes;
+    /// a spinning driver does not need it).
+    pub fn set_wake_driver(&mut self, on: bool) {
+        self.wake_driver = on;
+    }
+
+    /// The timeout of requests (default [`DEFAULT_REQUEST_TIMEOUT`]).
+    pub fn set_request_timeout(&mut self, timeout: Duration) {
+        self.request_timeout = timeout;
+    }
+
+    // ----- liveness ---------------------------------------------------------------------
+
+    /// Whether the device's driver process is alive. A dead driver's resources are
+    /// cleaned up on the way, so that a restarted driver is picked up by this client.
+    /// Costs tens of microseconds: not for every control cycle.
+    pub fn driver_status(&self) -> DriverStatus {
+        driver_status_of(&self.data_svc)
+    }
+}
+
+/// The status of the driver attached to a device's data service.
+pub(super) fn driver_status_of<P: PortFactory<Service = ipc::Service>>(svc: &P) -> DriverStatus {
+    let mut alive = false;
+    let mut dead = false;
+    let is_driver = |d: &Option<iceoryx2::node::NodeDetails>| {
+        d.as_ref()
+            .map(|d| d.name().as_str().starts_with(DRIVER_NODE_PREFIX))
+            .unwrap_or(false)
+    };
+    if let Err(e) = svc.nodes(|n| {
+        match &n {
+            NodeState::Alive(v) if is_driver(v.details()) => alive = true,
+            NodeState::Dead(v) if is_driver(v.details()) => dead = true,
+            _ => {}
+        }
+        CallbackProgression::Continue
+    }) {
+        // Nodes not listed are not known to be alive: the caller sees the driver as
+        // absent (or dead, if one was found before the failure).
+        tracing::warn!(error = %e, "cannot list the nodes of a device");
+    }
+    if alive {
+        DriverStatus::Alive
+    } else if dead {
+        svc.try_cleanup_dead_nodes();
+        DriverStatus::Dead
+    } else {
+        DriverStatus::Absent
+    }
+}

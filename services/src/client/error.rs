@@ -1,0 +1,140 @@
+//! What can go wrong on the client side, one enum per operation: connecting
+//! ([`ConnectError`]), sending a command ([`CommandError`]), a request ([`RequestError`])
+//! and waiting for a state or an outcome ([`WaitError`]).
+
+use core::time::Duration;
+
+use limber_interfaces::prelude::*;
+use thiserror::Error;
+
+use crate::context::ContextError;
+use crate::error::Iox2Error;
+use crate::naming::NameError;
+
+/// Connecting to a device failed.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum ConnectError {
+    /// The device or domain name is invalid.
+    #[error(transparent)]
+    Name(#[from] NameError),
+    /// Joining the domain failed.
+    #[error(transparent)]
+    Context(#[from] ContextError),
+    /// No driver offers this device in this domain.
+    #[error(
+        "no driver offers {device} in domain {domain} (is the driver running? is LIMBER_DOMAIN the same?)"
+    )]
+    NoDriver {
+        /// The device.
+        device: String,
+        /// The domain.
+        domain: String,
+    },
+    /// The device is of another interface, or speaks another layout version.
+    #[error("{device} is incompatible: {reason}")]
+    Incompatible {
+        /// The device.
+        device: String,
+        /// Why.
+        #[source]
+        reason: Incompatibility,
+    },
+    /// iceoryx2 failed to open a service or create a port.
+    #[error("{device}: cannot open the {channel} channel: {source}")]
+    Transport {
+        /// The device.
+        device: String,
+        /// The channel.
+        channel: &'static str,
+        /// iceoryx2's error.
+        #[source]
+        source: Iox2Error,
+    },
+}
+
+/// Why a device is incompatible with a client ([`ConnectError::Incompatible`]).
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum Incompatibility {
+    /// The device is of another interface than the client's.
+    #[error("it is a {actual} device, not a {expected}")]
+    Interface {
+        /// The device's interface.
+        actual: InterfaceKind,
+        /// The client's interface.
+        expected: InterfaceKind,
+    },
+    /// A service of the device has other attributes, types or qualities of service
+    /// (another layout version).
+    #[error("{channel}: {source} (another layout version?)")]
+    Layout {
+        /// The channel.
+        channel: &'static str,
+        /// iceoryx2's error.
+        #[source]
+        source: Iox2Error,
+    },
+}
+
+/// Sending a command failed; nothing was sent.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum CommandError {
+    /// A value is invalid (NaN, bad joint index, too many values, zero vector).
+    #[error("invalid command: {0}")]
+    Invalid(#[from] ValueError),
+    /// No driver receives commands for this device (not started, or gone and cleaned up).
+    #[error("no driver receives commands")]
+    NoDriver,
+    /// iceoryx2 failed to loan or send the command sample.
+    #[error("cannot send the command: {0}")]
+    Transport(#[source] Iox2Error),
+}
+
+/// A request failed.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum RequestError {
+    /// The driver refused (NACK) and said why.
+    #[error("refused: {0}")]
+    Nack(Status),
+    /// No reply within the timeout (the driver is alive but did not answer).
+    #[error("no reply within {0:?}")]
+    Timeout(Duration),
+    /// No driver serves requests for this device.
+    #[error("no driver serves requests")]
+    NoDriver,
+    /// The driver died while the request was pending.
+    #[error("the driver is gone")]
+    DriverGone,
+    /// A value is invalid; nothing was sent.
+    #[error("invalid request: {0}")]
+    Invalid(#[from] ValueError),
+    /// The reply could not be decoded (driver of another layout, or corrupted).
+    #[error("undecodable reply: {0}")]
+    Decode(#[source] DecodeError),
+    /// The reply was an ACK of an unexpected kind.
+    #[error("unexpected reply")]
+    Unexpected,
+    /// iceoryx2 failed (loaning, sending, receiving, or waiting for the reply).
+    #[error("request transport failed: {0}")]
+    Transport(#[source] Iox2Error),
+}
+
+/// Waiting for a state or an outcome failed.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum WaitError {
+    /// Nothing arrived within the timeout (the driver is alive).
+    #[error("nothing within {0:?}")]
+    Timeout(Duration),
+    /// The driver died (or was never there).
+    #[error("the driver is gone")]
+    DriverGone,
+    /// The outcome of this command was published but overwritten before it was read
+    /// (a later command of this client has been applied since).
+    #[error("outcome missed; a later command (seq {newer_seq}) was applied since")]
+    Missed {
+        /// The newer command's sequence number.
+        newer_seq: u64,
+    },
+    /// iceoryx2 failed (receiving states, or waiting for a notification).
+    #[error("receiving failed: {0}")]
+    Transport(#[source] Iox2Error),
+}

@@ -1,0 +1,58 @@
+//! Player's `LimbProxy`: the limb conveniences of [`LimbClient`](super::LimbClient).
+
+use limber_interfaces::prelude::*;
+
+use super::{Client, CommandError, RequestError, Ticket};
+
+/// Player's `LimbProxy`: every limb command and request.
+impl Client<Limb> {
+    /// CMD HOME.
+    pub fn home(&mut self) -> Result<Ticket, CommandError> {
+        self.send(&LimbCommand::Home)
+    }
+    /// CMD STOP: stop every joint now.
+    pub fn stop(&mut self) -> Result<Ticket, CommandError> {
+        self.send(&LimbCommand::Stop)
+    }
+    /// CMD SETPOSE: end effector to `position` (robot frame, m) with `approach` and
+    /// `orientation` vectors.
+    pub fn set_pose(
+        &mut self,
+        position: [f64; 3],
+        approach: [f64; 3],
+        orientation: [f64; 3],
+    ) -> Result<Ticket, CommandError> {
+        self.send(&LimbCommand::set_pose(
+            position.into(),
+            approach.into(),
+            orientation.into(),
+        )?)
+    }
+    /// CMD SETPOSITION: end effector to `position`, orientation chosen by the driver.
+    pub fn set_position(&mut self, position: [f64; 3]) -> Result<Ticket, CommandError> {
+        self.send(&LimbCommand::set_position(position.into())?)
+    }
+    /// CMD VECMOVE: move `length` m along `direction` in a straight line.
+    pub fn vec_move(&mut self, direction: [f64; 3], length: f64) -> Result<Ticket, CommandError> {
+        self.send(&LimbCommand::vec_move(direction.into(), length)?)
+    }
+    /// REQ POWER.
+    pub fn power(&mut self, on: bool) -> Result<(), RequestError> {
+        self.request(&LimbRequest::Power(on)).map(|_| ())
+    }
+    /// REQ BRAKES.
+    pub fn brakes(&mut self, on: bool) -> Result<(), RequestError> {
+        self.request(&LimbRequest::Brakes(on)).map(|_| ())
+    }
+    /// REQ SPEED: end-effector speed, m/s.
+    pub fn set_speed(&mut self, speed: f64) -> Result<(), RequestError> {
+        self.request(&LimbRequest::speed(speed)?).map(|_| ())
+    }
+    /// REQ GEOM.
+    pub fn geometry(&mut self) -> Result<LimbGeom, RequestError> {
+        match self.request(&LimbRequest::Geom)? {
+            LimbReply::Geom(g) => Ok(g),
+            LimbReply::Done => Err(RequestError::Unexpected),
+        }
+    }
+}

@@ -1,0 +1,28 @@
+//! The client side, in the spirit of Player's proxies: [`Client<I>`] for any interface, with
+//! typed conveniences for each ([`ActArrayClient`], [`LimbClient`], [`GripperClient`]).
+//!
+//! Read in this order: `connection.rs` opens the five channels of a device, `waiting.rs` reads states and waits for outcomes, `commands.rs` and
+//! `requests.rs` send, and `actarray.rs`, `limb.rs`, `gripper.rs` are the typed proxies.
+//! The errors of each operation are in `error.rs`.
+
+use core::time::Duration;
+
+mod actarray;
+mod commands;
+mod connection;
+mod error;
+mod gripper;
+mod limb;
+mod requests;
+mod waiting;
+
+pub use commands::Ticket;
+use connection::OUTCOME_SLOTS;
+pub use connection::{ActArrayClient, Client, GripperClient, LimbClient};
+pub use error::{CommandError, ConnectError, Incompatibility, RequestError, WaitError};
+pub use waiting::{DriverStatus, Freshness, WaitMode};
+
+/// Default time a request waits for its reply.
+pub const DEFAULT_REQUEST_TIMEOUT: Duration = Duration::from_secs(2);
+/// How often a waiting client checks that the driver is still alive.
+pub const LIVENESS_PERIOD: Duration = Duration::from_millis(20);

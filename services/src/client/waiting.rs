@@ -1,0 +1,201 @@
+//! Reading the state and waiting: for a state, for the outcome of a command, with the
+//! driver's liveness checked while waiting.
+
+use core::time::Duration;
+use std::time::Instant;
+
+use limber_interfaces::prelude::*;
+
+use super::{Client, LIVENESS_PERIOD, OUTCOME_SLOTS, Ticket, WaitError};
+use crate::context::monotonic_ns;
+use crate::error::Iox2Error;
+
+/// Whether the driver of a device is running.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DriverStatus {
+    /// Its process is alive.
+    Alive,
+    /// Its process died without cleaning up (found dead and cleaned up now).
+    Dead,
+    /// No driver is attached.
+    Absent,
+}
+
+/// How fresh the latest state is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Freshness {
+    /// Younger than the limit.
+    Fresh,
+    /// Older than the limit, but the driver is alive.
+    Stale,
+    /// The driver is gone.
+    Gone,
+    /// No state received yet.
+    NoData,
+}
+
+/// How a client waits for states and replies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WaitMode {
+    /// Block on the driver's notification (default; costs a wake-up, frees the CPU).
+    Event,
+    /// Busy-poll shared memory (lowest latency; takes a whole core).
+    Spin,
+}
+
+impl<I: Interface> Client<I> {
+    // ----- state ------------------------------------------------------------------------
+
+    /// Takes every state sample that arrived; returns true if there was a new one.
+    pub fn refresh(&mut self) -> Result<bool, WaitError> {
+        let mut got = false;
+        loop {
+            match self.states.receive() {
+                Ok(Some(s)) => {
+                    let d: &I::Data = &s;
+                    let h = d.header();
+                    if h.last_cmd.client_id == self.client_id {
+                        let slot = (h.last_cmd.cmd_seq as usize) % OUTCOME_SLOTS;
+                        self.outcomes[slot] = (h.last_cmd.cmd_seq, h.last_cmd.status);
+                        self.max_seen_seq = self.max_seen_seq.max(h.last_cmd.cmd_seq);
+                    }
+                    self.latest = Some(s);
+                    got = true;
+                }
+                Ok(None) => return Ok(got),
+                Err(e) => return Err(WaitError::Transport(e.into())),
+            }
+        }
+    }
+
+    /// The latest state (read in place from shared memory), after taking what arrived.
+    pub fn state(&mut self) -> Option<&I::Data> {
+        self.refresh_or_log();
+        self.latest.as_deref()
+    }
+
+    /// The latest state, waiting up to `timeout` for a first one if none arrived yet.
+    pub fn current(&mut self, timeout: Duration) -> Result<&I::Data, WaitError> {
+        self.refresh()?;
+        if self.latest.is_none() {
+            self.wait_state(timeout)?;
+        }
+        self.latest.as_deref().ok_or(WaitError::Timeout(timeout))
+    }
+
+    /// The latest state already taken, without looking for a newer one.
+    pub fn last_state(&self) -> Option<&I::Data> {
+        self.latest.as_deref()
+    }
+
+    /// Age of the latest state: now minus its acquisition time.
+    pub fn state_age(&self) -> Option<Duration> {
+        self.latest
+            .as_deref()
+            .map(|d| Duration::from_nanos(monotonic_ns().saturating_sub(d.header().stamp_ns)))
+    }
+
+    /// Fresh (younger than `max_age`), stale (older, driver alive), gone, or no data.
+    pub fn freshness(&mut self, max_age: Duration) -> Freshness {
+        self.refresh_or_log();
+        match self.state_age() {
+            None => Freshness::NoData,
+            Some(a) if a <= max_age => Freshness::Fresh,
+            Some(_) => match self.driver_status() {
+                DriverStatus::Alive => Freshness::Stale,
+                _ => Freshness::Gone,
+            },
+        }
+    }
+
+    /// [`Client::refresh`] for the callers that answer with the latest state taken: a
+    /// failure to receive leaves that state as it was (its age shows it) and is logged.
+    fn refresh_or_log(&mut self) {
+        if let Err(e) = self.refresh() {
+            tracing::warn!(device = %self.device, error = %e, "cannot receive the state");
+        }
+    }
+
+    /// Waits for a state sample newer than the latest one taken.
+    pub fn wait_state(&mut self, timeout: Duration) -> Result<&I::Data, WaitError> {
+        let deadline = Instant::now() + timeout;
+        let mut next_check = Instant::now() + LIVENESS_PERIOD;
+        loop {
+            if self.refresh()? {
+                break;
+            }
+            let now = Instant::now();
+            if now >= deadline {
+                return Err(WaitError::Timeout(timeout));
+            }
+            if now >= next_check {
+                next_check = now + LIVENESS_PERIOD;
+                if self.driver_status() != DriverStatus::Alive {
+                    return Err(WaitError::DriverGone);
+                }
+            }
+            self.pause(deadline.min(next_check))
+                .map_err(WaitError::Transport)?;
+        }
+        Ok(self.latest.as_deref().expect("refresh returned a sample"))
+    }
+
+    /// Waits for the outcome of the command of `ticket`, as published by the driver.
+    pub fn wait_outcome(&mut self, ticket: Ticket, timeout: Duration) -> Result<Status, WaitError> {
+        let deadline = Instant::now() + timeout;
+        let mut next_check = Instant::now() + LIVENESS_PERIOD;
+        loop {
+            self.refresh()?;
+            let (seq, status) = self.outcomes[(ticket.seq as usize) % OUTCOME_SLOTS];
+            if seq == ticket.seq {
+                return Ok(Status::try_from(status).unwrap_or_else(|e| {
+                    // A driver of another build: the outcome is not one we know.
+                    tracing::warn!(device = %self.device, error = %e, "unknown outcome status");
+                    Status::InvalidArgument
+                }));
+            }
+            // Commands of one client are applied in order: an outcome of a later one
+            // means this one was applied too, its sample overwritten before it was read.
+            if self.max_seen_seq > ticket.seq {
+                return Err(WaitError::Missed {
+                    newer_seq: self.max_seen_seq,
+                });
+            }
+            let now = Instant::now();
+            if now >= deadline {
+                return Err(WaitError::Timeout(timeout));
+            }
+            if now >= next_check {
+                next_check = now + LIVENESS_PERIOD;
+                if self.driver_status() != DriverStatus::Alive {
+                    return Err(WaitError::DriverGone);
+                }
+            }
+            self.pause(deadline.min(next_check))
+                .map_err(WaitError::Transport)?;
+        }
+    }
+
+    /// Blocks (event mode) or spins once (spin mode) until `until` or a notification.
+    pub(super) fn pause(&mut self, until: Instant) -> Result<(), Iox2Error> {
+        match self.wait_mode {
+            WaitMode::Spin => {
+                core::hint::spin_loop();
+                Ok(())
+            }
+            WaitMode::Event => {
+                if self.notify.is_none() {
+                    let l = self.notify_svc.listener_builder().create()?;
+                    self.notify = Some(l);
+                    // Something may have arrived before the listener existed.
+                    return Ok(());
+                }
+                let left = until.saturating_duration_since(Instant::now());
+                if let Some(l) = &self.notify {
+                    l.timed_wait(|_| {}, left)?;
+                }
+                Ok(())
+            }
+        }
+    }
+}

@@ -1,0 +1,432 @@
+//! [`DeviceSet`]: the devices one driver process offers, as one group. A driver says which
+//! devices it serves (`actarray/0`, `limb/0`, `gripper/1`, ...), implements
+//! [`DeviceSetHandler`] once for all of them, and its loop processes, publishes and waits
+//! on the whole set.
+//!
+//! ```
+//! use limber_services::prelude::*;
+//! use limber_services::{DeviceSet, DeviceSetHandler};
+//!
+//! /// A driver with one gripper that opens and closes at once.
+//! struct Hand;
+//! impl DeviceSetHandler for Hand {
+//!     fn gripper_command(&mut self, _: u16, cmd: &GripperCommand, _: &Origin, s: &mut GripperData) -> Status {
+//!         match cmd {
+//!             GripperCommand::Open => { s.state = GripperState::Open as u32; Status::Ok }
+//!             GripperCommand::Close => { s.state = GripperState::Closed as u32; Status::Ok }
+//!             _ => Status::Unsupported,
+//!         }
+//!     }
+//! }
+//!
+//! # let domain = Domain::unique_for_test();
+//! let ctx = Context::new(&domain, Role::Driver, "hand")?;
+//! let mut set = DeviceSet::new(&ctx, "demo", "hand", &[(InterfaceKind::Gripper, 0)])?;
+//! set.gripper_mut(0).unwrap().state_mut().state = GripperState::Open as u32;
+//! set.publish_all(monotonic_ns())?;
+//! let listeners = set.take_wake_listeners(); // for limber_services::event_loop::run
+//! # assert_eq!(listeners.len(), 1);
+//! set.process(&mut Hand)?; // after each wake-up
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use iceoryx2::port::listener::Listener;
+use iceoryx2::prelude::ipc;
+use limber_interfaces::prelude::*;
+use thiserror::Error;
+
+use crate::context::Context;
+use crate::host::{
+    Activity, DeviceHandler, DeviceHost, HostError, HostStats, Origin, ProcessError, PublishError,
+};
+use crate::naming::DeviceName;
+
+/// What a driver implements to serve a [`DeviceSet`]: the [`DeviceHandler`] methods of
+/// each interface, with the index of the device (`gripper/0` or `gripper/1`). A device
+/// the set serves but the handler does not override answers [`Status::Unsupported`].
+pub trait DeviceSetHandler {
+    /// A validated command for `actarray/<index>`; see [`DeviceHandler::command`].
+    fn actarray_command(
+        &mut self,
+        index: u16,
+        cmd: &ActArrayCommand,
+        from: &Origin,
+        state: &mut ActArrayData,
+    ) -> Status {
+        let _ = (index, cmd, from, state);
+        Status::Unsupported
+    }
+    /// A validated request for `actarray/<index>`; see [`DeviceHandler::request`].
+    fn actarray_request(
+        &mut self,
+        index: u16,
+        req: &ActArrayRequest,
+        from: &Origin,
+        state: &mut ActArrayData,
+    ) -> Result<ActArrayReply, Status> {
+        let _ = (index, req, from, state);
+        Err(Status::Unsupported)
+    }
+    /// A validated command for `limb/<index>`; see [`DeviceHandler::command`].
+    fn limb_command(
+        &mut self,
+        index: u16,
+        cmd: &LimbCommand,
+        from: &Origin,
+        state: &mut LimbData,
+    ) -> Status {
+        let _ = (index, cmd, from, state);
+        Status::Unsupported
+    }
+    /// A validated request for `limb/<index>`; see [`DeviceHandler::request`].
+    fn limb_request(
+        &mut self,
+        index: u16,
+        req: &LimbRequest,
+        from: &Origin,
+        state: &mut LimbData,
+    ) -> Result<LimbReply, Status> {
+        let _ = (index, req, from, state);
+        Err(Status::Unsupported)
+    }
+    /// A validated command for `gripper/<index>`; see [`DeviceHandler::command`].
+    fn gripper_command(
+        &mut self,
+        index: u16,
+        cmd: &GripperCommand,
+        from: &Origin,
+        state: &mut GripperData,
+    ) -> Status {
+        let _ = (index, cmd, from, state);
+        Status::Unsupported
+    }
+    /// A validated request for `gripper/<index>`; see [`DeviceHandler::request`].
+    fn gripper_request(
+        &mut self,
+        index: u16,
+        req: &GripperRequest,
+        from: &Origin,
+        state: &mut GripperData,
+    ) -> Result<GripperReply, Status> {
+        let _ = (index, req, from, state);
+        Err(Status::Unsupported)
+    }
+}
+
+/// An operation on one device of a [`DeviceSet`] failed: which device, and why.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[error("{device}: {source}")]
+pub struct DeviceError<E: std::error::Error + 'static> {
+    /// The device.
+    pub device: DeviceName,
+    /// What failed.
+    #[source]
+    pub source: E,
+}
+
+/// One device of the set, as a [`DeviceHandler`] of its interface.
+struct At<'a, H: ?Sized> {
+    handler: &'a mut H,
+    index: u16,
+}
+
+impl<H: DeviceSetHandler + ?Sized> DeviceHandler<ActArray> for At<'_, H> {
+    fn command(&mut self, cmd: &ActArrayCommand, from: &Origin, s: &mut ActArrayData) -> Status {
+        self.handler.actarray_command(self.index, cmd, from, s)
+    }
+    fn request(
+        &mut self,
+        req: &ActArrayRequest,
+        from: &Origin,
+        s: &mut ActArrayData,
+    ) -> Result<ActArrayReply, Status> {
+        self.handler.actarray_request(self.index, req, from, s)
+    }
+}
+
+impl<H: DeviceSetHandler + ?Sized> DeviceHandler<Limb> for At<'_, H> {
+    fn command(&mut self, cmd: &LimbCommand, from: &Origin, s: &mut LimbData) -> Status {
+        self.handler.limb_command(self.index, cmd, from, s)
+    }
+    fn request(
+        &mut self,
+        req: &LimbRequest,
+        from: &Origin,
+        s: &mut LimbData,
+    ) -> Result<LimbReply, Status> {
+        self.handler.limb_request(self.index, req, from, s)
+    }
+}
+
+impl<H: DeviceSetHandler + ?Sized> DeviceHandler<Gripper> for At<'_, H> {
+    fn command(&mut self, cmd: &GripperCommand, from: &Origin, s: &mut GripperData) -> Status {
+        self.handler.gripper_command(self.index, cmd, from, s)
+    }
+    fn request(
+        &mut self,
+        req: &GripperRequest,
+        from: &Origin,
+        s: &mut GripperData,
+    ) -> Result<GripperReply, Status> {
+        self.handler.gripper_request(self.index, req, from, s)
+    }
+}
+
+/// The devices of one driver process: any number of actarray, limb and gripper hosts of
+/// one robot, each optional (a driver serves what the robot has), keyed by interface and
+/// index.
+pub struct DeviceSet {
+    actarrays: Vec<DeviceHost<ActArray>>,
+    limbs: Vec<DeviceHost<Limb>>,
+    grippers: Vec<DeviceHost<Gripper>>,
+}
+
+impl core::fmt::Debug for DeviceSet {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_list()
+            .entries(self.devices().map(|d| d.to_string()))
+            .finish()
+    }
+}
+
+/// Which way [`DeviceSet::process_with`] drains a host.
+#[derive(Clone, Copy)]
+enum Drain {
+    All,
+    Spin,
+}
+
+impl DeviceSet {
+    /// Offers the devices `serve` (interface and index each) of `robot` as driver
+    /// `driver`, in that order. The states are all zero until set and published.
+    pub fn new(
+        ctx: &Context,
+        robot: &str,
+        driver: &str,
+        serve: &[(InterfaceKind, u16)],
+    ) -> Result<Self, HostError> {
+        let mut set = DeviceSet {
+            actarrays: Vec::new(),
+            limbs: Vec::new(),
+            grippers: Vec::new(),
+        };
+        for &(kind, index) in serve {
+            let name = DeviceName::new(robot, kind, index)?;
+            match kind {
+                InterfaceKind::ActArray => set.actarrays.push(DeviceHost::new(ctx, &name, driver)?),
+                InterfaceKind::Limb => set.limbs.push(DeviceHost::new(ctx, &name, driver)?),
+                InterfaceKind::Gripper => set.grippers.push(DeviceHost::new(ctx, &name, driver)?),
+            }
+        }
+        Ok(set)
+    }
+
+    /// The names of the devices served, actarrays first, then limbs, then grippers.
+    pub fn devices(&self) -> impl Iterator<Item = &DeviceName> {
+        self.actarrays
+            .iter()
+            .map(|h| h.device())
+            .chain(self.limbs.iter().map(|h| h.device()))
+            .chain(self.grippers.iter().map(|h| h.device()))
+    }
+
+    /// How many devices are served.
+    pub fn len(&self) -> usize {
+        self.actarrays.len() + self.limbs.len() + self.grippers.len()
+    }
+
+    /// True when no device is served.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The host of `actarray/<index>`, if served.
+    pub fn actarray(&self, index: u16) -> Option<&DeviceHost<ActArray>> {
+        self.actarrays.iter().find(|h| h.device().index() == index)
+    }
+
+    /// The host of `actarray/<index>`, if served, to update its state.
+    pub fn actarray_mut(&mut self, index: u16) -> Option<&mut DeviceHost<ActArray>> {
+        self.actarrays
+            .iter_mut()
+            .find(|h| h.device().index() == index)
+    }
+
+    /// The host of `limb/<index>`, if served.
+    pub fn limb(&self, index: u16) -> Option<&DeviceHost<Limb>> {
+        self.limbs.iter().find(|h| h.device().index() == index)
+    }
+
+    /// The host of `limb/<index>`, if served, to update its state.
+    pub fn limb_mut(&mut self, index: u16) -> Option<&mut DeviceHost<Limb>> {
+        self.limbs.iter_mut().find(|h| h.device().index() == index)
+    }
+
+    /// The host of `gripper/<index>`, if served.
+    pub fn gripper(&self, index: u16) -> Option<&DeviceHost<Gripper>> {
+        self.grippers.iter().find(|h| h.device().index() == index)
+    }
+
+    /// The host of `gripper/<index>`, if served, to update its state.
+    pub fn gripper_mut(&mut self, index: u16) -> Option<&mut DeviceHost<Gripper>> {
+        self.grippers
+            .iter_mut()
+            .find(|h| h.device().index() == index)
+    }
+
+    /// Sets the `DEVICE_FLAG` bits of every device (see [`DeviceHost::set_flags`]).
+    pub fn set_flags(&mut self, flags: u32) {
+        self.actarrays.iter_mut().for_each(|h| h.set_flags(flags));
+        self.limbs.iter_mut().for_each(|h| h.set_flags(flags));
+        self.grippers.iter_mut().for_each(|h| h.set_flags(flags));
+    }
+
+    /// See [`DeviceHost::set_publish_each_outcome`]; for every device.
+    pub fn set_publish_each_outcome(&mut self, on: bool) {
+        self.actarrays
+            .iter_mut()
+            .for_each(|h| h.set_publish_each_outcome(on));
+        self.limbs
+            .iter_mut()
+            .for_each(|h| h.set_publish_each_outcome(on));
+        self.grippers
+            .iter_mut()
+            .for_each(|h| h.set_publish_each_outcome(on));
+    }
+
+    /// Publishes the state of every device, acquired at `stamp_ns` (`CLOCK_MONOTONIC`).
+    /// Every device is published even if one fails; the first failure is returned.
+    pub fn publish_all(&mut self, stamp_ns: u64) -> Result<(), DeviceError<PublishError>> {
+        let mut first = None;
+        let mut note = |device: &DeviceName, r: Result<(), PublishError>| {
+            if let Err(source) = r {
+                tracing::warn!(device = %device, error = %source, "cannot publish the state");
+                first.get_or_insert_with(|| DeviceError {
+                    device: device.clone(),
+                    source,
+                });
+            }
+        };
+        for h in &mut self.actarrays {
+            let r = h.publish_acquired(stamp_ns);
+            note(h.device(), r);
+        }
+        for h in &mut self.limbs {
+            let r = h.publish_acquired(stamp_ns);
+            note(h.device(), r);
+        }
+        for h in &mut self.grippers {
+            let r = h.publish_acquired(stamp_ns);
+            note(h.device(), r);
+        }
+        first.map_or(Ok(()), Err)
+    }
+
+    /// Drains the commands and answers the requests of every device with `handler`
+    /// ([`DeviceHost::process`]); never blocks. Every device is processed even if one
+    /// fails; the first failure is returned.
+    pub fn process<H: DeviceSetHandler + ?Sized>(
+        &mut self,
+        handler: &mut H,
+    ) -> Result<Activity, DeviceError<ProcessError>> {
+        self.process_with(handler, Drain::All)
+    }
+
+    /// For a busy-polling loop: [`DeviceHost::process_spin`] on every device.
+    pub fn process_spin<H: DeviceSetHandler + ?Sized>(
+        &mut self,
+        handler: &mut H,
+    ) -> Result<Activity, DeviceError<ProcessError>> {
+        self.process_with(handler, Drain::Spin)
+    }
+
+    fn process_with<H: DeviceSetHandler + ?Sized>(
+        &mut self,
+        handler: &mut H,
+        drain: Drain,
+    ) -> Result<Activity, DeviceError<ProcessError>> {
+        fn one<I: Interface, D: DeviceHandler<I>>(
+            host: &mut DeviceHost<I>,
+            handler: &mut D,
+            drain: Drain,
+            total: &mut Activity,
+            first: &mut Option<DeviceError<ProcessError>>,
+        ) {
+            let r = match drain {
+                Drain::All => host.process(handler),
+                Drain::Spin => host.process_spin(handler),
+            };
+            match r {
+                Ok(a) => *total += a,
+                Err(source) => {
+                    tracing::warn!(device = %host.device(), error = %source, "cannot process clients");
+                    first.get_or_insert_with(|| DeviceError {
+                        device: host.device().clone(),
+                        source,
+                    });
+                }
+            }
+        }
+        let mut total = Activity::default();
+        let mut first = None;
+        for h in &mut self.actarrays {
+            let index = h.device().index();
+            let mut at = At {
+                handler: &mut *handler,
+                index,
+            };
+            one::<ActArray, _>(h, &mut at, drain, &mut total, &mut first);
+        }
+        for h in &mut self.limbs {
+            let index = h.device().index();
+            let mut at = At {
+                handler: &mut *handler,
+                index,
+            };
+            one::<Limb, _>(h, &mut at, drain, &mut total, &mut first);
+        }
+        for h in &mut self.grippers {
+            let index = h.device().index();
+            let mut at = At {
+                handler: &mut *handler,
+                index,
+            };
+            one::<Gripper, _>(h, &mut at, drain, &mut total, &mut first);
+        }
+        first.map_or(Ok(total), Err)
+    }
+
+    /// Hands the wake listeners of every device (those not yet taken) to the driver's
+    /// event loop ([`crate::event_loop::run`]); see [`DeviceHost::take_wake_listener`].
+    pub fn take_wake_listeners(&mut self) -> Vec<Listener<ipc::Service>> {
+        let mut out = Vec::with_capacity(self.len());
+        out.extend(
+            self.actarrays
+                .iter_mut()
+                .filter_map(|h| h.take_wake_listener()),
+        );
+        out.extend(self.limbs.iter_mut().filter_map(|h| h.take_wake_listener()));
+        out.extend(
+            self.grippers
+                .iter_mut()
+                .filter_map(|h| h.take_wake_listener()),
+        );
+        out
+    }
+
+    /// The counters of every device, added up.
+    pub fn stats(&self) -> HostStats {
+        let mut s = HostStats::default();
+        self.actarrays.iter().for_each(|h| s += h.stats());
+        self.limbs.iter().for_each(|h| s += h.stats());
+        self.grippers.iter().for_each(|h| s += h.stats());
+        s
+    }
+
+    /// [`DeviceHost::cleanup_dead`] on every device (a 1 Hz housekeeping tick).
+    pub fn cleanup_dead(&self) {
+        self.actarrays.iter().for_each(|h| h.cleanup_dead());
+        self.limbs.iter().for_each(|h| h.cleanup_dead());
+        self.grippers.iter().for_each(|h| h.cleanup_dead());
+    }
+}
