@@ -8,9 +8,7 @@ use limber_interfaces::diagnostics::{self, DriverStats, hardware, loop_mode};
 use limber_interfaces::prelude::*;
 use limber_services::diagnostics::StatsPublisher;
 use limber_services::event_loop::{self, FdSource, LoopExit, Wake};
-use limber_services::{
-    Context, DeviceHandler, DeviceHost, DeviceName, HostError, Origin, monotonic_ns,
-};
+use limber_services::{Context, DeviceSet, DeviceSetHandler, HostError, Origin, monotonic_ns};
 use thiserror::Error;
 
 use limber_p2os::{
@@ -100,14 +98,6 @@ fn options(cfg: &PioneerConfig, target: &LinkTarget) -> ConnectOptions {
     o
 }
 
-struct Hosts {
-    arm: Option<DeviceHost<ActArray>>,
-    limb: Option<DeviceHost<Limb>>,
-    armgrip: Option<DeviceHost<Gripper>>,
-    gripper: Option<DeviceHost<Gripper>>,
-    lift: Option<DeviceHost<ActArray>>,
-}
-
 /// The Pioneer driver: serves `<robot>/actarray/0` (arm), `<robot>/limb/0`,
 /// `<robot>/gripper/0` (body gripper), `<robot>/gripper/1` (arm gripper) and
 /// `<robot>/actarray/1` (lift), and `<robot>/driver/0` (statistics).
@@ -115,7 +105,7 @@ pub struct PioneerDriver {
     ctx: Context,
     target: LinkTarget,
     robot: RobotModel,
-    hosts: Hosts,
+    hosts: DeviceSet,
     stats_pub: StatsPublisher,
     stats: DriverStats,
     hardware: Hardware,
@@ -168,82 +158,86 @@ impl core::fmt::Debug for PioneerDriver {
     }
 }
 
-// One handler per device: each borrows the robot model for the duration of a `process` call.
-struct ArmH<'a>(&'a mut RobotModel);
-struct LimbH<'a>(&'a mut RobotModel);
-struct ArmGripH<'a>(&'a mut RobotModel);
-struct GripperH<'a>(&'a mut RobotModel);
-struct LiftH<'a>(&'a mut RobotModel);
+// The handler of every device: borrows the robot model for the duration of a `process`
+// call. `actarray/0` is the arm, `actarray/1` the lift, `gripper/0` the body gripper and
+// `gripper/1` the arm gripper.
+struct Serve<'a>(&'a mut RobotModel);
 
-impl DeviceHandler<ActArray> for ArmH<'_> {
-    fn command(&mut self, cmd: &ActArrayCommand, from: &Origin, _s: &mut ActArrayData) -> Status {
-        self.0.arm_command(cmd, from)
-    }
-    fn request(
+impl DeviceSetHandler for Serve<'_> {
+    fn actarray_command(
         &mut self,
+        index: u16,
+        cmd: &ActArrayCommand,
+        from: &Origin,
+        s: &mut ActArrayData,
+    ) -> Status {
+        if index == 0 {
+            self.0.arm_command(cmd, from)
+        } else {
+            let st = self.0.lift_command(cmd, from);
+            self.0.lift_state(s);
+            st
+        }
+    }
+    fn actarray_request(
+        &mut self,
+        index: u16,
         req: &ActArrayRequest,
         from: &Origin,
         _s: &mut ActArrayData,
     ) -> Result<ActArrayReply, Status> {
-        self.0.arm_request(req, from)
+        if index == 0 {
+            self.0.arm_request(req, from)
+        } else {
+            self.0.lift_request(req)
+        }
     }
-}
-impl DeviceHandler<Limb> for LimbH<'_> {
-    fn command(&mut self, cmd: &LimbCommand, from: &Origin, s: &mut LimbData) -> Status {
+    fn limb_command(
+        &mut self,
+        _index: u16,
+        cmd: &LimbCommand,
+        from: &Origin,
+        s: &mut LimbData,
+    ) -> Status {
         let st = self.0.limb_command(cmd, from);
         self.0.limb_state(s, Instant::now());
         st
     }
-    fn request(
+    fn limb_request(
         &mut self,
+        _index: u16,
         req: &LimbRequest,
         from: &Origin,
         _s: &mut LimbData,
     ) -> Result<LimbReply, Status> {
         self.0.limb_request(req, from)
     }
-}
-impl DeviceHandler<Gripper> for ArmGripH<'_> {
-    fn command(&mut self, cmd: &GripperCommand, from: &Origin, _s: &mut GripperData) -> Status {
-        self.0.armgrip_command(cmd, from)
-    }
-    fn request(
+    fn gripper_command(
         &mut self,
+        index: u16,
+        cmd: &GripperCommand,
+        from: &Origin,
+        _s: &mut GripperData,
+    ) -> Status {
+        if index == 0 {
+            self.0.gripper_command(cmd, from)
+        } else {
+            self.0.armgrip_command(cmd, from)
+        }
+    }
+    fn gripper_request(
+        &mut self,
+        index: u16,
         _req: &GripperRequest,
         _from: &Origin,
         _s: &mut GripperData,
     ) -> Result<GripperReply, Status> {
-        let g = &self.0.cfg.arm_gripper;
-        Ok(GripperReply::Geom(gripper_geom(g, 0)))
-    }
-}
-impl DeviceHandler<Gripper> for GripperH<'_> {
-    fn command(&mut self, cmd: &GripperCommand, from: &Origin, _s: &mut GripperData) -> Status {
-        self.0.gripper_command(cmd, from)
-    }
-    fn request(
-        &mut self,
-        _req: &GripperRequest,
-        _from: &Origin,
-        _s: &mut GripperData,
-    ) -> Result<GripperReply, Status> {
-        let g = &self.0.cfg.gripper;
-        Ok(GripperReply::Geom(gripper_geom(g, 2)))
-    }
-}
-impl DeviceHandler<ActArray> for LiftH<'_> {
-    fn command(&mut self, cmd: &ActArrayCommand, from: &Origin, s: &mut ActArrayData) -> Status {
-        let st = self.0.lift_command(cmd, from);
-        self.0.lift_state(s);
-        st
-    }
-    fn request(
-        &mut self,
-        req: &ActArrayRequest,
-        _from: &Origin,
-        _s: &mut ActArrayData,
-    ) -> Result<ActArrayReply, Status> {
-        self.0.lift_request(req)
+        let geom = if index == 0 {
+            gripper_geom(&self.0.cfg.gripper, 2)
+        } else {
+            gripper_geom(&self.0.cfg.arm_gripper, 0)
+        };
+        Ok(GripperReply::Geom(geom))
     }
 }
 
@@ -303,60 +297,19 @@ impl PioneerDriver {
         model.last_rx = Instant::now();
 
         let robot = cfg.robot.as_str();
-        let name = |i, n| {
-            DeviceName::new(robot, i, n).map_err(|source| DriverError::RobotName {
-                robot: robot.to_string(),
-                source,
-            })
-        };
+        let mut serve = Vec::new();
+        if hardware.arm {
+            serve.extend([
+                (InterfaceKind::ActArray, 0),
+                (InterfaceKind::Limb, 0),
+                (InterfaceKind::Gripper, 1),
+            ]);
+        }
+        if hardware.gripper {
+            serve.extend([(InterfaceKind::Gripper, 0), (InterfaceKind::ActArray, 1)]);
+        }
         let driver = "pioneer";
-        let hosts = Hosts {
-            arm: if hardware.arm {
-                Some(DeviceHost::new(
-                    ctx,
-                    &name(InterfaceKind::ActArray, 0)?,
-                    driver,
-                )?)
-            } else {
-                None
-            },
-            limb: if hardware.arm {
-                Some(DeviceHost::new(
-                    ctx,
-                    &name(InterfaceKind::Limb, 0)?,
-                    driver,
-                )?)
-            } else {
-                None
-            },
-            armgrip: if hardware.arm {
-                Some(DeviceHost::new(
-                    ctx,
-                    &name(InterfaceKind::Gripper, 1)?,
-                    driver,
-                )?)
-            } else {
-                None
-            },
-            gripper: if hardware.gripper {
-                Some(DeviceHost::new(
-                    ctx,
-                    &name(InterfaceKind::Gripper, 0)?,
-                    driver,
-                )?)
-            } else {
-                None
-            },
-            lift: if hardware.gripper {
-                Some(DeviceHost::new(
-                    ctx,
-                    &name(InterfaceKind::ActArray, 1)?,
-                    driver,
-                )?)
-            } else {
-                None
-            },
-        };
+        let hosts = DeviceSet::new(ctx, robot, driver, &serve)?;
         let stats_pub = StatsPublisher::new(ctx, robot).map_err(DriverError::Stats)?;
         let mut stats = DriverStats::default();
         diagnostics::put_text(&mut stats.driver, driver);
@@ -407,23 +360,7 @@ impl PioneerDriver {
     /// State samples published by all devices (each costs iceoryx2 one small allocation,
     /// see `tests/tests/alloc.rs`), and statistics samples.
     pub fn samples_published(&self) -> u64 {
-        let mut n = self.stats.header.seq;
-        if let Some(h) = &self.hosts.arm {
-            n += h.stats().published;
-        }
-        if let Some(h) = &self.hosts.limb {
-            n += h.stats().published;
-        }
-        if let Some(h) = &self.hosts.armgrip {
-            n += h.stats().published;
-        }
-        if let Some(h) = &self.hosts.gripper {
-            n += h.stats().published;
-        }
-        if let Some(h) = &self.hosts.lift {
-            n += h.stats().published;
-        }
-        n
+        self.stats.header.seq + self.hosts.stats().published
     }
 
     /// True while the link is up.
@@ -448,21 +385,21 @@ impl PioneerDriver {
         let robot = &mut self.robot;
         let failures = &mut self.failures;
         if robot.dirty.arm {
-            if let Some(h) = self.hosts.arm.as_mut() {
+            if let Some(h) = self.hosts.actarray_mut(0) {
                 h.set_flags(flags);
                 robot.arm_state(h.state_mut(), now);
                 if let Err(e) = h.publish() {
                     failures.note(Failure::Publish, &e);
                 }
             }
-            if let Some(h) = self.hosts.limb.as_mut() {
+            if let Some(h) = self.hosts.limb_mut(0) {
                 h.set_flags(flags);
                 robot.limb_state(h.state_mut(), now);
                 if let Err(e) = h.publish() {
                     failures.note(Failure::Publish, &e);
                 }
             }
-            if let Some(h) = self.hosts.armgrip.as_mut() {
+            if let Some(h) = self.hosts.gripper_mut(1) {
                 h.set_flags(flags);
                 robot.armgrip_state(h.state_mut(), now);
                 if let Err(e) = h.publish() {
@@ -473,7 +410,7 @@ impl PioneerDriver {
         }
         if robot.dirty.body {
             robot.lift_from_sip(now);
-            if let Some(h) = self.hosts.gripper.as_mut() {
+            if let Some(h) = self.hosts.gripper_mut(0) {
                 h.set_flags(flags & device_flag::LINK_UP);
                 robot.gripper_state(h.state_mut());
                 h.state_mut().header.stamp_ns = monotonic_ns();
@@ -481,7 +418,7 @@ impl PioneerDriver {
                     failures.note(Failure::Publish, &e);
                 }
             }
-            if let Some(h) = self.hosts.lift.as_mut() {
+            if let Some(h) = self.hosts.actarray_mut(1) {
                 h.set_flags(flags & device_flag::LINK_UP);
                 robot.lift_state(h.state_mut());
                 h.state_mut().header.stamp_ns = monotonic_ns();
@@ -529,61 +466,28 @@ impl PioneerDriver {
         }
         s.reconnects = self.reconnects;
         s.link_faults = self.link_faults;
-        let (mut c, mut r, mut q, mut o) = (0, 0, 0, 0);
-        let mut add = |st: limber_services::HostStats| {
-            c += st.commands;
-            r += st.refused;
-            q += st.requests;
-            o += st.overflows;
-        };
-        if let Some(h) = &self.hosts.arm {
-            add(h.stats())
-        }
-        if let Some(h) = &self.hosts.limb {
-            add(h.stats())
-        }
-        if let Some(h) = &self.hosts.armgrip {
-            add(h.stats())
-        }
-        if let Some(h) = &self.hosts.gripper {
-            add(h.stats())
-        }
-        if let Some(h) = &self.hosts.lift {
-            add(h.stats())
-        }
-        s.commands = c;
-        s.refused = r;
-        s.requests = q;
-        s.cmd_overflows = o;
+        let st = self.hosts.stats();
+        s.commands = st.commands;
+        s.refused = st.refused;
+        s.requests = st.requests;
+        s.cmd_overflows = st.overflows;
         if let Err(e) = self.stats_pub.publish(s) {
             self.failures.note(Failure::Publish, &e);
         }
     }
 
     /// Handles the pending commands and requests of every device. Spinning: commands on
-    /// every call, requests on every 16th ([`DeviceHost::process_spin`]).
+    /// every call, requests on every 16th ([`DeviceSet::process_spin`]).
     fn process_clients(&mut self, spin: bool) {
-        macro_rules! serve {
-            ($failures:expr, $host:expr, $handler:expr) => {
-                if let Some(h) = $host.as_mut() {
-                    let r = if spin {
-                        h.process_spin(&mut $handler)
-                    } else {
-                        h.process(&mut $handler)
-                    };
-                    if let Err(e) = r {
-                        $failures.note(Failure::Process, &e);
-                    }
-                }
-            };
+        let mut handler = Serve(&mut self.robot);
+        let r = if spin {
+            self.hosts.process_spin(&mut handler)
+        } else {
+            self.hosts.process(&mut handler)
+        };
+        if let Err(e) = r {
+            self.failures.note(Failure::Process, &e);
         }
-        let robot = &mut self.robot;
-        let failures = &mut self.failures;
-        serve!(failures, self.hosts.arm, ArmH(robot));
-        serve!(failures, self.hosts.limb, LimbH(robot));
-        serve!(failures, self.hosts.armgrip, ArmGripH(robot));
-        serve!(failures, self.hosts.gripper, GripperH(robot));
-        serve!(failures, self.hosts.lift, LiftH(robot));
     }
 
     /// Reads every packet the link has; returns false when the link failed.
@@ -697,9 +601,7 @@ impl PioneerDriver {
         // Housekeeping (allocates inside iceoryx2): resources of crashed clients.
         if now.duration_since(self.last_cleanup) > Duration::from_secs(60) {
             self.last_cleanup = now;
-            if let Some(h) = &self.hosts.arm {
-                h.cleanup_dead();
-            }
+            self.hosts.cleanup_dead();
         }
     }
 
@@ -731,28 +633,7 @@ impl PioneerDriver {
     }
 
     fn run_event(&mut self, stop: &mut dyn FnMut() -> bool) -> Result<LoopExit, DriverError> {
-        let listeners: Vec<_> = [
-            self.hosts.arm.as_mut().and_then(|h| h.take_wake_listener()),
-            self.hosts
-                .limb
-                .as_mut()
-                .and_then(|h| h.take_wake_listener()),
-            self.hosts
-                .armgrip
-                .as_mut()
-                .and_then(|h| h.take_wake_listener()),
-            self.hosts
-                .gripper
-                .as_mut()
-                .and_then(|h| h.take_wake_listener()),
-            self.hosts
-                .lift
-                .as_mut()
-                .and_then(|h| h.take_wake_listener()),
-        ]
-        .into_iter()
-        .flatten()
-        .collect();
+        let listeners = self.hosts.take_wake_listeners();
         let tick = self.robot.cfg.tick();
         let nominal = tick.as_nanos() as u64;
         loop {
