@@ -1,17 +1,17 @@
 //! The scenarios: the [`Scenario`] trait, the registry, and what a run shares
 //! ([`RunCtx`]).
 //!
-//! Adding a scenario (e.g. `loop` once the Pioneer driver and its emulator expose
-//! per-stage stamps) means implementing [`Scenario`] — run it, push [`Measurement`]s with
-//! [`RunCtx::push`] — and replacing its placeholder in [`registry`]; if it needs child
-//! processes, add a role to [`crate::roles::run_role`]. Ratios against the floor and
+//! Adding a scenario means implementing [`Scenario`] — run it, push [`Measurement`]s with
+//! [`RunCtx::push`] — and listing it in [`registry`]; if it needs child processes, add a
+//! role to [`crate::roles::run_role`] (`request` and `loop`, in [`pty_loop`], are worked
+//! examples with a driver child). Ratios against the floor and
 //! the peers are defined in [`crate::report::RATIOS`].
 
 pub mod command;
 pub mod floor;
 pub mod ik;
 pub mod peers;
-pub mod pending;
+pub mod pty_loop;
 pub mod request;
 pub mod state;
 
@@ -53,7 +53,7 @@ pub fn registry() -> Vec<Box<dyn Scenario>> {
         Box::new(peers::Peers),
         Box::new(ik::Ik),
         Box::new(request::Request),
-        Box::new(pending::Loop),
+        Box::new(pty_loop::Loop),
     ]
 }
 

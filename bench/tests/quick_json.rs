@@ -1,6 +1,7 @@
-//! End to end: the quick mode of cheap scenarios (floor, ik, and the `loop` placeholder) with
-//! small counts, through the real binary and its child processes; checks the structure
-//! of the JSON report and of the SVG plot. Asserts structure, never speed.
+//! End to end: the quick mode of cheap scenarios (floor, ik, and `loop` through the
+//! emulator over a pty) with small counts, through the real binary and its child
+//! processes; checks the structure of the JSON report and of the SVG plot. Asserts
+//! structure, never speed.
 
 use std::process::Command;
 

@@ -326,6 +326,9 @@ impl Emulator {
 
 impl Drop for Emulator {
     fn drop(&mut self) {
-        let _ = self.shutdown();
+        // `stop` reports how the thread ended; dropped without it, the log does.
+        if let Err(e) = self.shutdown() {
+            tracing::warn!(error = %e, "the emulator ended with an error");
+        }
     }
 }

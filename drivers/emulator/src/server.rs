@@ -81,8 +81,11 @@ impl Endpoint {
                 *slave = None;
             }
             Endpoint::Tcp { client, .. } => {
-                if let Some(c) = client.take() {
-                    let _ = c.shutdown(std::net::Shutdown::Both);
+                if let Some(c) = client.take()
+                    && let Err(e) = c.shutdown(std::net::Shutdown::Both)
+                {
+                    // The client may have closed its end already.
+                    tracing::debug!(error = %e, "shutting down the emulator's TCP client");
                 }
             }
         }
@@ -145,10 +148,18 @@ fn wait_input(ep: &mut Endpoint, buf: &mut [u8], timeout: Duration) -> io::Resul
                 match listener.accept() {
                     Ok((s, _)) => {
                         s.set_nonblocking(false)?;
-                        let _ = s.set_nodelay(true);
+                        if let Err(e) = s.set_nodelay(true) {
+                            tracing::warn!(
+                                error = %e,
+                                "cannot set TCP_NODELAY on the emulator's client; replies may be delayed"
+                            );
+                        }
                         s.set_write_timeout(Some(Duration::from_millis(200)))?;
-                        if let Some(old) = client.replace(s) {
-                            let _ = old.shutdown(std::net::Shutdown::Both);
+                        if let Some(old) = client.replace(s)
+                            && let Err(e) = old.shutdown(std::net::Shutdown::Both)
+                        {
+                            // The replaced client may have closed its end already.
+                            tracing::debug!(error = %e, "shutting down the replaced TCP client");
                         }
                         return Ok(Input::NewClient);
                     }

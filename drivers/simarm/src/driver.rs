@@ -108,6 +108,18 @@ impl DeviceHandler<Gripper> for GripH<'_> {
     }
 }
 
+/// What [`SimArm::run`] survived: failures it skipped, each retried at the next wake-up
+/// or tick. Each is logged too (a warning when a run of failures starts, debug while it
+/// repeats).
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
+pub struct SimArmFailures {
+    /// Wake-ups whose commands or requests could not all be received
+    /// ([`SimArm::process`] failed).
+    pub process: u64,
+    /// Ticks whose states could not all be published ([`SimArm::publish_all`] failed).
+    pub publish: u64,
+}
+
 /// The simulated arm: serves `<robot>/actarray/0` (the chain's joints, then the gripper
 /// opening as the last actuator), `<robot>/limb/0` and `<robot>/gripper/0`, every
 /// state flagged [`device_flag::SIMULATED`].
@@ -117,6 +129,7 @@ pub struct SimArm {
     limb_host: DeviceHost<Limb>,
     gripper_host: DeviceHost<Gripper>,
     last: Instant,
+    failures: SimArmFailures,
 }
 
 impl core::fmt::Debug for SimArm {
@@ -155,6 +168,7 @@ impl SimArm {
             limb_host,
             gripper_host,
             last: Instant::now(),
+            failures: SimArmFailures::default(),
         };
         s.publish_all()?;
         Ok(s)
@@ -163,6 +177,11 @@ impl SimArm {
     /// The simulation (read-only: joint values, gripper, object).
     pub fn model(&self) -> &ArmModel {
         &self.model
+    }
+
+    /// The failures [`run`](Self::run) survived so far.
+    pub fn failures(&self) -> SimArmFailures {
+        self.failures
     }
 
     /// Advances the simulation to now (real time since the last call, times the time
@@ -198,7 +217,8 @@ impl SimArm {
     /// Serves until SIGINT/SIGTERM ([`LoopExit::Signal`]) or until `stop` returns true
     /// (checked at every wake-up, [`LoopExit::Stopped`]): advances the simulation and
     /// publishes every device each tick, handles clients as they wake it. Transient
-    /// publish or receive failures are skipped (the next tick retries). The wake
+    /// publish or receive failures are skipped (the next tick retries), counted in
+    /// [`failures`](Self::failures) and logged. The wake
     /// listeners move into the loop: a second `run` reacts to clients only on ticks.
     pub fn run(&mut self, mut stop: impl FnMut() -> bool) -> Result<LoopExit, SimArmError> {
         let listeners: Vec<_> = [
@@ -211,11 +231,31 @@ impl SimArm {
         .collect();
         let tick = self.model.options().tick;
         let mut housekeeping = 0u32;
+        let (mut process_failing, mut publish_failing) = (false, false);
         self.last = Instant::now();
         let exit = event_loop::run(&listeners, tick, None, |wake| {
-            let _ = self.process();
+            match self.process() {
+                Ok(_) => process_failing = false,
+                Err(e) => {
+                    self.failures.process += 1;
+                    let n = self.failures.process;
+                    survived(
+                        &mut process_failing,
+                        "receiving commands and requests",
+                        &e,
+                        n,
+                    );
+                }
+            }
             if let Wake::Tick(_) = wake {
-                let _ = self.publish_all();
+                match self.publish_all() {
+                    Ok(()) => publish_failing = false,
+                    Err(e) => {
+                        self.failures.publish += 1;
+                        let n = self.failures.publish;
+                        survived(&mut publish_failing, "publishing the states", &e, n);
+                    }
+                }
                 housekeeping += 1;
                 if u128::from(housekeeping) * tick.as_millis().max(1) >= 1000 {
                     housekeeping = 0;
@@ -232,4 +272,20 @@ impl SimArm {
         })?;
         Ok(exit)
     }
+}
+
+/// Logs a failure the run loop survives: a warning when a run of failures starts, debug
+/// while it repeats (the loop retries at every tick, so a lasting fault would flood the
+/// log). `count` is the total so far.
+fn survived(failing: &mut bool, what: &str, error: &dyn std::error::Error, count: u64) {
+    if *failing {
+        tracing::debug!(error = %error, count, "simarm: {what} failed again");
+    } else {
+        tracing::warn!(
+            error = %error,
+            count,
+            "simarm: {what} failed; skipped, retried at the next tick"
+        );
+    }
+    *failing = true;
 }

@@ -31,5 +31,5 @@
 mod driver;
 pub mod model;
 
-pub use driver::{DRIVER_NAME, SimArm, SimArmError};
+pub use driver::{DRIVER_NAME, SimArm, SimArmError, SimArmFailures};
 pub use model::{ArmModel, OptionsError, SimArmOptions, SimObject};

@@ -1,0 +1,251 @@
+//! SETPOSITION: a position without an orientation. The 5-DOF arm reaches most positions
+//! with many approach vectors; [`PioneerGeometry::solve_position`] picks one
+//! deterministically, preferring the caller's approach, then the arm's vertical plane,
+//! then θ1 held on a yaw limit, then cones around the preferred approach.
+
+use std::f64::consts::{PI, TAU};
+
+use nalgebra::Vector3;
+
+use super::ik::WristGoal;
+use super::{
+    EXACT_ORIENTATION, EXACT_POSITION, IkCandidate, LIMIT_TOLERANCE, PioneerGeometry,
+    PioneerIkError, PioneerIkOptions, Theta, joint_distance,
+};
+use crate::pose::{FrameError, all_finite, fit_angle_to_limits};
+
+/// Where SETPOSITION should look for an approach vector.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ApproachPreference {
+    /// Keep the current approach (FK of the current joints) if possible.
+    Current,
+    /// Point the gripper straight down (−z).
+    Down,
+    /// Prefer this direction (any non-zero length).
+    Direction(Vector3<f64>),
+}
+
+impl PioneerGeometry {
+    /// SETPOSITION (position only, relative to the arm base). The approach is chosen
+    /// deterministically, in this order:
+    ///
+    /// 1. the preferred approach itself, if an in-limit solution attains it;
+    /// 2. the approach *in the arm's vertical plane* (through the yaw axis and the
+    ///    target, so the wrist roll is 0 or π and the gripper stays level) nearest in
+    ///    angle to the preferred one: elevations are scanned outward from the preferred
+    ///    approach's elevation in steps of [`PioneerIkOptions::approach_search_step`],
+    ///    alternately up and down, and the first feasible one is refined by bisection
+    ///    towards the preferred elevation to 1e-9 rad;
+    /// 3. if that plane lies beyond the base yaw limits, θ1 held on a limit, with the
+    ///    wrist centre scanned (same step) around the circle where that arm plane cuts
+    ///    the sphere of radius L5 about the target, keeping the feasible approach
+    ///    closest to the preferred one;
+    /// 4. failing that, approaches out of the plane, on cones around the preferred one
+    ///    five search steps apart, and finally the direction from the shoulder circle to
+    ///    the target (the only approach at full stretch).
+    ///
+    /// For the chosen approach the in-limit solution nearest to `current` wins. The
+    /// result's `orientation_error` is the error to the chosen approach. Fails with
+    /// [`PioneerIkError::OutOfReach`] when the position is beyond L2 + L4 + L5 from the
+    /// shoulder circle or no approach reaches it, and with
+    /// [`PioneerIkError::OutsideJointLimits`] when solutions exist only outside the
+    /// limits.
+    pub fn solve_position(
+        &self,
+        position: &Vector3<f64>,
+        preference: ApproachPreference,
+        current: &Theta,
+        options: &PioneerIkOptions,
+    ) -> Result<IkCandidate, PioneerIkError> {
+        self.check_inputs(current, options)?;
+        if !all_finite(position) {
+            return Err(PioneerIkError::NonFinite);
+        }
+        let preferred = match preference {
+            ApproachPreference::Current => self.fk_raw(current).approach(),
+            ApproachPreference::Down => -Vector3::z(),
+            ApproachPreference::Direction(d) => {
+                if !all_finite(&d) {
+                    return Err(PioneerIkError::NonFinite);
+                }
+                let n = d.norm();
+                if n < 1e-12 {
+                    return Err(FrameError::ZeroApproach.into());
+                }
+                d / n
+            }
+        };
+        let h = position.x.hypot(position.y);
+        let from_circle = (h - self.l1).hypot(position.z);
+        let max = self.l2 + self.l4 + self.l5;
+        if from_circle > max + options.position_tolerance {
+            return Err(PioneerIkError::OutOfReach {
+                distance: from_circle,
+                min: 0.0,
+                max,
+            });
+        }
+        let mut any_exact = false;
+        // The search accepts only exact solutions (round-off), so that the bisection
+        // cannot settle on a reach boundary blurred by the tolerance; the last resort
+        // (full stretch) accepts the tolerances.
+        let strict = PioneerIkOptions {
+            position_tolerance: EXACT_POSITION,
+            orientation_tolerance: EXACT_ORIENTATION,
+            ..*options
+        };
+        let mut attempt_with = |a: &Vector3<f64>, opts: &PioneerIkOptions| {
+            let cands = self
+                .candidates(
+                    position,
+                    WristGoal::Approach(a),
+                    current,
+                    opts.position_tolerance,
+                )
+                .ok()?;
+            match cands.select(current, opts) {
+                Ok(c) => Some(c),
+                Err(PioneerIkError::OutsideJointLimits) => {
+                    any_exact = true;
+                    None
+                }
+                Err(_) => None,
+            }
+        };
+        let mut attempt = |a: &Vector3<f64>| attempt_with(a, &strict);
+        // 1. The preferred approach.
+        if let Some(c) = attempt(&preferred) {
+            return Ok(c);
+        }
+        // 2. In the vertical plane through the yaw axis and the target.
+        let yaw = if h > 1e-12 {
+            position.y.atan2(position.x)
+        } else {
+            current[0]
+        };
+        let radial = Vector3::new(yaw.cos(), yaw.sin(), 0.0);
+        let in_plane = |phi: f64| radial * phi.cos() + Vector3::z() * phi.sin();
+        let phi0 = preferred.z.atan2(preferred.dot(&radial));
+        let step = options.approach_search_step;
+        let steps = (PI / step).ceil() as usize;
+        for k in 0..=steps {
+            for sign in [1.0, -1.0] {
+                let phi = phi0 + sign * (k as f64 * step).min(PI);
+                if let Some(found) = attempt(&in_plane(phi)) {
+                    if k == 0 {
+                        return Ok(found);
+                    }
+                    let mut good = (phi, found);
+                    let mut bad = phi0 + sign * ((k - 1) as f64 * step);
+                    for _ in 0..64 {
+                        if (good.0 - bad).abs() <= 1e-9 {
+                            break;
+                        }
+                        let mid = 0.5 * (good.0 + bad);
+                        match attempt(&in_plane(mid)) {
+                            Some(c) => good = (mid, c),
+                            None => bad = mid,
+                        }
+                    }
+                    return Ok(good.1);
+                }
+                if k == 0 {
+                    break;
+                }
+            }
+        }
+        // 3. Targets whose vertical plane lies beyond the base yaw limits: hold θ1 on
+        //    a limit; the wrist centre then lies on the circle where that arm plane
+        //    cuts the sphere of radius L5 around the target. Take the feasible approach
+        //    on it closest to the preferred one.
+        let yaw_limit = self.limits[0];
+        let yaw_ok = |y: f64| {
+            fit_angle_to_limits(y, yaw_limit.min, yaw_limit.max, current[0], LIMIT_TOLERANCE)
+                .is_some()
+        };
+        if !yaw_ok(yaw) || !yaw_ok(yaw + PI) {
+            let mut best: Option<(f64, IkCandidate)> = None;
+            for t1 in [yaw_limit.min, yaw_limit.max] {
+                let (s1, c1) = t1.sin_cos();
+                let normal = Vector3::new(-s1, c1, 0.0);
+                let off = position.dot(&normal);
+                if off.abs() >= self.l5 {
+                    continue;
+                }
+                let r = (self.l5 * self.l5 - off * off).sqrt();
+                let centre = position - normal * off;
+                let e1 = Vector3::new(c1, s1, 0.0);
+                for j in 0..steps * 2 {
+                    let psi = j as f64 * step;
+                    let w = centre + (e1 * psi.cos() + Vector3::z() * psi.sin()) * r;
+                    let a = (position - w) / self.l5;
+                    if let Some(c) = attempt(&a) {
+                        let score = -a.dot(&preferred);
+                        if best.is_none_or(|(bs, _)| score < bs) {
+                            best = Some((score, c));
+                        }
+                    }
+                }
+            }
+            if let Some((_, c)) = best {
+                return Ok(c);
+            }
+        }
+        // 4. Out of the plane: cones around the preferred approach.
+        let (u, v) = perpendicular_basis(&preferred);
+        let coarse = (5.0 * step).min(PI / 4.0);
+        let rings = (PI / coarse).ceil() as usize;
+        for k in 1..=rings {
+            let cone = (k as f64 * coarse).min(PI);
+            let (sc, cc) = cone.sin_cos();
+            let count = if k == rings {
+                1
+            } else {
+                ((TAU * sc / coarse).ceil() as usize).max(1)
+            };
+            let mut best: Option<(f64, IkCandidate)> = None;
+            for j in 0..count {
+                let phi = TAU * j as f64 / count as f64;
+                let (sp, cp) = phi.sin_cos();
+                let a = preferred * cc + (u * cp + v * sp) * sc;
+                if let Some(c) = attempt(&a) {
+                    let d = joint_distance(&c.theta, current);
+                    if best.is_none_or(|(bd, _)| d < bd) {
+                        best = Some((d, c));
+                    }
+                }
+            }
+            if let Some((_, c)) = best {
+                return Ok(c);
+            }
+        }
+        if from_circle > 1e-12 {
+            let c = radial * self.l1;
+            let toward = (position - c) / from_circle;
+            if let Some(c) = attempt_with(&toward, options) {
+                return Ok(c);
+            }
+        }
+        if any_exact {
+            Err(PioneerIkError::OutsideJointLimits)
+        } else {
+            Err(PioneerIkError::OutOfReach {
+                distance: from_circle,
+                min: 0.0,
+                max,
+            })
+        }
+    }
+}
+
+/// Two unit vectors that complete `a` (a unit vector) to an orthonormal basis.
+fn perpendicular_basis(a: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    let helper = if a.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    let u = a.cross(&helper).normalize();
+    let v = a.cross(&u);
+    (u, v)
+}

@@ -1,0 +1,242 @@
+//! The actuator-array interface of the model: one actuator per chain joint plus the
+//! gripper opening, moved to a position or at a speed, with its geometry and state.
+
+use limber_interfaces::prelude::*;
+
+use limber_kinematics::chain::JointKind;
+
+use super::ArmModel;
+use super::gripper::GripperCmd;
+
+impl ArmModel {
+    /// Carries out or refuses an actuator-array command.
+    pub fn arm_command(&mut self, cmd: &ActArrayCommand) -> Status {
+        let r = self.arm_command_inner(cmd);
+        r.err().unwrap_or(Status::Ok)
+    }
+
+    fn arm_command_inner(&mut self, cmd: &ActArrayCommand) -> Result<(), Status> {
+        match *cmd {
+            ActArrayCommand::Position { joint, position } => {
+                let j = joint as usize;
+                self.check(j, position)?;
+                self.powered()?;
+                if j < self.n {
+                    self.vecmove.active = false;
+                }
+                self.move_actuator(j, position, None);
+                Ok(())
+            }
+            ActArrayCommand::MultiPosition(v) => {
+                let v = v.as_slice();
+                if v.len() > self.actuators() {
+                    return Err(Status::UnknownJoint);
+                }
+                for (j, p) in v.iter().enumerate() {
+                    self.check(j, *p)?;
+                }
+                self.powered()?;
+                self.vecmove.active = false;
+                for (j, p) in v.iter().enumerate() {
+                    self.move_actuator(j, *p, None);
+                }
+                Ok(())
+            }
+            ActArrayCommand::Speed { joint, speed } => {
+                let j = joint as usize;
+                self.check_speed_target(j, speed)?;
+                self.powered()?;
+                if j < self.n {
+                    self.vecmove.active = false;
+                }
+                self.move_at_speed(j, speed);
+                Ok(())
+            }
+            ActArrayCommand::MultiSpeed(v) => {
+                let v = v.as_slice();
+                if v.len() > self.actuators() {
+                    return Err(Status::UnknownJoint);
+                }
+                for (j, s) in v.iter().enumerate() {
+                    self.check_speed_target(j, *s)?;
+                }
+                self.powered()?;
+                self.vecmove.active = false;
+                for (j, s) in v.iter().enumerate() {
+                    self.move_at_speed(j, *s);
+                }
+                Ok(())
+            }
+            ActArrayCommand::Home(JointSel::All) => {
+                self.powered()?;
+                self.vecmove.active = false;
+                for j in 0..self.n {
+                    let h = self.chain.joints()[j].home;
+                    self.move_actuator(j, h, None);
+                }
+                let open = self.gripper_stroke;
+                self.move_actuator(self.n, open, None);
+                self.gripper_cmd = GripperCmd::Open;
+                Ok(())
+            }
+            ActArrayCommand::Home(JointSel::One(j)) => {
+                let j = j as usize;
+                if j > self.n {
+                    return Err(Status::UnknownJoint);
+                }
+                self.powered()?;
+                if j < self.n {
+                    self.vecmove.active = false;
+                    let h = self.chain.joints()[j].home;
+                    self.move_actuator(j, h, None);
+                } else {
+                    let open = self.gripper_stroke;
+                    self.move_actuator(j, open, None);
+                    self.gripper_cmd = GripperCmd::Open;
+                }
+                Ok(())
+            }
+            ActArrayCommand::Current { .. } | ActArrayCommand::MultiCurrent(_) => {
+                Err(Status::Unsupported)
+            }
+        }
+    }
+
+    fn check_speed_target(&self, j: usize, speed: f64) -> Result<(), Status> {
+        self.joint_limits(j).ok_or(Status::UnknownJoint)?;
+        if !speed.is_finite() {
+            return Err(Status::NotFinite);
+        }
+        Ok(())
+    }
+
+    /// Moves actuator `j` toward its limit in the direction of `speed`'s sign at
+    /// |speed| (capped at the actuator's maximum speed); 0 stops it.
+    fn move_at_speed(&mut self, j: usize, speed: f64) {
+        if speed == 0.0 {
+            if j < self.n {
+                self.joints[j].stop();
+            } else {
+                self.gripper.stop();
+            }
+            return;
+        }
+        let Some((lo, hi)) = self.joint_limits(j) else {
+            return;
+        };
+        let end = if speed > 0.0 { hi } else { lo };
+        let max = if j < self.n {
+            self.chain.joints()[j].max_speed
+        } else {
+            self.gripper_max_speed
+        };
+        self.move_actuator(j, end, Some(speed.abs().min(max)));
+    }
+
+    /// Answers an actuator-array request.
+    pub fn arm_request(&mut self, req: &ActArrayRequest) -> Result<ActArrayReply, Status> {
+        match *req {
+            ActArrayRequest::Power(on) => {
+                self.set_power(on);
+                Ok(ActArrayReply::Done)
+            }
+            ActArrayRequest::GetGeom => Ok(ActArrayReply::Geom(self.arm_geometry())),
+            ActArrayRequest::Speed { joint, speed } => {
+                let j = joint as usize;
+                if j > self.n {
+                    return Err(Status::UnknownJoint);
+                }
+                if !speed.is_finite() {
+                    return Err(Status::NotFinite);
+                }
+                if speed <= 0.0 {
+                    return Err(Status::InvalidArgument);
+                }
+                if j < self.n {
+                    self.config_speed[j] = speed.min(self.chain.joints()[j].max_speed);
+                } else {
+                    self.gripper_config_speed = speed.min(self.gripper_max_speed);
+                }
+                Ok(ActArrayReply::Done)
+            }
+            ActArrayRequest::Brakes(_) | ActArrayRequest::Accel { .. } => Err(Status::Unsupported),
+        }
+    }
+
+    /// Switches the power; off stops every actuator.
+    pub(super) fn set_power(&mut self, on: bool) {
+        self.powered = on;
+        if !on {
+            self.stop_all_joints();
+            self.gripper.stop();
+        }
+    }
+
+    /// The actuator-array geometry: per joint its kind, axis, rest orientation (roll,
+    /// pitch, yaw), link length (the joint's origin offset), limits, centre, home and
+    /// configured speed; the gripper last (linear, 0 to the stroke, home open); the
+    /// chain base.
+    pub fn arm_geometry(&self) -> ActArrayGeom {
+        let mut g = ActArrayGeom {
+            actuators_count: self.actuators() as u32,
+            ..Default::default()
+        };
+        for (i, j) in self.chain.joints().iter().enumerate() {
+            let (roll, pitch, yaw) = j.rest.euler_angles();
+            let axis = j.axis.into_inner();
+            g.actuators[i] = ActuatorGeom {
+                kind: match j.kind {
+                    JointKind::Rotary => ActuatorKind::Rotary,
+                    JointKind::Linear => ActuatorKind::Linear,
+                } as u32,
+                has_brakes: 0,
+                length: j.origin.norm(),
+                orientation: Orientation3 { roll, pitch, yaw },
+                axis: Vec3::new(axis.x, axis.y, axis.z),
+                min: j.min,
+                centre: 0.5 * (j.min + j.max),
+                max: j.max,
+                home: j.home,
+                config_speed: self.config_speed[i],
+            };
+        }
+        g.actuators[self.n] = ActuatorGeom {
+            kind: ActuatorKind::Linear as u32,
+            has_brakes: 0,
+            length: 0.0,
+            orientation: Orientation3::default(),
+            axis: Vec3::new(0.0, 1.0, 0.0),
+            min: 0.0,
+            centre: 0.5 * self.gripper_stroke,
+            max: self.gripper_stroke,
+            home: self.gripper_stroke,
+            config_speed: self.gripper_config_speed,
+        };
+        let base = self.chain.base();
+        let (roll, pitch, yaw) = base.rotation.euler_angles();
+        g.base_pos = Vec3::new(base.position.x, base.position.y, base.position.z);
+        g.base_orientation = Orientation3 { roll, pitch, yaw };
+        g
+    }
+
+    /// Fills the actuator-array state (positions, velocities, IDLE/MOVING/STALLED).
+    pub fn arm_state(&self, s: &mut ActArrayData) {
+        s.actuators_count = self.actuators() as u32;
+        s.motor_state = self.powered as u32;
+        let all = self.joints[..self.n].iter().chain(Some(&self.gripper));
+        for (a, m) in s.actuators.iter_mut().zip(all) {
+            a.position = m.pos;
+            a.speed = m.velocity;
+            a.acceleration = -1.0;
+            a.current = -1.0;
+            a.state = if m.stalled {
+                ActuatorFlags::STALLED
+            } else if m.moving {
+                ActuatorFlags::MOVING
+            } else {
+                ActuatorFlags::IDLE
+            }
+            .bits();
+        }
+    }
+}
