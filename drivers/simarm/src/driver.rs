@@ -1,4 +1,4 @@
-//! The simulated arm on the services layer: three [`DeviceHost`]s around one
+//! The simulated arm on the services layer: a [`DeviceSet`] of three devices around one
 //! [`ArmModel`], advanced and published on a timer tick.
 
 use core::ops::ControlFlow;
@@ -7,7 +7,7 @@ use std::time::Instant;
 use limber_interfaces::common::device_flag;
 use limber_services::event_loop::{self, LoopError, LoopExit, Wake};
 use limber_services::prelude::*;
-use limber_services::{HostError, ProcessError, PublishError};
+use limber_services::{DeviceError, HostError, ProcessError, PublishError};
 
 use limber_kinematics::chain::Chain;
 
@@ -25,43 +25,39 @@ pub enum SimArmError {
     /// The options (tick, time scale, object) are invalid.
     #[error("invalid simarm options: {0}")]
     Options(#[from] OptionsError),
-    /// The robot name does not make valid device names.
-    #[error("invalid robot name {robot:?}: {reason}")]
-    RobotName {
-        /// The name.
-        robot: String,
-        /// Why.
-        reason: String,
-    },
-    /// The domain or the driver context could not be set up.
-    #[error("cannot join the domain: {0}")]
-    Setup(String),
     /// A device could not be offered (another driver serves it?).
     #[error(transparent)]
     Host(#[from] HostError),
     /// A state could not be published.
     #[error(transparent)]
-    Publish(#[from] PublishError),
+    Publish(#[from] DeviceError<PublishError>),
     /// Commands or requests could not be received.
     #[error(transparent)]
-    Process(#[from] ProcessError),
+    Process(#[from] DeviceError<ProcessError>),
     /// The event loop failed.
     #[error(transparent)]
     Loop(#[from] LoopError),
 }
 
-struct ArmH<'a>(&'a mut ArmModel);
-struct LimbH<'a>(&'a mut ArmModel);
-struct GripH<'a>(&'a mut ArmModel);
+/// The handler of the three devices (each index 0): borrows the model for one `process`
+/// call; every answer also refreshes the device's state in place.
+struct Serve<'a>(&'a mut ArmModel);
 
-impl DeviceHandler<ActArray> for ArmH<'_> {
-    fn command(&mut self, cmd: &ActArrayCommand, _: &Origin, state: &mut ActArrayData) -> Status {
+impl DeviceSetHandler for Serve<'_> {
+    fn actarray_command(
+        &mut self,
+        _: u16,
+        cmd: &ActArrayCommand,
+        _: &Origin,
+        state: &mut ActArrayData,
+    ) -> Status {
         let s = self.0.arm_command(cmd);
         self.0.arm_state(state);
         s
     }
-    fn request(
+    fn actarray_request(
         &mut self,
+        _: u16,
         req: &ActArrayRequest,
         _: &Origin,
         state: &mut ActArrayData,
@@ -70,16 +66,20 @@ impl DeviceHandler<ActArray> for ArmH<'_> {
         self.0.arm_state(state);
         r
     }
-}
-
-impl DeviceHandler<Limb> for LimbH<'_> {
-    fn command(&mut self, cmd: &LimbCommand, _: &Origin, state: &mut LimbData) -> Status {
+    fn limb_command(
+        &mut self,
+        _: u16,
+        cmd: &LimbCommand,
+        _: &Origin,
+        state: &mut LimbData,
+    ) -> Status {
         let s = self.0.limb_command(cmd);
         self.0.limb_state(state);
         s
     }
-    fn request(
+    fn limb_request(
         &mut self,
+        _: u16,
         req: &LimbRequest,
         _: &Origin,
         state: &mut LimbData,
@@ -88,16 +88,20 @@ impl DeviceHandler<Limb> for LimbH<'_> {
         self.0.limb_state(state);
         r
     }
-}
-
-impl DeviceHandler<Gripper> for GripH<'_> {
-    fn command(&mut self, cmd: &GripperCommand, _: &Origin, state: &mut GripperData) -> Status {
+    fn gripper_command(
+        &mut self,
+        _: u16,
+        cmd: &GripperCommand,
+        _: &Origin,
+        state: &mut GripperData,
+    ) -> Status {
         let s = self.0.gripper_command(cmd);
         self.0.gripper_state(state);
         s
     }
-    fn request(
+    fn gripper_request(
         &mut self,
+        _: u16,
         req: &GripperRequest,
         _: &Origin,
         state: &mut GripperData,
@@ -125,9 +129,7 @@ pub struct SimArmFailures {
 /// state flagged [`device_flag::SIMULATED`].
 pub struct SimArm {
     model: ArmModel,
-    arm_host: DeviceHost<ActArray>,
-    limb_host: DeviceHost<Limb>,
-    gripper_host: DeviceHost<Gripper>,
+    hosts: DeviceSet,
     last: Instant,
     failures: SimArmFailures,
 }
@@ -147,26 +149,20 @@ impl SimArm {
     pub fn new(ctx: &Context, chain: Chain, options: SimArmOptions) -> Result<Self, SimArmError> {
         let robot = options.robot.clone();
         let model = ArmModel::new(chain, options)?;
-        let name = |i: InterfaceKind| {
-            DeviceName::new(&robot, i, 0).map_err(|e| SimArmError::RobotName {
-                robot: robot.clone(),
-                reason: e.to_string(),
-            })
-        };
-        let mut arm_host =
-            DeviceHost::<ActArray>::new(ctx, &name(InterfaceKind::ActArray)?, DRIVER_NAME)?;
-        let mut limb_host = DeviceHost::<Limb>::new(ctx, &name(InterfaceKind::Limb)?, DRIVER_NAME)?;
-        let mut gripper_host =
-            DeviceHost::<Gripper>::new(ctx, &name(InterfaceKind::Gripper)?, DRIVER_NAME)?;
-        let flags = device_flag::SIMULATED | device_flag::LINK_UP | device_flag::CALIBRATED;
-        arm_host.set_flags(flags);
-        limb_host.set_flags(flags);
-        gripper_host.set_flags(flags);
+        let mut hosts = DeviceSet::new(
+            ctx,
+            &robot,
+            DRIVER_NAME,
+            &[
+                (InterfaceKind::ActArray, 0),
+                (InterfaceKind::Limb, 0),
+                (InterfaceKind::Gripper, 0),
+            ],
+        )?;
+        hosts.set_flags(device_flag::SIMULATED | device_flag::LINK_UP | device_flag::CALIBRATED);
         let mut s = SimArm {
             model,
-            arm_host,
-            limb_host,
-            gripper_host,
+            hosts,
             last: Instant::now(),
             failures: SimArmFailures::default(),
         };
@@ -194,24 +190,25 @@ impl SimArm {
     }
 
     /// Fills and publishes the state of all three devices.
-    pub fn publish_all(&mut self) -> Result<(), PublishError> {
-        self.model.arm_state(self.arm_host.state_mut());
-        self.model.limb_state(self.limb_host.state_mut());
-        self.model.gripper_state(self.gripper_host.state_mut());
-        let now = monotonic_ns();
-        self.arm_host.publish_acquired(now)?;
-        self.limb_host.publish_acquired(now)?;
-        self.gripper_host.publish_acquired(now)
+    pub fn publish_all(&mut self) -> Result<(), DeviceError<PublishError>> {
+        if let Some(h) = self.hosts.actarray_mut(0) {
+            self.model.arm_state(h.state_mut());
+        }
+        if let Some(h) = self.hosts.limb_mut(0) {
+            self.model.limb_state(h.state_mut());
+        }
+        if let Some(h) = self.hosts.gripper_mut(0) {
+            self.model.gripper_state(h.state_mut());
+        }
+        self.hosts.publish_all(monotonic_ns())
     }
 
     /// Handles every pending command and request of the three devices (the simulation
     /// is advanced to now first); never blocks. Returns how many there were.
-    pub fn process(&mut self) -> Result<usize, ProcessError> {
+    pub fn process(&mut self) -> Result<usize, DeviceError<ProcessError>> {
         self.advance();
-        let a = self.arm_host.process(&mut ArmH(&mut self.model))?;
-        let l = self.limb_host.process(&mut LimbH(&mut self.model))?;
-        let g = self.gripper_host.process(&mut GripH(&mut self.model))?;
-        Ok(a.commands + a.requests + l.commands + l.requests + g.commands + g.requests)
+        let a = self.hosts.process(&mut Serve(&mut self.model))?;
+        Ok(a.total())
     }
 
     /// Serves until SIGINT/SIGTERM ([`LoopExit::Signal`]) or until `stop` returns true
@@ -221,14 +218,7 @@ impl SimArm {
     /// [`failures`](Self::failures) and logged. The wake
     /// listeners move into the loop: a second `run` reacts to clients only on ticks.
     pub fn run(&mut self, mut stop: impl FnMut() -> bool) -> Result<LoopExit, SimArmError> {
-        let listeners: Vec<_> = [
-            self.arm_host.take_wake_listener(),
-            self.limb_host.take_wake_listener(),
-            self.gripper_host.take_wake_listener(),
-        ]
-        .into_iter()
-        .flatten()
-        .collect();
+        let listeners = self.hosts.take_wake_listeners();
         let tick = self.model.options().tick;
         let mut housekeeping = 0u32;
         let (mut process_failing, mut publish_failing) = (false, false);
@@ -259,9 +249,7 @@ impl SimArm {
                 housekeeping += 1;
                 if u128::from(housekeeping) * tick.as_millis().max(1) >= 1000 {
                     housekeeping = 0;
-                    self.arm_host.cleanup_dead();
-                    self.limb_host.cleanup_dead();
-                    self.gripper_host.cleanup_dead();
+                    self.hosts.cleanup_dead();
                 }
             }
             if stop() {
