@@ -211,10 +211,14 @@ impl ChildProc {
     }
 
     fn kill(&mut self) {
-        if let Ok(None) = self.child.try_wait() {
-            let _ = self.child.kill();
+        if let Ok(None) = self.child.try_wait()
+            && let Err(e) = self.child.kill()
+        {
+            tracing::warn!("cannot kill a benchmark child: {e}");
         }
-        let _ = self.child.wait();
+        if let Err(e) = self.child.wait() {
+            tracing::warn!("cannot reap a benchmark child: {e}");
+        }
     }
 }
 

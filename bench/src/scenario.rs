@@ -251,6 +251,8 @@ impl RunCtx {
 
 impl Drop for RunCtx {
     fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.tmp);
+        if let Err(e) = std::fs::remove_dir_all(&self.tmp) {
+            tracing::debug!("cannot remove {}: {e}", self.tmp.display());
+        }
     }
 }

@@ -3,9 +3,47 @@
 //! processes; checks the structure of the JSON report and of the SVG plot. Asserts
 //! structure, never speed.
 
-use std::process::Command;
+use std::io::Read;
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
 
 use serde_json::Value;
+
+/// Runs `cmd` to completion within `limit`; kills it and fails the test after that.
+fn output_within(cmd: &mut Command, limit: Duration) -> Output {
+    let mut child = cmd
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the benchmark binary runs");
+    let drain = |mut r: Box<dyn Read + Send>| {
+        std::thread::spawn(move || {
+            let mut v = Vec::new();
+            r.read_to_end(&mut v).expect("read the child's output");
+            v
+        })
+    };
+    let out = drain(Box::new(child.stdout.take().expect("piped stdout")));
+    let err = drain(Box::new(child.stderr.take().expect("piped stderr")));
+    let deadline = Instant::now() + limit;
+    let status = loop {
+        if let Some(st) = child.try_wait().expect("wait for the benchmark") {
+            break st;
+        }
+        if Instant::now() > deadline {
+            child.kill().expect("kill the benchmark");
+            child.wait().expect("reap the benchmark");
+            panic!("limber-bench did not finish within {limit:?}");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    Output {
+        status,
+        stdout: out.join().expect("stdout reader"),
+        stderr: err.join().expect("stderr reader"),
+    }
+}
 
 #[test]
 fn quick_run_writes_a_well_formed_report() {
@@ -13,15 +51,16 @@ fn quick_run_writes_a_well_formed_report() {
     std::fs::create_dir_all(&dir).unwrap();
     let json = dir.join("report.json");
     let svg = dir.join("report.svg");
-    let out = Command::new(env!("CARGO_BIN_EXE_limber-bench"))
-        .args(["--quick", "--scale", "0.1", "--no-progress", "--only"])
-        .arg("floor,ik,loop")
-        .arg("--json")
-        .arg(&json)
-        .arg("--plot")
-        .arg(&svg)
-        .output()
-        .expect("the benchmark binary runs");
+    let out = output_within(
+        Command::new(env!("CARGO_BIN_EXE_limber-bench"))
+            .args(["--quick", "--scale", "0.1", "--no-progress", "--only"])
+            .arg("floor,ik,loop")
+            .arg("--json")
+            .arg(&json)
+            .arg("--plot")
+            .arg(&svg),
+        Duration::from_secs(600),
+    );
     assert!(
         out.status.success(),
         "limber-bench failed: {}\n{}",
@@ -98,15 +137,15 @@ fn quick_run_writes_a_well_formed_report() {
     let svg_text = std::fs::read_to_string(&svg).unwrap();
     assert!(svg_text.starts_with("<svg"), "not an SVG");
     assert!(svg_text.contains("polyline") || svg_text.contains("path"));
-    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::remove_dir_all(&dir).expect("remove the test's directory");
 }
 
 #[test]
 fn unknown_scenario_is_an_error_not_a_panic() {
-    let out = Command::new(env!("CARGO_BIN_EXE_limber-bench"))
-        .args(["--only", "nosuch"])
-        .output()
-        .expect("the benchmark binary runs");
+    let out = output_within(
+        Command::new(env!("CARGO_BIN_EXE_limber-bench")).args(["--only", "nosuch"]),
+        Duration::from_secs(60),
+    );
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("unknown scenario"), "{err}");

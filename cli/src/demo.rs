@@ -59,8 +59,10 @@ struct Running {
 impl Drop for Running {
     fn drop(&mut self) {
         self.stop.store(true, Ordering::Relaxed);
-        if let Some(t) = self.thread.take() {
-            let _ = t.join();
+        if let Some(t) = self.thread.take()
+            && t.join().is_err()
+        {
+            tracing::error!("the demo's driver thread panicked");
         }
     }
 }
@@ -78,7 +80,7 @@ fn start_pioneer(domain: &Domain) -> Result<Running, CliError> {
             let emu = match Emulator::start_pty(EmulatorConfig::default()) {
                 Ok(e) => e,
                 Err(e) => {
-                    let _ = tx.send(Err(format!("cannot start the emulator: {e}")));
+                    report(&tx, Err(format!("cannot start the emulator: {e}")));
                     return;
                 }
             };
@@ -89,7 +91,7 @@ fn start_pioneer(domain: &Domain) -> Result<Running, CliError> {
             let ctx = match Context::new(&d, Role::Driver, "pioneer") {
                 Ok(c) => c,
                 Err(e) => {
-                    let _ = tx.send(Err(e.to_string()));
+                    report(&tx, Err(e.to_string()));
                     return;
                 }
             };
@@ -100,15 +102,19 @@ fn start_pioneer(domain: &Domain) -> Result<Running, CliError> {
             let mut driver = match PioneerDriver::start(&ctx, cfg, emu.link_target()) {
                 Ok(d) => d,
                 Err(e) => {
-                    let _ = tx.send(Err(e.to_string()));
+                    report(&tx, Err(e.to_string()));
                     return;
                 }
             };
-            let _ = tx.send(Ok(path));
-            let _ = driver.run_until(RunOptions::default(), || s.load(Ordering::Relaxed));
+            report(&tx, Ok(path));
+            if let Err(e) = driver.run_until(RunOptions::default(), || s.load(Ordering::Relaxed)) {
+                tracing::error!("the Pioneer driver stopped: {e}");
+            }
             driver.shutdown();
             drop(driver);
-            let _ = emu.stop();
+            if let Err(e) = emu.stop() {
+                tracing::warn!("stopping the emulator: {e}");
+            }
         })
         .map_err(|e| CliError::new(exit::FAILURE, e.to_string()))?;
     match rx.recv_timeout(Duration::from_secs(30)) {
@@ -145,7 +151,7 @@ fn start_simarm(domain: &Domain) -> Result<Running, CliError> {
             let ctx = match Context::new(&d, Role::Driver, "simarm") {
                 Ok(c) => c,
                 Err(e) => {
-                    let _ = tx.send(Err(e.to_string()));
+                    report(&tx, Err(e.to_string()));
                     return;
                 }
             };
@@ -157,12 +163,14 @@ fn start_simarm(domain: &Domain) -> Result<Running, CliError> {
             let mut arm = match SimArm::new(&ctx, Chain::default_6dof(), opts) {
                 Ok(a) => a,
                 Err(e) => {
-                    let _ = tx.send(Err(e.to_string()));
+                    report(&tx, Err(e.to_string()));
                     return;
                 }
             };
-            let _ = tx.send(Ok(()));
-            let _ = arm.run(|| s.load(Ordering::Relaxed));
+            report(&tx, Ok(()));
+            if let Err(e) = arm.run(|| s.load(Ordering::Relaxed)) {
+                tracing::error!("simarm stopped: {e}");
+            }
         })
         .map_err(|e| CliError::new(exit::FAILURE, e.to_string()))?;
     match rx.recv_timeout(Duration::from_secs(30)) {
@@ -254,7 +262,9 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
     if a.fast {
         let n = arm.geometry().map(|g| g.actuators_count).unwrap_or(0) as usize;
         for j in 0..n {
-            let _ = arm.set_speed_config(j, 50.0);
+            if let Err(e) = arm.set_speed_config(j, 50.0) {
+                tracing::warn!("--fast: joint {j} keeps its speed: {e}");
+            }
         }
     }
     let mut dev = Devices::connect(
@@ -370,5 +380,13 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
             exit::FAILURE,
             format!("the program stopped: {e}"),
         )),
+    }
+}
+
+/// Sends a start-up result to the waiting main thread; if it has given up waiting (its
+/// timeout passed), there is nobody left to tell, which is logged.
+fn report<T>(tx: &mpsc::Sender<Result<T, String>>, r: Result<T, String>) {
+    if tx.send(r).is_err() {
+        tracing::debug!("the demo stopped waiting for its driver to start");
     }
 }

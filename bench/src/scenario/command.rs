@@ -122,7 +122,10 @@ fn run_mode(ctx: &mut RunCtx, spin: bool) -> Result<(), BenchError> {
     }
     progress.finish();
     // HOME all joints stops the driver.
-    let _ = client.home(None);
+    // (If the command cannot be sent, the child's deadline below ends it.)
+    if let Err(e) = client.home(None) {
+        tracing::warn!("cannot tell the driver child to stop: {e}");
+    }
     child.finish(Duration::from_secs(10))?;
     let oneway = read_histogram(&out)?;
 

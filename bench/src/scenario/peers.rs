@@ -235,7 +235,7 @@ fn run_peer(ctx: &mut RunCtx, t: Transport, spin: bool) -> Result<(), BenchError
         }
         Transport::Uds => {
             let path = ctx.tmp_file(&format!("peer-{mode}.sock"));
-            let _ = std::fs::remove_file(&path);
+            remove_stale(&path);
             let l = UnixListener::bind(&path).map_err(|e| BenchError::io("uds bind", e))?;
             spec.addr = Some(path.display().to_string());
             let child = ChildProc::spawn(&spec)?;
@@ -258,7 +258,7 @@ fn run_peer(ctx: &mut RunCtx, t: Transport, spin: bool) -> Result<(), BenchError
             child.expect("ready", READY_TIMEOUT)?;
             let r = ping(ctx, &mut s, t, spin, warm, n)?;
             drop(s);
-            let _ = std::fs::remove_file(&path);
+            remove_stale(&path);
             (r, child)
         }
     };
@@ -381,5 +381,14 @@ fn echo<S: Sock>(
         reply.header.seq = msg.meta.seq;
         reply.header.stamp_ns = monotonic_ns();
         write_full(s, reply.as_bytes(), SAMPLE_TIMEOUT)?;
+    }
+}
+
+/// Removes a socket file left by an earlier run; a missing file is the normal case.
+fn remove_stale(path: &std::path::Path) {
+    match std::fs::remove_file(path) {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => tracing::warn!("cannot remove {}: {e}", path.display()),
     }
 }

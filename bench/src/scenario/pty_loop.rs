@@ -97,7 +97,9 @@ impl Scenario for Loop {
         }
         progress.finish();
         drop(arm);
-        let _ = child.send_line("quit");
+        if let Err(e) = child.send_line("quit") {
+            tracing::warn!("cannot tell the client child to quit: {e}");
+        }
         child.finish(Duration::from_secs(10))?;
         let bytes = Some((
             core::mem::size_of::<ActArrayCmdMsg>(),

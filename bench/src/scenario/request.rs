@@ -80,7 +80,9 @@ impl Scenario for Request {
         }
         progress.finish();
         drop(arm);
-        let _ = child.send_line("quit");
+        if let Err(e) = child.send_line("quit") {
+            tracing::warn!("cannot tell the client child to quit: {e}");
+        }
         child.finish(Duration::from_secs(10))?;
         ctx.push(Measurement {
             scenario: "request",
@@ -131,7 +133,9 @@ pub fn driver_role(args: &BenchArgs) -> Result<(), BenchError> {
         },
     );
     drop(driver);
-    let _ = emu.stop();
+    if let Err(e) = emu.stop() {
+        tracing::warn!("stopping the emulator: {e}");
+    }
     r.map(|_| ())
         .map_err(|e| err("pioneer driver loop", e.to_string()))
 }

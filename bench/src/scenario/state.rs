@@ -100,7 +100,9 @@ fn fanout(ctx: &mut RunCtx, fan: usize) -> Result<(), BenchError> {
     while !subs.iter_mut().all(|s| s.exited()) && Instant::now() < until {
         std::thread::sleep(Duration::from_millis(10));
     }
-    let _ = publisher.send_line("quit");
+    if let Err(e) = publisher.send_line("quit") {
+        tracing::warn!("cannot tell the publisher child to quit: {e}");
+    }
     let mut merged = new_histogram()?;
     for s in subs {
         s.finish(Duration::from_secs(5))?;
@@ -189,8 +191,13 @@ pub fn subscriber_role(args: &BenchArgs) -> Result<(), BenchError> {
     let mut client = ActArrayClient::connect_timeout(&ctx, DEVICE, READY_TIMEOUT)
         .map_err(|e| err("connect", e.to_string()))?;
     // The first wait takes the initial state; the second creates the notify listener.
-    let _ = client.wait_state(Duration::from_millis(1));
-    let _ = client.wait_state(Duration::from_millis(1));
+    // A timeout here is expected (no new state yet); anything else is an error.
+    for _ in 0..2 {
+        match client.wait_state(Duration::from_millis(1)) {
+            Ok(_) | Err(limber_services::WaitError::Timeout(_)) => {}
+            Err(e) => return Err(err("wait for the first state", e.to_string())),
+        }
+    }
     let mut oneway = new_histogram()?;
     roles::announce("ready");
     // Sample 1 is the initial state; the warm-up follows it.

@@ -157,8 +157,11 @@ impl Link {
             .timeout(DEFAULT_WRITE_TIMEOUT)
             .open_native()
             .map_err(err)?;
-        // Stale bytes from before we opened are of no use.
-        let _ = port.clear(ClearBuffer::Input);
+        // Stale bytes from before we opened are of no use; flush_input drains them too
+        // when the device cannot clear its buffer.
+        if let Err(e) = port.clear(ClearBuffer::Input) {
+            tracing::debug!("cannot clear the input buffer of {}: {e}", path.display());
+        }
         Ok(Link::from_transport(Transport::Serial(port)))
     }
 
@@ -191,8 +194,12 @@ impl Link {
 
     /// Wraps a connected TCP stream.
     pub fn from_tcp_stream(s: TcpStream) -> Link {
-        let _ = s.set_nodelay(true);
-        let _ = s.set_write_timeout(Some(DEFAULT_WRITE_TIMEOUT));
+        if let Err(e) = s.set_nodelay(true) {
+            tracing::warn!("TCP_NODELAY not set (commands may be delayed): {e}");
+        }
+        if let Err(e) = s.set_write_timeout(Some(DEFAULT_WRITE_TIMEOUT)) {
+            tracing::warn!("no write timeout on the TCP link (a stuck peer may block): {e}");
+        }
         Link::from_transport(Transport::Tcp(s))
     }
 
@@ -231,10 +238,14 @@ impl Link {
         self.write_timeout = t;
         match &mut self.io {
             Transport::Serial(p) => {
-                let _ = p.set_timeout(t);
+                if let Err(e) = p.set_timeout(t) {
+                    tracing::warn!("cannot set the serial write timeout to {t:?}: {e}");
+                }
             }
             Transport::Tcp(s) => {
-                let _ = s.set_write_timeout(Some(t.max(Duration::from_millis(1))));
+                if let Err(e) = s.set_write_timeout(Some(t.max(Duration::from_millis(1)))) {
+                    tracing::warn!("cannot set the TCP write timeout to {t:?}: {e}");
+                }
             }
         }
     }
@@ -296,8 +307,11 @@ impl Link {
     /// Discards input: the device's buffer (serial) and everything readable
     /// now, and the decoder's buffer.
     pub fn flush_input(&mut self) -> Result<(), LinkError> {
-        if let Transport::Serial(p) = &self.io {
-            let _ = p.clear(ClearBuffer::Input);
+        if let Transport::Serial(p) = &self.io
+            && let Err(e) = p.clear(ClearBuffer::Input)
+        {
+            // Not fatal: what is readable now is drained below.
+            tracing::debug!("cannot clear the serial input buffer: {e}");
         }
         let mut scratch = [0u8; 256];
         // Bounded: a robot that streams faster than we drain cannot hold us.
@@ -430,7 +444,8 @@ impl Link {
         };
         if !ok {
             self.malformed += 1;
-            let _ = self.decoder.next_packet();
+            // Drop the malformed packet (counted above); what it held is of no use.
+            self.decoder.next_packet();
         }
         ok
     }
