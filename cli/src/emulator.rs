@@ -1,7 +1,9 @@
 //! `limber emulator`: the command-line front end.
 
 use crate::{CliError, exit};
-use limber_emulator::{Emulator, EmulatorConfig, EmulatorError, Faults, ObjectPlacement};
+use limber_emulator::{
+    ArmpacLayout, Emulator, EmulatorConfig, EmulatorError, Faults, ObjectPlacement, Timing,
+};
 use std::io::{Read, Write};
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
 use std::sync::Arc;
@@ -24,6 +26,16 @@ pub struct EmulatorArgs {
     /// Controller cycle (SIP period) in milliseconds.
     #[arg(long, default_value_t = 100)]
     pub cycle_ms: u64,
+    /// Fast mode: answer SYNC, ARM_INFO and ARM_STATUS at once and send an extra ARMpac
+    /// after each arm command and motion change (for benchmarks). Default: like the
+    /// controller, every packet at the next cycle boundary.
+    #[arg(long)]
+    pub fast: bool,
+    /// ARMpac status byte layout: `manual` (the vendor's manuals: power/connection byte,
+    /// then the moving bits) or `aria` (ARIA's reading: one little-endian word, moving
+    /// bits first).
+    #[arg(long, value_name = "LAYOUT", default_value = "manual", value_parser = parse_layout)]
+    pub armpac_layout: ArmpacLayout,
     /// Emulate a robot without an arm (arm commands are ignored).
     #[arg(long)]
     pub no_arm: bool,
@@ -73,6 +85,10 @@ pub struct EmulatorArgs {
     pub ignore_stdin: bool,
 }
 
+fn parse_layout(s: &str) -> Result<ArmpacLayout, String> {
+    ArmpacLayout::from_name(s).ok_or_else(|| format!("{s:?}: expected manual or aria"))
+}
+
 fn check_rate(name: &str, v: f64) -> Result<f64, EmulatorError> {
     if (0.0..=1.0).contains(&v) {
         Ok(v)
@@ -102,8 +118,14 @@ impl EmulatorArgs {
                 slow_wire_baud: self.slow_wire,
             },
             watchdog: self.watchdog_ms.map(Duration::from_millis),
+            timing: if self.fast {
+                Timing::Fast
+            } else {
+                Timing::Controller
+            },
             ..EmulatorConfig::default()
         };
+        cfg.model.armpac_layout = self.armpac_layout;
         if self.no_arm {
             cfg.model.arm = None;
         }

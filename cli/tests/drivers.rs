@@ -137,3 +137,54 @@ fn simarm_serves_and_stops_on_sigterm() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(sim.term(), Some(0));
 }
+
+/// The README's `limber emulator --pty --armpac-layout aria` and `limber emulator --pty
+/// --fast`, run as written (stdin kept open, as in a terminal): a P2OS client syncs, gets
+/// the calibration, and reads the ARMpac status bytes in the layout asked for.
+#[test]
+fn emulator_layout_and_fast_flags_as_documented() {
+    use limber_p2os::{ArmpacLayout, Command as P2, ConnectOptions, Connection, LinkTarget};
+    for (args, layout) in [
+        (
+            &["emulator", "--pty", "--armpac-layout", "aria"][..],
+            ArmpacLayout::Aria,
+        ),
+        (&["emulator", "--pty", "--fast"][..], ArmpacLayout::Manual),
+    ] {
+        let d = Domain::unique_for_test();
+        let mut argv = args.to_vec();
+        argv.push("--ignore-stdin");
+        let mut emu = Bg::spawn(d.name(), &argv);
+        let pty = emu.line(|l| l.starts_with("/dev/"));
+        let mut c =
+            Connection::open(&LinkTarget::Serial(pty.into()), &ConnectOptions::default()).unwrap();
+        assert!(c.arm_calibration().is_some(), "{args:?}");
+        c.send(&P2::ArmPower(true)).unwrap();
+        let r = c.wait_until(
+            Duration::from_secs(5),
+            |p| matches!(p, limber_p2os::RobotPacket::Arm(a) if a.status(layout).powered),
+        );
+        assert!(r.is_ok(), "{args:?}: {r:?}; last {:?}", c.last_arm());
+        let a = *c.last_arm().unwrap();
+        assert!(!a.suggests_other_layout(layout), "{args:?}: {a:?}");
+        c.close().unwrap();
+        assert_eq!(emu.term(), Some(0));
+    }
+}
+
+/// The README's `limber pioneer --print-config`: every key with its default, including the
+/// ARMpac layout (the manuals'), documented in a comment; the output loads back.
+#[test]
+fn pioneer_print_config_documents_the_armpac_layout() {
+    let d = Domain::unique_for_test();
+    let o = limber(d.name(), &["pioneer", "--print-config"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert!(text.contains("armpac_layout = \"manual\""), "{text}");
+    assert!(text.contains("\"aria\""), "{text}");
+    let cfg = limber_pioneer::PioneerConfig::from_toml(&text).unwrap();
+    assert_eq!(cfg, limber_pioneer::PioneerConfig::default());
+    let aria = limber_pioneer::PioneerConfig::from_toml("armpac_layout = \"aria\"").unwrap();
+    assert_eq!(aria.armpac_layout, limber_p2os::ArmpacLayout::Aria);
+    assert!(limber_pioneer::PioneerConfig::from_toml("armpac_layout = \"player\"").is_err());
+}

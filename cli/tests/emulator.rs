@@ -4,6 +4,7 @@ use std::time::Duration;
 
 use clap::Parser;
 use limber_cli::emulator::EmulatorArgs;
+use limber_emulator::{ArmpacLayout, Timing};
 
 fn ms(n: u64) -> Duration {
     Duration::from_millis(n)
@@ -30,4 +31,28 @@ fn cli_arguments() {
     assert!(Cli::try_parse_from(["emulator", "--pty", "--tcp", "1"]).is_err());
     let c = Cli::try_parse_from(["emulator"]).unwrap();
     assert!(c.args.tcp.is_none() && !c.args.pty);
+}
+
+/// Issue 13 items 1 and 3: the controller's timing and the manuals' ARMpac layout by
+/// default; `--fast` and `--armpac-layout aria` select the others.
+#[test]
+fn timing_and_armpac_layout_flags() {
+    let cfg = Cli::try_parse_from(["emulator"])
+        .unwrap()
+        .args
+        .config()
+        .unwrap();
+    assert_eq!(cfg.timing, Timing::Controller);
+    assert_eq!(cfg.model.armpac_layout, ArmpacLayout::Manual);
+    let c =
+        Cli::try_parse_from(["emulator", "--pty", "--fast", "--armpac-layout", "aria"]).unwrap();
+    let cfg = c.args.config().unwrap();
+    assert_eq!(cfg.timing, Timing::Fast);
+    assert_eq!(cfg.model.armpac_layout, ArmpacLayout::Aria);
+    let c = Cli::try_parse_from(["emulator", "--armpac-layout", "manual"]).unwrap();
+    assert_eq!(
+        c.args.config().unwrap().model.armpac_layout,
+        ArmpacLayout::Manual
+    );
+    assert!(Cli::try_parse_from(["emulator", "--armpac-layout", "player"]).is_err());
 }

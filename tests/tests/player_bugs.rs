@@ -159,8 +159,9 @@ fn bug03_checksum_and_argument_encoding() {
     assert_eq!(&f.as_bytes()[3..7], &[36, 0x1B, 100, 0]);
 }
 
-/// Section 6, item 4: Joints are 1-based on the wire; "all" is the vendor's 0xFF: HOME all homes every
-/// joint, HOME of joint 2 only joint 2.
+/// Section 6, item 4: Joints are 1-based on the wire; "all" is 0xFF (the manuals accept any value
+/// above 6 for HOME, 255 for STOP; Player sends 7, which the emulator also takes): HOME all homes
+/// every joint, HOME of joint 2 only joint 2.
 #[test]
 fn bug04_joint_numbering_and_home_all() {
     let r = Rig::new("b04");
@@ -238,10 +239,14 @@ fn bug06_nothing_before_calibration() {
     );
 }
 
-/// Section 6, item 7: Moving flags are cleared when a joint arrives (ARIA's status byte order).
+/// Section 6, item 7, and issue 13 item 8: Player reads the ARMpac status bytes in the vendor's
+/// manuals' order (byte A power and connection, byte B the moving bits), as limber now does by
+/// default, but it only ever sets its moving flags: once a joint has moved it is MOVING forever.
+/// limber clears them when the joint arrives, reading the emulator's default (manual) layout.
 #[test]
 fn bug07_moving_flags_cleared() {
     let r = Rig::new("b07");
+    assert!(r.emu.state().robot.has_arm, "the emulator has an arm");
     let mut a = r.arm();
     // Slowly (about a second), so the motion is seen even on a loaded machine: at full
     // speed it could end between two samples this test reads.
@@ -261,8 +266,31 @@ fn bug07_moving_flags_cleared() {
     assert_eq!(
         a.state().unwrap().motor_state,
         1,
-        "power state from the ARIA status word"
+        "power state from the manuals' status byte"
     );
+}
+
+/// Issue 13 item 8: Player's arm GET_GEOM first sends ARM_INFO and then reads the robot's packets
+/// (3.10; every command is followed by a read, and an ARMINFOpac by another, 3.4 and 3.6), so
+/// the reply waits for the robot's cycles. limber answers from the calibration it holds: with
+/// the robot silent (no cycle at all) the geometry still comes back within 0.5 s.
+#[test]
+fn player_get_geom_waits_for_robot_cycles_ours_needs_none() {
+    let r = Rig::with(
+        "b_geom",
+        EmulatorConfig::default(),
+        "link_timeout_ms = 60000\n",
+    );
+    let mut a = ActArrayClient::connect_timeout(&r.ctx, "pioneer/actarray/0", T).unwrap();
+    assert_eq!(a.geometry().unwrap().actuators_count, 6);
+    r.emu.set_faults(Faults {
+        silent: true,
+        ..Faults::default()
+    });
+    a.set_request_timeout(Duration::from_millis(500));
+    for _ in 0..3 {
+        assert_eq!(a.geometry().unwrap().actuators_count, 6);
+    }
 }
 
 /// Section 6, item 8: REQ SPEED uses the joint's own calibration; speed 0 is refused, not infinite.
@@ -525,9 +553,11 @@ fn bug18_silent_robot_is_an_error() {
 /// robot cycle of 2 s, geometry requests still come back within a 0.5 s timeout.
 #[test]
 fn bug19_requests_answered_without_waiting_for_the_robot() {
+    // Fast mode: with the controller's timing a 2 s cycle would also delay the sync replies
+    // past the handshake's timeouts; here only the SIP cycle is slow.
     let cfg = EmulatorConfig {
         cycle: Duration::from_secs(2),
-        ..EmulatorConfig::default()
+        ..EmulatorConfig::fast()
     };
     let r = Rig::with("b19", cfg, "link_timeout_ms = 5000\n");
     let mut a = ActArrayClient::connect_timeout(&r.ctx, "pioneer/actarray/0", T).unwrap();

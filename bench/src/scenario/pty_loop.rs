@@ -1,7 +1,8 @@
 //! `loop`: the full control loop through the emulator over a pty. A client moves joint 0
 //! of the Pioneer arm (driver and emulator in the `pioneer-driver` child process,
 //! event-driven); the command goes to the driver, out as P2OS bytes on the pty, the
-//! emulator acts on it and answers with an ARMpac at once, the driver reads it and
+//! emulator (in fast mode, `EmulatorConfig::fast`: a real controller would answer at its
+//! next 100 ms cycle) acts on it and answers with an ARMpac at once, the driver reads it and
 //! publishes the arm state, and the client sees it. Split by stage with the stamps on
 //! the way:
 //!
@@ -44,7 +45,7 @@ impl Scenario for Loop {
         "loop"
     }
     fn description(&self) -> &'static str {
-        "full loop through the emulator over a pty (command → P2OS → emulator → ARMpac → state), split by stage"
+        "full loop through the emulator over a pty, fast mode (command → P2OS → emulator → ARMpac → state), split by stage"
     }
     fn run(&self, ctx: &mut RunCtx) -> Result<(), BenchError> {
         if !ctx.blocking_enabled() {
@@ -108,7 +109,7 @@ impl Scenario for Loop {
         for (id, label, metric, hist) in [
             (
                 "loop.to_robot",
-                "command → robot reply read by the driver",
+                "command → robot reply read by the driver (emulator fast mode)",
                 Metric::OneWay,
                 to_robot,
             ),
@@ -120,7 +121,7 @@ impl Scenario for Loop {
             ),
             (
                 "loop.total",
-                "command → state, through the emulator",
+                "command → state, through the emulator (fast mode)",
                 Metric::RoundTrip,
                 total,
             ),

@@ -4,13 +4,21 @@
 //!
 //! It answers the sync handshake like a real simulator (bare echoes, then
 //! the identity strings), streams a SIP every cycle (100 ms by default)
-//! after OPEN, sends ARMpac on request (ARM_STATUS 1 once, 2 every cycle and
-//! at once after any command or motion change), ARMINFOpac with a plausible
+//! after OPEN, sends ARMpac on request (ARM_STATUS 1 once, 2 every cycle)
+//! in the layout of the vendor's manuals (ARIA's with
+//! [`ModelConfig::armpac_layout`]), ARMINFOpac with a plausible
 //! calibration, steps each servo one tick per its ms/step toward its target,
-//! powers, homes, parks and stops the arm, opens and closes the paddles
-//! with breakbeams driven by a simulated object, and raises/lowers the lift
-//! (3.5 s per stroke). Commands are acted on as soon as they arrive (the I/O
-//! thread polls its fd with a short timeout), not at the next cycle.
+//! powers, homes, parks and stops the arm (HOME takes 1..6 or any value
+//! above 6 for all joints, STOP 1..6 or 255, as the manuals say), opens and
+//! closes the paddles with breakbeams driven by a simulated object, and
+//! raises/lowers the lift (3.5 s per stroke).
+//!
+//! Timing ([`EmulatorConfig::timing`]): by default like the controller,
+//! whose packets go out once per cycle: SYNC replies, ARMINFOpac and a
+//! requested ARMpac leave at the next cycle boundary, and the ARMpac stream
+//! sends one per cycle. [`Timing::Fast`] answers at once and adds an ARMpac
+//! after each arm command and motion change, for benchmarks and tests that
+//! need speed. Either way commands take effect as soon as they arrive.
 //!
 //! Fault injection ([`Faults`]): dropped or corrupted bytes, wrong checksums,
 //! garbage between packets, silence, a slow wire at a given baud, and
@@ -28,7 +36,10 @@
 mod model;
 mod server;
 
-pub use model::{ModelConfig, ObjectPlacement, Robot, RobotState, SyncStage, default_arm_info};
+pub use limber_p2os::ArmpacLayout;
+pub use model::{
+    ModelConfig, ObjectPlacement, Robot, RobotState, SyncStage, Timing, default_arm_info,
+};
 
 use limber_p2os::LinkTarget;
 use std::net::SocketAddr;
@@ -96,10 +107,22 @@ pub struct EmulatorConfig {
     pub faults: Faults,
     /// Seed of the fault generator.
     pub seed: u64,
+    /// When packets go out: like the controller (default) or at once.
+    pub timing: Timing,
     /// Like the simulator: after this long without any command (PULSE
     /// counts) the controller stops streaming and forgets the client, who
     /// must sync again. `None` (the default) disables it.
     pub watchdog: Option<Duration>,
+}
+
+impl EmulatorConfig {
+    /// The default configuration in [`Timing::Fast`] (immediate replies).
+    pub fn fast() -> EmulatorConfig {
+        EmulatorConfig {
+            timing: Timing::Fast,
+            ..EmulatorConfig::default()
+        }
+    }
 }
 
 impl Default for EmulatorConfig {
@@ -110,6 +133,7 @@ impl Default for EmulatorConfig {
             baud: None,
             faults: Faults::default(),
             seed: 0x5EED,
+            timing: Timing::Controller,
             watchdog: None,
         }
     }
@@ -209,7 +233,8 @@ impl Emulator {
     fn spawn(config: EmulatorConfig, ep: server::Endpoint) -> Result<Emulator, EmulatorError> {
         let pty_path = ep.pty_path();
         let tcp_addr = ep.tcp_addr();
-        let robot = Robot::new(config.model.clone(), Instant::now());
+        let mut robot = Robot::new(config.model.clone(), Instant::now());
+        robot.set_timing(config.timing);
         let shared = Arc::new(Shared {
             stop: AtomicBool::new(false),
             control: Mutex::new(Control {

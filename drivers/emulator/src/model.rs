@@ -3,8 +3,9 @@
 
 use limber_p2os::vendor_conventions as vc;
 use limber_p2os::{
-    ArmInfo, ArmPacket, Frame, GripperCommand, GripperPacket, GripperSwitchFacts, GripperSwitches,
-    JointCalibration, ReceivedCommand, RobotIdentity, Sip, SonarReading, num,
+    ArmInfo, ArmPacket, ArmStatus, ArmpacLayout, Frame, GripperCommand, GripperPacket,
+    GripperSwitchFacts, GripperSwitches, JointCalibration, ReceivedCommand, RobotIdentity, Sip,
+    SonarReading, num,
 };
 use std::time::{Duration, Instant};
 
@@ -16,6 +17,22 @@ pub enum ObjectPlacement {
     Outer,
     /// Fully between the paddles: breaks both beams.
     Inner,
+}
+
+/// When the emulated controller sends its packets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Timing {
+    /// Like a P2OS controller: everything goes out once per cycle (100 ms
+    /// by default). SYNC replies, ARMINFOpac and a requested ARMpac leave
+    /// at the next cycle boundary; the ARMpac stream sends one per cycle
+    /// and nothing in between. The default.
+    #[default]
+    Controller,
+    /// Immediate replies: SYNC, ARM_INFO and ARM_STATUS are answered as soon
+    /// as they arrive, and while the ARMpac stream is on an extra ARMpac
+    /// goes out after each arm command and whenever a joint starts or
+    /// stops. For benchmarks and tests that need speed; no robot does this.
+    Fast,
 }
 
 /// The sync/connection stage of the emulated controller.
@@ -72,6 +89,9 @@ pub struct ModelConfig {
     pub paddle_stroke: Duration,
     /// Paddle opening at which they close on an object (0 closed, 1 open).
     pub object_width: f64,
+    /// How the ARMpac status bytes are laid out: the vendor's manuals'
+    /// (default) or ARIA's.
+    pub armpac_layout: ArmpacLayout,
 }
 
 impl Default for ModelConfig {
@@ -87,6 +107,7 @@ impl Default for ModelConfig {
             lift_stroke: Duration::from_millis(3500),
             paddle_stroke: Duration::from_millis(1500),
             object_width: 0.35,
+            armpac_layout: ArmpacLayout::default(),
         }
     }
 }
@@ -196,6 +217,13 @@ pub struct Robot {
     commands: u64,
     last_moving: u8,
     wants_arm_pac: bool,
+    timing: Timing,
+    /// Replies waiting for the next cycle boundary (controller timing).
+    deferred: Vec<Frame>,
+    /// An ARMpac was requested (ARM_STATUS 1) for the next cycle.
+    arm_pac_once: bool,
+    /// A 0xE0 gripper packet was requested once for the next cycle.
+    gripper_pac_once: bool,
 }
 
 impl Robot {
@@ -238,6 +266,28 @@ impl Robot {
             commands: 0,
             last_moving: 0,
             wants_arm_pac: false,
+            timing: Timing::default(),
+            deferred: Vec::new(),
+            arm_pac_once: false,
+            gripper_pac_once: false,
+        }
+    }
+
+    /// Sets when packets go out (controller timing by default).
+    pub fn set_timing(&mut self, timing: Timing) {
+        self.timing = timing;
+    }
+
+    /// When packets go out.
+    pub fn timing(&self) -> Timing {
+        self.timing
+    }
+
+    /// A reply: at once in fast mode, else at the next cycle boundary.
+    fn reply(&mut self, f: Result<Frame, limber_p2os::EncodeError>, out: &mut Vec<Frame>) {
+        match self.timing {
+            Timing::Fast => push(out, f),
+            Timing::Controller => push(&mut self.deferred, f),
         }
     }
 
@@ -253,6 +303,9 @@ impl Robot {
         self.arm_status = 0;
         self.gripper_pac = 0;
         self.sonar = false;
+        self.deferred.clear();
+        self.arm_pac_once = false;
+        self.gripper_pac_once = false;
     }
 
     /// Places or removes the simulated object.
@@ -271,12 +324,25 @@ impl Robot {
         self.cfg.arm.as_ref()?.calibrations().get(idx).copied()
     }
 
-    fn joints(&self, arg: i32) -> std::ops::Range<usize> {
-        let n = self.cfg.arm.as_ref().map_or(0, |a| a.calibrations().len());
-        match u8::try_from(arg) {
-            Ok(vc::ARM_ALL_JOINTS) => 0..n,
-            Ok(j @ 1..=6) if usize::from(j) <= n => usize::from(j) - 1..usize::from(j),
+    fn joint_count(&self) -> usize {
+        self.cfg.arm.as_ref().map_or(0, |a| a.calibrations().len())
+    }
+
+    /// The joint numbered `arg` (1..6, if fitted), else none.
+    fn one_joint(&self, arg: i32) -> std::ops::Range<usize> {
+        match usize::try_from(arg) {
+            Ok(j @ 1..=6) if j <= self.joint_count() => j - 1..j,
             _ => 0..0,
+        }
+    }
+
+    /// The joints an ARM_HOME or ARM_STOP argument selects, per the manuals'
+    /// Table 2: 1..6 one joint; "all" is any value above 6 for HOME, 255
+    /// for STOP. Anything else (0, negative) selects nothing.
+    fn selected_joints(&self, arg: i32, all: fn(u16) -> bool) -> std::ops::Range<usize> {
+        match u16::try_from(arg) {
+            Ok(a) if all(a) => 0..self.joint_count(),
+            _ => self.one_joint(arg),
         }
     }
 
@@ -290,8 +356,10 @@ impl Robot {
         }
     }
 
-    /// Handles one command payload; replies (and an ARMpac when the command
-    /// changed the arm's state and the stream is on) go to `out` at once.
+    /// Handles one command payload. In [`Timing::Fast`] replies (and an
+    /// ARMpac when the command changed the arm's state and the stream is on)
+    /// go to `out` at once; in [`Timing::Controller`] they wait for the next
+    /// [`Robot::cycle`].
     pub fn handle(&mut self, payload: &[u8], now: Instant, out: &mut Vec<Frame>) {
         let Some(cmd) = ReceivedCommand::parse(payload) else {
             return;
@@ -303,19 +371,20 @@ impl Robot {
         match cmd.number {
             num::SYNC0 if !open => {
                 self.stage = SyncStage::AfterSync0;
-                push(out, Frame::new(&[0]));
+                self.reply(Frame::new(&[0]), out);
             }
             num::SYNC1 if !open => {
                 if self.stage == SyncStage::Synced {
                     self.stage = SyncStage::Open;
                 } else {
                     self.stage = SyncStage::AfterSync1;
-                    push(out, Frame::new(&[1]));
+                    self.reply(Frame::new(&[1]), out);
                 }
             }
             num::SYNC2 if !open && self.stage == SyncStage::AfterSync1 => {
                 self.stage = SyncStage::Synced;
-                push(out, self.cfg.identity.encode_sync2());
+                let f = self.cfg.identity.encode_sync2();
+                self.reply(f, out);
             }
             num::SYNC2 if !open => {}
             num::PULSE => {}
@@ -337,7 +406,10 @@ impl Robot {
             num::GRIPPERPACREQUEST if self.cfg.gripper => {
                 let a = arg.unwrap_or(0);
                 if a == 1 {
-                    push(out, self.gripper_packet().encode());
+                    match self.timing {
+                        Timing::Fast => push(out, self.gripper_packet().encode()),
+                        Timing::Controller => self.gripper_pac_once = true,
+                    }
                 } else {
                     self.gripper_pac = u8::from(a == 2);
                 }
@@ -382,23 +454,29 @@ impl Robot {
         let [lsb, msb] = (a.clamp(0, 0xFFFF) as u16).to_le_bytes();
         match n {
             num::ARM_INFO => {
-                if let Some(info) = &self.cfg.arm {
-                    push(out, info.encode());
+                if let Some(f) = self.cfg.arm.as_ref().map(ArmInfo::encode) {
+                    self.reply(f, out);
                 }
                 return;
             }
             num::ARM_STATUS => {
                 match a {
-                    1 => push(out, self.arm_packet().encode()),
-                    2 => {
-                        self.arm_status = 2;
-                        push(out, self.arm_packet().encode());
+                    1 | 2 => {
+                        if a == 2 {
+                            self.arm_status = 2;
+                        }
+                        match self.timing {
+                            Timing::Fast => push(out, self.arm_packet().encode()),
+                            // The stream's own packet serves as the reply.
+                            Timing::Controller => self.arm_pac_once |= a == 1,
+                        }
                     }
                     _ => self.arm_status = 0,
                 }
                 return;
             }
-            num::ARM_POWER => {
+            // The manuals: POWER takes 0 or 1; anything else is ignored.
+            num::ARM_POWER if a == 0 || a == 1 => {
                 self.arm_powered = a != 0;
                 if !self.arm_powered {
                     for s in &mut self.servos {
@@ -411,10 +489,14 @@ impl Robot {
             }
             num::ARM_HOME | num::ARM_PARK if self.arm_powered => {
                 let js = if n == num::ARM_PARK {
-                    self.joints(i32::from(vc::ARM_ALL_JOINTS))
+                    0..self.joint_count()
                 } else {
-                    self.joints(a)
+                    self.selected_joints(a, vc::arm_home_all)
                 };
+                if js.is_empty() {
+                    // Not a joint the manual names: ignored, no homing.
+                    return;
+                }
                 for j in js {
                     if let Some(c) = self.calib(j) {
                         self.set_servo_target(j, c.home, now);
@@ -424,17 +506,17 @@ impl Robot {
                 self.parking = n == num::ARM_PARK;
             }
             num::ARM_POS if self.arm_powered => {
-                for j in self.joints(i32::from(msb)) {
+                for j in self.one_joint(i32::from(msb)) {
                     self.set_servo_target(j, lsb, now);
                 }
             }
             num::ARM_SPEED => {
-                for j in self.joints(i32::from(msb)) {
+                for j in self.one_joint(i32::from(msb)) {
                     self.servos[j].ms = lsb;
                 }
             }
             num::ARM_STOP => {
-                for j in self.joints(a) {
+                for j in self.selected_joints(a, vc::arm_stop_all) {
                     let s = &mut self.servos[j];
                     s.target = s.tick;
                     s.next_step = None;
@@ -447,7 +529,11 @@ impl Robot {
     }
 
     fn flush_arm_pac(&mut self, out: &mut Vec<Frame>) {
-        if self.wants_arm_pac && self.arm_status == 2 && self.stage == SyncStage::Open {
+        if self.wants_arm_pac
+            && self.timing == Timing::Fast
+            && self.arm_status == 2
+            && self.stage == SyncStage::Open
+        {
             push(out, self.arm_packet().encode());
             // The client now knows which joints move.
             self.last_moving = self.moving_mask();
@@ -465,8 +551,9 @@ impl Robot {
         m
     }
 
-    /// Advances the servos, paddles and lift to `now`. When a joint stops
-    /// and the ARMpac stream is on, an ARMpac goes to `out` at once.
+    /// Advances the servos, paddles and lift to `now`. In [`Timing::Fast`],
+    /// when a joint starts or stops and the ARMpac stream is on, an ARMpac
+    /// goes to `out` at once.
     pub fn advance(&mut self, now: Instant, out: &mut Vec<Frame>) {
         if self.arm_powered {
             for s in &mut self.servos {
@@ -542,18 +629,20 @@ impl Robot {
         }
     }
 
-    /// The packets of one controller cycle (SIP, and the ARMpac and gripper
-    /// packet when streaming). Nothing before OPEN.
+    /// The packets of one controller cycle: the replies deferred to this
+    /// boundary (controller timing), then after OPEN the SIP, and the
+    /// ARMpac and gripper packet when streaming or requested once.
     pub fn cycle(&mut self, now: Instant, out: &mut Vec<Frame>) {
         self.advance(now, out);
+        out.append(&mut self.deferred);
         if self.stage != SyncStage::Open {
             return;
         }
         push(out, self.sip().encode());
-        if self.arm_status == 2 && self.has_arm() {
+        if (self.arm_status == 2 || std::mem::take(&mut self.arm_pac_once)) && self.has_arm() {
             push(out, self.arm_packet().encode());
         }
-        if self.gripper_pac == 1 {
+        if self.gripper_pac == 1 || std::mem::take(&mut self.gripper_pac_once) {
             push(out, self.gripper_packet().encode());
         }
     }
@@ -596,21 +685,25 @@ impl Robot {
         sip
     }
 
-    /// The current ARMpac.
+    /// The current ARMpac, in the configured layout.
     pub fn arm_packet(&self) -> ArmPacket {
-        let mut status = u16::from(self.moving_mask()) & vc::ARM_STATUS_MOVING_MASK;
-        status |= vc::ARM_STATUS_GOOD | vc::ARM_STATUS_INITED;
-        if self.arm_powered {
-            status |= vc::ARM_STATUS_POWERED;
-        }
-        if self.homing {
-            status |= vc::ARM_STATUS_HOMING;
-        }
+        let status = ArmStatus {
+            moving: self.moving_mask(),
+            powered: self.arm_powered,
+            connected: true,
+            inited: true,
+            homing: self.homing,
+        };
         let mut ticks = [0u8; 6];
         for (t, s) in ticks.iter_mut().zip(&self.servos) {
             *t = s.tick;
         }
-        ArmPacket { status, ticks }
+        ArmPacket::new(status, self.cfg.armpac_layout, ticks)
+    }
+
+    /// The ARMpac layout in use.
+    pub fn armpac_layout(&self) -> ArmpacLayout {
+        self.cfg.armpac_layout
     }
 
     /// The current 0xE0 gripper packet.

@@ -1,6 +1,6 @@
 //! The emulator's I/O thread: wire endpoint, fault injection, timing.
 
-use super::model::{Robot, SyncStage};
+use super::model::{Robot, SyncStage, Timing};
 use super::{Control, EmulatorConfig, EmulatorError, EmulatorStats, Faults, Shared, lock};
 use limber_p2os::sys::wait_readable;
 use limber_p2os::{Decoder, Frame, MAX_FRAME, ptype};
@@ -330,8 +330,11 @@ pub(super) fn run(
                     });
                     wire.stats.bad_checksums_in = decoder.stats().bad_checksums;
                     close_after_send = closed;
-                    if !was_open && robot.stage() == SyncStage::Open {
-                        // The first SIP goes out right after OPEN.
+                    if !was_open
+                        && robot.stage() == SyncStage::Open
+                        && config.timing == Timing::Fast
+                    {
+                        // Fast mode: the first SIP goes out right after OPEN.
                         next_cycle = now;
                     }
                 }

@@ -2,7 +2,8 @@
 //! and over TCP: handshake, calibration, arm joints, gripper, lift, faults.
 
 use limber_emulator::{
-    Emulator, EmulatorConfig, EmulatorState, Faults, ObjectPlacement, SyncStage, default_arm_info,
+    Emulator, EmulatorConfig, EmulatorState, Faults, ObjectPlacement, SyncStage, Timing,
+    default_arm_info,
 };
 use limber_p2os::*;
 use std::net::SocketAddr;
@@ -10,10 +11,12 @@ use std::time::{Duration, Instant};
 
 const WAIT: Duration = Duration::from_secs(5);
 
+/// Fast mode (immediate replies, extra ARMpacs) and a 20 ms cycle: these
+/// tests are about the protocol, not the controller's timing.
 fn fast_config() -> EmulatorConfig {
     let mut c = EmulatorConfig {
         cycle: Duration::from_millis(20),
-        ..EmulatorConfig::default()
+        ..EmulatorConfig::fast()
     };
     c.model.lift_stroke = Duration::from_millis(300);
     c.model.paddle_stroke = Duration::from_millis(150);
@@ -81,6 +84,11 @@ fn wait_arm(c: &mut Connection, what: &str, mut pred: impl FnMut(&ArmPacket) -> 
     );
 }
 
+/// The status in the manuals' layout (the emulator's default).
+fn st(a: &ArmPacket) -> ArmStatus {
+    a.status(ArmpacLayout::Manual)
+}
+
 fn full_session(wire: Wire) {
     let emu = start(wire, fast_config());
     let mut c = connect(&emu);
@@ -102,7 +110,7 @@ fn full_session(wire: Wire) {
 
     // Power, speed up, and move every joint (including the gripper).
     c.send(&Command::ArmPower(true)).unwrap();
-    wait_arm(&mut c, "power", |a| a.is_powered() && a.is_good());
+    wait_arm(&mut c, "power", |a| st(a).powered && st(a).connected);
     for joint in ArmJoint::all() {
         c.send(&Command::ArmSpeed {
             joint,
@@ -129,7 +137,7 @@ fn full_session(wire: Wire) {
         })
         .unwrap();
         wait_arm(&mut c, &format!("{joint:?} at {target}"), |a| {
-            a.tick(joint) == target && !a.joint_moving(joint)
+            a.tick(joint) == target && !st(a).joint_moving(joint)
         });
         assert_eq!(emu.state().robot.servo_ticks[joint.index()], target);
     }
@@ -138,7 +146,7 @@ fn full_session(wire: Wire) {
     c.send(&Command::ArmHome(JointSelection::All)).unwrap();
     let homes: Vec<u8> = cal.info().calibrations().iter().map(|k| k.home).collect();
     wait_arm(&mut c, "home", |a| {
-        a.ticks.to_vec() == homes && a.moving_mask() == 0 && !a.is_homing()
+        a.ticks.to_vec() == homes && st(a).moving_mask() == 0
     });
 
     // Stop: a slow move stopped half way stays where it stopped.
@@ -152,9 +160,9 @@ fn full_session(wire: Wire) {
         tick: 228,
     })
     .unwrap();
-    wait_arm(&mut c, "joint 1 moving", |a| a.joint_moving(j(1)));
+    wait_arm(&mut c, "joint 1 moving", |a| st(a).joint_moving(j(1)));
     c.send(&Command::ArmStop(JointSelection::All)).unwrap();
-    wait_arm(&mut c, "joint 1 stopped", |a| !a.joint_moving(j(1)));
+    wait_arm(&mut c, "joint 1 stopped", |a| !st(a).joint_moving(j(1)));
     let st = emu.state().robot;
     assert!(st.servo_ticks[0] < 228);
     assert_eq!(st.servo_ticks[0], st.servo_targets[0]);
@@ -262,7 +270,7 @@ fn arm_packets_are_prompt_not_only_per_cycle() {
     let mut c = connect(&emu);
     assert!(c.arm_calibration().is_some());
     c.send(&Command::ArmPower(true)).unwrap();
-    wait_arm(&mut c, "powered", |a| a.is_powered());
+    wait_arm(&mut c, "powered", |a| st(a).powered);
     c.send(&Command::ArmSpeed {
         joint: j(4),
         ms_per_step: 1,
@@ -273,9 +281,9 @@ fn arm_packets_are_prompt_not_only_per_cycle() {
         tick: 100,
     })
     .unwrap();
-    wait_arm(&mut c, "moving", |a| a.joint_moving(j(4)));
+    wait_arm(&mut c, "moving", |a| st(a).joint_moving(j(4)));
     wait_arm(&mut c, "arrived", |a| {
-        a.tick(j(4)) == 100 && a.moving_mask() == 0
+        a.tick(j(4)) == 100 && st(a).moving_mask() == 0
     });
     assert_eq!(emu.state().stats.sips_out, 1);
     // ARM_STATUS 1 = one ARMpac on demand.
@@ -315,12 +323,23 @@ fn silent_robot_is_an_error_not_a_hang() {
         o.baud_rates = vec![9600, 38400];
         let err = Connection::open(&emu.link_target(), &o).unwrap_err();
         match (wire, err) {
-            (Wire::Pty, ConnectError::NoSync { attempts, bauds }) => {
+            (Wire::Pty, e @ ConnectError::NoSync { .. }) => {
+                assert_eq!(
+                    e.to_string(),
+                    "no sync reply after 4 attempts at baud rates [9600, 38400]"
+                );
+                let ConnectError::NoSync { attempts, bauds } = e else {
+                    unreachable!()
+                };
                 assert_eq!(attempts, 4);
                 assert_eq!(bauds, vec![9600, 38400]);
             }
-            (Wire::Tcp, ConnectError::NoSync { attempts, bauds }) => {
-                // No baud changes over TCP.
+            (Wire::Tcp, e @ ConnectError::NoSync { .. }) => {
+                // Issue 13 item 5: no baud rates over TCP, in the message either.
+                assert_eq!(e.to_string(), "no sync reply after 2 attempts");
+                let ConnectError::NoSync { attempts, bauds } = e else {
+                    unreachable!()
+                };
                 assert_eq!(attempts, 2);
                 assert!(bauds.is_empty());
             }
@@ -468,7 +487,7 @@ fn corrupted_dropped_and_garbage_bytes_are_survived() {
         emu.set_faults(Faults::default());
         // Still usable: a command round trip.
         c.send(&Command::ArmPower(true)).unwrap();
-        wait_arm(&mut c, "power after faults", |a| a.is_powered());
+        wait_arm(&mut c, "power after faults", |a| st(a).powered);
     }
 }
 
@@ -481,7 +500,7 @@ fn slow_wire_still_works() {
         let emu = start(wire, cfg);
         let mut c = connect(&emu);
         c.send(&Command::ArmPower(true)).unwrap();
-        wait_arm(&mut c, "powered over a slow wire", |a| a.is_powered());
+        wait_arm(&mut c, "powered over a slow wire", |a| st(a).powered);
         assert!(emu.state().stats.bytes_out > 0);
     }
 }
@@ -630,4 +649,39 @@ fn event_loop_style_polling() {
     assert!(c.last_sip().is_some());
     // "No limit" does not overflow.
     assert!(c.recv(Duration::MAX).is_ok());
+}
+
+/// Issue 13 item 3: the default emulator keeps the controller's timing
+/// (replies at the cycle boundary, one ARMpac per cycle), and the
+/// connection's default timeouts still work with it.
+#[test]
+fn controller_timing_by_default_and_the_handshake_copes() {
+    let cfg = EmulatorConfig::default();
+    assert_eq!(cfg.timing, Timing::Controller);
+    assert_eq!(cfg.cycle, Duration::from_millis(100));
+    let emu = start(Wire::Pty, cfg);
+    let mut c = Connection::open(&emu.link_target(), &ConnectOptions::default()).unwrap();
+    assert!(
+        c.arm_calibration().is_some(),
+        "ARMINFOpac at the cycle boundary"
+    );
+    c.send(&Command::ArmPower(true)).unwrap();
+    wait_arm(&mut c, "powered", |a| st(a).powered);
+    c.send(&Command::ArmPos {
+        joint: j(4),
+        tick: 120,
+    })
+    .unwrap();
+    wait_arm(&mut c, "arrived", |a| {
+        a.tick(j(4)) == 120 && st(a).moving_mask() == 0
+    });
+    // No ARMpac outside the cycle: never more ARMpacs than SIPs.
+    let stats = emu.state().stats;
+    assert!(
+        stats.arm_packets_out <= stats.sips_out,
+        "{} ARMpacs for {} SIPs",
+        stats.arm_packets_out,
+        stats.sips_out
+    );
+    c.close().unwrap();
 }

@@ -1,6 +1,6 @@
 //! The emulated controller's behaviour on simulated time (no I/O, no sleeps).
 
-use limber_emulator::{ModelConfig, ObjectPlacement, Robot, SyncStage, default_arm_info};
+use limber_emulator::{ModelConfig, ObjectPlacement, Robot, SyncStage, Timing, default_arm_info};
 use limber_p2os::*;
 use std::time::{Duration, Instant};
 
@@ -15,10 +15,18 @@ struct Sim {
 }
 
 impl Sim {
+    /// A robot in fast mode (replies at once): most tests here are about
+    /// behaviour, not timing.
     fn new(cfg: ModelConfig) -> Sim {
+        Sim::with_timing(cfg, Timing::Fast)
+    }
+
+    fn with_timing(cfg: ModelConfig, timing: Timing) -> Sim {
         let t0 = Instant::now();
+        let mut robot = Robot::new(cfg, t0);
+        robot.set_timing(timing);
         Sim {
-            robot: Robot::new(cfg, t0),
+            robot,
             t0,
             out: Vec::new(),
         }
@@ -121,13 +129,25 @@ fn servos_step_one_tick_per_ms_per_step() {
     );
     s.advance(1055);
     assert_eq!(s.robot.state().servo_ticks[0], 133);
-    assert_eq!(s.robot.arm_packet().moving_mask(), 1);
+    assert_eq!(
+        s.robot
+            .arm_packet()
+            .status(ArmpacLayout::Manual)
+            .moving_mask(),
+        1
+    );
     s.advance(1099);
     assert_eq!(s.robot.state().servo_ticks[0], 137);
     // Reaching the target sends no ARMpac unless the stream is on.
     assert!(s.advance(1100).is_empty());
     assert_eq!(s.robot.state().servo_ticks[0], 138);
-    assert_eq!(s.robot.arm_packet().moving_mask(), 0);
+    assert_eq!(
+        s.robot
+            .arm_packet()
+            .status(ArmpacLayout::Manual)
+            .moving_mask(),
+        0
+    );
 
     // With the stream on, commands and arrivals produce an ARMpac at once.
     assert_eq!(
@@ -148,8 +168,9 @@ fn servos_step_one_tick_per_ms_per_step() {
     match RobotPacket::parse(&r[0]) {
         Ok(RobotPacket::Arm(a)) => {
             assert_eq!(a.tick(j(1)), 136);
-            assert_eq!(a.moving_mask(), 0);
-            assert!(a.is_powered());
+            let st = a.status(ArmpacLayout::Manual);
+            assert_eq!(st.moving_mask(), 0);
+            assert!(st.powered && st.connected);
         }
         other => panic!("{other:?}"),
     }
@@ -219,7 +240,7 @@ fn park_homes_then_powers_off() {
     s.advance(1000);
     assert_eq!(s.robot.state().servo_ticks[1], 100);
     s.cmd(1000, Command::ArmPark);
-    assert!(s.robot.arm_packet().is_homing());
+    assert!(s.robot.state().homing);
     s.advance(1050);
     s.advance(2000);
     let st = s.robot.state();
@@ -335,4 +356,210 @@ fn garbage_commands_do_not_panic() {
     }
     s.robot.handle(&[], s.t0, &mut out);
     s.robot.advance(s.t0 + ms(10_000), &mut out);
+}
+
+fn home_of_all() -> Vec<u8> {
+    default_arm_info()
+        .calibrations()
+        .iter()
+        .map(|c| c.home)
+        .collect()
+}
+
+/// Moves every joint off its home, 1 ms per step.
+fn powered_away_from_home(s: &mut Sim) {
+    s.open();
+    s.cmd(0, Command::ArmPower(true));
+    for joint in ArmJoint::all() {
+        s.cmd(
+            0,
+            Command::ArmSpeed {
+                joint,
+                ms_per_step: 1,
+            },
+        );
+        let home = home_of_all()[joint.index()];
+        s.cmd(
+            0,
+            Command::ArmPos {
+                joint,
+                tick: home - 10,
+            },
+        );
+    }
+    s.advance(1000);
+    assert!(
+        s.robot
+            .state()
+            .servo_ticks
+            .iter()
+            .zip(home_of_all())
+            .all(|(t, h)| *t == h - 10)
+    );
+}
+
+fn raw(number: u8, arg: i32) -> Command {
+    Command::Custom {
+        number,
+        arg: Some(arg),
+    }
+}
+
+/// Issue 13 item 2: HOME takes 1..6, or any value above 6 for all joints
+/// (Player sends 7, ARIA 255); 0 is ignored and raises no homing bit.
+#[test]
+fn home_7_and_255_home_every_joint_and_home_0_does_nothing() {
+    for all in [7, 255, 100] {
+        let mut s = Sim::new(ModelConfig::default());
+        powered_away_from_home(&mut s);
+        s.cmd(1000, raw(num::ARM_HOME, all));
+        assert!(s.robot.state().homing, "HOME {all}");
+        s.advance(2000);
+        let st = s.robot.state();
+        assert_eq!(st.servo_ticks.to_vec(), home_of_all(), "HOME {all}");
+        assert!(!st.homing);
+    }
+    let mut s = Sim::new(ModelConfig::default());
+    powered_away_from_home(&mut s);
+    let before = s.robot.state().servo_targets;
+    for bad in [0, -1] {
+        assert!(s.cmd(1000, raw(num::ARM_HOME, bad)).is_empty());
+        let st = s.robot.state();
+        assert!(!st.homing, "HOME {bad} raised the homing bit");
+        assert_eq!(st.servo_targets, before, "HOME {bad} moved a joint");
+    }
+    // One joint.
+    s.cmd(1000, raw(num::ARM_HOME, 3));
+    s.advance(2000);
+    let st = s.robot.state();
+    assert_eq!(st.servo_ticks[2], home_of_all()[2]);
+    assert_eq!(st.servo_ticks[1], home_of_all()[1] - 10);
+}
+
+/// Issue 13 item 2: STOP takes 1..6 or 255 (all); other values are ignored.
+#[test]
+fn stop_takes_one_joint_or_255() {
+    let mut s = Sim::new(ModelConfig::default());
+    powered_away_from_home(&mut s);
+    s.cmd(1000, raw(num::ARM_HOME, 7));
+    s.advance(1003);
+    for ignored in [0, 7, 254] {
+        s.cmd(1003, raw(num::ARM_STOP, ignored));
+        assert!(
+            s.robot
+                .state()
+                .servo_targets
+                .iter()
+                .zip(home_of_all())
+                .all(|(t, h)| *t == h)
+        );
+    }
+    s.cmd(1003, raw(num::ARM_STOP, 2));
+    let st = s.robot.state();
+    assert_eq!(st.servo_targets[1], st.servo_ticks[1]);
+    assert_eq!(st.servo_targets[0], home_of_all()[0]);
+    s.cmd(1003, raw(num::ARM_STOP, 255));
+    let st = s.robot.state();
+    assert_eq!(st.servo_targets, st.servo_ticks);
+    // POWER takes 0 or 1 only.
+    s.cmd(1003, raw(num::ARM_POWER, 2));
+    assert!(s.robot.state().arm_powered);
+    s.cmd(1003, raw(num::ARM_POWER, 0));
+    assert!(!s.robot.state().arm_powered);
+}
+
+/// Issue 13 item 1: the emulator sends the manuals' layout by default and
+/// ARIA's when configured.
+#[test]
+fn armpac_layout_manual_by_default_aria_on_request() {
+    for (layout, idle) in [
+        (ArmpacLayout::Manual, [0b11, 0]),
+        (ArmpacLayout::Aria, [0, 0b0111]),
+    ] {
+        let cfg = ModelConfig {
+            armpac_layout: layout,
+            ..ModelConfig::default()
+        };
+        if layout == ArmpacLayout::Manual {
+            assert_eq!(cfg.armpac_layout, ModelConfig::default().armpac_layout);
+        }
+        let mut s = Sim::new(cfg);
+        s.open();
+        s.cmd(0, Command::ArmPower(true));
+        assert_eq!(s.robot.arm_packet().status_bytes, idle, "{layout}");
+        s.cmd(
+            0,
+            Command::ArmPos {
+                joint: j(1),
+                tick: 100,
+            },
+        );
+        s.advance(1);
+        let st = s.robot.arm_packet().status(layout);
+        assert!(st.powered && st.joint_moving(j(1)) && !st.joint_moving(j(2)));
+    }
+}
+
+/// Issue 13 item 3: with the controller's timing, replies wait for the next
+/// cycle boundary and no ARMpac leaves outside the cycle.
+#[test]
+fn controller_timing_replies_at_the_cycle_boundary() {
+    let mut s = Sim::with_timing(ModelConfig::default(), Timing::Controller);
+    assert_eq!(s.robot.timing(), Timing::Controller);
+    assert!(
+        s.cmd(0, Command::Sync0).is_empty(),
+        "SYNC0 answered at once"
+    );
+    assert_eq!(s.cycle(100), vec![vec![0]]);
+    assert!(s.cmd(110, Command::Sync1).is_empty());
+    assert_eq!(s.cycle(200), vec![vec![1]]);
+    assert!(s.cmd(210, Command::Sync2).is_empty());
+    let c = s.cycle(300);
+    assert_eq!(c.len(), 1);
+    assert_eq!(
+        RobotIdentity::parse(&c[0][1..]),
+        ModelConfig::default().identity
+    );
+    assert!(s.cmd(310, Command::Open).is_empty());
+    assert_eq!(s.robot.stage(), SyncStage::Open);
+    // ARM_INFO and ARM_STATUS 1: answered with the next cycle's packets.
+    assert!(s.cmd(320, Command::ArmInfo).is_empty());
+    assert!(
+        s.cmd(320, Command::ArmStatus(ArmStatusMode::Once))
+            .is_empty()
+    );
+    let c = s.cycle(400);
+    let kinds: Vec<u8> = c.iter().map(|p| p[0]).collect();
+    assert_eq!(kinds, vec![ptype::ARM_INFO, ptype::SIP_STOPPED, ptype::ARM]);
+    // Once means once.
+    assert_eq!(s.cycle(500).len(), 1);
+    // The stream: one ARMpac per cycle, none on commands or motion changes.
+    assert!(
+        s.cmd(510, Command::ArmStatus(ArmStatusMode::Continuous))
+            .is_empty()
+    );
+    assert!(s.cmd(510, Command::ArmPower(true)).is_empty());
+    assert!(
+        s.cmd(
+            510,
+            Command::ArmPos {
+                joint: j(1),
+                tick: 130,
+            },
+        )
+        .is_empty()
+    );
+    assert!(s.advance(550).is_empty());
+    assert!(
+        s.advance(599).is_empty(),
+        "joint 1 stopped: no extra ARMpac"
+    );
+    assert_eq!(s.robot.state().servo_ticks[0], 130);
+    let c = s.cycle(600);
+    let kinds: Vec<u8> = c.iter().map(|p| p[0]).collect();
+    assert_eq!(kinds, vec![ptype::SIP_STOPPED, ptype::ARM]);
+    // The gripper packet requested once also waits for the cycle.
+    assert!(s.cmd(610, Command::GripperPacketRequest(1)).is_empty());
+    assert_eq!(s.cycle(700).len(), 3);
+    assert_eq!(s.cycle(800).len(), 2);
 }

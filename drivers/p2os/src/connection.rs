@@ -64,8 +64,9 @@ pub enum ConnectError {
     /// The link could not be opened.
     #[error(transparent)]
     Open(#[from] OpenError),
-    /// No sync at any baud rate (or, over TCP, after all attempts).
-    #[error("no sync reply after {attempts} attempts at baud rates {bauds:?}")]
+    /// No sync at any baud rate (or, over TCP, after all attempts). Over TCP the
+    /// message says nothing of baud rates.
+    #[error("no sync reply after {attempts} attempts{}", at_bauds(bauds))]
     NoSync {
         /// SYNC0 attempts made.
         attempts: u32,
@@ -78,6 +79,14 @@ pub enum ConnectError {
     /// The link failed (closed, I/O error).
     #[error("link failed during the handshake: {0}")]
     Link(#[from] LinkError),
+}
+
+fn at_bauds(bauds: &[u32]) -> String {
+    if bauds.is_empty() {
+        String::new()
+    } else {
+        format!(" at baud rates {bauds:?}")
+    }
 }
 
 /// Why an orderly close failed.

@@ -11,8 +11,9 @@
 //! * [`ArmCalibration`]: tick ↔ radian and speed conversions from ARMINFOpac.
 //! * [`Link`]: a serial device, pty or TCP connection with counters and a
 //!   raw fd for epoll; [`Connection`]: the handshake state machine.
-//! * [`vendor_conventions`]: where Player and ARIA disagree, the reading
-//!   limber follows (ARIA's).
+//! * [`vendor_conventions`]: where Player, ARIA and the vendor's manuals
+//!   disagree, the reading limber follows (the manuals'; ARIA's where an
+//!   option says so, e.g. [`ArmpacLayout`]).
 //!
 //! ```
 //! use limber_p2os::{Command, Decoder, RobotPacket};
@@ -45,7 +46,7 @@ pub use connection::{BAUD_RATES, CloseError, ConnectError, ConnectOptions, Conne
 pub use convert::{ArmCalibration, ConversionError, TickTarget};
 pub use link::{DEFAULT_TCP_PORT, Link, LinkError, LinkStats, LinkTarget, OpenError};
 pub use packet::{
-    ArmInfo, ArmPacket, GripperPacket, GripperSwitchFacts, GripperSwitches, JointCalibration,
-    MAX_SONAR, MAX_VERSION, PacketError, PaddleState, RobotIdentity, RobotPacket, Sip,
-    SonarReading, ptype,
+    ArmInfo, ArmPacket, ArmStatus, ArmpacLayout, GripperPacket, GripperSwitchFacts,
+    GripperSwitches, JointCalibration, MAX_SONAR, MAX_VERSION, PacketError, PaddleState,
+    RobotIdentity, RobotPacket, Sip, SonarReading, ptype,
 };

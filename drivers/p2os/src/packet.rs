@@ -355,11 +355,93 @@ impl Sip {
     }
 }
 
-/// An ARMpac (0xA0): arm status and the current tick of each joint.
+/// How the two status bytes of an ARMpac are read (see [`vc`] and the
+/// reference, section 3.8). The vendor's manuals and ARIA disagree.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash)]
+pub enum ArmpacLayout {
+    /// The vendor's manuals (Pioneer 2 Arm manual, 2001; Pioneer Arm Manual
+    /// v7.1, 2007, Table 4), which Player also reads: byte A bit 0 = servo
+    /// power, bit 1 = arm controller connected; byte B bits 0..5 = joint
+    /// 1..6 moving. The default.
+    #[default]
+    Manual,
+    /// ARIA's ArP2Arm: A and B form one little-endian word. A (low) bits
+    /// 0..5 = joint 1..6 moving; B (high) bit 0 = good, 1 = initialised,
+    /// 2 = powered, 3 = homing.
+    Aria,
+}
+
+impl ArmpacLayout {
+    /// The other reading.
+    pub fn other(self) -> ArmpacLayout {
+        match self {
+            ArmpacLayout::Manual => ArmpacLayout::Aria,
+            ArmpacLayout::Aria => ArmpacLayout::Manual,
+        }
+    }
+
+    /// The name used in configurations and on command lines (`manual`, `aria`).
+    pub fn name(self) -> &'static str {
+        match self {
+            ArmpacLayout::Manual => "manual",
+            ArmpacLayout::Aria => "aria",
+        }
+    }
+
+    /// Parses [`ArmpacLayout::name`] (case-insensitive).
+    pub fn from_name(s: &str) -> Option<ArmpacLayout> {
+        if s.eq_ignore_ascii_case("manual") {
+            Some(ArmpacLayout::Manual)
+        } else if s.eq_ignore_ascii_case("aria") {
+            Some(ArmpacLayout::Aria)
+        } else {
+            None
+        }
+    }
+}
+
+impl std::fmt::Display for ArmpacLayout {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The arm status an ARMpac carries, independent of the byte layout.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ArmStatus {
+    /// Bits 0..5: joints 1..6 moving.
+    pub moving: u8,
+    /// The arm servos are powered.
+    pub powered: bool,
+    /// The arm controller is in contact with the robot controller (the
+    /// manuals' "connection"; ARIA's "good").
+    pub connected: bool,
+    /// ARIA only: the arm controller is initialised (read as `connected`
+    /// in the manuals' layout, which has no such bit).
+    pub inited: bool,
+    /// ARIA only: the arm is homing (always false in the manuals' layout,
+    /// where a homing arm shows as moving joints).
+    pub homing: bool,
+}
+
+impl ArmStatus {
+    /// The joint is moving.
+    pub fn joint_moving(&self, joint: ArmJoint) -> bool {
+        self.moving & (1 << joint.index()) != 0
+    }
+
+    /// Bits 0..5: joints 1..6 moving.
+    pub fn moving_mask(&self) -> u8 {
+        self.moving & vc::ARM_MOVING_MASK
+    }
+}
+
+/// An ARMpac (0xA0): the two raw status bytes and the current tick of each
+/// joint. Read the status with [`ArmPacket::status`] and a layout.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct ArmPacket {
-    /// The 16-bit status word in the vendor's reading (see [`vc`]).
-    pub status: u16,
+    /// Status bytes A and B (payload bytes 1 and 2), as on the wire.
+    pub status_bytes: [u8; 2],
     /// Current tick of joints 1..6 (index 0..5).
     pub ticks: [u8; 6],
 }
@@ -368,65 +450,105 @@ impl ArmPacket {
     /// Payload length of an ARMpac (N = 11).
     pub const LEN: usize = 9;
 
+    /// Builds an ARMpac carrying `status` in `layout`.
+    pub fn new(status: ArmStatus, layout: ArmpacLayout, ticks: [u8; 6]) -> ArmPacket {
+        let moving = status.moving & vc::ARM_MOVING_MASK;
+        let flag = |b: bool, bit: u8| if b { bit } else { 0 };
+        let status_bytes = match layout {
+            ArmpacLayout::Manual => [
+                flag(status.powered, vc::MANUAL_A_POWER)
+                    | flag(status.connected, vc::MANUAL_A_CONNECTED),
+                moving,
+            ],
+            ArmpacLayout::Aria => [
+                moving,
+                flag(status.connected, vc::ARIA_HI_GOOD)
+                    | flag(status.inited, vc::ARIA_HI_INITED)
+                    | flag(status.powered, vc::ARIA_HI_POWERED)
+                    | flag(status.homing, vc::ARIA_HI_HOMING),
+            ],
+        };
+        ArmPacket {
+            status_bytes,
+            ticks,
+        }
+    }
+
     /// Parses an ARMpac payload.
     pub fn parse(p: &[u8]) -> Result<ArmPacket, PacketError> {
         if p.len() != Self::LEN {
             return Err(PacketError::ArmPacketLength(p.len()));
         }
-        let (lo, hi) = if vc::ARMPAC_STATUS_LOW_BYTE_FIRST {
-            (p[1], p[2])
-        } else {
-            (p[2], p[1])
-        };
         let mut ticks = [0u8; 6];
         ticks.copy_from_slice(&p[3..9]);
         Ok(ArmPacket {
-            status: u16::from_le_bytes([lo, hi]),
+            status_bytes: [p[1], p[2]],
             ticks,
         })
     }
 
     /// Encodes the ARMpac.
     pub fn encode(&self) -> Result<Frame, EncodeError> {
-        let [lo, hi] = self.status.to_le_bytes();
-        let (a, b) = if vc::ARMPAC_STATUS_LOW_BYTE_FIRST {
-            (lo, hi)
-        } else {
-            (hi, lo)
-        };
         let mut pb = PayloadBuilder::new(ptype::ARM);
-        pb.byte(a).byte(b).bytes(&self.ticks);
+        pb.bytes(&self.status_bytes).bytes(&self.ticks);
         pb.frame()
     }
 
-    /// The joint is moving.
-    pub fn joint_moving(&self, joint: ArmJoint) -> bool {
-        self.status & (1 << joint.index()) != 0
+    /// The status, read in `layout`.
+    pub fn status(&self, layout: ArmpacLayout) -> ArmStatus {
+        let [a, b] = self.status_bytes;
+        match layout {
+            ArmpacLayout::Manual => {
+                let connected = a & vc::MANUAL_A_CONNECTED != 0;
+                ArmStatus {
+                    moving: b & vc::ARM_MOVING_MASK,
+                    powered: a & vc::MANUAL_A_POWER != 0,
+                    connected,
+                    inited: connected,
+                    homing: false,
+                }
+            }
+            ArmpacLayout::Aria => ArmStatus {
+                moving: a & vc::ARM_MOVING_MASK,
+                powered: b & vc::ARIA_HI_POWERED != 0,
+                connected: b & vc::ARIA_HI_GOOD != 0,
+                inited: b & vc::ARIA_HI_INITED != 0,
+                homing: b & vc::ARIA_HI_HOMING != 0,
+            },
+        }
     }
 
-    /// Bits 0..5: joints 1..6 moving.
-    pub fn moving_mask(&self) -> u8 {
-        (self.status & vc::ARM_STATUS_MOVING_MASK) as u8
+    /// Whether the status bytes describe a possible arm in `layout`: no bit
+    /// outside the layout's fields is set, and joints move only while the
+    /// arm is connected and powered (the manuals: the arm neither moves nor
+    /// updates positions otherwise). A powered, idle arm, and an unpowered
+    /// but connected one, are told apart by this: each layout reads the
+    /// other's bytes as joints moving on an arm that is off or absent.
+    pub fn plausible(&self, layout: ArmpacLayout) -> bool {
+        let [a, b] = self.status_bytes;
+        let (unknown, s) = match layout {
+            ArmpacLayout::Manual => (
+                a & !(vc::MANUAL_A_POWER | vc::MANUAL_A_CONNECTED) != 0
+                    || b & !vc::ARM_MOVING_MASK != 0,
+                self.status(layout),
+            ),
+            ArmpacLayout::Aria => (
+                a & !vc::ARM_MOVING_MASK != 0
+                    || b & !(vc::ARIA_HI_GOOD
+                        | vc::ARIA_HI_INITED
+                        | vc::ARIA_HI_POWERED
+                        | vc::ARIA_HI_HOMING)
+                        != 0,
+                self.status(layout),
+            ),
+        };
+        !unknown && (s.moving == 0 || (s.powered && s.connected))
     }
 
-    /// The arm controller is alive and communicating.
-    pub fn is_good(&self) -> bool {
-        self.status & vc::ARM_STATUS_GOOD != 0
-    }
-
-    /// The arm controller is initialised.
-    pub fn is_inited(&self) -> bool {
-        self.status & vc::ARM_STATUS_INITED != 0
-    }
-
-    /// The arm servos are powered.
-    pub fn is_powered(&self) -> bool {
-        self.status & vc::ARM_STATUS_POWERED != 0
-    }
-
-    /// The arm is homing.
-    pub fn is_homing(&self) -> bool {
-        self.status & vc::ARM_STATUS_HOMING != 0
+    /// The packet cannot come from an arm in `layout` but can in the other:
+    /// the robot most likely uses the other layout.
+    pub fn suggests_other_layout(&self, layout: ArmpacLayout) -> bool {
+        !self.plausible(layout) && self.plausible(layout.other())
     }
 
     /// Tick of a joint.

@@ -1,36 +1,66 @@
-//! Every place where Player's p2os driver and the vendor's SDK (ARIA) read the
-//! protocol differently, and the reading limber follows: **the vendor's**.
+//! Every place where Player's p2os driver, the vendor's SDK (ARIA) and the
+//! vendor's own manuals read the protocol differently, and the reading limber
+//! follows. **Where the vendor's manuals speak, they win** (the protocol is
+//! theirs, and two of their documents agree); an SDK's different reading is
+//! kept as an option where it matters ([`crate::ArmpacLayout`]). Where the
+//! manuals are silent, limber follows ARIA (the vendor's code) over Player.
 //!
-//! Both the decoder in [`crate::p2os`] and the emulator in the emulator (`limber-emulator`)
-//! take their bit layouts and magic numbers from here, so a change of mind is
-//! one edit. Each item says what Player does instead (see the reference,
+//! Both the decoder in this crate and the emulator (`limber-emulator`) take
+//! their bit layouts and magic numbers from here, so a change of mind is one
+//! edit. Each item says what Player and ARIA do (see the reference,
 //! `player-reference.md` sections 3.3, 3.7, 3.8, 3.9 and 6).
 
-/// ARM_HOME / ARM_STOP argument meaning "all joints".
+/// ARM_HOME / ARM_STOP argument meaning "all joints", as limber sends it.
 ///
-/// ARIA sends `0xFF`; Player sends `7` for HOME. Firmware that follows ARIA
-/// treats 7 as an invalid joint, so limber sends `0xFF`.
+/// The manuals (Table 2): HOME 75 takes 1..6, or **any value above 6** for
+/// all joints; STOP 79 takes 1..6 or 255. Player sends 7 for HOME, ARIA
+/// 0xFF. 0xFF is valid for both commands, so limber sends it; the emulator
+/// accepts every value the manual allows ([`arm_home_all`], [`arm_stop_all`]).
 pub const ARM_ALL_JOINTS: u8 = 0xFF;
 
-/// ARMpac status byte order: byte 1 of the payload (after the type byte) is
-/// the **low** byte of a 16-bit little-endian status word (ARIA).
-///
-/// ARIA: low byte bits 0..5 = joint 1..6 moving; high byte bit 0 = arm good
-/// (communicating), bit 1 = initialised, bit 2 = powered, bit 3 = homing.
-/// Player swaps the two bytes (it reads byte 1 bit 0 as "power" and byte 2 as
-/// the moving bits).
-pub const ARMPAC_STATUS_LOW_BYTE_FIRST: bool = true;
+/// ARM_HOME's argument means "all joints" (the manuals: any value > 6).
+pub fn arm_home_all(arg: u16) -> bool {
+    arg > 6
+}
 
-/// ARMpac status, low byte: bit `j` (0..5) set = joint `j + 1` moving.
-pub const ARM_STATUS_MOVING_MASK: u16 = 0x003F;
-/// ARMpac status, high byte bit 0: the arm controller is alive and communicating.
-pub const ARM_STATUS_GOOD: u16 = 0x0100;
-/// ARMpac status, high byte bit 1: the arm controller is initialised.
-pub const ARM_STATUS_INITED: u16 = 0x0200;
-/// ARMpac status, high byte bit 2: the arm servos are powered.
-pub const ARM_STATUS_POWERED: u16 = 0x0400;
-/// ARMpac status, high byte bit 3: the arm is homing.
-pub const ARM_STATUS_HOMING: u16 = 0x0800;
+/// ARM_STOP's argument means "all joints" (the manuals: 255 only).
+pub fn arm_stop_all(arg: u16) -> bool {
+    arg == 0xFF
+}
+
+/// ARMpac status: the layout limber uses unless configured otherwise: the
+/// vendor's manuals' ([`crate::ArmpacLayout::Manual`]).
+///
+/// The manuals (Pioneer 2 Arm manual, 2001; Pioneer Arm Manual v7.1, 2007,
+/// Table 4 "ARMpac contents") say byte 2 (the byte after the type) holds
+/// servo power (b0) and the connection between arm and robot controller
+/// (b1), and byte 3 the per-joint motion bits (b0..b5 = joints 1..6).
+/// Player reads it that way. ARIA's ArP2Arm reads the two bytes as one
+/// little-endian word with the motion bits first (low byte) and
+/// good/inited/powered/homing in the high byte: the bytes are swapped.
+/// Two documents of the protocol's owner outweigh one SDK's code, so the
+/// manuals' layout is the default; ARIA's stays selectable (`armpac_layout =
+/// "aria"` in the driver's configuration, `--armpac-layout aria` on the
+/// emulator) until hardware settles it. The driver warns when packets only
+/// make sense in the other layout ([`crate::ArmPacket::suggests_other_layout`]).
+pub const DEFAULT_ARMPAC_LAYOUT: crate::ArmpacLayout = crate::ArmpacLayout::Manual;
+
+/// ARMpac motion bits (byte B in the manuals' layout, byte A in ARIA's):
+/// bit `j` (0..5) set = joint `j + 1` moving.
+pub const ARM_MOVING_MASK: u8 = 0x3F;
+/// Manuals' layout, byte A bit 0: servo power on.
+pub const MANUAL_A_POWER: u8 = 0x01;
+/// Manuals' layout, byte A bit 1: the arm controller is connected to the
+/// robot controller.
+pub const MANUAL_A_CONNECTED: u8 = 0x02;
+/// ARIA's layout, byte B (high byte) bit 0: the arm is good (communicating).
+pub const ARIA_HI_GOOD: u8 = 0x01;
+/// ARIA's layout, byte B bit 1: the arm controller is initialised.
+pub const ARIA_HI_INITED: u8 = 0x02;
+/// ARIA's layout, byte B bit 2: the arm servos are powered.
+pub const ARIA_HI_POWERED: u8 = 0x04;
+/// ARIA's layout, byte B bit 3: the arm is homing.
+pub const ARIA_HI_HOMING: u8 = 0x08;
 
 /// Gripper switch byte (General-I/O gripper: high byte of the SIP "timer"
 /// field, and byte 2 of the 0xE0 gripper packet), ARIA's **active-low**

@@ -13,7 +13,7 @@ static GLOBAL: Counting = Counting;
 #[test]
 fn decoding_and_receiving_do_not_allocate() {
     let arm = ArmPacket {
-        status: 0x0503,
+        status_bytes: [0x03, 0x05],
         ticks: [1, 2, 3, 4, 5, 6],
     }
     .encode()

@@ -65,6 +65,13 @@ fn reference_test_vectors() {
 
 #[test]
 fn vendor_all_joints_and_negative_arguments() {
+    // The manuals: HOME takes any value above 6 for all joints, STOP only 255.
+    assert!(vc::arm_home_all(7) && vc::arm_home_all(255) && vc::arm_home_all(300));
+    assert!(!vc::arm_home_all(0) && !vc::arm_home_all(6));
+    assert!(vc::arm_stop_all(255) && !vc::arm_stop_all(7) && !vc::arm_stop_all(0));
+    assert!(
+        vc::arm_home_all(vc::ARM_ALL_JOINTS.into()) && vc::arm_stop_all(vc::ARM_ALL_JOINTS.into())
+    );
     let home_all = bytes(Command::ArmHome(JointSelection::All));
     assert_eq!(&home_all[3..7], &[0x4B, 0x3B, vc::ARM_ALL_JOINTS, 0x00]);
     let stop6 = bytes(Command::ArmStop(JointSelection::One(ArmJoint::GRIPPER)));
@@ -224,19 +231,24 @@ fn robot_packets_roundtrip() {
         }
         other => panic!("{other:?}"),
     }
-    let arm = ArmPacket {
-        status: vc::ARM_STATUS_GOOD | vc::ARM_STATUS_POWERED | 0b100010,
-        ticks: [1, 2, 3, 4, 5, 6],
+    let st = ArmStatus {
+        moving: 0b100010,
+        powered: true,
+        connected: true,
+        inited: true,
+        homing: false,
     };
+    let arm = ArmPacket::new(st, ArmpacLayout::Manual, [1, 2, 3, 4, 5, 6]);
     let f = arm.encode().unwrap();
     assert_eq!(f.as_bytes()[2], 11, "ARMpac N must be 11");
-    // Vendor order: the moving bits are the first status byte.
-    assert_eq!(f.payload()[1], 0b100010);
+    // The manuals' order: power/connection first, then the moving bits.
+    assert_eq!(&f.payload()[1..3], &[0b11, 0b100010]);
     match roundtrip(f) {
         RobotPacket::Arm(a) => {
             assert_eq!(a, arm);
-            assert!(a.is_good() && a.is_powered() && !a.is_homing() && !a.is_inited());
-            assert!(a.joint_moving(j(2)) && a.joint_moving(j(6)) && !a.joint_moving(j(1)));
+            let s = a.status(ArmpacLayout::Manual);
+            assert_eq!(s, st);
+            assert!(s.joint_moving(j(2)) && s.joint_moving(j(6)) && !s.joint_moving(j(1)));
             assert_eq!(a.tick(j(4)), 4);
         }
         other => panic!("{other:?}"),
@@ -449,4 +461,55 @@ fn joints_and_targets() {
         LinkTarget::parse("/dev/ttyS0"),
         LinkTarget::Serial("/dev/ttyS0".into())
     );
+}
+
+/// Issue 13 item 1: the manuals' layout (byte A power/connection, byte B
+/// motion) and ARIA's (one LE word, motion bits first) swap the bytes.
+#[test]
+fn armpac_layouts_manual_and_aria() {
+    let powered_idle = ArmStatus {
+        moving: 0,
+        powered: true,
+        connected: true,
+        inited: true,
+        homing: false,
+    };
+    let ticks = [10, 20, 30, 40, 50, 60];
+    let manual = ArmPacket::new(powered_idle, ArmpacLayout::Manual, ticks);
+    let aria = ArmPacket::new(powered_idle, ArmpacLayout::Aria, ticks);
+    assert_eq!(manual.status_bytes, [0b11, 0]);
+    assert_eq!(aria.status_bytes, [0, 0b0111]);
+    assert_eq!(manual.status(ArmpacLayout::Manual), powered_idle);
+    assert_eq!(aria.status(ArmpacLayout::Aria), powered_idle);
+    // Read the wrong way, the other's powered idle arm looks like an
+    // unpowered arm with joints moving: impossible, and detected.
+    assert_eq!(aria.status(ArmpacLayout::Manual).moving, 0b111);
+    assert!(!aria.status(ArmpacLayout::Manual).powered);
+    assert!(aria.suggests_other_layout(ArmpacLayout::Manual));
+    assert!(manual.suggests_other_layout(ArmpacLayout::Aria));
+    assert!(!manual.suggests_other_layout(ArmpacLayout::Manual));
+    assert!(!aria.suggests_other_layout(ArmpacLayout::Aria));
+    // Moving bits ride in the layout's own byte.
+    let moving = ArmStatus {
+        moving: 0b1,
+        ..powered_idle
+    };
+    assert_eq!(
+        ArmPacket::new(moving, ArmpacLayout::Manual, ticks).status_bytes,
+        [0b11, 1]
+    );
+    assert_eq!(
+        ArmPacket::new(moving, ArmpacLayout::Aria, ticks).status_bytes,
+        [1, 0b0111]
+    );
+    // An unpowered, disconnected arm (both bytes 0) fits both: no warning.
+    let off = ArmPacket::new(ArmStatus::default(), ArmpacLayout::Manual, ticks);
+    assert!(off.plausible(ArmpacLayout::Manual) && off.plausible(ArmpacLayout::Aria));
+    assert_eq!(ArmpacLayout::default(), vc::DEFAULT_ARMPAC_LAYOUT);
+    assert_eq!(ArmpacLayout::from_name("ARIA"), Some(ArmpacLayout::Aria));
+    assert_eq!(
+        ArmpacLayout::from_name("manual"),
+        Some(ArmpacLayout::Manual)
+    );
+    assert_eq!(ArmpacLayout::from_name("x"), None);
 }

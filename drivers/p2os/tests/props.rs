@@ -112,8 +112,8 @@ proptest! {
     }
 
     #[test]
-    fn typed_packets_roundtrip(ticks in any::<[u8; 6]>(), status in any::<u16>(), cal in any::<[u8; 36]>(), nj in 0usize..=6, timer in any::<u16>()) {
-        let a = ArmPacket { status, ticks };
+    fn typed_packets_roundtrip(ticks in any::<[u8; 6]>(), status in any::<[u8; 2]>(), cal in any::<[u8; 36]>(), nj in 0usize..=6, timer in any::<u16>()) {
+        let a = ArmPacket { status_bytes: status, ticks };
         let f = a.encode().unwrap();
         prop_assert_eq!(RobotPacket::parse(f.payload()).unwrap(), RobotPacket::Arm(a));
         let joints: Vec<JointCalibration> = cal.chunks(6).take(nj).map(|c| JointCalibration {
@@ -166,7 +166,7 @@ fn random_frame(r: &mut SmallRng) -> Vec<u8> {
             sip.encode().unwrap().as_bytes().to_vec()
         }
         1 => ArmPacket {
-            status: r.random::<u16>(),
+            status_bytes: r.random::<u16>().to_le_bytes(),
             ticks: r.random(),
         }
         .encode()

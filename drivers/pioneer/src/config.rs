@@ -4,6 +4,7 @@
 use std::path::Path;
 use std::time::Duration;
 
+use limber_p2os::ArmpacLayout;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -81,6 +82,35 @@ pub struct PioneerConfig {
     pub limb_speed: f64,
     /// Largest deviation from the straight line allowed in VECMOVE, m.
     pub vecmove_deviation: f64,
+    /// How the two ARMpac status bytes are read: `"manual"` (the vendor's manuals: byte A
+    /// servo power and arm connection, byte B the joints' moving bits; the default) or
+    /// `"aria"` (ARIA's ArP2Arm: one little-endian word, moving bits first). The driver
+    /// warns when the robot's packets only make sense in the other layout.
+    #[serde(with = "layout_name")]
+    pub armpac_layout: ArmpacLayout,
+    /// The robot has the body gripper and its lift: serve `<robot>/gripper/0` and
+    /// `<robot>/actarray/1`. Set false for a robot without them (e.g. a simulator), so no
+    /// gripper or lift command is ever sent to it.
+    pub body_gripper: bool,
+}
+
+/// `armpac_layout` as its name in TOML.
+mod layout_name {
+    use limber_p2os::ArmpacLayout;
+    use serde::{Deserialize, Deserializer, Serializer, de::Error};
+
+    pub fn serialize<S: Serializer>(l: &ArmpacLayout, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(l.name())
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<ArmpacLayout, D::Error> {
+        let name = String::deserialize(d)?;
+        ArmpacLayout::from_name(&name).ok_or_else(|| {
+            D::Error::custom(format!(
+                "armpac_layout {name:?}: expected \"manual\" or \"aria\""
+            ))
+        })
+    }
 }
 
 impl Default for PioneerConfig {
@@ -113,6 +143,8 @@ impl Default for PioneerConfig {
             stall_timeout_ms: 2000,
             limb_speed: 0.1,
             vecmove_deviation: 0.002,
+            armpac_layout: ArmpacLayout::default(),
+            body_gripper: true,
         }
     }
 }
@@ -134,9 +166,16 @@ impl PioneerConfig {
         Ok(c)
     }
 
-    /// The defaults as TOML (what `limber pioneer --print-config` shows).
+    /// The configuration as TOML (what `limber pioneer --print-config` shows), with a
+    /// comment on the keys whose values are words.
     pub fn to_toml(&self) -> String {
-        toml::to_string_pretty(self).unwrap_or_default()
+        toml::to_string_pretty(self)
+            .unwrap_or_default()
+            .replacen(
+                "armpac_layout =",
+                "# ARMpac status bytes: \"manual\" (the vendor's manuals, Player) or \"aria\" (ARIA's ArP2Arm)\narmpac_layout =",
+                1,
+            )
     }
 
     /// Checks ranges.

@@ -73,7 +73,7 @@ pub struct Hardware {
     pub identity: RobotIdentity,
     /// ARM_INFO was answered.
     pub arm: bool,
-    /// The body gripper and lift are served (not detectable over P2OS; from the config).
+    /// The body gripper and lift are served (from the config's `body_gripper`).
     pub gripper: bool,
 }
 
@@ -284,7 +284,7 @@ impl PioneerDriver {
         let hardware = Hardware {
             identity: conn.identity().clone(),
             arm: conn.arm_calibration().is_some(),
-            gripper: true,
+            gripper: cfg.body_gripper,
         };
         if let Some(cal) = conn.arm_calibration() {
             model.set_calibration(*cal);
@@ -355,6 +355,19 @@ impl PioneerDriver {
     /// What the robot has.
     pub fn hardware(&self) -> &Hardware {
         &self.hardware
+    }
+
+    /// The arm as the last ARMpac described it, read in the configured layout: servo power
+    /// and the moving bits (joint i = bit i). `None` before the first ARMpac.
+    pub fn arm_status(&self) -> Option<(bool, u8)> {
+        let a = &self.robot.arm;
+        a.seen.then_some((a.powered, a.moving))
+    }
+
+    /// ARMpacs received whose status bytes make sense only in the other layout than the
+    /// configured `armpac_layout` (the first one is logged as a warning).
+    pub fn armpac_layout_mismatches(&self) -> u64 {
+        self.robot.arm.layout_mismatches
     }
 
     /// State samples published by all devices (each costs iceoryx2 one small allocation,
@@ -515,7 +528,7 @@ impl PioneerDriver {
                     robot.stats.sips_this_second += 1;
                 }
                 Owned::Arm(a) => {
-                    robot.arm.update(&a, now);
+                    robot.arm.update(&a, robot.cfg.armpac_layout, now);
                     robot.dirty.arm = true;
                     if let Err(status) = robot.stream_vecmove(&origin_internal()) {
                         // The next waypoint could not be written (the link is failing):

@@ -22,7 +22,7 @@ use nalgebra::Vector3;
 use limber_kinematics::pioneer::{
     DriverAngleMap, PIONEER_DOF, PioneerGeometry, PioneerIkError, PioneerIkOptions, Theta,
 };
-use limber_p2os::{ArmCalibration, ArmJoint, ArmPacket, Command, Connection, Sip};
+use limber_p2os::{ArmCalibration, ArmJoint, ArmPacket, ArmpacLayout, Command, Connection, Sip};
 
 use crate::config::PioneerConfig;
 use crate::stats::LoopStats;
@@ -58,6 +58,9 @@ pub struct ArmModel {
     pub short_since: [Option<Instant>; ARM_JOINTS],
     /// When the last ARMpac arrived (`CLOCK_MONOTONIC` ns).
     pub stamp_ns: u64,
+    /// ARMpacs whose status bytes make sense only in the other layout than the
+    /// configured `armpac_layout` (see [`ArmPacket::suggests_other_layout`]).
+    pub layout_mismatches: u64,
 }
 
 impl Default for ArmModel {
@@ -70,6 +73,7 @@ impl Default for ArmModel {
             target: [None; ARM_JOINTS],
             short_since: [None; ARM_JOINTS],
             stamp_ns: 0,
+            layout_mismatches: 0,
         }
     }
 }
@@ -92,11 +96,26 @@ impl ArmModel {
         }
     }
 
-    /// Applies an ARMpac.
-    pub fn update(&mut self, p: &ArmPacket, now: Instant) {
+    /// Applies an ARMpac, reading its status bytes in `layout`. A packet that only makes
+    /// sense in the other layout is counted, and the first one is logged.
+    pub fn update(&mut self, p: &ArmPacket, layout: ArmpacLayout, now: Instant) {
+        if p.suggests_other_layout(layout) {
+            if self.layout_mismatches == 0 {
+                tracing::warn!(
+                    status_bytes = ?p.status_bytes,
+                    "the ARMpac status bytes make sense only in the {} layout, not the configured {} \
+                     (set armpac_layout = \"{}\" if this robot reads them that way)",
+                    layout.other(),
+                    layout,
+                    layout.other()
+                );
+            }
+            self.layout_mismatches += 1;
+        }
+        let status = p.status(layout);
         self.ticks = p.ticks;
-        self.moving = p.moving_mask();
-        self.powered = p.is_powered();
+        self.moving = status.moving_mask();
+        self.powered = status.powered;
         self.seen = true;
         self.stamp_ns = monotonic_ns();
         for j in 0..ARM_JOINTS {
