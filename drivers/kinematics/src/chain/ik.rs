@@ -1,0 +1,304 @@
+//! The numeric inverse kinematics of a chain: damped least squares with restarts.
+
+use nalgebra::{Vector3, Vector6};
+
+use super::*;
+
+impl Chain {
+    /// Tool pose and the geometric Jacobian (rows: linear velocity, then angular
+    /// velocity scaled by `w`; columns past `dof()` are zero).
+    fn fk_jacobian(&self, q: &[f64], w: f64, jac: &mut Jacobian) -> Pose {
+        let mut axes = [Vector3::zeros(); MAX_JOINTS];
+        let mut points = [Vector3::zeros(); MAX_JOINTS];
+        let tip = self.walk(q, |i, before, _| {
+            axes[i] = before.rotation * self.joints[i].axis.into_inner();
+            points[i] = before.position;
+        });
+        jac.fill(0.0);
+        for (i, j) in self.joints.iter().enumerate() {
+            let z = axes[i];
+            let (lin, ang) = match j.kind {
+                JointKind::Rotary => (z.cross(&(tip.position - points[i])), z * w),
+                JointKind::Linear => (z, Vector3::zeros()),
+            };
+            jac.fixed_view_mut::<3, 1>(0, i).copy_from(&lin);
+            jac.fixed_view_mut::<3, 1>(3, i).copy_from(&ang);
+        }
+        tip
+    }
+
+    /// Numeric IK: joint values inside the limits that bring the tool to `target`.
+    /// The first attempt starts at `seed` (clamped into the limits), then up to
+    /// `max_restarts` attempts start at deterministic random configurations. Each
+    /// attempt is Levenberg–Marquardt on the damped least-squares step
+    /// `Δq = Jᵀ(JJᵀ + λI)⁻¹e` with λ adapted to the cost, the step limited to 0.5 rad
+    /// (or m) per joint, abandoned when the cost falls by less than 10 % in 10
+    /// iterations, joints pushing against a limit frozen for that step, and the
+    /// result clamped into the limits. No allocation.
+    // The error carries the best configuration on the stack (136 bytes) so that a
+    // failed solve does not allocate either.
+    #[allow(clippy::result_large_err)]
+    pub fn ik(
+        &self,
+        target: &IkTarget,
+        seed: &[f64],
+        options: &NumericIkOptions,
+    ) -> Result<ChainSolution, ChainIkError> {
+        let n = self.dof();
+        if seed.len() != n {
+            return Err(ChainIkError::WrongJointCount {
+                expected: n,
+                got: seed.len(),
+            });
+        }
+        let (target_p, target_r) = match target {
+            IkTarget::Position(p) => (*p, None),
+            IkTarget::Pose(pose) => (pose.position, Some(pose.rotation)),
+        };
+        let finite_target = all_finite(&target_p)
+            && target_r.is_none_or(|r| r.matrix().iter().all(|v| v.is_finite()));
+        if !finite_target || !seed.iter().all(|v| v.is_finite()) {
+            return Err(ChainIkError::NonFinite);
+        }
+        let pos = |v: f64| v.is_finite() && v > 0.0;
+        if !(pos(options.position_tolerance)
+            && pos(options.orientation_tolerance)
+            && pos(options.orientation_weight)
+            && options.max_iterations > 0)
+        {
+            return Err(ChainIkError::InvalidOptions);
+        }
+        // Reach bound from the first joint's origin, which no joint moves.
+        let j0 = &self.joints[0];
+        let first = self.base.position + self.base.rotation * j0.origin;
+        let d = target_p - first;
+        let distance = d.x.hypot(d.y).hypot(d.z);
+        if distance > self.reach + options.position_tolerance {
+            return Err(ChainIkError::OutOfReach {
+                distance,
+                reach: self.reach,
+            });
+        }
+
+        let w = if target_r.is_some() {
+            options.orientation_weight
+        } else {
+            0.0
+        };
+        let residual = |pose: &Pose| -> Vector6<f64> {
+            let dp = target_p - pose.position;
+            let dw = match target_r {
+                Some(r) => (r * pose.rotation.inverse()).scaled_axis() * w,
+                None => Vector3::zeros(),
+            };
+            Vector6::new(dp.x, dp.y, dp.z, dw.x, dw.y, dw.z)
+        };
+        let errors = |pose: &Pose| -> (f64, f64) {
+            let pe = (target_p - pose.position).norm();
+            let oe = match target_r {
+                Some(r) => crate::pose::angle_between_rotations(&r, &pose.rotation),
+                None => 0.0,
+            };
+            (pe, oe)
+        };
+        let converged = |(pe, oe): (f64, f64)| {
+            pe <= options.position_tolerance && oe <= options.orientation_tolerance
+        };
+
+        let mut rng = DeterministicRng::new(options.seed);
+        let mut q = JointVec::from_slice(seed).ok_or(ChainIkError::WrongJointCount {
+            expected: n,
+            got: seed.len(),
+        })?;
+        self.clamp_to_limits(&mut q);
+        let mut jac = Jacobian::zeros();
+        let mut jac_new = Jacobian::zeros();
+        let mut best_q = q;
+        let mut best_cost = f64::INFINITY;
+        let mut iterations = 0u32;
+        for attempt in 0..=options.max_restarts {
+            if attempt > 0 {
+                q = self.random_configuration(&mut rng);
+            }
+            let mut pose = self.fk_jacobian(&q, w, &mut jac);
+            let mut e = residual(&pose);
+            let mut cost = e.norm_squared();
+            let mut lambda = 1e-3;
+            let mut checkpoint = cost;
+            for it in 0..=options.max_iterations {
+                // Stalled (less than 10 % progress in 10 iterations): restart.
+                if it > 0 && it % 10 == 0 {
+                    if cost > 0.9 * checkpoint {
+                        break;
+                    }
+                    checkpoint = cost;
+                }
+                if !cost.is_finite() {
+                    break;
+                }
+                if cost < best_cost {
+                    best_cost = cost;
+                    best_q = q;
+                }
+                let errs = errors(&pose);
+                if converged(errs) {
+                    return Ok(ChainSolution {
+                        q,
+                        position_error: errs.0,
+                        orientation_error: errs.1,
+                        iterations,
+                        restarts: attempt,
+                    });
+                }
+                if it == options.max_iterations {
+                    break;
+                }
+                iterations += 1;
+                let Some(mut dq) = dls_step(&jac, &e, lambda, n) else {
+                    lambda *= 10.0;
+                    continue;
+                };
+                // Freeze joints that sit on a limit and would be pushed beyond it.
+                let mut frozen = false;
+                let mut jf = jac;
+                for (i, j) in self.joints.iter().enumerate() {
+                    let out = (q[i] <= j.min && dq[i] < 0.0) || (q[i] >= j.max && dq[i] > 0.0);
+                    if out {
+                        jf.column_mut(i).fill(0.0);
+                        frozen = true;
+                    }
+                }
+                if frozen {
+                    match dls_step(&jf, &e, lambda, n) {
+                        Some(d) => dq = d,
+                        None => {
+                            lambda *= 10.0;
+                            continue;
+                        }
+                    }
+                }
+                let biggest = dq.iter().take(n).fold(0.0_f64, |m, v| m.max(v.abs()));
+                let scale = if biggest > 0.5 { 0.5 / biggest } else { 1.0 };
+                let mut q_new = q;
+                for (i, v) in q_new.iter_mut().enumerate() {
+                    *v += dq[i] * scale;
+                }
+                self.clamp_to_limits(&mut q_new);
+                let pose_new = self.fk_jacobian(&q_new, w, &mut jac_new);
+                let e_new = residual(&pose_new);
+                let cost_new = e_new.norm_squared();
+                if cost_new < cost {
+                    q = q_new;
+                    pose = pose_new;
+                    e = e_new;
+                    cost = cost_new;
+                    std::mem::swap(&mut jac, &mut jac_new);
+                    lambda = (lambda * 0.3).max(1e-12);
+                } else {
+                    lambda *= 5.0;
+                    if lambda > 1e6 {
+                        break;
+                    }
+                }
+            }
+            if cost < best_cost {
+                best_cost = cost;
+                best_q = q;
+            }
+        }
+        let pose = self.walk(&best_q, |_, _, _| {});
+        let (position_error, orientation_error) = errors(&pose);
+        if converged((position_error, orientation_error)) {
+            return Ok(ChainSolution {
+                q: best_q,
+                position_error,
+                orientation_error,
+                iterations,
+                restarts: options.max_restarts,
+            });
+        }
+        Err(ChainIkError::NotConverged {
+            position_error,
+            orientation_error,
+            best: best_q,
+        })
+    }
+}
+
+/// `Jᵀ (J Jᵀ + λ I)⁻¹ e` over the first `n` columns, `None` if the 6×6 system is not
+/// positive definite. Plain loops and a hand-written Cholesky: small, allocation-free
+/// and fast even in unoptimised builds.
+#[allow(clippy::needless_range_loop)]
+fn dls_step(
+    jac: &Jacobian,
+    e: &Vector6<f64>,
+    lambda: f64,
+    n: usize,
+) -> Option<SMatrix<f64, MAX_JOINTS, 1>> {
+    let mut a = [[0.0f64; 6]; 6];
+    for (r, row) in a.iter_mut().enumerate() {
+        for (c, cell) in row.iter_mut().enumerate().take(r + 1) {
+            let mut sum = 0.0;
+            for i in 0..n {
+                sum += jac[(r, i)] * jac[(c, i)];
+            }
+            *cell = sum;
+        }
+        row[r] += lambda;
+    }
+    // Cholesky A = L·Lᵀ in place (lower triangle).
+    for j in 0..6 {
+        let mut d = a[j][j];
+        for k in 0..j {
+            d -= a[j][k] * a[j][k];
+        }
+        if !(d > 0.0 && d.is_finite()) {
+            return None;
+        }
+        let d = d.sqrt();
+        a[j][j] = d;
+        for i in j + 1..6 {
+            let mut v = a[i][j];
+            for k in 0..j {
+                v -= a[i][k] * a[j][k];
+            }
+            a[i][j] = v / d;
+        }
+    }
+    let mut y = [0.0f64; 6];
+    for i in 0..6 {
+        let mut v = e[i];
+        for k in 0..i {
+            v -= a[i][k] * y[k];
+        }
+        y[i] = v / a[i][i];
+    }
+    for i in (0..6).rev() {
+        let mut v = y[i];
+        for k in i + 1..6 {
+            v -= a[k][i] * y[k];
+        }
+        y[i] = v / a[i][i];
+    }
+    let mut dq = SMatrix::<f64, MAX_JOINTS, 1>::zeros();
+    for i in 0..n {
+        let mut v = 0.0;
+        for (r, yr) in y.iter().enumerate() {
+            v += jac[(r, i)] * yr;
+        }
+        dq[i] = v;
+    }
+    dq.iter().all(|v| v.is_finite()).then_some(dq)
+}
+
+pub(super) fn sample_range(j: &JointSpec) -> (f64, f64) {
+    use std::f64::consts::PI;
+    if j.kind == JointKind::Rotary {
+        let lo = j.min.max(-PI);
+        let hi = j.max.min(PI);
+        if lo < hi {
+            return (lo, hi);
+        }
+    }
+    (j.min, j.max)
+}
