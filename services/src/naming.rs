@@ -86,7 +86,13 @@ impl Domain {
     pub fn unique_for_test() -> Self {
         static N: AtomicU32 = AtomicU32::new(0);
         let n = N.fetch_add(1, Ordering::Relaxed);
-        let name = format!("limber_t{}_{}", std::process::id(), n);
+        // The pid alone repeats over a long run of test processes, and a test that
+        // SIGKILLs a driver leaves its files behind: the clock makes a reused pid a new
+        // domain.
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.subsec_nanos());
+        let name = format!("limber_t{}_{}_{nanos:x}", std::process::id(), n);
         Domain::new(&name).expect("generated test domain names are valid")
     }
 
