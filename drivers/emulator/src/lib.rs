@@ -28,7 +28,10 @@
 mod model;
 mod server;
 
-pub use model::{ModelConfig, ObjectPlacement, Robot, RobotState, SyncStage, default_arm_info};
+pub use model::{
+    AUTOPARK_DEFAULT_S, ModelConfig, ObjectPlacement, Robot, RobotState, SyncStage,
+    default_arm_info,
+};
 
 use limber_p2os::LinkTarget;
 use std::net::SocketAddr;
