@@ -157,6 +157,9 @@ fn simarm_and_emulator_survive_sigcont_and_sigwinch_and_end_on_sighup() {
     sim.line(|l| l.ends_with("ready"));
     let mut emu = Bg::spawn(d.name(), &["emulator", "--pty", "--ignore-stdin"]);
     emu.line(|l| l.starts_with("/dev/"));
+    // simarm's loop is running (its "ready" line comes just before it starts waiting).
+    let o = limber(d.name(), &["actarray", "simarm/actarray/0", "geom"]);
+    assert!(o.status.success(), "{}", stderr(&o));
     for sig in [
         libc::SIGCONT,
         libc::SIGWINCH,

@@ -359,14 +359,19 @@ fn other_signals_do_not_end_the_driver(extra: &[&str], name: &str) {
     let c = ctx(&domain);
     let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
     arm.set_wake_driver(extra.is_empty());
-    for sig in [
-        libc::SIGCONT,
-        libc::SIGWINCH,
-        libc::SIGCHLD,
-        libc::SIGSTOP,
-        libc::SIGCONT,
+    // The loop is running (the "ready" line comes just before it starts waiting).
+    assert_eq!(arm.geometry().unwrap().actuators_count, 6);
+    for sigs in [
+        &[libc::SIGCONT][..],
+        &[libc::SIGWINCH][..],
+        &[libc::SIGCHLD][..],
+        &[libc::SIGSTOP, libc::SIGCONT][..],
     ] {
-        driver.signal(sig);
+        for &sig in sigs {
+            driver.signal(sig);
+        }
+        // A round trip after each: the loop is back in its wait before the next signal.
+        assert_eq!(arm.geometry().unwrap().actuators_count, 6, "{sigs:?}");
     }
     // Requests are answered and commands carried out, by the same driver on the same link.
     assert_eq!(arm.geometry().unwrap().actuators_count, 6);
