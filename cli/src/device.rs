@@ -7,6 +7,7 @@ use clap::{Args, Subcommand, ValueEnum};
 use limber_services::prelude::*;
 use limber_services::{CommandError, ConnectError, RequestError, WaitError};
 
+use crate::out::outln;
 use crate::{CliError, exit};
 
 /// How long commands wait for their outcome and requests for their reply.
@@ -14,7 +15,8 @@ use crate::{CliError, exit};
 pub struct Common {
     /// Seconds to wait for the driver's answer (the outcome of a command, the reply to a
     /// request, the connection).
-    #[arg(long, global = true, default_value_t = 2.0, value_name = "S")]
+    #[arg(long, global = true, default_value_t = 2.0, value_name = "S",
+          value_parser = crate::parse_seconds)]
     timeout: f64,
     /// Send commands without waiting for their outcome.
     #[arg(long, global = true)]
@@ -226,6 +228,11 @@ pub(crate) fn connect_err(e: ConnectError) -> CliError {
     let code = match e {
         ConnectError::NoDriver { .. } => exit::NO_DRIVER,
         ConnectError::Name(_) => exit::USAGE,
+        // A verb of another interface than the device's: a usage error.
+        ConnectError::Incompatible {
+            reason: limber_services::Incompatibility::Interface { .. },
+            ..
+        } => exit::USAGE,
         _ => exit::FAILURE,
     };
     CliError::new(code, e.to_string())
@@ -263,8 +270,8 @@ pub(crate) fn wait_err(e: WaitError) -> CliError {
 
 fn connect<I: Interface>(device: &str, timeout: Duration) -> Result<Client<I>, CliError> {
     let ctx = crate::client_context()?;
-    let mut c = Client::<I>::connect_timeout(&ctx, device, timeout.min(Duration::from_millis(500)))
-        .map_err(connect_err)?;
+    // A driver that is starting gets the whole --timeout to appear.
+    let mut c = Client::<I>::connect_timeout(&ctx, device, timeout).map_err(connect_err)?;
     c.set_request_timeout(timeout);
     Ok(c)
 }
@@ -277,17 +284,17 @@ fn finish<I: Interface>(
 ) -> Result<(), CliError> {
     let ticket = sent.map_err(command_err)?;
     if common.no_wait {
-        println!("sent");
+        outln!("sent")?;
         return Ok(());
     }
     match c.wait_outcome(ticket, common.timeout()) {
         Ok(Status::Ok) => {
-            println!("ok");
+            outln!("ok")?;
             Ok(())
         }
         Ok(s) => Err(CliError::new(exit::REFUSED, format!("refused: {s}"))),
         Err(WaitError::Missed { .. }) => {
-            println!("ok (applied; outcome overwritten by a later command)");
+            outln!("ok (applied; outcome overwritten by a later command)")?;
             Ok(())
         }
         Err(e) => Err(wait_err(e)),
@@ -308,7 +315,7 @@ fn joint_sel(s: &str) -> Result<Option<usize>, CliError> {
 
 fn done(r: Result<(), RequestError>) -> Result<(), CliError> {
     r.map_err(request_err)?;
-    println!("ok");
+    outln!("ok")?;
     Ok(())
 }
 
@@ -329,17 +336,24 @@ pub fn actarray(a: ActArrayArgs) -> Result<(), CliError> {
         ActArrayVerb::Accel { joint, accel } => return done(c.set_accel_config(joint, accel)),
         ActArrayVerb::Geom => {
             let g = c.geometry().map_err(request_err)?;
-            println!(
+            outln!(
                 "{:<5} {:<7} {:>9} {:>9} {:>9} {:>9} {:>9} {:>7}",
-                "joint", "type", "min", "centre", "max", "home", "speed", "brakes"
-            );
+                "joint",
+                "type",
+                "min",
+                "centre",
+                "max",
+                "home",
+                "speed",
+                "brakes"
+            )?;
             for (i, a) in g.actuators().iter().enumerate() {
                 let kind = match a.actuator_kind() {
                     Ok(ActuatorKind::Rotary) => "rotary",
                     Ok(ActuatorKind::Linear) => "linear",
                     Err(_) => "?",
                 };
-                println!(
+                outln!(
                     "{i:<5} {kind:<7} {:>9.4} {:>9.4} {:>9.4} {:>9.4} {:>9.4} {:>7}",
                     a.min,
                     a.centre,
@@ -347,12 +361,14 @@ pub fn actarray(a: ActArrayArgs) -> Result<(), CliError> {
                     a.home,
                     a.config_speed,
                     if a.has_brakes != 0 { "yes" } else { "no" }
-                );
+                )?;
             }
-            println!(
+            outln!(
                 "base position ({:.4}, {:.4}, {:.4}) m",
-                g.base_pos.x, g.base_pos.y, g.base_pos.z
-            );
+                g.base_pos.x,
+                g.base_pos.y,
+                g.base_pos.z
+            )?;
             return Ok(());
         }
     };
@@ -381,10 +397,12 @@ pub fn limb(a: LimbArgs) -> Result<(), CliError> {
         LimbVerb::Speed { speed } => return done(c.set_speed(speed)),
         LimbVerb::Geom => {
             let g = c.geometry().map_err(request_err)?;
-            println!(
+            outln!(
                 "base position ({:.4}, {:.4}, {:.4}) m",
-                g.base_pos.x, g.base_pos.y, g.base_pos.z
-            );
+                g.base_pos.x,
+                g.base_pos.y,
+                g.base_pos.z
+            )?;
             return Ok(());
         }
     };
@@ -403,7 +421,7 @@ pub fn gripper(a: GripperArgs) -> Result<(), CliError> {
         GripperVerb::Geom => {
             let g = c.geometry().map_err(request_err)?;
             let p = g.pose.position;
-            println!(
+            outln!(
                 "pose ({:.4}, {:.4}, {:.4}) m; outer {:.3} x {:.3} x {:.3} m; inner {:.3} x {:.3} x {:.3} m; {} beams; capacity {}",
                 p.x,
                 p.y,
@@ -416,7 +434,7 @@ pub fn gripper(a: GripperArgs) -> Result<(), CliError> {
                 g.inner_size.height,
                 g.num_beams,
                 g.capacity
-            );
+            )?;
             return Ok(());
         }
     };

@@ -11,6 +11,7 @@ use limber_services::{DeviceName, WaitError};
 use serde_json::{Value, json};
 
 use crate::device::{connect_err, wait_err};
+use crate::out::outln;
 use crate::{CliError, exit};
 
 /// Arguments of `limber echo`.
@@ -26,7 +27,7 @@ pub struct EchoArgs {
     #[arg(long, value_name = "N")]
     count: Option<u64>,
     /// Seconds without a new sample before giving up.
-    #[arg(long, default_value_t = 5.0, value_name = "S")]
+    #[arg(long, default_value_t = 5.0, value_name = "S", value_parser = crate::parse_seconds)]
     timeout: f64,
 }
 
@@ -217,9 +218,9 @@ where
         if a.json {
             let mut v = s.json();
             v["device"] = json!(a.device);
-            println!("{v}");
+            outln!("{v}")?;
         } else {
-            println!("{}", s.human());
+            outln!("{}", s.human())?;
         }
         n += 1;
     }
@@ -306,9 +307,9 @@ fn echo_driver(robot: &str, a: &EchoArgs) -> Result<(), CliError> {
         if a.json {
             let mut v = stats_json(&s);
             v["device"] = json!(format!("{robot}/driver/0"));
-            println!("{v}");
+            outln!("{v}")?;
         } else {
-            println!("{}", stats_human(&s));
+            outln!("{}", stats_human(&s))?;
         }
         n += 1;
     }

@@ -80,7 +80,7 @@ pub struct EmulatorArgs {
     #[arg(long)]
     pub watchdog_ms: Option<u64>,
     /// Keep running when stdin closes (for `&` in scripts, whose stdin is
-    /// /dev/null); stop with SIGINT/SIGTERM only.
+    /// /dev/null); stop with SIGINT/SIGTERM/SIGHUP only.
     #[arg(long)]
     pub ignore_stdin: bool,
 }
@@ -137,7 +137,7 @@ impl EmulatorArgs {
     }
 }
 
-/// Runs `limber emulator` until SIGINT/SIGTERM or until stdin closes (unless
+/// Runs `limber emulator` until SIGINT/SIGTERM/SIGHUP or until stdin closes (unless
 /// `--ignore-stdin`). The first line on stdout is the pty path or the TCP
 /// address.
 pub fn run(args: EmulatorArgs) -> Result<(), CliError> {
@@ -171,6 +171,7 @@ fn serve(args: EmulatorArgs) -> Result<(), EmulatorError> {
     let stop = Arc::new(AtomicBool::new(false));
     signal_hook::flag::register(signal_hook::consts::SIGINT, Arc::clone(&stop))?;
     signal_hook::flag::register(signal_hook::consts::SIGTERM, Arc::clone(&stop))?;
+    signal_hook::flag::register(signal_hook::consts::SIGHUP, Arc::clone(&stop))?;
     if !args.ignore_stdin {
         let s = Arc::clone(&stop);
         std::thread::Builder::new()

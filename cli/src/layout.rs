@@ -37,7 +37,7 @@ pub fn run(args: LayoutArgs) -> Result<(), CliError> {
     };
     std::io::stdout()
         .write_all(text.as_bytes())
-        .map_err(|e| CliError::new(1, format!("cannot write to stdout: {e}")))
+        .map_err(crate::out::stdout_error)
 }
 
 fn catalogue(m: &limber_interfaces::Manifest) -> String {

@@ -18,6 +18,7 @@ mod layout;
 mod list;
 mod logging;
 mod monitor;
+mod out;
 pub mod pioneer;
 pub mod simarm;
 
@@ -133,6 +134,8 @@ where
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // A closed stdout (`| head -1`): done, quietly, as Unix tools do.
+        Err(e) if e.quiet => ExitCode::from(e.exit_code()),
         Err(e) => {
             eprintln!("limber: {e}");
             ExitCode::from(e.exit_code())
@@ -149,6 +152,17 @@ fn parse_domain(s: &str) -> Result<Domain, String> {
         return Err("the domain name is empty (unset LIMBER_DOMAIN or name a domain)".into());
     }
     Domain::new(s).map_err(|e| e.to_string())
+}
+
+/// A number of seconds for a flag: finite and not negative (at most an hour).
+pub(crate) fn parse_seconds(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .parse()
+        .map_err(|e| format!("{s:?} is not a number of seconds: {e}"))?;
+    if !v.is_finite() || !(0.0..=3600.0).contains(&v) {
+        return Err(format!("{s:?}: seconds must be between 0 and 3600"));
+    }
+    Ok(v)
 }
 
 /// The domain selected by `--domain` or `LIMBER_DOMAIN` (default `limber`).
@@ -192,6 +206,8 @@ pub mod exit {
 pub struct CliError {
     message: String,
     code: u8,
+    /// Nothing to say (the reader of stdout went away).
+    quiet: bool,
 }
 
 impl CliError {
@@ -200,6 +216,16 @@ impl CliError {
         CliError {
             message: message.into(),
             code,
+            quiet: false,
+        }
+    }
+
+    /// Stdout is a closed pipe: the verb ends with exit 0 and prints nothing.
+    pub fn stdout_closed() -> Self {
+        CliError {
+            message: "stdout is closed".into(),
+            code: 0,
+            quiet: true,
         }
     }
 

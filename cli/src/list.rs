@@ -3,6 +3,7 @@
 use clap::Args;
 use limber_services::list_devices;
 
+use crate::out::outln;
 use crate::{CliError, domain, exit};
 
 /// Arguments of `limber list`.
@@ -19,7 +20,7 @@ pub fn run(args: ListArgs) -> Result<(), CliError> {
     let devices = list_devices(&domain).map_err(|e| CliError::new(exit::FAILURE, e.to_string()))?;
     if args.json {
         for d in &devices {
-            println!(
+            outln!(
                 "{}",
                 serde_json::json!({
                     "device": d.name.to_string(),
@@ -31,29 +32,32 @@ pub fn run(args: ListArgs) -> Result<(), CliError> {
                     "layout": d.layout,
                     "processes": d.nodes,
                 })
-            );
+            )?;
         }
         return Ok(());
     }
     if devices.is_empty() {
-        println!(
+        outln!(
             "no devices in domain {} (start a driver, e.g. `limber pioneer --emulated`, or check --domain / LIMBER_DOMAIN)",
             domain.name()
-        );
+        )?;
         return Ok(());
     }
-    println!(
+    outln!(
         "{:<28} {:<12} {:<6} {:>9}",
-        "DEVICE", "DRIVER", "STATE", "PROCESSES"
-    );
+        "DEVICE",
+        "DRIVER",
+        "STATE",
+        "PROCESSES"
+    )?;
     for d in &devices {
-        println!(
+        outln!(
             "{:<28} {:<12} {:<6} {:>9}",
             d.name.to_string(),
             d.driver,
             if d.alive { "alive" } else { "dead" },
             d.nodes
-        );
+        )?;
     }
     Ok(())
 }

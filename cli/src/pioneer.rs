@@ -10,6 +10,7 @@ use limber_pioneer::{
 };
 use limber_services::{Context, Role};
 
+use crate::out::{noteln, out};
 use crate::{CliError, exit};
 
 /// Arguments of `limber pioneer`.
@@ -81,24 +82,25 @@ pub fn config_from(args: &PioneerArgs) -> Result<PioneerConfig, PioneerCliError>
     Ok(cfg)
 }
 
-/// Runs `limber pioneer` until SIGINT/SIGTERM.
+/// Runs `limber pioneer` until SIGINT/SIGTERM/SIGHUP.
 pub fn run(args: PioneerArgs) -> Result<(), CliError> {
-    let domain = crate::domain()?;
-    serve(args, &domain).map_err(|e| {
+    let to_cli = |e: PioneerCliError| {
         let code = match e {
             PioneerCliError::Config(_) => exit::USAGE,
             _ => exit::FAILURE,
         };
         CliError::new(code, e.to_string())
-    })
+    };
+    if args.print_config {
+        let cfg = config_from(&args).map_err(to_cli)?;
+        return out!("{}", cfg.to_toml());
+    }
+    let domain = crate::domain()?;
+    serve(args, &domain).map_err(to_cli)
 }
 
 fn serve(args: PioneerArgs, domain: &limber_services::Domain) -> Result<(), PioneerCliError> {
     let cfg = config_from(&args)?;
-    if args.print_config {
-        print!("{}", cfg.to_toml());
-        return Ok(());
-    }
     let ctx = Context::new(domain, Role::Driver, "pioneer").map_err(|e| {
         PioneerCliError::Setup(format!("cannot join domain {}: {e}", domain.name()))
     })?;
@@ -131,16 +133,16 @@ fn serve(args: PioneerArgs, domain: &limber_services::Domain) -> Result<(), Pion
     );
     let r = &cfg.robot;
     if hw.arm {
-        println!("serving {r}/actarray/0 (arm), {r}/limb/0, {r}/gripper/1 (arm gripper)");
+        noteln!("serving {r}/actarray/0 (arm), {r}/limb/0, {r}/gripper/1 (arm gripper)");
     } else {
-        println!(
+        noteln!(
             "no arm: the robot did not answer ARM_INFO; not serving {r}/actarray/0, {r}/limb/0, {r}/gripper/1"
         );
     }
     if hw.gripper {
-        println!("serving {r}/gripper/0 (body gripper), {r}/actarray/1 (lift)");
+        noteln!("serving {r}/gripper/0 (body gripper), {r}/actarray/1 (lift)");
     }
-    println!("serving {r}/driver/0 (statistics); ready");
+    noteln!("serving {r}/driver/0 (statistics); ready");
     let mode = if args.spin {
         LoopMode::Spin
     } else {

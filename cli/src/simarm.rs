@@ -6,9 +6,10 @@ use std::time::Duration;
 use clap::{Args, ValueEnum};
 use limber_kinematics::chain::Chain;
 use limber_services::event_loop::LoopExit;
-use limber_services::{Context, Role};
+use limber_services::{Context, HostError, Role};
 use limber_simarm::{SimArm, SimArmError, SimArmOptions, SimObject};
 
+use crate::out::noteln;
 use crate::{CliError, exit};
 
 /// A built-in chain.
@@ -94,7 +95,7 @@ fn parse_object(s: &str) -> Result<SimObject, String> {
     Ok(SimObject::block([v[0], v[1], v[2]], v[3]))
 }
 
-/// Runs `limber simarm` until SIGINT/SIGTERM: joins the domain of `LIMBER_DOMAIN`,
+/// Runs `limber simarm` until SIGINT/SIGTERM/SIGHUP: joins the domain of `LIMBER_DOMAIN`,
 /// prints `serving <robot>/actarray/0, <robot>/limb/0, <robot>/gripper/0; ready` and
 /// serves.
 pub fn run(args: SimArmArgs) -> Result<(), CliError> {
@@ -111,7 +112,24 @@ pub fn run(args: SimArmArgs) -> Result<(), CliError> {
         )
     })?;
     let robot = options.robot.clone();
-    let mut arm = SimArm::new(&ctx, chain, options).map_err(fail)?;
+    let mut arm = SimArm::new(&ctx, chain, options).map_err(|e| match e {
+        // Bad option values (time scale, object, robot name) are usage errors.
+        SimArmError::Options(_) | SimArmError::Chain(_) | SimArmError::Host(HostError::Name(_)) => {
+            CliError::new(exit::USAGE, e.to_string())
+        }
+        // Another driver holds the robot name (a second simarm, or another driver).
+        SimArmError::Host(HostError::AlreadyServed { .. } | HostError::Incompatible { .. }) => {
+            CliError::new(
+                exit::FAILURE,
+                format!(
+                    "robot {robot} is already served in domain {} by another driver ({e}); \
+                     stop it or choose another name with --robot",
+                    domain.name()
+                ),
+            )
+        }
+        e => fail(e),
+    })?;
     eprintln!(
         "limber simarm: chain {:?}, {} joints + gripper, time scale {}; domain {}",
         arm.model().chain().name(),
@@ -119,7 +137,7 @@ pub fn run(args: SimArmArgs) -> Result<(), CliError> {
         args.time_scale,
         domain.name()
     );
-    println!("serving {robot}/actarray/0, {robot}/limb/0, {robot}/gripper/0; ready");
+    noteln!("serving {robot}/actarray/0, {robot}/limb/0, {robot}/gripper/0; ready");
     let ended = arm.run(|| false).map_err(fail)?;
     if ended == LoopExit::Signal {
         eprintln!("limber simarm: stopped");

@@ -61,8 +61,18 @@ impl Bg {
     }
 
     fn term(&mut self) -> Option<i32> {
+        self.end_with(libc::SIGTERM)
+    }
+
+    /// Sends `sig` (one that does not end the process).
+    fn signal(&self, sig: i32) {
         // SAFETY: kill(2) on our own child; no memory is involved.
-        unsafe { libc::kill(self.0.id() as i32, libc::SIGTERM) };
+        unsafe { libc::kill(self.0.id() as i32, sig) };
+    }
+
+    /// Sends `sig` and waits up to 10 s for the exit; the exit code.
+    fn end_with(&mut self, sig: i32) -> Option<i32> {
+        self.signal(sig);
         let deadline = Instant::now() + Duration::from_secs(10);
         while Instant::now() < deadline {
             if let Ok(Some(s)) = self.0.try_wait() {
@@ -187,4 +197,68 @@ fn pioneer_print_config_documents_the_armpac_layout() {
     let aria = limber_pioneer::PioneerConfig::from_toml("armpac_layout = \"aria\"").unwrap();
     assert_eq!(aria.armpac_layout, limber_p2os::ArmpacLayout::Aria);
     assert!(limber_pioneer::PioneerConfig::from_toml("armpac_layout = \"player\"").is_err());
+}
+
+/// Signals that only interrupt a wait (a stop and continue, a terminal resize, a child's
+/// end) do not end a driver; SIGHUP does, cleanly (exit 0), like SIGTERM.
+#[test]
+fn simarm_and_emulator_survive_sigcont_and_sigwinch_and_end_on_sighup() {
+    let d = Domain::unique_for_test();
+    let mut sim = Bg::spawn(d.name(), &["simarm"]);
+    sim.line(|l| l.ends_with("ready"));
+    let mut emu = Bg::spawn(d.name(), &["emulator", "--pty", "--ignore-stdin"]);
+    emu.line(|l| l.starts_with("/dev/"));
+    // simarm's loop is running (its "ready" line comes just before it starts waiting).
+    let o = limber(d.name(), &["actarray", "simarm/actarray/0", "geom"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for sig in [
+        libc::SIGCONT,
+        libc::SIGWINCH,
+        libc::SIGCHLD,
+        libc::SIGSTOP,
+        libc::SIGCONT,
+    ] {
+        sim.signal(sig);
+        emu.signal(sig);
+    }
+    // Still serving: a request is answered and a command carried out.
+    let o = limber(d.name(), &["actarray", "simarm/actarray/0", "geom"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = limber(
+        d.name(),
+        &["actarray", "simarm/actarray/0", "pos", "1", "0.2"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(matches!(sim.0.try_wait(), Ok(None)), "simarm ended");
+    assert!(matches!(emu.0.try_wait(), Ok(None)), "the emulator ended");
+    assert_eq!(sim.end_with(libc::SIGHUP), Some(0));
+    assert_eq!(emu.end_with(libc::SIGHUP), Some(0));
+}
+
+#[test]
+fn a_second_simarm_of_the_same_robot_name_is_refused_with_a_sentence() {
+    let d = Domain::unique_for_test();
+    let mut sim = Bg::spawn(d.name(), &["simarm"]);
+    sim.line(|l| l.ends_with("ready"));
+    let o = limber(d.name(), &["simarm", "--builtin", "7dof"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let want = format!("robot simarm is already served in domain {}", d.name());
+    assert!(stderr(&o).contains(&want), "{}", stderr(&o));
+    // The first one serves on.
+    let o = limber(d.name(), &["actarray", "simarm/actarray/0", "geom"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(sim.term(), Some(0));
+}
+
+#[test]
+fn bad_simarm_option_values_exit_2() {
+    let d = Domain::unique_for_test();
+    for args in [
+        &["simarm", "--time-scale", "0"][..],
+        &["simarm", "--time-scale", "nan"][..],
+        &["simarm", "--robot", "a b"][..],
+    ] {
+        let o = limber(d.name(), args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+    }
 }

@@ -48,6 +48,15 @@ impl InterfaceKind {
         }
     }
 
+    /// The name with its indefinite article, for messages ("an actarray", "a limb").
+    pub const fn with_article(self) -> &'static str {
+        match self {
+            InterfaceKind::ActArray => "an actarray",
+            InterfaceKind::Limb => "a limb",
+            InterfaceKind::Gripper => "a gripper",
+        }
+    }
+
     /// Player's interface code (53, 54, 3).
     pub const fn player_code(self) -> u16 {
         match self {

@@ -41,6 +41,10 @@ pub enum ContextError {
         #[source]
         source: NodeCreationFailure,
     },
+    /// The handlers of the termination signals (SIGINT, SIGTERM, SIGHUP) could not be
+    /// installed (driver contexts).
+    #[error("cannot install the SIGINT/SIGTERM/SIGHUP handlers: {0}")]
+    Signals(#[source] rustix::io::Errno),
 }
 
 pub(crate) struct Inner {
@@ -73,9 +77,10 @@ impl Context {
     /// Joins `domain` as a driver or a client named `name` (shown by `limber list`).
     ///
     /// iceoryx2's own log output is limited to errors unless `IOX2_LOG_LEVEL` says
-    /// otherwise. A client context leaves SIGINT/SIGTERM to the program; a driver context
-    /// lets iceoryx2 catch them so the driver loop can stop cleanly (see
-    /// [`Context::termination_requested`]).
+    /// otherwise. A client context leaves signals to the program; a driver context catches
+    /// SIGINT, SIGTERM and SIGHUP ([`crate::signals`]) so the driver loop can stop its
+    /// hardware and end cleanly (see [`Context::termination_requested`]); other signals do
+    /// not end it.
     pub fn new(domain: &Domain, role: Role, name: &str) -> Result<Self, ContextError> {
         set_log_level_from_env_or(LogLevel::Error);
         let prefix = match role {
@@ -87,7 +92,10 @@ impl Context {
             .try_into()
             .map_err(|_| ContextError::Name(name.to_string()))?;
         let mode = match role {
-            Role::Driver => SignalHandlingMode::HandleTerminationRequests,
+            Role::Driver => {
+                crate::signals::install().map_err(ContextError::Signals)?;
+                SignalHandlingMode::HandleTerminationRequests
+            }
             Role::Client => SignalHandlingMode::Disabled,
         };
         let node = NodeBuilder::new()
@@ -139,10 +147,10 @@ impl Context {
         &self.inner.node
     }
 
-    /// True once SIGINT or SIGTERM arrived (driver contexts only; always false for
-    /// clients, whose signals are the program's own).
+    /// True once SIGINT, SIGTERM or SIGHUP arrived (driver contexts only; always false
+    /// for clients, whose signals are the program's own). Other signals never make it true.
     pub fn termination_requested(&self) -> bool {
-        self.inner.role == Role::Driver && self.inner.node.wait(core::time::Duration::ZERO).is_err()
+        self.inner.role == Role::Driver && crate::signals::termination_requested()
     }
 
     /// A new client id, unique in the domain while this process lives: the process id in

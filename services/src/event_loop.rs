@@ -1,6 +1,8 @@
 //! The driver loop's waiting: a WaitSet over the wake listeners of a driver's devices, a
 //! precise periodic timer (`timerfd`, not the WaitSet's 1 ms-rounded interval) and any
-//! other file descriptor (a serial port), returning on SIGINT/SIGTERM.
+//! other file descriptor (a serial port), returning on a termination request (SIGINT,
+//! SIGTERM, SIGHUP: [`crate::signals`]) and on nothing else: a signal that merely
+//! interrupts the wait (SIGCONT, SIGWINCH, SIGCHLD...) is waited through.
 
 use core::ops::ControlFlow;
 use core::time::Duration;
@@ -37,7 +39,7 @@ pub enum LoopError {
 /// Why the loop returned.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LoopExit {
-    /// SIGINT or SIGTERM arrived.
+    /// A termination request arrived (SIGINT, SIGTERM or SIGHUP).
     Signal,
     /// The callback asked to stop.
     Stopped,
@@ -138,7 +140,9 @@ impl SynchronousMultiplexing for FdSource {}
 
 /// Runs the loop of a driver: waits on the wake `listeners` of its devices, a timer of
 /// `period`, and `extra` (e.g. the serial port), and calls `on` for each wake-up until it
-/// returns `Break` or SIGINT/SIGTERM arrives. Listener events are consumed before `on` runs.
+/// returns `Break` or a termination request (SIGINT, SIGTERM, SIGHUP) arrives; any other
+/// signal that interrupts the wait is waited through. Listener events are consumed before
+/// `on` runs.
 pub fn run<F>(
     listeners: &[Listener<ipc::Service>],
     period: Duration,
@@ -169,32 +173,50 @@ where
         ),
         None => None,
     };
-    let result = ws
-        .wait_and_process(|id| {
-            let wake = if id.has_event_from(&timer_guard) {
-                Wake::Tick(timer.consume())
-            } else if extra_guard.as_ref().is_some_and(|g| id.has_event_from(g)) {
-                Wake::Fd
-            } else {
-                for (l, g) in listeners.iter().zip(&guards) {
-                    // Unconsumed events wake the loop again at once: logged.
-                    if id.has_event_from(g)
-                        && let Err(e) = l.try_wait(|_| {})
-                    {
-                        tracing::warn!(error = %e, "cannot consume wake-up events");
-                    }
+    let mut terminate = false;
+    loop {
+        let result = ws
+            .wait_and_process(|id| {
+                // A request that arrived between two waits (not interrupting either).
+                if crate::signals::termination_requested() {
+                    terminate = true;
+                    return CallbackProgression::Stop;
                 }
-                Wake::Clients
-            };
-            if on(wake).is_break() {
-                CallbackProgression::Stop
-            } else {
-                CallbackProgression::Continue
+                let wake = if id.has_event_from(&timer_guard) {
+                    Wake::Tick(timer.consume())
+                } else if extra_guard.as_ref().is_some_and(|g| id.has_event_from(g)) {
+                    Wake::Fd
+                } else {
+                    for (l, g) in listeners.iter().zip(&guards) {
+                        // Unconsumed events wake the loop again at once: logged.
+                        if id.has_event_from(g)
+                            && let Err(e) = l.try_wait(|_| {})
+                        {
+                            tracing::warn!(error = %e, "cannot consume wake-up events");
+                        }
+                    }
+                    Wake::Clients
+                };
+                if on(wake).is_break() {
+                    CallbackProgression::Stop
+                } else {
+                    CallbackProgression::Continue
+                }
+            })
+            .map_err(LoopError::Wait)?;
+        match result {
+            // iceoryx2's own record of SIGINT/SIGTERM.
+            WaitSetRunResult::TerminationRequest => return Ok(LoopExit::Signal),
+            // EINTR: any caught signal, or a stop and continue. Only a termination
+            // request ends the loop.
+            WaitSetRunResult::Interrupt => {
+                if crate::signals::termination_requested() {
+                    return Ok(LoopExit::Signal);
+                }
+                tracing::debug!("the wait was interrupted by a signal that does not end the loop");
             }
-        })
-        .map_err(LoopError::Wait)?;
-    Ok(match result {
-        WaitSetRunResult::Interrupt | WaitSetRunResult::TerminationRequest => LoopExit::Signal,
-        _ => LoopExit::Stopped,
-    })
+            _ if terminate => return Ok(LoopExit::Signal),
+            _ => return Ok(LoopExit::Stopped),
+        }
+    }
 }

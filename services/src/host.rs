@@ -58,7 +58,7 @@ pub enum HostError {
     #[error(transparent)]
     Name(#[from] NameError),
     /// The device is of another interface than the host.
-    #[error("device {device} is not a {expected}")]
+    #[error("device {device} is not {}", .expected.with_article())]
     WrongInterface {
         /// The device.
         device: String,

@@ -77,6 +77,7 @@ pub mod event_loop;
 pub mod host;
 pub mod naming;
 pub mod qos;
+pub mod signals;
 pub mod testing;
 
 pub use client::{

@@ -101,7 +101,7 @@ fn clients_tell_absent_wrong_and_incompatible_devices_apart() {
     );
     assert_eq!(
         err.to_string(),
-        "r/actarray/0 is incompatible: it is a actarray device, not a limb"
+        "r/actarray/0 is incompatible: it is an actarray device, not a limb"
     );
 
     // A data channel without the layout attribute: another layout version.

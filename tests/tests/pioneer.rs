@@ -303,23 +303,100 @@ fn silence_and_garbage_are_detected_and_survived() {
     );
 }
 
-#[test]
-fn sigterm_stops_the_arm_closes_the_link_and_exits_zero() {
+/// `sig` ends the driver with exit 0 after it stopped the arm (ARM_STOP) and closed the
+/// link (CLOSE), while a joint was moving at a slow speed.
+fn a_termination_signal_stops_the_arm(sig: i32, name: &str) {
     let domain = Domain::unique_for_test();
     let emu = Emulator::start_pty(EmulatorConfig::default()).unwrap();
-    let mut driver = start(&domain, &emu, "sigterm");
+    let mut driver = start(&domain, &emu, name);
     let c = ctx(&domain);
     let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
     arm.power(true).unwrap();
-    let t = arm.move_to(0, 1.5).unwrap();
+    let t = arm.move_at_speed(0, 0.1).unwrap();
     assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
-    driver.signal(libc::SIGTERM);
-    assert_eq!(driver.wait_timeout(T), Some(0));
+    let (moving, st) = emu.wait_for(T, |s| s.robot.servo_targets[0] != s.robot.servo_ticks[0]);
+    assert!(moving, "the joint does not move: {:?}", st.robot);
+    driver.signal(sig);
+    assert_eq!(
+        driver.wait_timeout(T),
+        Some(0),
+        "exit status after signal {sig}"
+    );
     let (closed, st) = emu.wait_for(T, |s| s.robot.stage == limber_emulator::SyncStage::NoSync);
     assert!(closed, "no CLOSE: {:?}", st.robot.stage);
     // The arm was stopped where it was, not left running to the old target.
     assert_eq!(st.robot.servo_targets[0], st.robot.servo_ticks[0]);
     drop(arm);
+}
+
+#[test]
+fn sigterm_stops_the_arm_closes_the_link_and_exits_zero() {
+    a_termination_signal_stops_the_arm(libc::SIGTERM, "sigterm");
+}
+
+#[test]
+fn sighup_stops_the_arm_closes_the_link_and_exits_zero() {
+    a_termination_signal_stops_the_arm(libc::SIGHUP, "sighup");
+}
+
+#[test]
+fn sigint_stops_the_arm_closes_the_link_and_exits_zero() {
+    a_termination_signal_stops_the_arm(libc::SIGINT, "sigint");
+}
+
+/// Signals that are not termination requests (a stop and continue as Ctrl-Z and `bg` do,
+/// a terminal resize, SIGCHLD) only interrupt the driver's wait: it goes on
+/// serving, the link stays open, and a later SIGTERM still ends it cleanly.
+fn other_signals_do_not_end_the_driver(extra: &[&str], name: &str) {
+    let domain = Domain::unique_for_test();
+    let emu = Emulator::start_pty(EmulatorConfig::default()).unwrap();
+    let port = emu.pty_path().unwrap().display().to_string();
+    let cfg = config_file(name);
+    let mut args = vec!["--port", &port, "--config", cfg.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    let mut driver = Proc::spawn(PIONEER, domain.name(), &args);
+    assert!(driver.read_until(|l| l.ends_with("ready")).is_some());
+    let c = ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
+    arm.set_wake_driver(extra.is_empty());
+    // The loop is running (the "ready" line comes just before it starts waiting).
+    assert_eq!(arm.geometry().unwrap().actuators_count, 6);
+    for sigs in [
+        &[libc::SIGCONT][..],
+        &[libc::SIGWINCH][..],
+        &[libc::SIGCHLD][..],
+        &[libc::SIGSTOP, libc::SIGCONT][..],
+        // Ctrl-Z: caught (by iceoryx2), so the driver is not even suspended.
+        &[libc::SIGTSTP][..],
+    ] {
+        for &sig in sigs {
+            driver.signal(sig);
+        }
+        // A round trip after each: the loop is back in its wait before the next signal.
+        assert_eq!(arm.geometry().unwrap().actuators_count, 6, "{sigs:?}");
+    }
+    // Requests are answered and commands carried out, by the same driver on the same link.
+    assert_eq!(arm.geometry().unwrap().actuators_count, 6);
+    let t = arm.move_to(3, 0.4).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
+    assert!(
+        matches!(driver.child.try_wait(), Ok(None)),
+        "the driver ended"
+    );
+    let st = emu.state();
+    assert_eq!(st.robot.stage, limber_emulator::SyncStage::Open);
+    driver.signal(libc::SIGTERM);
+    assert_eq!(driver.wait_timeout(T), Some(0));
+}
+
+#[test]
+fn sigcont_sigwinch_and_stop_continue_do_not_end_the_driver() {
+    other_signals_do_not_end_the_driver(&[], "othersignals");
+}
+
+#[test]
+fn sigcont_sigwinch_and_stop_continue_do_not_end_the_spinning_driver() {
+    other_signals_do_not_end_the_driver(&["--spin"], "othersignals-spin");
 }
 
 #[test]
@@ -389,4 +466,50 @@ fn spin_mode_with_pinning_serves_and_stops_cleanly() {
     assert_eq!(s.loop_mode, limber_interfaces::diagnostics::loop_mode::SPIN);
     d.signal(libc::SIGTERM);
     assert_eq!(d.wait_timeout(T), Some(0));
+}
+
+/// SIGKILL leaves the driver no chance to stop the arm: the arm's autopark watchdog, which
+/// the driver sets at connection (`autopark_s`), homes it and powers it off once no command
+/// arrives. While the driver lives, its PULSE keep-alives count as contact: the arm moving
+/// slowly for longer than the watchdog's time, with no client command, is not parked.
+#[test]
+fn a_sigkilled_drivers_arm_parks_by_itself() {
+    let domain = Domain::unique_for_test();
+    let emu = Emulator::start_pty(EmulatorConfig::default()).unwrap();
+    let port = emu.pty_path().unwrap().display().to_string();
+    let cfg = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("autopark.toml");
+    std::fs::write(&cfg, "autopark_s = 2\npulse_interval_ms = 1000\n").unwrap();
+    let mut driver = Proc::spawn(
+        PIONEER,
+        domain.name(),
+        &["--port", &port, "--config", cfg.to_str().unwrap()],
+    );
+    assert!(driver.read_until(|l| l.ends_with("ready")).is_some());
+    let (set, st) = emu.wait_for(T, |s| s.robot.autopark_s == 2);
+    assert!(set, "AUTOPARK not set: {:?}", st.robot);
+    let c = ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
+    arm.power(true).unwrap();
+    let t = arm.move_at_speed(0, 0.05).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
+    let (moving, st) = emu.wait_for(T, |s| s.robot.servo_targets[0] != s.robot.servo_ticks[0]);
+    assert!(moving, "the joint does not move: {:?}", st.robot);
+    // Twice the watchdog's time with only keep-alives on the link: no park.
+    let (parked, st) = emu.wait_for(Duration::from_secs(4), |s| {
+        s.robot.autoparks > 0 || !s.robot.arm_powered
+    });
+    assert!(!parked, "a live driver's arm parked: {:?}", st.robot);
+
+    driver.signal(libc::SIGKILL);
+    assert_eq!(driver.wait_timeout(T), None, "SIGKILL leaves no exit code");
+    let home: Vec<u8> = limber_emulator::default_arm_info()
+        .calibrations()
+        .iter()
+        .map(|c| c.home)
+        .collect();
+    let (parked, st) = emu.wait_for(Duration::from_secs(20), |s| {
+        s.robot.autoparks == 1 && !s.robot.arm_powered && s.robot.servo_ticks[..] == home[..]
+    });
+    assert!(parked, "the arm did not park: {:?}", st.robot);
+    drop(arm);
 }

@@ -16,6 +16,7 @@ use std::time::{Duration, Instant};
 use clap::Args;
 use crossterm::event::{self, Event, KeyCode, KeyEventKind, KeyModifiers};
 
+use crate::out::out;
 use crate::{CliError, exit};
 use app::App;
 
@@ -51,7 +52,7 @@ pub fn run(args: MonitorArgs) -> Result<(), CliError> {
                     .flatten()
             })
             .unwrap_or(120);
-        print!("{}", ui::render_text(&app, width));
+        out!("{}", ui::render_text(&app, width))?;
         return Ok(());
     }
     let interval = Duration::from_millis(args.interval_ms.clamp(10, 10_000));

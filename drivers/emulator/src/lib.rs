@@ -38,7 +38,8 @@ mod server;
 
 pub use limber_p2os::ArmpacLayout;
 pub use model::{
-    ModelConfig, ObjectPlacement, Robot, RobotState, SyncStage, Timing, default_arm_info,
+    AUTOPARK_DEFAULT_S, ModelConfig, ObjectPlacement, Robot, RobotState, SyncStage, Timing,
+    default_arm_info,
 };
 
 use limber_p2os::LinkTarget;

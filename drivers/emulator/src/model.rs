@@ -73,6 +73,9 @@ pub fn default_arm_info() -> ArmInfo {
     )
 }
 
+/// The arm's autopark watchdog until a client sets it, s (ARIA: 10 minutes).
+pub const AUTOPARK_DEFAULT_S: u16 = 600;
+
 /// Physical parameters of the emulated robot.
 #[derive(Debug, Clone)]
 pub struct ModelConfig {
@@ -195,6 +198,10 @@ pub struct RobotState {
     pub sonar: bool,
     /// Valid commands received.
     pub commands: u64,
+    /// The autopark watchdog, s (AUTOPARK; 0 disabled).
+    pub autopark_s: u16,
+    /// Times the autopark watchdog parked the arm (homed it and powered it off).
+    pub autoparks: u64,
 }
 
 /// The emulated controller.
@@ -224,6 +231,10 @@ pub struct Robot {
     arm_pac_once: bool,
     /// A 0xE0 gripper packet was requested once for the next cycle.
     gripper_pac_once: bool,
+    /// The last command (any, PULSE included) from the client.
+    last_contact: Instant,
+    autopark_s: u16,
+    autoparks: u64,
 }
 
 impl Robot {
@@ -266,6 +277,9 @@ impl Robot {
             commands: 0,
             last_moving: 0,
             wants_arm_pac: false,
+            last_contact: now,
+            autopark_s: AUTOPARK_DEFAULT_S,
+            autoparks: 0,
             timing: Timing::default(),
             deferred: Vec::new(),
             arm_pac_once: false,
@@ -366,6 +380,7 @@ impl Robot {
         };
         self.advance(now, out);
         self.commands += 1;
+        self.last_contact = now;
         let arg = cmd.int();
         let open = self.stage == SyncStage::Open;
         match cmd.number {
@@ -510,6 +525,10 @@ impl Robot {
                     self.set_servo_target(j, lsb, now);
                 }
             }
+            num::ARM_AUTOPARK => {
+                self.autopark_s = a.clamp(0, 0xFFFF) as u16;
+                return;
+            }
             num::ARM_SPEED => {
                 for j in self.one_joint(i32::from(msb)) {
                     self.servos[j].ms = lsb;
@@ -555,6 +574,7 @@ impl Robot {
     /// when a joint starts or stops and the ARMpac stream is on, an ARMpac
     /// goes to `out` at once.
     pub fn advance(&mut self, now: Instant, out: &mut Vec<Frame>) {
+        self.autopark(now);
         if self.arm_powered {
             for s in &mut self.servos {
                 while s.tick != s.target {
@@ -606,6 +626,28 @@ impl Robot {
             // Opened: the object is released (and falls if lifted).
             self.gripped = false;
         }
+    }
+
+    /// The autopark watchdog (Pioneer Arm Manual: "if contact is lost while powered, the
+    /// arm reverts to HOME with power off"): no command for `autopark_s` seconds while
+    /// powered parks the arm.
+    fn autopark(&mut self, now: Instant) {
+        if !self.arm_powered
+            || self.parking
+            || self.autopark_s == 0
+            || now.saturating_duration_since(self.last_contact)
+                < Duration::from_secs(u64::from(self.autopark_s))
+        {
+            return;
+        }
+        for j in 0..self.joint_count() {
+            if let Some(c) = self.calib(j) {
+                self.set_servo_target(j, c.home, now);
+            }
+        }
+        self.homing = true;
+        self.parking = true;
+        self.autoparks += 1;
     }
 
     fn object_visible(&self) -> bool {
@@ -743,6 +785,8 @@ impl Robot {
             switches: self.switches(),
             sonar: self.sonar,
             commands: self.commands,
+            autopark_s: self.autopark_s,
+            autoparks: self.autoparks,
         }
     }
 }

@@ -92,6 +92,11 @@ pub struct PioneerConfig {
     /// `<robot>/actarray/1`. Set false for a robot without them (e.g. a simulator), so no
     /// gripper or lift command is ever sent to it.
     pub body_gripper: bool,
+    /// The arm's autopark watchdog (AUTOPARK, P2OS command 80), s: when no command
+    /// (PULSE included) reaches the robot for this long, the arm homes and powers off by
+    /// itself, so a driver killed with SIGKILL does not leave it moving. Sent at every
+    /// connection; 0 disables the watchdog. Must exceed the keep-alive interval.
+    pub autopark_s: u16,
 }
 
 /// `armpac_layout` as its name in TOML.
@@ -145,6 +150,8 @@ impl Default for PioneerConfig {
             vecmove_deviation: 0.002,
             armpac_layout: ArmpacLayout::default(),
             body_gripper: true,
+            // The link timeout (1 s) and a reconnection or two, with room to spare.
+            autopark_s: 10,
         }
     }
 }
@@ -167,15 +174,19 @@ impl PioneerConfig {
     }
 
     /// The configuration as TOML (what `limber pioneer --print-config` shows), with a
-    /// comment on the keys whose values are words.
+    /// comment on the keys whose meaning is not obvious from their name or value.
     pub fn to_toml(&self) -> String {
-        toml::to_string_pretty(self)
-            .unwrap_or_default()
-            .replacen(
-                "armpac_layout =",
-                "# ARMpac status bytes: \"manual\" (the vendor's manuals, Player) or \"aria\" (ARIA's ArP2Arm)\narmpac_layout =",
-                1,
-            )
+        format!(
+            "# autopark_s: seconds without any command (PULSE included) after which the arm\n\
+             # homes and powers off by itself (AUTOPARK, sent at every connection); 0 disables.\n{}",
+            toml::to_string_pretty(self)
+                .unwrap_or_default()
+                .replacen(
+                    "armpac_layout =",
+                    "# ARMpac status bytes: \"manual\" (the vendor's manuals, Player) or \"aria\" (ARIA's ArP2Arm)\narmpac_layout =",
+                    1,
+                )
+        )
     }
 
     /// Checks ranges.
@@ -210,6 +221,11 @@ impl PioneerConfig {
         if self.tick_ms == 0 || self.tick_ms > 1000 {
             return bad("tick_ms must be 1..=1000");
         }
+        if self.autopark_s != 0 && u64::from(self.autopark_s) * 1000 <= self.pulse_interval_ms {
+            return bad(
+                "autopark_s must be 0 (disabled) or longer than pulse_interval_ms, or a live driver's arm parks",
+            );
+        }
         if self.link_timeout_ms < 200 {
             return bad("link_timeout_ms must be >= 200 (a robot sends a SIP every 100 ms)");
         }
@@ -227,5 +243,33 @@ impl PioneerConfig {
     /// The loop tick.
     pub fn tick(&self) -> Duration {
         Duration::from_millis(self.tick_ms)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn autopark_defaults_to_ten_seconds_and_is_printed_with_its_meaning() {
+        let c = PioneerConfig::default();
+        assert_eq!(c.autopark_s, 10);
+        let text = c.to_toml();
+        assert!(text.contains("autopark_s = 10"), "{text}");
+        assert!(text.contains("# autopark_s:"), "{text}");
+        assert_eq!(PioneerConfig::from_toml(&text).unwrap(), c);
+    }
+
+    #[test]
+    fn autopark_must_be_off_or_longer_than_the_keep_alive() {
+        assert_eq!(
+            PioneerConfig::from_toml("autopark_s = 0")
+                .unwrap()
+                .autopark_s,
+            0
+        );
+        let e = PioneerConfig::from_toml("autopark_s = 1\npulse_interval_ms = 1000").unwrap_err();
+        assert!(e.to_string().contains("autopark_s"), "{e}");
+        assert!(PioneerConfig::from_toml("autopark_s = 70000").is_err());
     }
 }

@@ -346,10 +346,26 @@ impl PioneerDriver {
         {
             tracing::warn!("cannot power the arm at start: {status}");
         }
+        d.set_autopark();
         d.robot.dirty.arm = true;
         d.robot.dirty.body = true;
         d.publish_all(Instant::now());
         Ok(d)
+    }
+
+    /// Sets the arm's autopark watchdog (AUTOPARK, `autopark_s`), at every connection: a
+    /// driver that dies without a word (SIGKILL) leaves the arm to park itself.
+    fn set_autopark(&mut self) {
+        if !self.hardware.arm {
+            return;
+        }
+        let s = self.robot.cfg.autopark_s;
+        if let Err(status) = self
+            .robot
+            .send(&Command::ArmAutoPark(s), &origin_internal())
+        {
+            tracing::warn!("cannot set the arm's autopark watchdog to {s} s: {status}");
+        }
     }
 
     /// What the robot has.
@@ -579,6 +595,7 @@ impl PioneerDriver {
                 self.robot.last_rx = Instant::now();
                 // Whatever was commanded before is void; hold where the arm is.
                 self.robot.arm.target = [None; 6];
+                self.set_autopark();
                 self.reconnects += 1;
                 self.robot.dirty.arm = true;
                 self.robot.dirty.body = true;
@@ -618,14 +635,14 @@ impl PioneerDriver {
         }
     }
 
-    /// Runs until SIGINT/SIGTERM; then stops the arm, closes the link and returns.
+    /// Runs until SIGINT/SIGTERM/SIGHUP; then stops the arm, closes the link and returns.
     pub fn run(&mut self, opts: RunOptions) -> Result<LoopExit, DriverError> {
         let exit = self.run_until(opts, || false);
         self.shutdown();
         exit
     }
 
-    /// Runs until SIGINT/SIGTERM or until `stop` (checked at every wake-up, at least every
+    /// Runs until SIGINT/SIGTERM/SIGHUP or until `stop` (checked at every wake-up, at least every
     /// tick) returns true. The link stays open: run again, or call
     /// [`PioneerDriver::shutdown`] to stop the arm and close it.
     pub fn run_until(

@@ -56,7 +56,7 @@ pub enum ConnectError {
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
 pub enum Incompatibility {
     /// The device is of another interface than the client's.
-    #[error("it is a {actual} device, not a {expected}")]
+    #[error("it is {} device, not {}", .actual.with_article(), .expected.with_article())]
     Interface {
         /// The device's interface.
         actual: InterfaceKind,

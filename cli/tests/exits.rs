@@ -1,0 +1,182 @@
+//! Exit codes and messages of the command line as the README's table states them, and a
+//! closed stdout (`| head -1`) ending a verb quietly.
+
+use std::io::{BufRead, BufReader};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use limber_services::Domain;
+
+mod common;
+use common::{LIMBER, driver, limber, stderr};
+
+/// `--timeout` covers waiting for the driver to appear: a verb started before its driver
+/// waits for it (here longer than the 0.5 s it used to) and is answered.
+#[test]
+fn timeout_covers_waiting_for_the_driver_to_appear() {
+    let d = Domain::unique_for_test();
+    let mut verb = Command::new(LIMBER)
+        .args(["actarray", "cli/actarray/0", "geom", "--timeout", "30"])
+        .env("LIMBER_DOMAIN", d.name())
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .unwrap();
+    // The driver is late: it appears only after the verb has been waiting for a while,
+    // and the verb is still waiting then.
+    let late = Instant::now() + Duration::from_millis(1500);
+    while Instant::now() < late {
+        assert!(
+            matches!(verb.try_wait(), Ok(None)),
+            "the verb gave up before its --timeout: {:?}",
+            verb.try_wait()
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let _stop = driver(d.name());
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let status = loop {
+        if let Some(s) = verb.try_wait().unwrap() {
+            break s;
+        }
+        assert!(Instant::now() < deadline, "the verb never ended");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert_eq!(status.code(), Some(0));
+}
+
+/// Without a driver, the verb ends with 3 once its --timeout has passed.
+#[test]
+fn no_driver_within_the_timeout_exits_3() {
+    let d = Domain::unique_for_test();
+    let o = limber(
+        d.name(),
+        &["actarray", "nobody/actarray/0", "geom", "--timeout", "0.2"],
+    );
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no driver offers"), "{}", stderr(&o));
+}
+
+#[test]
+fn bad_values_and_verbs_of_the_wrong_interface_exit_2() {
+    let d = Domain::unique_for_test();
+    let _stop = driver(d.name());
+    let dom = d.name();
+    let usage = |args: &[&str], says: &str| {
+        let o = limber(dom, args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(says), "{args:?}: {}", stderr(&o));
+    };
+    // A verb of another interface than the device's.
+    usage(
+        &["limb", "cli/actarray/0", "geom"],
+        "it is an actarray device, not a limb",
+    );
+    usage(
+        &["gripper", "cli/actarray/0", "open"],
+        "it is an actarray device, not a gripper",
+    );
+    // Bad flag values.
+    for t in ["nan", "-1", "inf", "x"] {
+        let flag = format!("--timeout={t}");
+        usage(&["actarray", "cli/actarray/0", "geom", &flag], "timeout");
+        usage(&["echo", "cli/actarray/0", &flag], "timeout");
+    }
+    // A bad configuration value.
+    let cfg = std::env::temp_dir().join(format!("limber-bad-{}.toml", std::process::id()));
+    std::fs::write(&cfg, "autopark_s = 1\npulse_interval_ms = 1000\n").unwrap();
+    usage(
+        &[
+            "pioneer",
+            "--config",
+            cfg.to_str().unwrap(),
+            "--print-config",
+        ],
+        "autopark_s",
+    );
+    std::fs::write(&cfg, "tick_ms = 0\n").unwrap();
+    usage(&["pioneer", "--config", cfg.to_str().unwrap()], "tick_ms");
+    std::fs::remove_file(&cfg).unwrap();
+    // An empty domain is an error with a sentence, not silently "limber".
+    usage(&["list", "--domain", ""], "the domain name is empty");
+    let o = common::output(Command::new(LIMBER).args(["list"]).env("LIMBER_DOMAIN", ""));
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("the domain name is empty"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+/// `--print-config` shows the autopark key with its meaning.
+#[test]
+fn print_config_documents_autopark() {
+    let o = limber("limber", &["pioneer", "--print-config"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = common::stdout(&o);
+    assert!(text.contains("autopark_s = 10"), "{text}");
+    assert!(text.contains("# autopark_s:"), "{text}");
+}
+
+/// Runs `limber <args>` with its stdout a pipe that this test closes after the first
+/// line; the exit status and stderr.
+fn first_line_then_close(domain: &str, args: &[&str]) -> (Option<i32>, String) {
+    let mut child = Command::new(LIMBER)
+        .args(args)
+        .env("LIMBER_DOMAIN", domain)
+        .env("RUST_BACKTRACE", "1")
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut line = String::new();
+    out.read_line(&mut line).unwrap();
+    assert!(!line.is_empty(), "{args:?}: no first line");
+    drop(out); // the reader goes away, as `head -1` does
+    let mut err = child.stderr.take().unwrap();
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let mut s = String::new();
+        let r = std::io::Read::read_to_string(&mut err, &mut s);
+        let _ = tx.send((r.is_ok(), s));
+    });
+    let deadline = Instant::now() + Duration::from_secs(30);
+    let code = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s.code();
+        }
+        if Instant::now() >= deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("{args:?} still running 30 s after its stdout closed");
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    let (_, err) = rx.recv_timeout(Duration::from_secs(30)).unwrap();
+    (code, err)
+}
+
+/// A closed stdout ends every verb quietly with exit 0, as Unix tools do (it used to
+/// panic: "failed printing to stdout: Broken pipe", exit 101).
+#[test]
+fn a_closed_stdout_ends_the_verb_quietly() {
+    let d = Domain::unique_for_test();
+    let _stop = driver(d.name());
+    for args in [
+        &["echo", "cli/actarray/0", "--count", "100000"][..],
+        &["echo", "cli/actarray/0", "--json"][..],
+        &["echo", "cli/actarray/0"][..],
+        &["layout"][..],
+        &["list"][..],
+        &["monitor", "--once"][..],
+        &["actarray", "cli/actarray/0", "geom"][..],
+    ] {
+        let (code, err) = first_line_then_close(d.name(), args);
+        assert_eq!(code, Some(0), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert!(!err.contains("Broken pipe"), "{args:?}: {err}");
+    }
+}
