@@ -28,7 +28,7 @@ use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
-use super::pose::{FrameError, Pose, all_finite, fit_angle_to_limits, wrap_pi};
+use super::pose::{FrameError, Pose, all_finite, fit_angle_to_limits, unit_direction, wrap_pi};
 
 /// Number of arm joints in the kinematics (the gripper is not one of them).
 pub const PIONEER_DOF: usize = 5;
@@ -941,15 +941,14 @@ impl PioneerGeometry {
         {
             return Err(VecMoveError::InvalidOptions);
         }
-        let n = direction.norm();
-        if n < 1e-12 {
-            return Err(VecMoveError::ZeroDirection);
-        }
+        // Scaled by the largest component first: (1e308, 1e308, 0) is a direction too
+        // (its norm overflows).
+        let direction = unit_direction(direction).ok_or(VecMoveError::ZeroDirection)?;
         let start = self.fk_raw(current);
         Ok(VecMove {
             geometry: self,
             start: start.position,
-            direction: direction / n,
+            direction,
             approach: start.approach(),
             length,
             travelled: 0.0,

@@ -9,10 +9,11 @@
 use limber_interfaces::prelude::*;
 use nalgebra::Vector3;
 
+use limber_kinematics::chain::ChainIkError;
 use limber_kinematics::chain::{
     Chain, IkTarget, JointKind, JointVec, MAX_JOINTS, NumericIkOptions,
 };
-use limber_kinematics::{Pose, fit_angle_to_limits};
+use limber_kinematics::{Pose, fit_angle_to_limits, unit_direction};
 
 /// Most waypoints of one VECMOVE (at [`SimArmOptions::vecmove_step`] apart).
 pub const MAX_WAYPOINTS: usize = 512;
@@ -461,11 +462,12 @@ impl ArmModel {
         Ok(())
     }
 
+    /// Motion needs power: refused as POWERED_OFF otherwise (it would not move).
     fn powered(&self) -> Result<(), Status> {
         if self.powered {
             Ok(())
         } else {
-            Err(Status::Busy)
+            Err(Status::PoweredOff)
         }
     }
 
@@ -524,13 +526,13 @@ impl ArmModel {
 
     // ----- actarray --------------------------------------------------------------------
 
-    /// Carries out or refuses an actuator-array command.
+    /// Carries out or refuses an actuator-array command. A SPEED above the actuator's
+    /// maximum speed runs at the maximum and is answered CLAMPED.
     pub fn arm_command(&mut self, cmd: &ActArrayCommand) -> Status {
-        let r = self.arm_command_inner(cmd);
-        r.err().unwrap_or(Status::Ok)
+        self.arm_command_inner(cmd).unwrap_or_else(|e| e)
     }
 
-    fn arm_command_inner(&mut self, cmd: &ActArrayCommand) -> Result<(), Status> {
+    fn arm_command_inner(&mut self, cmd: &ActArrayCommand) -> Result<Status, Status> {
         match *cmd {
             ActArrayCommand::Position { joint, position } => {
                 let j = joint as usize;
@@ -540,7 +542,7 @@ impl ArmModel {
                     self.vecmove.active = false;
                 }
                 self.move_actuator(j, position, None);
-                Ok(())
+                Ok(Status::Ok)
             }
             ActArrayCommand::MultiPosition(v) => {
                 let v = v.as_slice();
@@ -555,17 +557,18 @@ impl ArmModel {
                 for (j, p) in v.iter().enumerate() {
                     self.move_actuator(j, *p, None);
                 }
-                Ok(())
+                Ok(Status::Ok)
             }
             ActArrayCommand::Speed { joint, speed } => {
                 let j = joint as usize;
                 self.check_speed_target(j, speed)?;
-                self.powered()?;
+                if speed != 0.0 {
+                    self.powered()?;
+                }
                 if j < self.n {
                     self.vecmove.active = false;
                 }
-                self.move_at_speed(j, speed);
-                Ok(())
+                Ok(self.move_at_speed(j, speed))
             }
             ActArrayCommand::MultiSpeed(v) => {
                 let v = v.as_slice();
@@ -575,12 +578,17 @@ impl ArmModel {
                 for (j, s) in v.iter().enumerate() {
                     self.check_speed_target(j, *s)?;
                 }
-                self.powered()?;
-                self.vecmove.active = false;
-                for (j, s) in v.iter().enumerate() {
-                    self.move_at_speed(j, *s);
+                if v.iter().any(|s| *s != 0.0) {
+                    self.powered()?;
                 }
-                Ok(())
+                self.vecmove.active = false;
+                let mut status = Status::Ok;
+                for (j, s) in v.iter().enumerate() {
+                    if self.move_at_speed(j, *s) == Status::Clamped {
+                        status = Status::Clamped;
+                    }
+                }
+                Ok(status)
             }
             ActArrayCommand::Home(JointSel::All) => {
                 self.powered()?;
@@ -592,7 +600,7 @@ impl ArmModel {
                 let open = self.gripper_stroke;
                 self.move_actuator(self.n, open, None);
                 self.gripper_cmd = GripperCmd::Open;
-                Ok(())
+                Ok(Status::Ok)
             }
             ActArrayCommand::Home(JointSel::One(j)) => {
                 let j = j as usize;
@@ -609,7 +617,7 @@ impl ArmModel {
                     self.move_actuator(j, open, None);
                     self.gripper_cmd = GripperCmd::Open;
                 }
-                Ok(())
+                Ok(Status::Ok)
             }
             ActArrayCommand::Current { .. } | ActArrayCommand::MultiCurrent(_) => {
                 Err(Status::Unsupported)
@@ -626,18 +634,19 @@ impl ArmModel {
     }
 
     /// Moves actuator `j` toward its limit in the direction of `speed`'s sign at
-    /// |speed| (capped at the actuator's maximum speed); 0 stops it.
-    fn move_at_speed(&mut self, j: usize, speed: f64) {
+    /// |speed|, capped at the actuator's maximum speed (then `Status::Clamped`); 0 stops
+    /// it.
+    fn move_at_speed(&mut self, j: usize, speed: f64) -> Status {
         if speed == 0.0 {
             if j < self.n {
                 self.joints[j].stop();
             } else {
                 self.gripper.stop();
             }
-            return;
+            return Status::Ok;
         }
         let Some((lo, hi)) = self.joint_limits(j) else {
-            return;
+            return Status::UnknownJoint;
         };
         let end = if speed > 0.0 { hi } else { lo };
         let max = if j < self.n {
@@ -646,6 +655,12 @@ impl ArmModel {
             self.gripper_max_speed
         };
         self.move_actuator(j, end, Some(speed.abs().min(max)));
+        if speed.abs() > max {
+            tracing::debug!(joint = j, speed, max, "speed clamped");
+            Status::Clamped
+        } else {
+            Status::Ok
+        }
     }
 
     /// Answers an actuator-array request.
@@ -764,11 +779,17 @@ impl ArmModel {
                 self.limb_oor = false;
                 Status::Ok
             }
-            Err(Status::OutOfReach) => {
-                self.limb_oor = true;
-                Status::OutOfReach
+            Err(e) => {
+                // The limb cannot get there: beyond its reach, an orientation its joints
+                // cannot hold, or a joint limit in the way.
+                if matches!(
+                    e,
+                    Status::OutOfReach | Status::UnreachableOrientation | Status::BeyondLimits
+                ) {
+                    self.limb_oor = true;
+                }
+                e
             }
-            Err(e) => e,
         }
     }
 
@@ -776,12 +797,7 @@ impl ArmModel {
         let sol = self
             .chain
             .ik(target, seed, &self.options.ik)
-            .map_err(|e| match e {
-                limber_kinematics::chain::ChainIkError::NonFinite => Status::NotFinite,
-                limber_kinematics::chain::ChainIkError::WrongJointCount { .. }
-                | limber_kinematics::chain::ChainIkError::InvalidOptions => Status::InvalidArgument,
-                _ => Status::OutOfReach,
-            })?;
+            .map_err(|e| self.ik_status(&e))?;
         let mut q = sol.q;
         // Take the turn of each revolute joint nearest to the seed (less travel).
         for ((v, j), s) in q.iter_mut().zip(self.chain.joints()).zip(seed) {
@@ -792,9 +808,35 @@ impl ArmModel {
             }
         }
         if !self.chain.within_limits(&q) {
-            return Err(Status::OutOfReach);
+            return Err(Status::BeyondLimits);
         }
         Ok(q)
+    }
+
+    /// The cause of an IK failure: beyond the reach; a position reached but not the
+    /// orientation (the joints cannot hold it); or neither within the joint limits.
+    fn ik_status(&self, e: &ChainIkError) -> Status {
+        let ik = &self.options.ik;
+        match *e {
+            ChainIkError::NonFinite => Status::NotFinite,
+            ChainIkError::WrongJointCount { .. } | ChainIkError::InvalidOptions => {
+                Status::InvalidArgument
+            }
+            ChainIkError::OutOfReach { .. } => Status::OutOfReach,
+            ChainIkError::NotConverged {
+                position_error,
+                orientation_error,
+                ..
+            } => {
+                if position_error <= ik.position_tolerance
+                    && orientation_error > ik.orientation_tolerance
+                {
+                    Status::UnreachableOrientation
+                } else {
+                    Status::OutOfReach
+                }
+            }
+        }
     }
 
     fn limb_command_inner(&mut self, cmd: &LimbCommand) -> Result<(), Status> {
@@ -847,12 +889,13 @@ impl ArmModel {
                 if !(direction.is_finite() && length.is_finite()) {
                     return Err(Status::NotFinite);
                 }
-                let n = direction.norm();
-                if length < 0.0 || n < 1e-9 {
+                // Normalised without overflow: (1e308, 1e308, 0) is a direction too.
+                let dir = unit_direction(&Vector3::from(direction.to_array()));
+                let Some(dir) = dir.filter(|_| length >= 0.0) else {
                     return Err(Status::InvalidArgument);
-                }
+                };
                 self.powered()?;
-                self.plan_vecmove(&(Vector3::from(direction.to_array()) / n), length)
+                self.plan_vecmove(&dir, length)
             }
         }
     }
