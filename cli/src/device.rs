@@ -281,10 +281,12 @@ fn finish<I: Interface>(
         return Ok(());
     }
     match c.wait_outcome(ticket, common.timeout()) {
-        Ok(Status::Ok) => {
-            println!("ok");
+        // "ok", or "ok, clamped to the limit": carried out either way.
+        Ok(s) if s.is_carried_out() => {
+            println!("{s}");
             Ok(())
         }
+        // The cause in words: "refused: powered off", "refused: out of reach", ...
         Ok(s) => Err(CliError::new(exit::REFUSED, format!("refused: {s}"))),
         Err(WaitError::Missed { .. }) => {
             println!("ok (applied; outcome overwritten by a later command)");
