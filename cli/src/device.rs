@@ -288,10 +288,12 @@ fn finish<I: Interface>(
         return Ok(());
     }
     match c.wait_outcome(ticket, common.timeout()) {
-        Ok(Status::Ok) => {
-            outln!("ok")?;
+        // "ok", or "ok, clamped to the limit": carried out either way.
+        Ok(s) if s.is_carried_out() => {
+            outln!("{s}")?;
             Ok(())
         }
+        // The cause in words: "refused: powered off", "refused: out of reach", ...
         Ok(s) => Err(CliError::new(exit::REFUSED, format!("refused: {s}"))),
         Err(WaitError::Missed { .. }) => {
             outln!("ok (applied; outcome overwritten by a later command)")?;

@@ -262,3 +262,73 @@ fn bad_simarm_option_values_exit_2() {
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
     }
 }
+
+/// Issue 12, items 7 to 10, as a user types them against `limber pioneer --emulated`:
+/// "ok" only when the arm will do it, the cause in words otherwise.
+#[test]
+fn ok_means_it_on_the_emulated_pioneer() {
+    let d = Domain::unique_for_test();
+    let mut drv = Bg::spawn(d.name(), &["pioneer", "--emulated"]);
+    drv.line(|l| l.ends_with("ready"));
+    let run = |args: &[&str]| limber(d.name(), args);
+    let arm = |args: &[&str]| {
+        let mut a = vec!["actarray", "pioneer/actarray/0"];
+        a.extend_from_slice(args);
+        run(&a)
+    };
+    let limb = |args: &[&str]| {
+        let mut a = vec!["limb", "pioneer/limb/0"];
+        a.extend_from_slice(args);
+        run(&a)
+    };
+    let refused = |o: &std::process::Output, why: &str| {
+        assert_eq!(o.status.code(), Some(5), "{}{}", stdout(o), stderr(o));
+        assert!(
+            stderr(o).contains(&format!("refused: {why}")),
+            "{}",
+            stderr(o)
+        );
+    };
+    // Item 7.
+    assert!(arm(&["power", "off"]).status.success());
+    refused(&arm(&["pos", "2", "0.3"]), "powered off");
+    refused(&limb(&["vecmove", "1", "1", "0", "0.02"]), "powered off");
+    let o = arm(&["power", "on"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = arm(&["pos", "2", "0.3"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(stdout(&o).trim(), "ok");
+    // Item 9.
+    let o = arm(&["speed", "2", "1e308"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(stdout(&o).trim(), "ok, clamped to the limit");
+    let o = arm(&["speed", "2", "0"]);
+    assert_eq!(stdout(&o).trim(), "ok", "{}", stderr(&o));
+    // Item 8.
+    let o = limb(&["setposition", "0.35", "0", "0.25"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = limb(&["vecmove", "1e308", "1e308", "0", "0.02"]);
+    assert_eq!(stdout(&o).trim(), "ok", "{}", stderr(&o));
+    let o = limb(&["vecmove", "0", "0", "0", "0.02"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    // Item 10.
+    refused(
+        &limb(&[
+            "setpose",
+            "0.35",
+            "0",
+            "0.25",
+            "--approach",
+            "1",
+            "0",
+            "0",
+            "--orient",
+            "1",
+            "0",
+            "0",
+        ]),
+        "invalid argument",
+    );
+    refused(&limb(&["setposition", "1.5", "0", "0.3"]), "out of reach");
+    assert_eq!(drv.term(), Some(0));
+}

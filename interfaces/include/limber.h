@@ -27,13 +27,16 @@ extern "C" {
 #define LIMBER_STATUS_UNSUPPORTED 1 /* the driver cannot do this */
 #define LIMBER_STATUS_UNKNOWN_JOINT 2 /* the joint index does not exist */
 #define LIMBER_STATUS_NOT_FINITE 3 /* a value was NaN or infinite */
-#define LIMBER_STATUS_BEYOND_LIMITS 4 /* a value lies outside the joint limits */
-#define LIMBER_STATUS_OUT_OF_REACH 5 /* the pose cannot be reached */
+#define LIMBER_STATUS_BEYOND_LIMITS 4 /* a value (or every solution for a pose) lies outside the joint limits */
+#define LIMBER_STATUS_OUT_OF_REACH 5 /* the position lies beyond the limb's reach */
 #define LIMBER_STATUS_NOT_CALIBRATED 6 /* calibration not known yet */
 #define LIMBER_STATUS_LINK_DOWN 7 /* the link to the hardware is down */
 #define LIMBER_STATUS_BUSY 8 /* device busy */
 #define LIMBER_STATUS_TIMEOUT 9 /* the hardware did not answer in time */
-#define LIMBER_STATUS_INVALID_ARGUMENT 10 /* malformed argument */
+#define LIMBER_STATUS_INVALID_ARGUMENT 10 /* malformed argument (e.g. parallel approach and orientation) */
+#define LIMBER_STATUS_POWERED_OFF 11 /* the arm is powered off */
+#define LIMBER_STATUS_UNREACHABLE_ORIENTATION 12 /* the orientation is not attainable by the limb's joints */
+#define LIMBER_STATUS_CLAMPED 13 /* carried out, a value clamped to the limit */
 
 /* Bits of StateHeader.flags */
 #define LIMBER_DEVICE_FLAG_LINK_UP 1 /* link to the hardware up */

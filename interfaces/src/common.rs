@@ -131,9 +131,10 @@ pub enum Status {
     UnknownJoint = 2,
     /// A value was NaN or infinite.
     NotFinite = 3,
-    /// A value lies outside the joint's limits.
+    /// A value lies outside the joint's limits, or every way of reaching a pose needs a
+    /// joint beyond its limits.
     BeyondLimits = 4,
-    /// The pose cannot be reached by the limb.
+    /// The position lies beyond the limb's reach.
     OutOfReach = 5,
     /// The device has not reported its calibration yet.
     NotCalibrated = 6,
@@ -143,13 +144,23 @@ pub enum Status {
     Busy = 8,
     /// The hardware did not answer in time.
     Timeout = 9,
-    /// An argument is malformed (bad count, zero-length vector, unknown kind, ...).
+    /// An argument is malformed (bad count, zero-length vector, parallel approach and
+    /// orientation vectors, unknown kind, ...).
     InvalidArgument = 10,
+    /// The arm is powered off: a motion command would not move it.
+    PoweredOff = 11,
+    /// The position is within reach but no configuration of the limb's joints holds the
+    /// requested orientation (e.g. a 5-joint arm asked for a full 6-DOF pose).
+    UnreachableOrientation = 12,
+    /// Carried out, with a value clamped to the device's limit (e.g. a speed above the
+    /// joint's maximum runs at the maximum). Counts as carried out
+    /// ([`Status::is_carried_out`]).
+    Clamped = 13,
 }
 
 impl Status {
     /// Every status, in code order.
-    pub const ALL: [Status; 11] = [
+    pub const ALL: [Status; 14] = [
         Status::Ok,
         Status::Unsupported,
         Status::UnknownJoint,
@@ -161,6 +172,9 @@ impl Status {
         Status::Busy,
         Status::Timeout,
         Status::InvalidArgument,
+        Status::PoweredOff,
+        Status::UnreachableOrientation,
+        Status::Clamped,
     ];
 
     /// The wire code.
@@ -168,9 +182,16 @@ impl Status {
         self as u32
     }
 
-    /// True for `Ok`.
+    /// True for `Ok` only (carried out exactly as asked); see also
+    /// [`Status::is_carried_out`].
     pub const fn is_ok(self) -> bool {
         matches!(self, Status::Ok)
+    }
+
+    /// True when the command was carried out: `Ok`, or `Clamped` (carried out with a value
+    /// clamped to the device's limit). Everything else is a refusal.
+    pub const fn is_carried_out(self) -> bool {
+        matches!(self, Status::Ok | Status::Clamped)
     }
 
     /// A short human-readable reason.
@@ -187,6 +208,9 @@ impl Status {
             Status::Busy => "device busy",
             Status::Timeout => "hardware timeout",
             Status::InvalidArgument => "invalid argument",
+            Status::PoweredOff => "powered off",
+            Status::UnreachableOrientation => "orientation not attainable by this limb's joints",
+            Status::Clamped => "ok, clamped to the limit",
         }
     }
 }
@@ -251,12 +275,12 @@ pub(crate) const STATUS_GROUP: ConstantGroup = ConstantGroup {
         Constant {
             name: "BEYOND_LIMITS",
             value: 4,
-            doc: "a value lies outside the joint limits",
+            doc: "a value (or every solution for a pose) lies outside the joint limits",
         },
         Constant {
             name: "OUT_OF_REACH",
             value: 5,
-            doc: "the pose cannot be reached",
+            doc: "the position lies beyond the limb's reach",
         },
         Constant {
             name: "NOT_CALIBRATED",
@@ -281,7 +305,22 @@ pub(crate) const STATUS_GROUP: ConstantGroup = ConstantGroup {
         Constant {
             name: "INVALID_ARGUMENT",
             value: 10,
-            doc: "malformed argument",
+            doc: "malformed argument (e.g. parallel approach and orientation)",
+        },
+        Constant {
+            name: "POWERED_OFF",
+            value: 11,
+            doc: "the arm is powered off",
+        },
+        Constant {
+            name: "UNREACHABLE_ORIENTATION",
+            value: 12,
+            doc: "the orientation is not attainable by the limb's joints",
+        },
+        Constant {
+            name: "CLAMPED",
+            value: 13,
+            doc: "carried out, a value clamped to the limit",
         },
     ],
 };

@@ -294,7 +294,7 @@ fn unknown_codes_in_state_are_named_errors() {
     let mut geom = ActuatorGeom::default();
     geom.kind = 3;
     assert!(geom.actuator_kind().is_err());
-    assert!(Status::try_from(11).is_err());
+    assert!(Status::try_from(Status::ALL.len() as u32).is_err());
     let mut raw = ActArrayReqMsg::default();
     raw.meta.kind = actarray::req::POWER;
     raw.meta.body_len = 4;
@@ -416,4 +416,31 @@ fn manifest_describes_every_struct_without_padding() {
     }
     let json: serde_json::Value = serde_json::from_str(&m.to_json()).unwrap();
     assert_eq!(json["structs"][0]["fields"][0]["name"], "x");
+}
+
+#[test]
+fn every_status_code_decodes_to_itself_and_names_its_cause() {
+    for (i, s) in Status::ALL.iter().enumerate() {
+        assert_eq!(s.code() as usize, i, "{s:?} out of code order");
+        assert_eq!(Status::try_from(s.code()), Ok(*s));
+    }
+    // The codes of the wire never change: new causes get new numbers.
+    assert_eq!(Status::InvalidArgument.code(), 10);
+    assert_eq!(Status::PoweredOff.code(), 11);
+    assert_eq!(Status::UnreachableOrientation.code(), 12);
+    assert_eq!(Status::Clamped.code(), 13);
+    let mut texts: Vec<&str> = Status::ALL.iter().map(|s| s.describe()).collect();
+    texts.sort_unstable();
+    texts.dedup();
+    assert_eq!(texts.len(), Status::ALL.len(), "two causes share a text");
+    assert_eq!(Status::PoweredOff.to_string(), "powered off");
+    // Clamped was carried out; only Ok is exactly as asked.
+    assert!(Status::Clamped.is_carried_out() && !Status::Clamped.is_ok());
+    assert!(Status::Ok.is_carried_out());
+    assert!(
+        Status::ALL[1..]
+            .iter()
+            .filter(|s| s.is_carried_out())
+            .eq([Status::Clamped].iter())
+    );
 }

@@ -16,13 +16,16 @@ STATUS_OK = 0  # carried out (ACK)
 STATUS_UNSUPPORTED = 1  # the driver cannot do this
 STATUS_UNKNOWN_JOINT = 2  # the joint index does not exist
 STATUS_NOT_FINITE = 3  # a value was NaN or infinite
-STATUS_BEYOND_LIMITS = 4  # a value lies outside the joint limits
-STATUS_OUT_OF_REACH = 5  # the pose cannot be reached
+STATUS_BEYOND_LIMITS = 4  # a value (or every solution for a pose) lies outside the joint limits
+STATUS_OUT_OF_REACH = 5  # the position lies beyond the limb's reach
 STATUS_NOT_CALIBRATED = 6  # calibration not known yet
 STATUS_LINK_DOWN = 7  # the link to the hardware is down
 STATUS_BUSY = 8  # device busy
 STATUS_TIMEOUT = 9  # the hardware did not answer in time
-STATUS_INVALID_ARGUMENT = 10  # malformed argument
+STATUS_INVALID_ARGUMENT = 10  # malformed argument (e.g. parallel approach and orientation)
+STATUS_POWERED_OFF = 11  # the arm is powered off
+STATUS_UNREACHABLE_ORIENTATION = 12  # the orientation is not attainable by the limb's joints
+STATUS_CLAMPED = 13  # carried out, a value clamped to the limit
 
 # Bits of StateHeader.flags
 DEVICE_FLAG_LINK_UP = 1  # link to the hardware up

@@ -125,10 +125,19 @@ class Status(enum.IntEnum):
     BUSY = L.STATUS_BUSY
     TIMEOUT = L.STATUS_TIMEOUT
     INVALID_ARGUMENT = L.STATUS_INVALID_ARGUMENT
+    POWERED_OFF = L.STATUS_POWERED_OFF
+    UNREACHABLE_ORIENTATION = L.STATUS_UNREACHABLE_ORIENTATION
+    CLAMPED = L.STATUS_CLAMPED
 
     @property
     def is_ok(self) -> bool:
+        """``OK`` only: carried out exactly as asked (see :attr:`is_carried_out`)."""
         return self is Status.OK
+
+    @property
+    def is_carried_out(self) -> bool:
+        """``OK`` or ``CLAMPED`` (carried out with a value clamped to the limit)."""
+        return self in (Status.OK, Status.CLAMPED)
 
     def __str__(self) -> str:
         return self.name
@@ -150,6 +159,9 @@ _STATUS_TEXT = {
     Status.BUSY: "device busy",
     Status.TIMEOUT: "hardware timeout",
     Status.INVALID_ARGUMENT: "invalid argument",
+    Status.POWERED_OFF: "powered off",
+    Status.UNREACHABLE_ORIENTATION: "orientation not attainable by this limb's joints",
+    Status.CLAMPED: "ok, clamped to the limit",
 }
 
 

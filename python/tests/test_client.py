@@ -522,6 +522,12 @@ def test_status_names_are_the_rust_names():
     assert Status.BEYOND_LIMITS.describe() == "beyond the joint limits"
     assert str(Status.UNKNOWN_JOINT) == "UNKNOWN_JOINT"
     assert Status(4) is Status.BEYOND_LIMITS
+    # Every cause has its text (the same as Rust's), and CLAMPED counts as carried out.
+    assert all(s.describe() for s in Status)
+    assert Status.POWERED_OFF.describe() == "powered off"
+    assert Status.CLAMPED.describe() == "ok, clamped to the limit"
+    assert Status.CLAMPED.is_carried_out and not Status.CLAMPED.is_ok
+    assert [s for s in Status if s.is_carried_out] == [Status.OK, Status.CLAMPED]
 
 
 # ----- Python and Rust side by side ------------------------------------------------------

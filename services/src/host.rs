@@ -122,9 +122,10 @@ pub enum ProcessError {
 pub struct HostStats {
     /// Commands received.
     pub commands: u64,
-    /// Commands refused (any status other than ok).
+    /// Commands refused (any status but ok and clamped: see `Status::is_carried_out`).
     pub refused: u64,
-    /// Commands lost before the driver saw them (gaps in a client's sequence numbers).
+    /// Commands lost before the driver saw them: gaps in the sequence numbers of one of
+    /// the [`CLIENT_SLOTS`] most recently active clients (only gaps that can be proven).
     pub overflows: u64,
     /// Requests answered.
     pub requests: u64,
@@ -176,36 +177,53 @@ pub struct Activity {
     pub requests: usize,
 }
 
-const CLIENT_SLOTS: usize = 64;
+/// Clients per device whose sequence numbers are followed (the most recently active).
+pub const CLIENT_SLOTS: usize = 64;
 
 /// [`DeviceHost::process_spin`] looks for requests on every this many calls.
 pub const SPIN_REQUEST_EVERY: u32 = 16;
 
-/// Per-client last sequence number, to detect lost commands. Fixed size, no allocation.
+/// Per-client last sequence number, to detect lost commands: a bounded table of the
+/// [`CLIENT_SLOTS`] most recently active clients, least recently active evicted first. Fixed
+/// size, no allocation.
+///
+/// Only gaps that can be proven are counted: a gap between two commands of a client in the
+/// table. A client not in the table (new, evicted after [`CLIENT_SLOTS`] others commanded,
+/// or from before a driver restart) starts a new entry and counts nothing: its earlier
+/// sequence numbers may have been delivered before the entry was evicted.
 struct ClientTable {
-    slots: [(u64, u64); CLIENT_SLOTS],
-    next: usize,
+    /// (client id, last sequence number, last use); client id 0 marks a free slot.
+    slots: [(u64, u64, u64); CLIENT_SLOTS],
+    /// Use counter (the LRU clock).
+    clock: u64,
 }
 
 impl ClientTable {
     fn new() -> Self {
         ClientTable {
-            slots: [(0, 0); CLIENT_SLOTS],
-            next: 0,
+            slots: [(0, 0, 0); CLIENT_SLOTS],
+            clock: 0,
         }
     }
 
-    /// Records `seq` from `client`; returns how many commands were skipped.
+    /// Records `seq` from `client`; returns how many of its commands provably went missing
+    /// since its previous one.
     fn record(&mut self, client: u64, seq: u64) -> u64 {
-        if let Some(slot) = self.slots.iter_mut().find(|s| s.0 == client) {
-            let lost = seq.saturating_sub(slot.1 + 1);
+        self.clock += 1;
+        if let Some(slot) = self.slots.iter_mut().find(|s| s.0 == client && client != 0) {
+            let lost = seq.saturating_sub(slot.1.saturating_add(1));
             slot.1 = slot.1.max(seq);
+            slot.2 = self.clock;
             return lost;
         }
-        // A client seen for the first time: its first command is seq 1.
-        self.slots[self.next] = (client, seq);
-        self.next = (self.next + 1) % CLIENT_SLOTS;
-        seq.saturating_sub(1)
+        // Unknown: take a free slot, else the least recently active client's.
+        let victim = self
+            .slots
+            .iter_mut()
+            .min_by_key(|s| if s.0 == 0 { 0 } else { s.2 })
+            .expect("CLIENT_SLOTS > 0");
+        *victim = (client, seq, self.clock);
+        0
     }
 }
 
@@ -572,7 +590,7 @@ impl<I: Interface> DeviceHost<I> {
                 Err(e) => e.status(),
             };
             self.stats.commands += 1;
-            if !status.is_ok() {
+            if !status.is_carried_out() {
                 self.stats.refused += 1;
             }
             self.outcome = CmdOutcome {
@@ -655,5 +673,56 @@ impl<I: Interface> DeviceHost<I> {
     pub fn cleanup_dead(&self) {
         use iceoryx2::service::port_factory::PortFactory;
         self.data_svc.try_cleanup_dead_nodes();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{CLIENT_SLOTS, ClientTable};
+
+    #[test]
+    fn gaps_of_a_followed_client_are_counted_exactly() {
+        let mut t = ClientTable::new();
+        assert_eq!(t.record(7, 1), 0);
+        assert_eq!(t.record(7, 2), 0);
+        // 3 and 4 went missing.
+        assert_eq!(t.record(7, 5), 2);
+        // A late or repeated one is no loss and does not move the mark back.
+        assert_eq!(t.record(7, 4), 0);
+        assert_eq!(t.record(7, 6), 0);
+    }
+
+    /// Issue 12, item 11: after more than `CLIENT_SLOTS` other clients commanded, a
+    /// long-lived client's next command counted `seq - 1` overflows.
+    #[test]
+    fn a_forgotten_client_is_not_counted_as_losing_its_history() {
+        let mut t = ClientTable::new();
+        let mut lost = 0;
+        for seq in 1..=1000 {
+            lost += t.record(1, seq);
+        }
+        for other in 0..70u64 {
+            lost += t.record(1000 + other, 1);
+        }
+        // Client 1 was evicted (the least recently active): its next command proves no gap.
+        lost += t.record(1, 1001);
+        assert_eq!(lost, 0);
+        // Followed again from there on.
+        assert_eq!(t.record(1, 1003), 1);
+    }
+
+    #[test]
+    fn an_active_client_is_never_evicted_by_many_one_shot_clients() {
+        let mut t = ClientTable::new();
+        let mut seq = 0;
+        for other in 0..(10 * CLIENT_SLOTS as u64) {
+            seq += 1;
+            assert_eq!(t.record(1, seq), 0);
+            assert_eq!(t.record(1000 + other, 1), 0);
+        }
+        // Still followed: a gap is still seen.
+        assert_eq!(t.record(1, seq + 3), 2);
+        // Bounded: the table holds CLIENT_SLOTS entries whatever the number of clients.
+        assert_eq!(t.slots.len(), CLIENT_SLOTS);
     }
 }

@@ -89,7 +89,8 @@ pub use device_set::{DeviceError, DeviceSet, DeviceSetHandler};
 pub use discovery::{DeviceInfo, ListError, list_devices};
 pub use error::Iox2Error;
 pub use host::{
-    Activity, DeviceHandler, DeviceHost, HostError, HostStats, Origin, ProcessError, PublishError,
+    Activity, CLIENT_SLOTS, DeviceHandler, DeviceHost, HostError, HostStats, Origin, ProcessError,
+    PublishError,
 };
 pub use naming::{Channel, DeviceName, Domain, NameError};
 

@@ -243,3 +243,41 @@ fn discovery_lists_devices_with_driver_and_liveness() {
     // Another domain sees nothing.
     assert!(list_devices(&Domain::unique_for_test()).unwrap().is_empty());
 }
+
+/// Issue 12, item 11: the driver follows the sequence numbers of `CLIENT_SLOTS` clients per
+/// device; after more than that many others commanded, a long-lived client's next command
+/// was counted as (seq - 1) lost commands. Counters stay exact: nothing was lost, nothing
+/// is counted.
+#[test]
+fn many_clients_do_not_make_a_long_lived_client_look_lossy() {
+    let domain = Domain::unique_for_test();
+    let mut driver = start_driver(&domain, &[]);
+    let ctx = client_ctx(&domain);
+    let mut long = ActArrayClient::connect_timeout(&ctx, "test/actarray/0", T).unwrap();
+    let mut sent = 0u64;
+    for i in 0..20 {
+        let t = long.move_to(0, 0.01 * f64::from(i)).unwrap();
+        assert_eq!(long.wait_outcome(t, T).unwrap(), Status::Ok);
+        sent += 1;
+    }
+    let others = limber_services::CLIENT_SLOTS + 6;
+    for _ in 0..others {
+        // One at a time (a device serves a bounded number of clients at once).
+        let mut c = ActArrayClient::connect_timeout(&ctx, "test/actarray/0", T).unwrap();
+        let t = c.move_to(1, 0.2).unwrap();
+        assert_eq!(c.wait_outcome(t, T).unwrap(), Status::Ok);
+        sent += 1;
+    }
+    let t = long.move_to(0, 0.3).unwrap();
+    assert_eq!(long.wait_outcome(t, T).unwrap(), Status::Ok);
+    sent += 1;
+    let s = long.state().expect("the state with the outcome");
+    assert_eq!(s.header.cmd_overflows, 0, "commands counted as lost");
+    driver.signal(libc::SIGTERM);
+    assert_eq!(driver.wait_timeout(T), Some(0));
+    let out = driver.rest_of_stdout();
+    assert!(
+        out.contains(&format!("stats commands={sent} overflows=0 ")),
+        "{out}"
+    );
+}

@@ -556,7 +556,7 @@ impl App {
             return;
         };
         let (kind, text) = match conn.poll_outcome(p.ticket) {
-            Ok(Status::Ok) => (StatusKind::Ok, format!("{what} {name}: ok")),
+            Ok(s) if s.is_carried_out() => (StatusKind::Ok, format!("{what} {name}: {s}")),
             Ok(s) => (StatusKind::Error, format!("{what} {name}: refused: {s}")),
             Err(WaitError::Missed { .. }) => (
                 StatusKind::Ok,

@@ -42,4 +42,4 @@ pub mod chain;
 pub mod pioneer;
 mod pose;
 
-pub use pose::{FrameError, Pose, angle_between_rotations, fit_angle_to_limits};
+pub use pose::{FrameError, Pose, angle_between_rotations, fit_angle_to_limits, unit_direction};

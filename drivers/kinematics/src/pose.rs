@@ -35,6 +35,22 @@ pub enum FrameError {
     },
 }
 
+/// `v` scaled to unit length without overflow or underflow: divided by its largest
+/// component first, so `(1e308, 1e308, 0)` gives `(0.707, 0.707, 0)` where `v / v.norm()`
+/// gives zero (the norm overflows to infinity). `None` for the zero vector and for a
+/// vector with a NaN or infinite component.
+pub fn unit_direction(v: &Vector3<f64>) -> Option<Vector3<f64>> {
+    if !all_finite(v) {
+        return None;
+    }
+    let m = v.amax();
+    if m == 0.0 {
+        return None;
+    }
+    let s = v / m;
+    Some(s / s.norm())
+}
+
 impl Pose {
     /// A pose from a position and a rotation.
     pub fn new(position: Vector3<f64>, rotation: Rotation3<f64>) -> Self {

@@ -548,3 +548,48 @@ fn setposition_at_the_yaw_limit() {
     assert!(g.within_limits(&sol.theta));
     assert!((g.fk(&sol.theta).unwrap().position - target).norm() < 1e-6);
 }
+
+/// Issue 12, item 8: a huge direction is a direction (its norm overflows; scaling by the
+/// largest component first keeps it), the zero vector is not.
+#[test]
+fn vecmove_direction_of_huge_components_is_normalised_without_overflow() {
+    let g = geom();
+    let start = [0.1, 0.3, 0.6, 0.2, 0.4];
+    let options = VecMoveOptions::default();
+    let plan = |dir: Vector3<f64>| -> Vec<[f64; 5]> {
+        g.vecmove(&start, &dir, 0.02, &options)
+            .unwrap()
+            .map(|w| w.unwrap().theta)
+            .collect()
+    };
+    let same = |a: &[[f64; 5]], b: &[[f64; 5]]| {
+        a.len() == b.len()
+            && a.iter()
+                .zip(b)
+                .all(|(x, y)| x.iter().zip(y).all(|(p, q)| (p - q).abs() < 1e-9))
+    };
+    let small = plan(Vector3::new(0.5, -1.0, -0.5));
+    let huge = plan(Vector3::new(0.5e308, -1e308, -0.5e308));
+    assert!(!huge.is_empty());
+    assert!(same(&small, &huge), "{small:?} vs {huge:?}");
+    let p0 = g.fk(&start).unwrap().position;
+    let end = g.fk(huge.last().unwrap()).unwrap().position;
+    assert!(
+        ((end - p0).norm() - 0.02).abs() < 1e-6,
+        "{}",
+        (end - p0).norm()
+    );
+    // Subnormal components are a direction too; zero is not.
+    assert!(same(
+        &plan(Vector3::new(0.5e-320, -1e-320, -0.5e-320)),
+        &small
+    ));
+    assert!(matches!(
+        g.vecmove(&start, &Vector3::zeros(), 0.02, &options),
+        Err(VecMoveError::ZeroDirection)
+    ));
+    let u =
+        limber_kinematics::unit_direction(&Vector3::new(f64::MAX, -f64::MAX, f64::MAX)).unwrap();
+    assert!((u - Vector3::new(1.0, -1.0, 1.0) / 3f64.sqrt()).norm() < 1e-15);
+    assert_eq!(limber_kinematics::unit_direction(&Vector3::zeros()), None);
+}

@@ -352,7 +352,7 @@ fn move_at_speed_and_stop() {
     // Power off: motion refused until power is on.
     arm.power(false).unwrap();
     let t = arm.move_to(0, 0.5).unwrap();
-    assert_eq!(arm.wait_outcome(t, TIMEOUT), Ok(Status::Busy));
+    assert_eq!(arm.wait_outcome(t, TIMEOUT), Ok(Status::PoweredOff));
     arm.power(true).unwrap();
     let t = arm.home(None).unwrap();
     assert_eq!(arm.wait_outcome(t, TIMEOUT), Ok(Status::Ok));

@@ -273,3 +273,94 @@ fn a_refused_line_leaves_the_running_one_alone() {
     m.limb_state(&mut s);
     assert_eq!(s.state, LimbState::Idle as u32);
 }
+
+/// Issue 12, items 7 to 10 on the simulated arm: the same refusals, with the same causes,
+/// as the Pioneer's.
+#[test]
+fn refusals_name_their_cause_like_the_pioneer() {
+    let mut m = model(Chain::default_6dof());
+    // Item 7: an unpowered arm refuses motion (POWERED_OFF); stopping is fine.
+    assert!(m.arm_request(&ActArrayRequest::Power(false)).is_ok());
+    let refused = [
+        m.arm_command(&ActArrayCommand::position(0, 0.1).unwrap()),
+        m.arm_command(&ActArrayCommand::speed(0, 0.1).unwrap()),
+        m.arm_command(&ActArrayCommand::multi_speed(&[0.0, 0.1]).unwrap()),
+        m.arm_command(&ActArrayCommand::home(-1).unwrap()),
+        m.limb_command(&LimbCommand::Home),
+        m.limb_command(&LimbCommand::vec_move(Vec3::new(1.0, 0.0, 0.0), 0.01).unwrap()),
+    ];
+    assert!(
+        refused.iter().all(|s| *s == Status::PoweredOff),
+        "{refused:?}"
+    );
+    assert_eq!(
+        m.arm_command(&ActArrayCommand::speed(0, 0.0).unwrap()),
+        Status::Ok
+    );
+    assert_eq!(m.limb_command(&LimbCommand::Stop), Status::Ok);
+    assert!(!moving(&m));
+    assert!(m.arm_request(&ActArrayRequest::Power(true)).is_ok());
+
+    // Item 9: beyond the joint's maximum speed: clamped, and said so.
+    let max = m.chain().joints()[2].max_speed;
+    assert_eq!(
+        m.arm_command(&ActArrayCommand::speed(2, 1e308).unwrap()),
+        Status::Clamped
+    );
+    m.advance(0.01);
+    let mut s = ActArrayData::default();
+    m.arm_state(&mut s);
+    assert!(
+        (s.actuators()[2].speed - max).abs() < 1e-9,
+        "{}",
+        s.actuators()[2].speed
+    );
+    assert_eq!(
+        m.arm_command(&ActArrayCommand::speed(2, -max / 2.0).unwrap()),
+        Status::Ok
+    );
+    assert_eq!(
+        m.arm_command(&ActArrayCommand::multi_speed(&[0.0, 0.0, -1e9]).unwrap()),
+        Status::Clamped
+    );
+    assert_eq!(
+        m.arm_command(&ActArrayCommand::speed(2, 0.0).unwrap()),
+        Status::Ok
+    );
+
+    // Item 8: a direction whose norm overflows still is one; it moves like (1, 1, 0).
+    let st = m.limb_command(
+        &LimbCommand::set_pose(
+            Vec3::new(0.4, 0.1, 0.3),
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::new(1.0, 0.0, 0.0),
+        )
+        .unwrap(),
+    );
+    assert_eq!(st, Status::Ok);
+    run_until_idle(&mut m);
+    let p0 = m.tool_pose().position;
+    assert_eq!(
+        m.limb_command(&LimbCommand::vec_move(Vec3::new(1e308, 1e308, 0.0), 0.02).unwrap()),
+        Status::Ok
+    );
+    run_until_idle(&mut m);
+    let d = m.tool_pose().position - p0;
+    assert!((d.norm() - 0.02).abs() < 1e-3, "{d:?}");
+    assert!((d.x - d.y).abs() < 1e-3 && d.z.abs() < 1e-3, "{d:?}");
+
+    // Item 10: parallel approach and orientation are an invalid argument, reachable or
+    // not; beyond the reach is OUT_OF_REACH.
+    for p in [Vec3::new(0.4, 0.1, 0.3), Vec3::new(5.0, 0.0, 0.0)] {
+        let parallel =
+            LimbCommand::set_pose(p, Vec3::new(1.0, 0.0, 0.0), Vec3::new(2.0, 0.0, 0.0)).unwrap();
+        assert_eq!(m.limb_command(&parallel), Status::InvalidArgument);
+    }
+    let far = LimbCommand::set_pose(
+        Vec3::new(5.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, -1.0),
+        Vec3::new(1.0, 0.0, 0.0),
+    )
+    .unwrap();
+    assert_eq!(m.limb_command(&far), Status::OutOfReach);
+}

@@ -6,7 +6,7 @@
 use nalgebra::Vector3;
 
 use super::{PioneerGeometry, PioneerIkError, PioneerIkOptions, Theta};
-use crate::pose::all_finite;
+use crate::pose::{all_finite, unit_direction};
 
 impl PioneerGeometry {
     /// VECMOVE: plans a straight line from the current end-effector position along
@@ -41,15 +41,14 @@ impl PioneerGeometry {
         {
             return Err(VecMoveError::InvalidOptions);
         }
-        let n = direction.norm();
-        if n < 1e-12 {
-            return Err(VecMoveError::ZeroDirection);
-        }
+        // Scaled by the largest component first: (1e308, 1e308, 0) is a direction too
+        // (its norm overflows).
+        let direction = unit_direction(direction).ok_or(VecMoveError::ZeroDirection)?;
         let start = self.fk_raw(current);
         Ok(VecMove {
             geometry: self,
             start: start.position,
-            direction: direction / n,
+            direction,
             approach: start.approach(),
             length,
             travelled: 0.0,

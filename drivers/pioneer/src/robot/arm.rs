@@ -11,11 +11,14 @@ use super::*;
 
 impl RobotModel {
     /// An arm actarray command.
+    /// A SPEED faster than the joint's configured speed (the geometry's `config_speed`,
+    /// from the calibration) runs at that speed and is answered CLAMPED.
     pub fn arm_command(&mut self, cmd: &ActArrayCommand, from: &Origin) -> Status {
         let r = match *cmd {
             ActArrayCommand::Position { joint, position } => {
                 self.vecmove = None;
                 self.move_joint(joint as usize, position, from)
+                    .map(|()| Status::Ok)
             }
             ActArrayCommand::MultiPosition(v) => {
                 self.vecmove = None;
@@ -25,13 +28,13 @@ impl RobotModel {
                     ticks[j] = self.joint_tick(j, *p)?;
                     Ok(())
                 });
-                r.and_then(|()| {
+                r.and_then(|()| self.require_power()).and_then(|()| {
                     for (j, &tick) in ticks.iter().enumerate().take(v.len()) {
                         let joint = ArmJoint::from_index(j).map_err(|_| Status::UnknownJoint)?;
                         self.send(&Command::ArmPos { joint, tick }, from)?;
                         self.arm.set_target(j, tick);
                     }
-                    Ok(())
+                    Ok(Status::Ok)
                 })
             }
             ActArrayCommand::Speed { joint, speed } => {
@@ -47,27 +50,40 @@ impl RobotModel {
                         }
                     })
                 });
+                let r = r.and_then(|()| {
+                    if v.as_slice().iter().any(|s| *s != 0.0) {
+                        self.require_power()
+                    } else {
+                        Ok(())
+                    }
+                });
                 r.and_then(|()| {
-                    v.as_slice()
-                        .iter()
-                        .enumerate()
-                        .try_for_each(|(j, s)| self.move_at_speed(j, *s, from))
+                    let mut status = Status::Ok;
+                    for (j, s) in v.as_slice().iter().enumerate() {
+                        if self.move_at_speed(j, *s, from)? == Status::Clamped {
+                            status = Status::Clamped;
+                        }
+                    }
+                    Ok(status)
                 })
             }
-            ActArrayCommand::Home(sel) => self.home(sel, from),
+            ActArrayCommand::Home(sel) => self.home(sel, from).map(|()| Status::Ok),
             ActArrayCommand::Current { .. } | ActArrayCommand::MultiCurrent(_) => {
                 Err(Status::Unsupported)
             }
         };
-        r.err().unwrap_or(Status::Ok)
+        r.unwrap_or_else(|e| e)
     }
 
+    /// Moves joint `j` toward its limit in the direction of `speed`'s sign (0 stops it):
+    /// `Ok(Status::Clamped)` when |speed| exceeded the joint's configured speed and the
+    /// joint runs at that instead.
     pub(super) fn move_at_speed(
         &mut self,
         j: usize,
         speed: f64,
         from: &Origin,
-    ) -> Result<(), Status> {
+    ) -> Result<Status, Status> {
         let cal = self.calibration()?;
         if j >= cal.num_joints().min(ARM_JOINTS) {
             return Err(Status::UnknownJoint);
@@ -79,11 +95,20 @@ impl RobotModel {
         if speed == 0.0 {
             self.send(&Command::ArmStop(JointSelection::One(joint)), from)?;
             self.arm.target[j] = None;
-            return Ok(());
+            return Ok(Status::Ok);
         }
+        self.require_power()?;
         let ms = cal
             .speed_to_ms_per_step(joint, speed.abs())
             .map_err(|_| Status::InvalidArgument)?;
+        // Fewer ms per step is faster: never faster than the joint's configured speed.
+        let limit = cal.joint(joint).map_err(|_| Status::NotCalibrated)?.speed;
+        let (ms, status) = if limit > 0 && ms < limit {
+            tracing::debug!(joint = j, speed, limit_ms_per_step = limit, "speed clamped");
+            (limit, Status::Clamped)
+        } else {
+            (ms, Status::Ok)
+        };
         let [a, _, b, _] = cal
             .limits_radians(joint)
             .map_err(|_| Status::NotCalibrated)?;
@@ -98,11 +123,12 @@ impl RobotModel {
         )?;
         self.send(&Command::ArmPos { joint, tick }, from)?;
         self.arm.set_target(j, tick);
-        Ok(())
+        Ok(status)
     }
 
     pub(super) fn home(&mut self, sel: JointSel, from: &Origin) -> Result<(), Status> {
         let cal = *self.calibration()?;
+        self.require_power()?;
         self.vecmove = None;
         match sel {
             JointSel::All => {

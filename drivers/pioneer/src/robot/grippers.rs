@@ -18,6 +18,7 @@ impl RobotModel {
             let c = *cal.joint(joint).map_err(|_| Status::Unsupported)?;
             match cmd {
                 GripperCommand::Open | GripperCommand::Close => {
+                    self.require_power()?;
                     let tick = if *cmd == GripperCommand::Open {
                         c.max.max(c.min)
                     } else {

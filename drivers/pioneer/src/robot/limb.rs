@@ -13,18 +13,24 @@ use limber_p2os::{ArmJoint, Command, JointSelection};
 
 use super::*;
 
+/// The cause of a VECMOVE that cannot be planned.
+fn vecmove_status(e: &VecMoveError) -> Status {
+    match e {
+        VecMoveError::NonFinite => Status::NotFinite,
+        VecMoveError::ZeroDirection | VecMoveError::InvalidOptions => Status::InvalidArgument,
+        VecMoveError::Ik(e) | VecMoveError::Unreachable { cause: e, .. } => ik_status(e),
+        // The line crosses a singularity or a branch change: it cannot be followed.
+        VecMoveError::DeviationExceeded { .. } => Status::OutOfReach,
+    }
+}
+
 impl RobotModel {
     pub(super) fn send_theta(&mut self, theta: &Theta, from: &Origin) -> Result<(), Status> {
         let q = self.map.driver_from_theta(theta);
         let mut ticks = [0u8; PIONEER_DOF];
         for j in 0..PIONEER_DOF {
-            ticks[j] = self.joint_tick(j, q[j]).map_err(|e| {
-                if e == Status::BeyondLimits {
-                    Status::OutOfReach
-                } else {
-                    e
-                }
-            })?;
+            // BEYOND_LIMITS: the solution needs a joint past its limits.
+            ticks[j] = self.joint_tick(j, q[j])?;
         }
         self.send_ticks(&ticks, from)
     }
@@ -52,11 +58,12 @@ impl RobotModel {
                 self.limb_oor = false;
                 Status::Ok
             }
-            Err(Status::OutOfReach) => {
-                self.limb_oor = true;
-                Status::OutOfReach
+            Err(e) => {
+                if cannot_get_there(e) {
+                    self.limb_oor = true;
+                }
+                e
             }
-            Err(e) => e,
         }
     }
 
@@ -67,6 +74,9 @@ impl RobotModel {
     ) -> Result<(), Status> {
         self.calibration()?;
         let current = self.theta().ok_or(Status::NotCalibrated)?;
+        if !matches!(cmd, LimbCommand::Stop) {
+            self.require_power()?;
+        }
         match *cmd {
             LimbCommand::Home => {
                 self.vecmove = None;
@@ -123,13 +133,7 @@ impl RobotModel {
                         length,
                         &opts,
                     )
-                    .map_err(|e| match e {
-                        VecMoveError::NonFinite => Status::NotFinite,
-                        VecMoveError::ZeroDirection | VecMoveError::InvalidOptions => {
-                            Status::InvalidArgument
-                        }
-                        _ => Status::OutOfReach,
-                    })?;
+                    .map_err(|e| vecmove_status(&e))?;
                 // Validate the whole line before moving: every waypoint reachable and
                 // inside the limits.
                 let mut p = Box::new(VecMovePlan {
@@ -138,20 +142,14 @@ impl RobotModel {
                     next: 0,
                 });
                 for wp in plan {
-                    let theta = wp.map_err(|_| Status::OutOfReach)?.theta;
+                    let theta = wp.map_err(|e| vecmove_status(&e))?.theta;
                     if p.len == MAX_WAYPOINTS {
                         return Err(Status::InvalidArgument);
                     }
                     let q = self.map.driver_from_theta(&theta);
                     #[allow(clippy::needless_range_loop)]
                     for j in 0..PIONEER_DOF {
-                        p.waypoints[p.len][j] = self.joint_tick(j, q[j]).map_err(|e| {
-                            if e == Status::BeyondLimits {
-                                Status::OutOfReach
-                            } else {
-                                e
-                            }
-                        })?;
+                        p.waypoints[p.len][j] = self.joint_tick(j, q[j])?;
                     }
                     p.len += 1;
                 }

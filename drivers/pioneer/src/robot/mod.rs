@@ -19,6 +19,7 @@ use limber_services::Origin;
 use limber_services::monotonic_ns;
 use nalgebra::Vector3;
 
+use limber_kinematics::FrameError;
 use limber_kinematics::pioneer::{
     DriverAngleMap, PIONEER_DOF, PioneerGeometry, PioneerIkError, PioneerIkOptions, Theta,
 };
@@ -31,6 +32,9 @@ use crate::stats::LoopStats;
 pub const ARM_JOINTS: usize = 6;
 /// Waypoints a VECMOVE may have (2 cm apart at most: several metres).
 pub const MAX_WAYPOINTS: usize = 256;
+/// ARMpacs saying "unpowered" believed only after this many arrived since a power-on was
+/// sent (the first may have left the controller before it read the command).
+const POWER_ON_GRACE_PACKETS: u8 = 3;
 /// Rotation axes of the arm joints in the geometry (Player's aa_axes).
 const AXES: [[f64; 3]; ARM_JOINTS] = [
     [0.0, 0.0, -1.0],
@@ -52,6 +56,11 @@ pub struct ArmModel {
     pub moving: u8,
     /// Powered, per the status word.
     pub powered: bool,
+    /// A power-on command went out and the controller has not confirmed it yet: ARMpacs
+    /// still to tolerate saying "unpowered" (packets already in flight) before believing
+    /// them. Commands written after the power-on reach the controller after it, so they
+    /// are carried out powered.
+    pub power_on_pending: u8,
     /// Commanded target tick per joint (None: hold wherever it is).
     pub target: [Option<u8>; ARM_JOINTS],
     /// Since when a joint has been still but short of its target.
@@ -70,6 +79,7 @@ impl Default for ArmModel {
             seen: false,
             moving: 0,
             powered: false,
+            power_on_pending: 0,
             target: [None; ARM_JOINTS],
             short_since: [None; ARM_JOINTS],
             stamp_ns: 0,
@@ -116,6 +126,11 @@ impl ArmModel {
         self.ticks = p.ticks;
         self.moving = status.moving_mask();
         self.powered = status.powered;
+        if self.powered {
+            self.power_on_pending = 0;
+        } else {
+            self.power_on_pending = self.power_on_pending.saturating_sub(1);
+        }
         self.seen = true;
         self.stamp_ns = monotonic_ns();
         for j in 0..ARM_JOINTS {
@@ -126,6 +141,22 @@ impl ArmModel {
             } else if self.short_since[j].is_none() {
                 self.short_since[j] = Some(now);
             }
+        }
+    }
+
+    /// True when the arm is powered, or a power-on was sent and not yet contradicted.
+    pub fn powered_or_pending(&self) -> bool {
+        self.powered || self.power_on_pending > 0
+    }
+
+    /// Records a power command written to the link.
+    fn power_commanded(&mut self, on: bool) {
+        if on {
+            self.power_on_pending = POWER_ON_GRACE_PACKETS;
+        } else {
+            // Off at once: no motion command is accepted after it.
+            self.power_on_pending = 0;
+            self.powered = false;
         }
     }
 
@@ -203,12 +234,30 @@ impl core::fmt::Debug for RobotModel {
     }
 }
 
-fn ik_status(e: &PioneerIkError) -> Status {
+/// The cause of an IK failure, as the status a refused limb command carries.
+pub(crate) fn ik_status(e: &PioneerIkError) -> Status {
     match e {
-        PioneerIkError::NonFinite => Status::NotFinite,
-        e if e.is_out_of_reach() => Status::OutOfReach,
-        _ => Status::OutOfReach,
+        PioneerIkError::NonFinite | PioneerIkError::Frame(FrameError::NonFinite) => {
+            Status::NotFinite
+        }
+        // Zero-length or parallel approach and orientation vectors make no frame: the
+        // argument is malformed, whether or not the position is reachable.
+        PioneerIkError::Frame(_) => Status::InvalidArgument,
+        PioneerIkError::OutOfReach { .. } => Status::OutOfReach,
+        PioneerIkError::UnreachableOrientation { .. } => Status::UnreachableOrientation,
+        PioneerIkError::OutsideJointLimits => Status::BeyondLimits,
+        // The driver's own geometry or options are wrong: not the client's doing.
+        PioneerIkError::Geometry(_) | PioneerIkError::InvalidOptions => Status::Unsupported,
     }
+}
+
+/// True for the statuses that mean "the limb cannot get there" (the limb's OUT_OF_REACH
+/// state): beyond its reach, an orientation its joints cannot hold, or a joint limit.
+pub(crate) fn cannot_get_there(s: Status) -> bool {
+    matches!(
+        s,
+        Status::OutOfReach | Status::UnreachableOrientation | Status::BeyondLimits
+    )
 }
 
 impl RobotModel {
@@ -283,6 +332,9 @@ impl RobotModel {
         let conn = self.conn.as_mut().ok_or(Status::LinkDown)?;
         match conn.send(cmd) {
             Ok(()) => {
+                if let Command::ArmPower(on) = *cmd {
+                    self.arm.power_commanded(on);
+                }
                 if from.sent_ns != 0 {
                     self.stats
                         .cmd_to_wire
@@ -294,6 +346,16 @@ impl RobotModel {
                 // The loop notices the dead link (read error or silence) and reconnects.
                 Err(Status::LinkDown)
             }
+        }
+    }
+
+    /// Motion needs a powered arm: an unpowered one would leave the command undone (and
+    /// the joint STALLED), so it is refused as POWERED_OFF. Stopping needs no power.
+    pub(super) fn require_power(&self) -> Result<(), Status> {
+        if self.arm.powered_or_pending() {
+            Ok(())
+        } else {
+            Err(Status::PoweredOff)
         }
     }
 
@@ -355,6 +417,7 @@ impl RobotModel {
 
     pub(super) fn move_joint(&mut self, j: usize, rad: f64, from: &Origin) -> Result<(), Status> {
         let tick = self.joint_tick(j, rad)?;
+        self.require_power()?;
         let joint = ArmJoint::from_index(j).map_err(|_| Status::UnknownJoint)?;
         self.send(&Command::ArmPos { joint, tick }, from)?;
         self.arm.set_target(j, tick);

@@ -9,13 +9,13 @@ use super::ArmModel;
 use super::gripper::GripperCmd;
 
 impl ArmModel {
-    /// Carries out or refuses an actuator-array command.
+    /// Carries out or refuses an actuator-array command. A SPEED above the actuator's
+    /// maximum speed runs at the maximum and is answered CLAMPED.
     pub fn arm_command(&mut self, cmd: &ActArrayCommand) -> Status {
-        let r = self.arm_command_inner(cmd);
-        r.err().unwrap_or(Status::Ok)
+        self.arm_command_inner(cmd).unwrap_or_else(|e| e)
     }
 
-    fn arm_command_inner(&mut self, cmd: &ActArrayCommand) -> Result<(), Status> {
+    fn arm_command_inner(&mut self, cmd: &ActArrayCommand) -> Result<Status, Status> {
         match *cmd {
             ActArrayCommand::Position { joint, position } => {
                 let j = joint as usize;
@@ -25,7 +25,7 @@ impl ArmModel {
                     self.vecmove.active = false;
                 }
                 self.move_actuator(j, position, None);
-                Ok(())
+                Ok(Status::Ok)
             }
             ActArrayCommand::MultiPosition(v) => {
                 let v = v.as_slice();
@@ -40,17 +40,18 @@ impl ArmModel {
                 for (j, p) in v.iter().enumerate() {
                     self.move_actuator(j, *p, None);
                 }
-                Ok(())
+                Ok(Status::Ok)
             }
             ActArrayCommand::Speed { joint, speed } => {
                 let j = joint as usize;
                 self.check_speed_target(j, speed)?;
-                self.powered()?;
+                if speed != 0.0 {
+                    self.powered()?;
+                }
                 if j < self.n {
                     self.vecmove.active = false;
                 }
-                self.move_at_speed(j, speed);
-                Ok(())
+                Ok(self.move_at_speed(j, speed))
             }
             ActArrayCommand::MultiSpeed(v) => {
                 let v = v.as_slice();
@@ -60,12 +61,17 @@ impl ArmModel {
                 for (j, s) in v.iter().enumerate() {
                     self.check_speed_target(j, *s)?;
                 }
-                self.powered()?;
-                self.vecmove.active = false;
-                for (j, s) in v.iter().enumerate() {
-                    self.move_at_speed(j, *s);
+                if v.iter().any(|s| *s != 0.0) {
+                    self.powered()?;
                 }
-                Ok(())
+                self.vecmove.active = false;
+                let mut status = Status::Ok;
+                for (j, s) in v.iter().enumerate() {
+                    if self.move_at_speed(j, *s) == Status::Clamped {
+                        status = Status::Clamped;
+                    }
+                }
+                Ok(status)
             }
             ActArrayCommand::Home(JointSel::All) => {
                 self.powered()?;
@@ -77,7 +83,7 @@ impl ArmModel {
                 let open = self.gripper_stroke;
                 self.move_actuator(self.n, open, None);
                 self.gripper_cmd = GripperCmd::Open;
-                Ok(())
+                Ok(Status::Ok)
             }
             ActArrayCommand::Home(JointSel::One(j)) => {
                 let j = j as usize;
@@ -94,7 +100,7 @@ impl ArmModel {
                     self.move_actuator(j, open, None);
                     self.gripper_cmd = GripperCmd::Open;
                 }
-                Ok(())
+                Ok(Status::Ok)
             }
             ActArrayCommand::Current { .. } | ActArrayCommand::MultiCurrent(_) => {
                 Err(Status::Unsupported)
@@ -111,18 +117,19 @@ impl ArmModel {
     }
 
     /// Moves actuator `j` toward its limit in the direction of `speed`'s sign at
-    /// |speed| (capped at the actuator's maximum speed); 0 stops it.
-    fn move_at_speed(&mut self, j: usize, speed: f64) {
+    /// |speed|, capped at the actuator's maximum speed (then `Status::Clamped`); 0 stops
+    /// it.
+    fn move_at_speed(&mut self, j: usize, speed: f64) -> Status {
         if speed == 0.0 {
             if j < self.n {
                 self.joints[j].stop();
             } else {
                 self.gripper.stop();
             }
-            return;
+            return Status::Ok;
         }
         let Some((lo, hi)) = self.joint_limits(j) else {
-            return;
+            return Status::UnknownJoint;
         };
         let end = if speed > 0.0 { hi } else { lo };
         let max = if j < self.n {
@@ -131,6 +138,12 @@ impl ArmModel {
             self.gripper_max_speed
         };
         self.move_actuator(j, end, Some(speed.abs().min(max)));
+        if speed.abs() > max {
+            tracing::debug!(joint = j, speed, max, "speed clamped");
+            Status::Clamped
+        } else {
+            Status::Ok
+        }
     }
 
     /// Answers an actuator-array request.

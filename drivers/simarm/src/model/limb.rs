@@ -5,8 +5,8 @@
 use limber_interfaces::prelude::*;
 use nalgebra::Vector3;
 
-use limber_kinematics::chain::{IkTarget, JointKind, JointVec};
-use limber_kinematics::{Pose, fit_angle_to_limits};
+use limber_kinematics::chain::{ChainIkError, IkTarget, JointKind, JointVec};
+use limber_kinematics::{Pose, fit_angle_to_limits, unit_direction};
 
 use super::{ArmModel, MAX_WAYPOINTS};
 
@@ -39,11 +39,17 @@ impl ArmModel {
                 self.limb_oor = false;
                 Status::Ok
             }
-            Err(Status::OutOfReach) => {
-                self.limb_oor = true;
-                Status::OutOfReach
+            Err(e) => {
+                // The limb cannot get there: beyond its reach, an orientation its joints
+                // cannot hold, or a joint limit in the way.
+                if matches!(
+                    e,
+                    Status::OutOfReach | Status::UnreachableOrientation | Status::BeyondLimits
+                ) {
+                    self.limb_oor = true;
+                }
+                e
             }
-            Err(e) => e,
         }
     }
 
@@ -51,12 +57,7 @@ impl ArmModel {
         let sol = self
             .chain
             .ik(target, seed, &self.options.ik)
-            .map_err(|e| match e {
-                limber_kinematics::chain::ChainIkError::NonFinite => Status::NotFinite,
-                limber_kinematics::chain::ChainIkError::WrongJointCount { .. }
-                | limber_kinematics::chain::ChainIkError::InvalidOptions => Status::InvalidArgument,
-                _ => Status::OutOfReach,
-            })?;
+            .map_err(|e| self.ik_status(&e))?;
         let mut q = sol.q;
         // Take the turn of each revolute joint nearest to the seed (less travel).
         for ((v, j), s) in q.iter_mut().zip(self.chain.joints()).zip(seed) {
@@ -67,9 +68,35 @@ impl ArmModel {
             }
         }
         if !self.chain.within_limits(&q) {
-            return Err(Status::OutOfReach);
+            return Err(Status::BeyondLimits);
         }
         Ok(q)
+    }
+
+    /// The cause of an IK failure: beyond the reach; a position reached but not the
+    /// orientation (the joints cannot hold it); or neither within the joint limits.
+    fn ik_status(&self, e: &ChainIkError) -> Status {
+        let ik = &self.options.ik;
+        match *e {
+            ChainIkError::NonFinite => Status::NotFinite,
+            ChainIkError::WrongJointCount { .. } | ChainIkError::InvalidOptions => {
+                Status::InvalidArgument
+            }
+            ChainIkError::OutOfReach { .. } => Status::OutOfReach,
+            ChainIkError::NotConverged {
+                position_error,
+                orientation_error,
+                ..
+            } => {
+                if position_error <= ik.position_tolerance
+                    && orientation_error > ik.orientation_tolerance
+                {
+                    Status::UnreachableOrientation
+                } else {
+                    Status::OutOfReach
+                }
+            }
+        }
     }
 
     fn limb_command_inner(&mut self, cmd: &LimbCommand) -> Result<(), Status> {
@@ -122,12 +149,13 @@ impl ArmModel {
                 if !(direction.is_finite() && length.is_finite()) {
                     return Err(Status::NotFinite);
                 }
-                let n = direction.norm();
-                if length < 0.0 || n < 1e-9 {
+                // Normalised without overflow: (1e308, 1e308, 0) is a direction too.
+                let dir = unit_direction(&Vector3::from(direction.to_array()));
+                let Some(dir) = dir.filter(|_| length >= 0.0) else {
                     return Err(Status::InvalidArgument);
-                }
+                };
                 self.powered()?;
-                self.plan_vecmove(&(Vector3::from(direction.to_array()) / n), length)
+                self.plan_vecmove(&dir, length)
             }
         }
     }

@@ -266,11 +266,12 @@ impl ArmModel {
         Ok(())
     }
 
+    /// Motion needs power: refused as POWERED_OFF otherwise (it would not move).
     fn powered(&self) -> Result<(), Status> {
         if self.powered {
             Ok(())
         } else {
-            Err(Status::Busy)
+            Err(Status::PoweredOff)
         }
     }
 
