@@ -596,6 +596,15 @@ impl PioneerDriver {
                 // Whatever was commanded before is void; hold where the arm is.
                 self.robot.arm.target = [None; 6];
                 self.set_autopark();
+                // An arm that lost contact with its controller reverts to HOME with
+                // power off (the vendor's manuals): power it again, as at start.
+                if self.hardware.arm
+                    && let Err(status) = self
+                        .robot
+                        .send(&Command::ArmPower(true), &origin_internal())
+                {
+                    tracing::warn!("cannot power the arm after reconnecting: {status}");
+                }
                 self.reconnects += 1;
                 self.robot.dirty.arm = true;
                 self.robot.dirty.body = true;

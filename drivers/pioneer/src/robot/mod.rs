@@ -33,8 +33,12 @@ pub const ARM_JOINTS: usize = 6;
 /// Waypoints a VECMOVE may have (2 cm apart at most: several metres).
 pub const MAX_WAYPOINTS: usize = 256;
 /// ARMpacs saying "unpowered" believed only after this many arrived since a power-on was
-/// sent (the first may have left the controller before it read the command).
+/// sent (the first may have left the controller before it read the command)...
 const POWER_ON_GRACE_PACKETS: u8 = 3;
+/// ...and only those that arrived this long after it: packets queued in the link's
+/// buffers while the driver was busy (e.g. offering its services at start) all predate the
+/// command, however many they are. Two and a half controller cycles.
+const POWER_ON_SETTLE: Duration = Duration::from_millis(250);
 /// Rotation axes of the arm joints in the geometry (Player's aa_axes).
 const AXES: [[f64; 3]; ARM_JOINTS] = [
     [0.0, 0.0, -1.0],
@@ -61,6 +65,9 @@ pub struct ArmModel {
     /// them. Commands written after the power-on reach the controller after it, so they
     /// are carried out powered.
     pub power_on_pending: u8,
+    /// When the last power-on was written: "unpowered" reports before
+    /// [`POWER_ON_SETTLE`] after it are not counted against the grace.
+    pub power_on_sent: Option<Instant>,
     /// Commanded target tick per joint (None: hold wherever it is).
     pub target: [Option<u8>; ARM_JOINTS],
     /// Since when a joint has been still but short of its target.
@@ -80,6 +87,7 @@ impl Default for ArmModel {
             moving: 0,
             powered: false,
             power_on_pending: 0,
+            power_on_sent: None,
             target: [None; ARM_JOINTS],
             short_since: [None; ARM_JOINTS],
             stamp_ns: 0,
@@ -128,7 +136,10 @@ impl ArmModel {
         self.powered = status.powered;
         if self.powered {
             self.power_on_pending = 0;
-        } else {
+        } else if self
+            .power_on_sent
+            .is_none_or(|t| now.saturating_duration_since(t) >= POWER_ON_SETTLE)
+        {
             self.power_on_pending = self.power_on_pending.saturating_sub(1);
         }
         self.seen = true;
@@ -153,6 +164,7 @@ impl ArmModel {
     fn power_commanded(&mut self, on: bool) {
         if on {
             self.power_on_pending = POWER_ON_GRACE_PACKETS;
+            self.power_on_sent = Some(Instant::now());
         } else {
             // Off at once: no motion command is accepted after it.
             self.power_on_pending = 0;
