@@ -70,7 +70,7 @@ impl ChildProc {
         let mut c = command()?;
         c.arg("--role").arg(&spec.role);
         if let Some(d) = &spec.domain {
-            c.arg("--domain").arg(d);
+            c.arg("--child-domain").arg(d);
         }
         if let Some(o) = &spec.out {
             c.arg("--out").arg(o);

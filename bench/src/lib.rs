@@ -187,8 +187,9 @@ pub struct BenchArgs {
     /// Internal: run as a child process of a scenario (driver, echo, subscriber).
     #[arg(long, hide = true)]
     pub role: Option<String>,
-    /// Internal: the child's domain.
-    #[arg(long, hide = true)]
+    /// Internal: the child's domain (its own flag: `limber`'s global `--domain` is the
+    /// parent's).
+    #[arg(id = "child_domain", long = "child-domain", hide = true)]
     pub domain: Option<String>,
     /// Internal: where the child writes its histogram.
     #[arg(long, hide = true)]
