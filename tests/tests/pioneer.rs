@@ -611,3 +611,36 @@ fn a_driver_that_started_without_an_answer_keeps_asking_for_the_arm() {
     let t = grip.close().unwrap();
     assert_eq!(grip.wait_outcome(t, T).unwrap(), Status::Ok);
 }
+
+#[test]
+fn a_second_driver_with_the_same_robot_name_is_refused_before_it_opens_the_link() {
+    let domain = Domain::unique_for_test();
+    let emu = emulator_with(Faults::default());
+    let _first = start(&domain, &emu, "twice1");
+    let c = ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
+    assert!(wait_flag(&mut arm, true, T));
+    assert_eq!(emu.state().stats.connections, 1);
+
+    let port = format!("tcp://{}", emu.tcp_addr().unwrap());
+    let cfg = config_file("twice2");
+    let mut second = Proc::spawn(
+        PIONEER,
+        domain.name(),
+        &["--port", &port, "--config", cfg.to_str().unwrap()],
+    );
+    let code = second.wait_timeout(Duration::from_secs(10));
+    assert!(
+        matches!(code, Some(c) if c != 0),
+        "the second driver was not refused: {code:?}"
+    );
+    // It never connected: the first driver's link was left alone.
+    let st = emu.state();
+    assert_eq!(st.stats.connections, 1, "the second driver opened the link");
+    assert!(st.connected);
+    let mut stats = StatsReader::open(&c, "pioneer").unwrap();
+    let s = stats.wait(Duration::from_secs(3)).unwrap();
+    assert_eq!((s.link_faults, s.reconnects), (0, 0));
+    let t = arm.move_to(0, 0.3).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
+}

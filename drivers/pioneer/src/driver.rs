@@ -33,6 +33,29 @@ pub enum DriverError {
     /// A device could not be offered.
     #[error(transparent)]
     Host(#[from] HostError),
+    /// A running driver already serves devices of this robot name: refused before the
+    /// link is opened, so the other driver's link is left alone.
+    #[error(
+        "robot {robot} is already served in domain {domain} by a running driver ({}); \
+         choose another robot name",
+        devices.join(", ")
+    )]
+    AlreadyServed {
+        /// The robot name.
+        robot: String,
+        /// The domain.
+        domain: String,
+        /// The devices a live driver serves.
+        devices: Vec<String>,
+    },
+    /// The domain's devices could not be listed (to check the robot name is free).
+    #[error("cannot check that robot {robot} is free: {source}")]
+    List {
+        /// The robot name.
+        robot: String,
+        /// The cause.
+        source: limber_services::ListError,
+    },
     /// The configured robot name does not make valid device names.
     #[error("invalid robot name {robot:?}: {source}")]
     RobotName {
@@ -300,6 +323,7 @@ impl PioneerDriver {
         cfg: PioneerConfig,
         target: LinkTarget,
     ) -> Result<Self, DriverError> {
+        Self::check_name_free(ctx, &cfg.robot)?;
         let conn = Connection::open(&target, &options(&cfg, &target)).map_err(|source| {
             DriverError::Connect {
                 port: cfg.port.clone(),
@@ -387,6 +411,28 @@ impl PioneerDriver {
         d.robot.dirty.body = true;
         d.publish_all(Instant::now());
         Ok(d)
+    }
+
+    /// Refuses a robot name whose devices a live driver serves, before the link is opened.
+    fn check_name_free(ctx: &Context, robot: &str) -> Result<(), DriverError> {
+        let devices: Vec<String> = limber_services::list_devices(ctx.domain())
+            .map_err(|source| DriverError::List {
+                robot: robot.to_string(),
+                source,
+            })?
+            .into_iter()
+            .filter(|d| d.alive && d.name.robot() == robot)
+            .map(|d| d.name.to_string())
+            .collect();
+        if devices.is_empty() {
+            Ok(())
+        } else {
+            Err(DriverError::AlreadyServed {
+                robot: robot.to_string(),
+                domain: ctx.domain().name().to_string(),
+                devices,
+            })
+        }
     }
 
     /// Sets the arm's autopark watchdog (AUTOPARK, `autopark_s`), at every connection: a
