@@ -72,6 +72,9 @@ pub struct EmulatorArgs {
     /// Fault: probability of garbage bytes before each outgoing packet.
     #[arg(long, default_value_t = 0.0)]
     pub garbage_rate: f64,
+    /// Fault: drop the first N ARMINFOpac replies (a lost ARM_INFO answer).
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    pub drop_arm_info: u32,
     /// Seed of the fault generator.
     #[arg(long, default_value_t = 0x5EED)]
     pub seed: u64,
@@ -116,6 +119,7 @@ impl EmulatorArgs {
                 garbage_rate: check_rate("garbage-rate", self.garbage_rate)?,
                 silent: false,
                 slow_wire_baud: self.slow_wire,
+                drop_arm_info_replies: self.drop_arm_info,
             },
             watchdog: self.watchdog_ms.map(Duration::from_millis),
             timing: if self.fast {

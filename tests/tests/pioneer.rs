@@ -513,3 +513,134 @@ fn a_sigkilled_drivers_arm_parks_by_itself() {
     assert!(parked, "the arm did not park: {:?}", st.robot);
     drop(arm);
 }
+
+fn emulator_with(faults: Faults) -> Emulator {
+    let cfg = EmulatorConfig {
+        faults,
+        ..EmulatorConfig::default()
+    };
+    Emulator::start_tcp(cfg, "127.0.0.1:0".parse().unwrap()).unwrap()
+}
+
+fn device_names(domain: &Domain) -> Vec<String> {
+    list_devices(domain)
+        .unwrap()
+        .iter()
+        .map(|d| d.name.to_string())
+        .collect()
+}
+
+#[test]
+fn a_lost_arm_info_reply_at_start_does_not_remove_the_arm() {
+    let domain = Domain::unique_for_test();
+    let emu = emulator_with(Faults {
+        drop_arm_info_replies: 1,
+        ..Faults::default()
+    });
+    let _driver = start(&domain, &emu, "armlost1");
+    assert_eq!(emu.state().stats.arm_info_dropped, 1);
+    assert!(
+        device_names(&domain).contains(&"pioneer/actarray/0".to_string()),
+        "the arm is not served"
+    );
+    let c = ctx(&domain);
+    let mut stats = StatsReader::open(&c, "pioneer").unwrap();
+    let s = stats.wait(Duration::from_secs(3)).unwrap();
+    assert_ne!(s.hardware & hardware::ARM, 0);
+    let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
+    assert!(wait_flag(&mut arm, true, T));
+    arm.power(true).unwrap();
+    let t = arm.move_to(0, 0.3).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
+}
+
+#[test]
+fn arm_info_lost_at_a_reconnect_is_retried_by_the_loop_and_the_arm_stream_restored() {
+    let domain = Domain::unique_for_test();
+    let emu = emulator_with(Faults::default());
+    let _driver = start(&domain, &emu, "armlost2");
+    let c = ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
+    assert!(wait_flag(&mut arm, true, T));
+    let answered_at_start = emu.state().stats.arm_info_out;
+    assert!(answered_at_start >= 1);
+
+    // Every ARM_INFO of the reconnection's handshake goes unanswered (3 attempts): the
+    // handshake stops the ARMpac stream; the loop asks again and restarts it.
+    emu.set_faults(Faults {
+        drop_arm_info_replies: 3,
+        ..Faults::default()
+    });
+    emu.disconnect();
+    let (ok, st) = emu.wait_for(Duration::from_secs(15), |s| {
+        s.stats.arm_info_dropped == 3 && s.stats.arm_info_out > answered_at_start
+    });
+    assert!(
+        ok,
+        "no ARM_INFO answered after the lost ones: {:?}",
+        st.stats
+    );
+    // That answer came after the handshake's ARM_STATUS stop: the stream runs again.
+    let (ok, st) = emu.wait_for(T, |s| s.robot.arm_status_mode == 2);
+    assert!(ok, "the ARMpac stream was not restarted: {:?}", st.robot);
+    let before = emu.state().stats.arm_packets_out;
+    let (ok, _) = emu.wait_for(T, |s| s.stats.arm_packets_out > before + 3);
+    assert!(ok, "no ARMpacs after the restart");
+    assert!(wait_flag(&mut arm, true, T));
+    let t = arm.move_to(0, 0.3).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
+}
+
+#[test]
+fn a_driver_that_started_without_an_answer_keeps_asking_for_the_arm() {
+    let domain = Domain::unique_for_test();
+    let emu = emulator_with(Faults {
+        drop_arm_info_replies: 3,
+        ..Faults::default()
+    });
+    let _driver = start(&domain, &emu, "armlost3");
+    assert_eq!(emu.state().stats.arm_info_dropped, 3);
+    assert!(!device_names(&domain).contains(&"pioneer/actarray/0".to_string()));
+    // The loop asks again (in the background: the driver is ready meanwhile) and the robot
+    // answers.
+    let (ok, st) = emu.wait_for(Duration::from_secs(10), |s| s.stats.arm_info_out >= 1);
+    assert!(ok, "the driver stopped asking for the arm: {:?}", st.stats);
+    // It keeps serving what it offered.
+    let c = ctx(&domain);
+    let mut grip = GripperClient::connect(&c, "pioneer/gripper/0").unwrap();
+    let t = grip.close().unwrap();
+    assert_eq!(grip.wait_outcome(t, T).unwrap(), Status::Ok);
+}
+
+#[test]
+fn a_second_driver_with_the_same_robot_name_is_refused_before_it_opens_the_link() {
+    let domain = Domain::unique_for_test();
+    let emu = emulator_with(Faults::default());
+    let _first = start(&domain, &emu, "twice1");
+    let c = ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
+    assert!(wait_flag(&mut arm, true, T));
+    assert_eq!(emu.state().stats.connections, 1);
+
+    let port = format!("tcp://{}", emu.tcp_addr().unwrap());
+    let cfg = config_file("twice2");
+    let mut second = Proc::spawn(
+        PIONEER,
+        domain.name(),
+        &["--port", &port, "--config", cfg.to_str().unwrap()],
+    );
+    let code = second.wait_timeout(Duration::from_secs(10));
+    assert!(
+        matches!(code, Some(c) if c != 0),
+        "the second driver was not refused: {code:?}"
+    );
+    // It never connected: the first driver's link was left alone.
+    let st = emu.state();
+    assert_eq!(st.stats.connections, 1, "the second driver opened the link");
+    assert!(st.connected);
+    let mut stats = StatsReader::open(&c, "pioneer").unwrap();
+    let s = stats.wait(Duration::from_secs(3)).unwrap();
+    assert_eq!((s.link_faults, s.reconnects), (0, 0));
+    let t = arm.move_to(0, 0.3).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
+}

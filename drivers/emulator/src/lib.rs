@@ -92,6 +92,10 @@ pub struct Faults {
     /// Slow wire: after each packet, wait the time it takes at this baud
     /// (10 bits per byte).
     pub slow_wire_baud: Option<u32>,
+    /// Drop this many ARMINFOpac replies (counted from the emulator's start, across
+    /// connections; see [`EmulatorStats::arm_info_dropped`]): a deterministic "lost
+    /// ARM_INFO reply". Raising it later drops that many in all.
+    pub drop_arm_info_replies: u32,
 }
 
 /// Configuration of an emulator.
@@ -170,6 +174,10 @@ pub struct EmulatorStats {
     pub connections: u64,
     /// Times the command watchdog stopped the stream.
     pub watchdog_trips: u64,
+    /// ARMINFOpac replies dropped by [`Faults::drop_arm_info_replies`].
+    pub arm_info_dropped: u64,
+    /// ARMINFOpac replies written (not dropped).
+    pub arm_info_out: u64,
 }
 
 /// A snapshot of the emulator.

@@ -223,6 +223,13 @@ impl Wire {
                 self.stats.sips_out += 1
             }
             Some(&ptype::ARM) => self.stats.arm_packets_out += 1,
+            Some(&ptype::ARM_INFO) => {
+                if self.stats.arm_info_dropped < u64::from(faults.drop_arm_info_replies) {
+                    self.stats.arm_info_dropped += 1;
+                    return Ok(());
+                }
+                self.stats.arm_info_out += 1;
+            }
             _ => {}
         }
         self.stats.packets_out += 1;

@@ -32,9 +32,10 @@ pub struct ConnectOptions {
     pub arm: bool,
     /// ARMpac stream mode requested when the arm is set up.
     pub arm_status: ArmStatusMode,
-    /// How long to wait for the ARMINFOpac; no answer means "no arm".
+    /// How long to wait for the ARMINFOpac after each ARM_INFO.
     pub arm_info_timeout: Duration,
-    /// ARM_INFO attempts before deciding there is no arm.
+    /// ARM_INFO attempts (each waiting `arm_info_timeout`) before deciding there is no
+    /// arm: one lost reply (a bad checksum) must not remove the arm.
     pub arm_info_attempts: u32,
     /// Send PULSE when nothing was sent for this long ([`Connection::keep_alive`]).
     pub pulse_interval: Duration,
@@ -52,7 +53,7 @@ impl Default for ConnectOptions {
             arm: true,
             arm_status: ArmStatusMode::Continuous,
             arm_info_timeout: Duration::from_secs(1),
-            arm_info_attempts: 2,
+            arm_info_attempts: 3,
             pulse_interval: Duration::from_secs(1),
         }
     }
@@ -185,9 +186,16 @@ impl Connection {
         }
         if opts.arm {
             conn.send(&Command::ArmStatus(opts.arm_status))?;
-            for _ in 0..opts.arm_info_attempts.max(1) {
+            let attempts = opts.arm_info_attempts.max(1);
+            for attempt in 1..=attempts {
                 if conn.request_arm_info(opts.arm_info_timeout)?.is_some() {
                     break;
+                }
+                if attempt < attempts {
+                    tracing::debug!(
+                        "no ARMINFOpac within {:?} (attempt {attempt} of {attempts}); asking again",
+                        opts.arm_info_timeout
+                    );
                 }
             }
             if conn.arm.is_none() && opts.arm_status != ArmStatusMode::Stop {

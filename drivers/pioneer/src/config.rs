@@ -72,7 +72,10 @@ pub struct PioneerConfig {
     pub link_timeout_ms: u64,
     /// Pause between reconnection attempts, ms.
     pub reconnect_interval_ms: u64,
-    /// How long ARM_INFO may go unanswered before the robot counts as armless, ms.
+    /// How long each ARM_INFO may go unanswered, ms. The handshake asks 3 times before
+    /// the robot counts as armless; the loop then keeps asking in the background, the wait
+    /// doubling from this value up to 30 s (an arm found so late needs a driver restart to
+    /// be served; after a reconnect, the arm's ARMpac stream is restarted).
     pub arm_info_timeout_ms: u64,
     /// Send PULSE when nothing was sent for this long, ms.
     pub pulse_interval_ms: u64,

@@ -33,6 +33,29 @@ pub enum DriverError {
     /// A device could not be offered.
     #[error(transparent)]
     Host(#[from] HostError),
+    /// A running driver already serves devices of this robot name: refused before the
+    /// link is opened, so the other driver's link is left alone.
+    #[error(
+        "robot {robot} is already served in domain {domain} by a running driver ({}); \
+         choose another robot name",
+        devices.join(", ")
+    )]
+    AlreadyServed {
+        /// The robot name.
+        robot: String,
+        /// The domain.
+        domain: String,
+        /// The devices a live driver serves.
+        devices: Vec<String>,
+    },
+    /// The domain's devices could not be listed (to check the robot name is free).
+    #[error("cannot check that robot {robot} is free: {source}")]
+    List {
+        /// The robot name.
+        robot: String,
+        /// The cause.
+        source: limber_services::ListError,
+    },
     /// The configured robot name does not make valid device names.
     #[error("invalid robot name {robot:?}: {source}")]
     RobotName {
@@ -117,6 +140,32 @@ pub struct PioneerDriver {
     mode: LoopMode,
     wakeups: u64,
     failures: Failures,
+    arm_probe: Option<ArmProbe>,
+    arm_info_arrived: bool,
+}
+
+/// Longest wait between two ARM_INFO retries of the loop.
+const ARM_PROBE_MAX: Duration = Duration::from_secs(30);
+
+/// ARM_INFO retries of the loop, while the link is up but no ARMINFOpac answered the
+/// handshake's: sent from the timer (never waited for), the reply is read by
+/// [`PioneerDriver::read_link`]; the wait doubles after each, up to [`ARM_PROBE_MAX`].
+#[derive(Debug, Clone, Copy)]
+struct ArmProbe {
+    next: Instant,
+    delay: Duration,
+    sent: u32,
+}
+
+impl ArmProbe {
+    fn new(now: Instant, first: Duration) -> Self {
+        let delay = first.clamp(Duration::from_millis(10), ARM_PROBE_MAX);
+        ArmProbe {
+            next: now + delay,
+            delay,
+            sent: 0,
+        }
+    }
 }
 
 /// A failure the loop survives (it is retried on the next cycle or the next event).
@@ -274,6 +323,7 @@ impl PioneerDriver {
         cfg: PioneerConfig,
         target: LinkTarget,
     ) -> Result<Self, DriverError> {
+        Self::check_name_free(ctx, &cfg.robot)?;
         let conn = Connection::open(&target, &options(&cfg, &target)).map_err(|source| {
             DriverError::Connect {
                 port: cfg.port.clone(),
@@ -338,7 +388,17 @@ impl PioneerDriver {
             mode: LoopMode::Event,
             wakeups: 0,
             failures: Failures::default(),
+            arm_probe: None,
+            arm_info_arrived: false,
         };
+        if !d.hardware.arm {
+            tracing::warn!(
+                "no ARMINFOpac after {} ARM_INFO requests: serving no arm; asking again in the \
+                 background",
+                options(&d.robot.cfg, &d.target).arm_info_attempts
+            );
+            d.start_arm_probe(Instant::now());
+        }
         // Like Player when the first client subscribes: power the arm. (Left on at exit:
         // an unpowered arm drops under gravity.)
         if d.hardware.arm
@@ -353,6 +413,28 @@ impl PioneerDriver {
         Ok(d)
     }
 
+    /// Refuses a robot name whose devices a live driver serves, before the link is opened.
+    fn check_name_free(ctx: &Context, robot: &str) -> Result<(), DriverError> {
+        let devices: Vec<String> = limber_services::list_devices(ctx.domain())
+            .map_err(|source| DriverError::List {
+                robot: robot.to_string(),
+                source,
+            })?
+            .into_iter()
+            .filter(|d| d.alive && d.name.robot() == robot)
+            .map(|d| d.name.to_string())
+            .collect();
+        if devices.is_empty() {
+            Ok(())
+        } else {
+            Err(DriverError::AlreadyServed {
+                robot: robot.to_string(),
+                domain: ctx.domain().name().to_string(),
+                devices,
+            })
+        }
+    }
+
     /// Sets the arm's autopark watchdog (AUTOPARK, `autopark_s`), at every connection: a
     /// driver that dies without a word (SIGKILL) leaves the arm to park itself.
     fn set_autopark(&mut self) {
@@ -365,6 +447,66 @@ impl PioneerDriver {
             .send(&Command::ArmAutoPark(s), &origin_internal())
         {
             tracing::warn!("cannot set the arm's autopark watchdog to {s} s: {status}");
+        }
+    }
+
+    fn start_arm_probe(&mut self, now: Instant) {
+        let first = Duration::from_millis(self.robot.cfg.arm_info_timeout_ms);
+        self.arm_probe = Some(ArmProbe::new(now, first));
+    }
+
+    /// Sends the next ARM_INFO retry when due (the timer's work; the reply is read by
+    /// `read_link`). Returns false when the link failed.
+    fn probe_arm(&mut self, now: Instant) -> bool {
+        let Some(p) = self.arm_probe.as_mut() else {
+            return true;
+        };
+        if now < p.next {
+            return true;
+        }
+        let Some(conn) = self.robot.conn.as_mut() else {
+            return true;
+        };
+        if let Err(e) = conn.send(&Command::ArmInfo) {
+            tracing::warn!("cannot send ARM_INFO: {e}");
+            return false;
+        }
+        p.sent += 1;
+        p.next = now + p.delay;
+        p.delay = (p.delay * 2).min(ARM_PROBE_MAX);
+        true
+    }
+
+    /// An ARMINFOpac arrived in the loop (an answer to a retry, or a late answer).
+    fn on_arm_info(&mut self) {
+        let Some(p) = self.arm_probe.take() else {
+            return;
+        };
+        if self.hardware.arm {
+            // The reconnection's handshake stopped the ARMpac stream when it got no
+            // answer: start it again.
+            if let Err(status) = self.robot.send(
+                &Command::ArmStatus(ArmStatusMode::Continuous),
+                &origin_internal(),
+            ) {
+                tracing::warn!("cannot restart the ARMpac stream: {status}");
+            }
+            tracing::info!(
+                "ARMINFOpac received after {} retries: arm calibration and status stream restored",
+                p.sent
+            );
+            self.robot.dirty.arm = true;
+        } else {
+            // DeviceSet offers its devices at creation only, and the loop's wake
+            // listeners are taken once: the arm's devices cannot be added while running.
+            tracing::warn!(
+                "the robot answers ARM_INFO now (after {} retries): it has an arm, but this \
+                 driver started without one and cannot offer {robot}/actarray/0, \
+                 {robot}/limb/0 and {robot}/gripper/1 while running: restart the driver to \
+                 serve the arm",
+                p.sent,
+                robot = self.robot.cfg.robot
+            );
         }
     }
 
@@ -553,7 +695,10 @@ impl PioneerDriver {
                         failures.note(Failure::VecMove, &status);
                     }
                 }
-                Owned::ArmInfo(i) => robot.set_calibration(limber_p2os::ArmCalibration::from(i)),
+                Owned::ArmInfo(i) => {
+                    robot.set_calibration(limber_p2os::ArmCalibration::from(i));
+                    self.arm_info_arrived = true;
+                }
                 Owned::Other => {}
             }
         }
@@ -569,6 +714,8 @@ impl PioneerDriver {
         self.robot.dirty.arm = true;
         self.robot.dirty.body = true;
         self.next_reconnect = Instant::now();
+        // The retries start again with the next link.
+        self.arm_probe = None;
     }
 
     /// One reconnection attempt (bounded by the handshake's timeouts).
@@ -583,6 +730,7 @@ impl PioneerDriver {
         opts.arm = self.hardware.arm;
         match Connection::open(&self.target, &opts) {
             Ok(conn) => {
+                let answered = conn.arm_calibration().is_some();
                 if let Some(cal) = conn.arm_calibration() {
                     self.robot.set_calibration(*cal);
                 }
@@ -609,6 +757,16 @@ impl PioneerDriver {
                 self.robot.dirty.arm = true;
                 self.robot.dirty.body = true;
                 tracing::info!("link up again (reconnect #{})", self.reconnects);
+                if !answered {
+                    if self.hardware.arm {
+                        tracing::warn!(
+                            "no ARMINFOpac after reconnect #{}: keeping the last calibration, \
+                             asking again in the background",
+                            self.reconnects
+                        );
+                    }
+                    self.start_arm_probe(Instant::now());
+                }
             }
             Err(e) => {
                 // Logged at the first failure and then at powers of two: a robot that
@@ -625,9 +783,12 @@ impl PioneerDriver {
                 > Duration::from_millis(self.robot.cfg.link_timeout_ms)
             {
                 self.link_failed("silent");
+            } else if !self.probe_arm(now) {
+                self.link_failed("write failed");
             } else if let Some(c) = self.robot.conn.as_mut()
-                && c.keep_alive().is_err()
+                && let Err(e) = c.keep_alive()
             {
+                tracing::warn!("keep-alive failed: {e}");
                 self.link_failed("write failed");
             }
         } else {
@@ -703,6 +864,9 @@ impl PioneerDriver {
                         self.tick(now);
                     }
                 }
+                if std::mem::take(&mut self.arm_info_arrived) {
+                    self.on_arm_info();
+                }
                 self.publish_all(now);
                 if stop() {
                     stopped = true;
@@ -741,6 +905,9 @@ impl PioneerDriver {
                 self.robot.stats.tick(now, nominal, 1 + missed);
                 next_tick += tick * (1 + missed as u32);
                 self.tick(now);
+            }
+            if std::mem::take(&mut self.arm_info_arrived) {
+                self.on_arm_info();
             }
             self.publish_all(now);
             n += 1;
