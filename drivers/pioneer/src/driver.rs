@@ -728,6 +728,10 @@ impl PioneerDriver {
         let mut opts = options(&self.robot.cfg, &self.target);
         opts.sync_attempts = 2;
         opts.arm = self.hardware.arm;
+        // One ARM_INFO in the handshake: the handshake still runs on the loop thread, so
+        // every attempt here is time the loop is not serving; if it goes unanswered, the
+        // loop asks again without waiting (a bounded backoff), as after a start.
+        opts.arm_info_attempts = 1;
         match Connection::open(&self.target, &opts) {
             Ok(conn) => {
                 let answered = conn.arm_calibration().is_some();
