@@ -140,3 +140,43 @@ impl Drop for Proc {
         let _ = self.child.wait();
     }
 }
+
+/// The keys every multi-process Pioneer test sets: short timeouts, so faults are detected
+/// quickly.
+const PIONEER_TEST_KEYS: [&str; 4] = [
+    "link_timeout_ms = 400",
+    "reconnect_interval_ms = 100",
+    "arm_info_timeout_ms = 500",
+    "stall_timeout_ms = 1500",
+];
+
+/// Writes `<dir>/<name>.toml`, a Pioneer driver configuration with the tests' short
+/// timeouts and the keys of `extra` (which win over the defaults here); returns its path.
+pub fn pioneer_test_config(dir: &std::path::Path, name: &str, extra: &str) -> std::path::PathBuf {
+    let mut toml = extra.to_string();
+    if !toml.is_empty() && !toml.ends_with('\n') {
+        toml.push('\n');
+    }
+    for line in PIONEER_TEST_KEYS {
+        let key = line.split(' ').next().unwrap_or(line);
+        if !extra.lines().any(|l| l.trim_start().starts_with(key)) {
+            toml += line;
+            toml.push('\n');
+        }
+    }
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, toml).expect("write the test configuration");
+    path
+}
+
+/// Starts the Pioneer driver binary `bin` in `domain` on the link `port` with the
+/// configuration file `cfg`, and waits (bounded) for its "ready" line.
+pub fn start_pioneer(bin: &str, domain: &str, port: &str, cfg: &std::path::Path) -> Proc {
+    let cfg = cfg.to_str().expect("a UTF-8 configuration path");
+    let mut d = Proc::spawn(bin, domain, &["--port", port, "--config", cfg]);
+    assert!(
+        d.read_until(|l| l.ends_with("ready")).is_some(),
+        "driver did not start"
+    );
+    d
+}

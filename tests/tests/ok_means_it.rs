@@ -15,23 +15,10 @@ const PIONEER: &str = env!("CARGO_BIN_EXE_limber-test-pioneer");
 const T: Duration = Duration::from_secs(5);
 
 fn start(domain: &Domain, emu: &Emulator, name: &str) -> Proc {
-    let cfg = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("{name}.toml"));
-    std::fs::write(
-        &cfg,
-        "link_timeout_ms = 400\nreconnect_interval_ms = 100\narm_info_timeout_ms = 500\nstall_timeout_ms = 1500\n",
-    )
-    .unwrap();
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+    let cfg = limber_tests::pioneer_test_config(&dir, name, "");
     let port = emu.pty_path().unwrap().display().to_string();
-    let mut d = Proc::spawn(
-        PIONEER,
-        domain.name(),
-        &["--port", &port, "--config", cfg.to_str().unwrap()],
-    );
-    assert!(
-        d.read_until(|l| l.ends_with("ready")).is_some(),
-        "driver did not start"
-    );
-    d
+    limber_tests::start_pioneer(PIONEER, domain.name(), &port, &cfg)
 }
 
 fn ctx(domain: &Domain) -> Context {

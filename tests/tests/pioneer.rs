@@ -19,13 +19,7 @@ const T: Duration = Duration::from_secs(5);
 
 /// Short timeouts so faults are detected quickly in tests.
 fn config_file(name: &str) -> PathBuf {
-    let p = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("{name}.toml"));
-    std::fs::write(
-        &p,
-        "link_timeout_ms = 400\nreconnect_interval_ms = 100\narm_info_timeout_ms = 500\nstall_timeout_ms = 1500\n",
-    )
-    .unwrap();
-    p
+    limber_tests::pioneer_test_config(std::path::Path::new(env!("CARGO_TARGET_TMPDIR")), name, "")
 }
 
 fn start(domain: &Domain, emu: &Emulator, name: &str) -> Proc {
@@ -33,17 +27,7 @@ fn start(domain: &Domain, emu: &Emulator, name: &str) -> Proc {
         Some(a) => format!("tcp://{a}"),
         None => emu.pty_path().unwrap().display().to_string(),
     };
-    let cfg = config_file(name);
-    let mut d = Proc::spawn(
-        PIONEER,
-        domain.name(),
-        &["--port", &port, "--config", cfg.to_str().unwrap()],
-    );
-    assert!(
-        d.read_until(|l| l.ends_with("ready")).is_some(),
-        "driver did not start"
-    );
-    d
+    limber_tests::start_pioneer(PIONEER, domain.name(), &port, &config_file(name))
 }
 
 fn ctx(domain: &Domain) -> Context {

@@ -33,31 +33,13 @@ impl Rig {
     fn with(name: &str, cfg: EmulatorConfig, extra_toml: &str) -> Rig {
         let domain = Domain::unique_for_test();
         let emu = Emulator::start_pty(cfg).unwrap();
-        let p = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("bug_{name}.toml"));
-        let mut toml = extra_toml.to_string();
-        for line in [
-            "link_timeout_ms = 400",
-            "reconnect_interval_ms = 100",
-            "arm_info_timeout_ms = 500",
-            "stall_timeout_ms = 1500",
-        ] {
-            let key = line.split(' ').next().unwrap();
-            if !extra_toml.contains(key) {
-                toml += line;
-                toml += "\n";
-            }
-        }
-        std::fs::write(&p, toml).unwrap();
+        let p = limber_tests::pioneer_test_config(
+            &PathBuf::from(env!("CARGO_TARGET_TMPDIR")),
+            &format!("bug_{name}"),
+            extra_toml,
+        );
         let port = emu.pty_path().unwrap().display().to_string();
-        let mut driver = Proc::spawn(
-            PIONEER,
-            domain.name(),
-            &["--port", &port, "--config", p.to_str().unwrap()],
-        );
-        assert!(
-            driver.read_until(|l| l.ends_with("ready")).is_some(),
-            "driver did not start"
-        );
+        let driver = limber_tests::start_pioneer(PIONEER, domain.name(), &port, &p);
         let ctx = Context::new(&domain, Role::Client, "bugs").unwrap();
         Rig {
             emu,
