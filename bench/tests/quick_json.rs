@@ -3,47 +3,10 @@
 //! processes; checks the structure of the JSON report and of the SVG plot. Asserts
 //! structure, never speed.
 
-use std::io::Read;
-use std::process::{Command, Output, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
+use std::time::Duration;
 
 use serde_json::Value;
-
-/// Runs `cmd` to completion within `limit`; kills it and fails the test after that.
-fn output_within(cmd: &mut Command, limit: Duration) -> Output {
-    let mut child = cmd
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the benchmark binary runs");
-    let drain = |mut r: Box<dyn Read + Send>| {
-        std::thread::spawn(move || {
-            let mut v = Vec::new();
-            r.read_to_end(&mut v).expect("read the child's output");
-            v
-        })
-    };
-    let out = drain(Box::new(child.stdout.take().expect("piped stdout")));
-    let err = drain(Box::new(child.stderr.take().expect("piped stderr")));
-    let deadline = Instant::now() + limit;
-    let status = loop {
-        if let Some(st) = child.try_wait().expect("wait for the benchmark") {
-            break st;
-        }
-        if Instant::now() > deadline {
-            child.kill().expect("kill the benchmark");
-            child.wait().expect("reap the benchmark");
-            panic!("limber-bench did not finish within {limit:?}");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    };
-    Output {
-        status,
-        stdout: out.join().expect("stdout reader"),
-        stderr: err.join().expect("stderr reader"),
-    }
-}
 
 #[test]
 fn quick_run_writes_a_well_formed_report() {
@@ -51,7 +14,7 @@ fn quick_run_writes_a_well_formed_report() {
     std::fs::create_dir_all(&dir).unwrap();
     let json = dir.join("report.json");
     let svg = dir.join("report.svg");
-    let out = output_within(
+    let out = limber_bounded_run::output_within(
         Command::new(env!("CARGO_BIN_EXE_limber-bench"))
             .args(["--quick", "--scale", "0.1", "--no-progress", "--only"])
             .arg("floor,ik,loop")
@@ -142,7 +105,7 @@ fn quick_run_writes_a_well_formed_report() {
 
 #[test]
 fn unknown_scenario_is_an_error_not_a_panic() {
-    let out = output_within(
+    let out = limber_bounded_run::output_within(
         Command::new(env!("CARGO_BIN_EXE_limber-bench")).args(["--only", "nosuch"]),
         Duration::from_secs(60),
     );

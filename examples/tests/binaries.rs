@@ -2,10 +2,9 @@
 //! against the test driver (instant joints) on a thread of this process, each test in a
 //! domain of its own. Their output and exit codes are checked; every run is bounded.
 
-use std::io::Read;
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Output};
 use std::sync::mpsc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use limber_services::testing::TestDriver;
 use limber_services::{Context, Domain, Role};
@@ -37,46 +36,9 @@ fn driver(domain: &Domain) -> mpsc::Sender<()> {
 
 /// Runs `exe args` in `domain`; fails the test if it runs longer than [`RUN_TIMEOUT`].
 fn run(exe: &str, domain: &Domain, args: &[&str]) -> Output {
-    let mut child = Command::new(exe)
-        .args(args)
-        .env("LIMBER_DOMAIN", domain.name())
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap_or_else(|e| panic!("cannot start {exe}: {e}"));
-    let drain = |mut r: Box<dyn Read + Send>| {
-        let (tx, rx) = mpsc::channel();
-        std::thread::spawn(move || {
-            let mut v = Vec::new();
-            let _ = r.read_to_end(&mut v);
-            let _ = tx.send(v);
-        });
-        rx
-    };
-    let out = drain(Box::new(child.stdout.take().unwrap()));
-    let err = drain(Box::new(child.stderr.take().unwrap()));
-    let deadline = Instant::now() + RUN_TIMEOUT;
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if Instant::now() >= deadline {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("{exe} {args:?} still running after {RUN_TIMEOUT:?}: killed");
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    };
-    let rest = |rx: mpsc::Receiver<Vec<u8>>| {
-        rx.recv_timeout(deadline.saturating_duration_since(Instant::now()))
-            .unwrap_or_else(|_| panic!("{exe}: output still open after its exit"))
-    };
-    Output {
-        status,
-        stdout: rest(out),
-        stderr: rest(err),
-    }
+    let mut cmd = Command::new(exe);
+    cmd.args(args).env("LIMBER_DOMAIN", domain.name());
+    limber_bounded_run::output_within(cmd, RUN_TIMEOUT)
 }
 
 fn text(b: &[u8]) -> String {

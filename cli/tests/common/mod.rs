@@ -2,10 +2,9 @@
 
 #![allow(dead_code)]
 
-use std::io::Read;
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Output};
 use std::sync::mpsc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use limber_services::testing::TestDriver;
 use limber_services::{Context, Domain, Role};
@@ -41,45 +40,7 @@ pub fn limber(domain: &str, args: &[&str]) -> Output {
 
 /// `cmd.output()` (stdin closed), but killed and failing the test after [`VERB_TIMEOUT`].
 pub fn output(cmd: &mut Command) -> Output {
-    let mut child = cmd
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("limber runs");
-    let drain = |mut r: Box<dyn Read + Send>| {
-        let (tx, rx) = mpsc::channel();
-        std::thread::spawn(move || {
-            let mut v = Vec::new();
-            let _ = r.read_to_end(&mut v);
-            let _ = tx.send(v);
-        });
-        rx
-    };
-    let out = drain(Box::new(child.stdout.take().unwrap()));
-    let err = drain(Box::new(child.stderr.take().unwrap()));
-    let deadline = Instant::now() + VERB_TIMEOUT;
-    let status = loop {
-        if let Some(status) = child.try_wait().expect("wait for limber") {
-            break status;
-        }
-        if Instant::now() >= deadline {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("{cmd:?} still running after {VERB_TIMEOUT:?}: killed");
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    };
-    // A process it left behind could hold the pipes open: bounded too.
-    let rest = |rx: mpsc::Receiver<Vec<u8>>| {
-        rx.recv_timeout(deadline.saturating_duration_since(Instant::now()))
-            .unwrap_or_else(|_| panic!("{cmd:?}: output still open after {VERB_TIMEOUT:?}"))
-    };
-    Output {
-        status,
-        stdout: rest(out),
-        stderr: rest(err),
-    }
+    limber_bounded_run::output_within(cmd, VERB_TIMEOUT)
 }
 
 /// Stdout as text.
