@@ -56,3 +56,18 @@ fn timing_and_armpac_layout_flags() {
     );
     assert!(Cli::try_parse_from(["emulator", "--armpac-layout", "player"]).is_err());
 }
+
+/// `--drop-arm-info N` (from `limber emulator --help`): the first N ARMINFOpac replies are
+/// dropped; none by default.
+#[test]
+fn drop_arm_info_flag() {
+    let cfg = Cli::try_parse_from(["emulator"])
+        .unwrap()
+        .args
+        .config()
+        .unwrap();
+    assert_eq!(cfg.faults.drop_arm_info_replies, 0);
+    let c = Cli::try_parse_from(["emulator", "--pty", "--drop-arm-info", "2"]).unwrap();
+    assert_eq!(c.args.config().unwrap().faults.drop_arm_info_replies, 2);
+    assert!(Cli::try_parse_from(["emulator", "--drop-arm-info", "-1"]).is_err());
+}

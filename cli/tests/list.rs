@@ -47,3 +47,18 @@ fn list_of_an_empty_domain_says_so_and_bad_domains_are_refused() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("invalid domain"));
 }
+
+/// `-v` (`limber --help`: more log output, repeatable) is accepted by every verb and
+/// changes nothing else: the empty domain is still reported on stdout, exit 0.
+#[test]
+fn verbose_flag_is_global() {
+    let d = Domain::unique_for_test();
+    for v in ["-v", "-vv", "-vvv"] {
+        let out = common::output(Command::new(LIMBER).args([v, "list", "--domain", d.name()]));
+        assert!(out.status.success(), "{v}");
+        assert!(
+            String::from_utf8_lossy(&out.stdout).contains("no devices"),
+            "{v}"
+        );
+    }
+}
