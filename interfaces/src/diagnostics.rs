@@ -81,6 +81,35 @@ pub mod hardware {
     pub const GRIPPER: u32 = 2;
     /// The robot has the gripper lift.
     pub const LIFT: u32 = 4;
+    /// The driver looked for an arm and the robot has none (ARM_INFO unanswered): its
+    /// devices are not served (the driver keeps asking, and serves them if it answers).
+    pub const NO_ARM: u32 = 0x100;
+    /// The robot has no body gripper (or the configuration says so): not served.
+    pub const NO_GRIPPER: u32 = 0x200;
+    /// The robot has no gripper lift (or the configuration says so): not served.
+    pub const NO_LIFT: u32 = 0x400;
+
+    /// The hardware a device stands for in the Pioneer driver's naming (`actarray/0`,
+    /// `limb/0` and `gripper/1`: the arm; `gripper/0`: the body gripper; `actarray/1`:
+    /// the lift): its `NO_*` bit and its name. `None` for any other device.
+    pub fn of_device(interface: crate::InterfaceKind, index: u16) -> Option<(u32, &'static str)> {
+        use crate::InterfaceKind::{ActArray, Gripper, Limb};
+        match (interface, index) {
+            (ActArray, 0) | (Limb, 0) | (Gripper, 1) => Some((NO_ARM, "arm")),
+            (Gripper, 0) => Some((NO_GRIPPER, "gripper")),
+            (ActArray, 1) => Some((NO_LIFT, "lift")),
+            _ => None,
+        }
+    }
+
+    /// The names of the hardware `bits` says the robot lacks (`NO_*`), in bit order.
+    pub fn lacking(bits: u32) -> Vec<&'static str> {
+        [(NO_ARM, "arm"), (NO_GRIPPER, "gripper"), (NO_LIFT, "lift")]
+            .into_iter()
+            .filter(|&(b, _)| bits & b != 0)
+            .map(|(_, n)| n)
+            .collect()
+    }
 }
 
 /// Values of [`DriverStats::loop_mode`].
@@ -129,6 +158,21 @@ pub(crate) const GROUPS: &[ConstantGroup] = &[
                 name: "LIFT",
                 value: 4,
                 doc: "gripper lift present",
+            },
+            Constant {
+                name: "NO_ARM",
+                value: 0x100,
+                doc: "the driver looked for an arm and the robot has none",
+            },
+            Constant {
+                name: "NO_GRIPPER",
+                value: 0x200,
+                doc: "no body gripper (robot or configuration)",
+            },
+            Constant {
+                name: "NO_LIFT",
+                value: 0x400,
+                doc: "no gripper lift (robot or configuration)",
             },
         ],
     },

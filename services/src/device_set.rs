@@ -24,8 +24,12 @@
 //! let mut set = DeviceSet::new(&ctx, "demo", "hand", &[(InterfaceKind::Gripper, 0)])?;
 //! set.gripper_mut(0).unwrap().state_mut().state = GripperState::Open as u32;
 //! set.publish_all(monotonic_ns())?;
-//! let listeners = set.take_wake_listeners(); // for limber_services::event_loop::run
+//! let mut listeners = set.take_wake_listeners(); // for limber_services::event_loop::run
 //! # assert_eq!(listeners.len(), 1);
+//! // Hardware that answers later is offered while running; the loop takes its listener.
+//! set.add(&ctx, "demo", "hand", &[(InterfaceKind::Gripper, 1)])?;
+//! listeners.extend(set.take_wake_listeners());
+//! # assert_eq!((listeners.len(), set.len()), (2, 2));
 //! set.process(&mut Hand)?; // after each wake-up
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
@@ -210,15 +214,32 @@ impl DeviceSet {
             limbs: Vec::new(),
             grippers: Vec::new(),
         };
+        set.add(ctx, robot, driver, serve)?;
+        Ok(set)
+    }
+
+    /// Offers more devices while running (hardware that answered late, such as an arm
+    /// whose controller was slow to reply). Their wake listeners are not yet taken: hand
+    /// them to the loop with [`DeviceSet::take_wake_listeners`]. On an error, the devices
+    /// offered before the failing one stay offered.
+    pub fn add(
+        &mut self,
+        ctx: &Context,
+        robot: &str,
+        driver: &str,
+        serve: &[(InterfaceKind, u16)],
+    ) -> Result<(), HostError> {
         for &(kind, index) in serve {
             let name = DeviceName::new(robot, kind, index)?;
             match kind {
-                InterfaceKind::ActArray => set.actarrays.push(DeviceHost::new(ctx, &name, driver)?),
-                InterfaceKind::Limb => set.limbs.push(DeviceHost::new(ctx, &name, driver)?),
-                InterfaceKind::Gripper => set.grippers.push(DeviceHost::new(ctx, &name, driver)?),
+                InterfaceKind::ActArray => {
+                    self.actarrays.push(DeviceHost::new(ctx, &name, driver)?)
+                }
+                InterfaceKind::Limb => self.limbs.push(DeviceHost::new(ctx, &name, driver)?),
+                InterfaceKind::Gripper => self.grippers.push(DeviceHost::new(ctx, &name, driver)?),
             }
         }
-        Ok(set)
+        Ok(())
     }
 
     /// The names of the devices served, actarrays first, then limbs, then grippers.

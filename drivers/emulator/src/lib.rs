@@ -172,6 +172,9 @@ pub struct EmulatorStats {
     pub wrong_baud_bytes: u64,
     /// TCP clients accepted.
     pub connections: u64,
+    /// TCP clients refused because another client was connected (one client at a time,
+    /// like a P2OS simulator): each was closed at once, before any reply.
+    pub refused_clients: u64,
     /// Times the command watchdog stopped the stream.
     pub watchdog_trips: u64,
     /// ARMINFOpac replies dropped by [`Faults::drop_arm_info_replies`].

@@ -116,6 +116,7 @@ enum Input {
     Nothing,
     Bytes(usize),
     NewClient,
+    Refused,
     Gone,
 }
 
@@ -144,29 +145,8 @@ fn wait_input(ep: &mut Endpoint, buf: &mut [u8], timeout: Duration) -> io::Resul
                 client.as_ref().map_or(-1, |c| c.as_raw_fd()),
             ];
             let ready = wait_readable(&fds, timeout)?;
-            if ready & 1 != 0 {
-                match listener.accept() {
-                    Ok((s, _)) => {
-                        s.set_nonblocking(false)?;
-                        if let Err(e) = s.set_nodelay(true) {
-                            tracing::warn!(
-                                error = %e,
-                                "cannot set TCP_NODELAY on the emulator's client; replies may be delayed"
-                            );
-                        }
-                        s.set_write_timeout(Some(Duration::from_millis(200)))?;
-                        if let Some(old) = client.replace(s)
-                            && let Err(e) = old.shutdown(std::net::Shutdown::Both)
-                        {
-                            // The replaced client may have closed its end already.
-                            tracing::debug!(error = %e, "shutting down the replaced TCP client");
-                        }
-                        return Ok(Input::NewClient);
-                    }
-                    Err(e) if is_transient(&e) => {}
-                    Err(e) => return Err(e),
-                }
-            }
+            // The connected client first: its last bytes and its end (EOF) are handled
+            // before a newcomer is considered.
             if ready & 2 != 0
                 && let Some(c) = client.as_mut()
             {
@@ -181,6 +161,34 @@ fn wait_input(ep: &mut Endpoint, buf: &mut [u8], timeout: Duration) -> io::Resul
                         *client = None;
                         return Ok(Input::Gone);
                     }
+                }
+            }
+            if ready & 1 != 0 {
+                match listener.accept() {
+                    // One client at a time, like a P2OS simulator: while one is
+                    // connected, a newcomer is closed at once (before any reply), and the
+                    // connected client keeps its link.
+                    Ok((s, peer)) if client.is_some() => {
+                        tracing::info!(%peer, "refusing a second TCP client: one client at a time");
+                        if let Err(e) = s.shutdown(std::net::Shutdown::Both) {
+                            tracing::debug!(error = %e, "shutting down a refused TCP client");
+                        }
+                        return Ok(Input::Refused);
+                    }
+                    Ok((s, _)) => {
+                        s.set_nonblocking(false)?;
+                        if let Err(e) = s.set_nodelay(true) {
+                            tracing::warn!(
+                                error = %e,
+                                "cannot set TCP_NODELAY on the emulator's client; replies may be delayed"
+                            );
+                        }
+                        s.set_write_timeout(Some(Duration::from_millis(200)))?;
+                        *client = Some(s);
+                        return Ok(Input::NewClient);
+                    }
+                    Err(e) if is_transient(&e) => {}
+                    Err(e) => return Err(e),
                 }
             }
             Ok(Input::Nothing)
@@ -313,6 +321,7 @@ pub(super) fn run(
         let now = Instant::now();
         match input {
             Input::Nothing => {}
+            Input::Refused => wire.stats.refused_clients += 1,
             Input::NewClient => {
                 wire.stats.connections += 1;
                 robot.reset_connection();

@@ -74,6 +74,14 @@ pub enum ConnectError {
         /// Baud rates tried (empty over TCP).
         bauds: Vec<u32>,
     },
+    /// The other end closed the connection before answering the first SYNC0: over TCP,
+    /// a server of one client at a time (a simulator, the emulator) that serves another
+    /// client.
+    #[error(
+        "the other end closed the connection before answering SYNC0 (a TCP endpoint that \
+         serves one client at a time is held by another client)"
+    )]
+    ClosedBeforeSync,
     /// Synced, but no SIP arrived after OPEN.
     #[error("no SIP within {0:?} after OPEN")]
     NoSip(Duration),
@@ -216,6 +224,11 @@ impl Connection {
         };
         let mut close_sent = false;
         let mut attempts = 0;
+        let mut answered = false;
+        let closed_early = |e: LinkError, answered: bool| match e {
+            LinkError::Closed if !answered => ConnectError::ClosedBeforeSync,
+            e => ConnectError::Link(e),
+        };
         for baud in bauds {
             if let Some(b) = baud {
                 link.set_baud_rate(b)?;
@@ -223,12 +236,16 @@ impl Connection {
             }
             for _ in 0..opts.sync_attempts.max(1) {
                 attempts += 1;
-                link.send(&Command::Sync0)?;
-                match wait_sync(link, 0, opts.sync_timeout, close_sent)? {
-                    SyncWait::Got(_) => {}
+                link.send(&Command::Sync0)
+                    .map_err(|e| closed_early(e, answered))?;
+                match wait_sync(link, 0, opts.sync_timeout, close_sent)
+                    .map_err(|e| closed_early(e, answered))?
+                {
+                    SyncWait::Got(_) => answered = true,
                     SyncWait::Timeout => continue,
                     SyncWait::Running => {
                         // Still running from an earlier connection: CLOSE once.
+                        answered = true;
                         close_sent = true;
                         link.send(&Command::Close)?;
                         std::thread::sleep(opts.close_wait);

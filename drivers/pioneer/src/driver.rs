@@ -2,6 +2,7 @@
 //! link faults.
 
 use core::ops::ControlFlow;
+use std::sync::mpsc::{self, Receiver, TryRecvError};
 use std::time::{Duration, Instant};
 
 use limber_interfaces::diagnostics::{self, DriverStats, hardware, loop_mode};
@@ -12,8 +13,8 @@ use limber_services::{Context, DeviceSet, DeviceSetHandler, HostError, Origin, m
 use thiserror::Error;
 
 use limber_p2os::{
-    ArmStatusMode, Command, ConnectOptions, Connection, LinkError, LinkTarget, RobotIdentity,
-    RobotPacket,
+    ArmStatusMode, Command, ConnectError, ConnectOptions, Connection, LinkError, LinkTarget,
+    RobotIdentity, RobotPacket,
 };
 
 use super::config::PioneerConfig;
@@ -100,6 +101,32 @@ pub struct Hardware {
     pub gripper: bool,
 }
 
+/// The driver's name in device attributes and statistics.
+const DRIVER: &str = "pioneer";
+
+/// The devices of the arm: `actarray/0`, `limb/0` and the arm gripper `gripper/1`.
+const ARM_DEVICES: [(InterfaceKind, u16); 3] = [
+    (InterfaceKind::ActArray, 0),
+    (InterfaceKind::Limb, 0),
+    (InterfaceKind::Gripper, 1),
+];
+
+/// [`DriverStats::hardware`]: what the robot has, and what the driver looked for and
+/// found missing (`NO_*`, shown by `limber list` and the CLI's "no driver" message).
+fn hardware_bits(hw: &Hardware) -> u32 {
+    let arm = if hw.arm {
+        hardware::ARM
+    } else {
+        hardware::NO_ARM
+    };
+    let body = if hw.gripper {
+        hardware::GRIPPER | hardware::LIFT
+    } else {
+        hardware::NO_GRIPPER | hardware::NO_LIFT
+    };
+    arm | body
+}
+
 fn origin_internal() -> Origin {
     Origin {
         client_id: 0,
@@ -142,6 +169,9 @@ pub struct PioneerDriver {
     failures: Failures,
     arm_probe: Option<ArmProbe>,
     arm_info_arrived: bool,
+    connecting: Option<Receiver<Result<Connection, ConnectError>>>,
+    reconnect_log: ReconnectLog,
+    devices_added: bool,
 }
 
 /// Longest wait between two ARM_INFO retries of the loop.
@@ -177,8 +207,6 @@ enum Failure {
     Process,
     /// Writing the next VECMOVE waypoint.
     VecMove,
-    /// A reconnection attempt.
-    Reconnect,
 }
 
 /// Counts the failures the loop survives and logs them: each kind at its first
@@ -186,7 +214,7 @@ enum Failure {
 /// flooding the log.
 #[derive(Debug, Default)]
 struct Failures {
-    counts: [u64; 4],
+    counts: [u64; 3],
 }
 
 impl Failures {
@@ -196,6 +224,69 @@ impl Failures {
         if n.is_power_of_two() {
             tracing::warn!("{kind:?} failed ({} so far): {cause}", *n);
         }
+    }
+}
+
+/// Longest wait between two reconnection attempts while the endpoint is held by another
+/// client.
+const TAKEN_BACKOFF_MAX: Duration = Duration::from_secs(10);
+
+/// How often a robot that stays away is logged again.
+const RECONNECT_LOG_EVERY: Duration = Duration::from_secs(10);
+
+/// Failed reconnection attempts: the first is logged at once, then one line at most every
+/// [`RECONNECT_LOG_EVERY`] with the count since. While the endpoint is held by another
+/// client (a TCP server of one client at a time closed the connection before the
+/// handshake), the wait before the next attempt doubles, up to [`TAKEN_BACKOFF_MAX`]:
+/// the other client is left alone.
+#[derive(Debug, Default)]
+struct ReconnectLog {
+    failed: u64,
+    unlogged: u64,
+    last_logged: Option<Instant>,
+    taken_backoff: Option<Duration>,
+}
+
+impl ReconnectLog {
+    /// Notes a failed attempt; returns how long to wait before the next one (zero: the
+    /// configured interval).
+    fn failed(&mut self, port: &str, e: &ConnectError, now: Instant) -> Duration {
+        self.failed += 1;
+        let wait = if matches!(e, ConnectError::ClosedBeforeSync) {
+            let w = self
+                .taken_backoff
+                .map_or(Duration::from_secs(1), |w| (w * 2).min(TAKEN_BACKOFF_MAX));
+            self.taken_backoff = Some(w);
+            w
+        } else {
+            self.taken_backoff = None;
+            Duration::ZERO
+        };
+        let due = self
+            .last_logged
+            .is_none_or(|t| now.duration_since(t) >= RECONNECT_LOG_EVERY);
+        if due {
+            let retry = if wait.is_zero() {
+                String::new()
+            } else {
+                format!("; the endpoint is held by another client: next attempt in {wait:?}")
+            };
+            tracing::warn!(
+                "reconnecting to {port} failed ({} attempts so far, {} since the last \
+                 report): {e}{retry}",
+                self.failed,
+                self.unlogged + 1
+            );
+            self.last_logged = Some(now);
+            self.unlogged = 0;
+        } else {
+            self.unlogged += 1;
+        }
+        wait
+    }
+
+    fn succeeded(&mut self) {
+        *self = ReconnectLog::default();
     }
 }
 
@@ -349,29 +440,19 @@ impl PioneerDriver {
         let robot = cfg.robot.as_str();
         let mut serve = Vec::new();
         if hardware.arm {
-            serve.extend([
-                (InterfaceKind::ActArray, 0),
-                (InterfaceKind::Limb, 0),
-                (InterfaceKind::Gripper, 1),
-            ]);
+            serve.extend(ARM_DEVICES);
         }
         if hardware.gripper {
             serve.extend([(InterfaceKind::Gripper, 0), (InterfaceKind::ActArray, 1)]);
         }
-        let driver = "pioneer";
-        let hosts = DeviceSet::new(ctx, robot, driver, &serve)?;
+        let hosts = DeviceSet::new(ctx, robot, DRIVER, &serve)?;
         let stats_pub = StatsPublisher::new(ctx, robot).map_err(DriverError::Stats)?;
         let mut stats = DriverStats::default();
-        diagnostics::put_text(&mut stats.driver, driver);
+        diagnostics::put_text(&mut stats.driver, DRIVER);
         diagnostics::put_text(&mut stats.robot_name, &hardware.identity.name);
         diagnostics::put_text(&mut stats.robot_class, &hardware.identity.class);
         diagnostics::put_text(&mut stats.robot_subclass, &hardware.identity.subclass);
-        stats.hardware = if hardware.arm { hardware::ARM } else { 0 }
-            | if hardware.gripper {
-                hardware::GRIPPER | hardware::LIFT
-            } else {
-                0
-            };
+        stats.hardware = hardware_bits(&hardware);
         let mut d = PioneerDriver {
             ctx: ctx.clone(),
             target,
@@ -390,6 +471,9 @@ impl PioneerDriver {
             failures: Failures::default(),
             arm_probe: None,
             arm_info_arrived: false,
+            connecting: None,
+            reconnect_log: ReconnectLog::default(),
+            devices_added: false,
         };
         if !d.hardware.arm {
             tracing::warn!(
@@ -497,17 +581,40 @@ impl PioneerDriver {
             );
             self.robot.dirty.arm = true;
         } else {
-            // DeviceSet offers its devices at creation only, and the loop's wake
-            // listeners are taken once: the arm's devices cannot be added while running.
-            tracing::warn!(
-                "the robot answers ARM_INFO now (after {} retries): it has an arm, but this \
-                 driver started without one and cannot offer {robot}/actarray/0, \
-                 {robot}/limb/0 and {robot}/gripper/1 while running: restart the driver to \
-                 serve the arm",
-                p.sent,
-                robot = self.robot.cfg.robot
-            );
+            self.arm_appeared(p.sent);
         }
+    }
+
+    /// The robot answered ARM_INFO after the driver started without an arm: offer the
+    /// arm's devices now (the loop takes their wake listeners), start the ARMpac stream,
+    /// power the arm and set its autopark watchdog, as at a start with an arm.
+    fn arm_appeared(&mut self, retries: u32) {
+        let robot = self.robot.cfg.robot.clone();
+        if let Err(e) = self.hosts.add(&self.ctx, &robot, DRIVER, &ARM_DEVICES) {
+            tracing::error!(
+                "the robot answers ARM_INFO now (after {retries} retries), but its arm cannot \
+                 be offered: {e}"
+            );
+            return;
+        }
+        self.devices_added = true;
+        self.hardware.arm = true;
+        self.stats.hardware = hardware_bits(&self.hardware);
+        let o = origin_internal();
+        for cmd in [
+            Command::ArmStatus(ArmStatusMode::Continuous),
+            Command::ArmPower(true),
+        ] {
+            if let Err(status) = self.robot.send(&cmd, &o) {
+                tracing::warn!("cannot set up the arm that appeared ({cmd:?}): {status}");
+            }
+        }
+        self.set_autopark();
+        self.robot.dirty.arm = true;
+        tracing::info!(
+            "the robot answers ARM_INFO now (after {retries} retries): serving {robot}/actarray/0 \
+             (arm), {robot}/limb/0, {robot}/gripper/1 (arm gripper)"
+        );
     }
 
     /// What the robot has.
@@ -718,9 +825,34 @@ impl PioneerDriver {
         self.arm_probe = None;
     }
 
-    /// One reconnection attempt (bounded by the handshake's timeouts).
+    /// Reconnection, never blocking the loop: the handshake runs on a thread of its own
+    /// (it waits for the robot, up to seconds when the robot is silent), which hands the
+    /// connection back; the loop takes it at a later tick. Meanwhile requests are answered
+    /// and commands refused (LinkDown) as usual.
     fn try_reconnect(&mut self) {
         let now = Instant::now();
+        if let Some(rx) = self.connecting.as_ref() {
+            match rx.try_recv() {
+                Err(TryRecvError::Empty) => {}
+                Ok(Ok(conn)) => {
+                    self.connecting = None;
+                    self.reconnect_log.succeeded();
+                    self.link_up_again(conn);
+                }
+                Ok(Err(e)) => {
+                    self.connecting = None;
+                    let wait = self.reconnect_log.failed(&self.robot.cfg.port, &e, now);
+                    let base = Duration::from_millis(self.robot.cfg.reconnect_interval_ms);
+                    self.next_reconnect = now + wait.max(base);
+                }
+                Err(TryRecvError::Disconnected) => {
+                    // The thread ended without an answer (it panicked): try again.
+                    self.connecting = None;
+                    tracing::error!("the reconnection thread ended without an answer");
+                }
+            }
+            return;
+        }
         if now < self.next_reconnect {
             return;
         }
@@ -728,55 +860,66 @@ impl PioneerDriver {
         let mut opts = options(&self.robot.cfg, &self.target);
         opts.sync_attempts = 2;
         opts.arm = self.hardware.arm;
-        // One ARM_INFO in the handshake: the handshake still runs on the loop thread, so
-        // every attempt here is time the loop is not serving; if it goes unanswered, the
-        // loop asks again without waiting (a bounded backoff), as after a start.
+        // One ARM_INFO in the handshake; if it goes unanswered, the loop asks again
+        // without waiting (a bounded backoff), as after a start.
         opts.arm_info_attempts = 1;
-        match Connection::open(&self.target, &opts) {
-            Ok(conn) => {
-                let answered = conn.arm_calibration().is_some();
-                if let Some(cal) = conn.arm_calibration() {
-                    self.robot.set_calibration(*cal);
-                }
-                if let Some(sip) = conn.last_sip() {
-                    self.robot.sip = Some(*sip);
-                }
-                self.robot.conn = Some(conn);
-                // Commands sent before this instant were sent to a dead link: refused.
-                self.robot.link_up_since_ns = monotonic_ns();
-                self.robot.last_rx = Instant::now();
-                // Whatever was commanded before is void; hold where the arm is.
-                self.robot.arm.target = [None; 6];
-                self.set_autopark();
-                // An arm that lost contact with its controller reverts to HOME with
-                // power off (the vendor's manuals): power it again, as at start.
-                if self.hardware.arm
-                    && let Err(status) = self
-                        .robot
-                        .send(&Command::ArmPower(true), &origin_internal())
+        let target = self.target.clone();
+        let (tx, rx) = mpsc::sync_channel(1);
+        let spawned = std::thread::Builder::new()
+            .name("limber-connect".into())
+            .spawn(move || {
+                let r = Connection::open(&target, &opts);
+                // Nobody waits any more (the driver ended): close what was opened.
+                if let Err(mpsc::SendError(Ok(conn))) = tx.send(r)
+                    && let Err(e) = conn.close()
                 {
-                    tracing::warn!("cannot power the arm after reconnecting: {status}");
+                    tracing::debug!("closing an unwanted connection: {e}");
                 }
-                self.reconnects += 1;
-                self.robot.dirty.arm = true;
-                self.robot.dirty.body = true;
-                tracing::info!("link up again (reconnect #{})", self.reconnects);
-                if !answered {
-                    if self.hardware.arm {
-                        tracing::warn!(
-                            "no ARMINFOpac after reconnect #{}: keeping the last calibration, \
-                             asking again in the background",
-                            self.reconnects
-                        );
-                    }
-                    self.start_arm_probe(Instant::now());
-                }
+            });
+        match spawned {
+            Ok(_) => self.connecting = Some(rx),
+            Err(e) => tracing::error!("cannot start a reconnection thread: {e}"),
+        }
+    }
+
+    /// Takes a connection the reconnection thread established.
+    fn link_up_again(&mut self, conn: Connection) {
+        let answered = conn.arm_calibration().is_some();
+        if let Some(cal) = conn.arm_calibration() {
+            self.robot.set_calibration(*cal);
+        }
+        if let Some(sip) = conn.last_sip() {
+            self.robot.sip = Some(*sip);
+        }
+        self.robot.conn = Some(conn);
+        // Commands sent before this instant were sent to a dead link: refused.
+        self.robot.link_up_since_ns = monotonic_ns();
+        self.robot.last_rx = Instant::now();
+        // Whatever was commanded before is void; hold where the arm is.
+        self.robot.arm.target = [None; 6];
+        self.set_autopark();
+        // An arm that lost contact with its controller reverts to HOME with power off
+        // (the vendor's manuals): power it again, as at start.
+        if self.hardware.arm
+            && let Err(status) = self
+                .robot
+                .send(&Command::ArmPower(true), &origin_internal())
+        {
+            tracing::warn!("cannot power the arm after reconnecting: {status}");
+        }
+        self.reconnects += 1;
+        self.robot.dirty.arm = true;
+        self.robot.dirty.body = true;
+        tracing::info!("link up again (reconnect #{})", self.reconnects);
+        if !answered {
+            if self.hardware.arm {
+                tracing::warn!(
+                    "no ARMINFOpac after reconnect #{}: keeping the last calibration, asking \
+                     again in the background",
+                    self.reconnects
+                );
             }
-            Err(e) => {
-                // Logged at the first failure and then at powers of two: a robot that
-                // stays away does not flood the log.
-                self.failures.note(Failure::Reconnect, &e);
-            }
+            self.start_arm_probe(Instant::now());
         }
     }
 
@@ -837,10 +980,13 @@ impl PioneerDriver {
     }
 
     fn run_event(&mut self, stop: &mut dyn FnMut() -> bool) -> Result<LoopExit, DriverError> {
-        let listeners = self.hosts.take_wake_listeners();
+        let mut listeners = self.hosts.take_wake_listeners();
         let tick = self.robot.cfg.tick();
         let nominal = tick.as_nanos() as u64;
         loop {
+            // Devices offered while running (an arm that answered late) wake the loop too.
+            listeners.extend(self.hosts.take_wake_listeners());
+            self.devices_added = false;
             // (Re)attach the link's fd: it changes when the link is re-established.
             let fd = self
                 .robot
@@ -876,8 +1022,9 @@ impl PioneerDriver {
                     stopped = true;
                     return ControlFlow::Break(());
                 }
-                // Leave the wait to re-attach when the link went down or came up.
-                if self.robot.conn.is_some() != had_link {
+                // Leave the wait to re-attach when the link went down or came up, or to
+                // attach the listeners of new devices.
+                if self.robot.conn.is_some() != had_link || self.devices_added {
                     ControlFlow::Break(())
                 } else {
                     ControlFlow::Continue(())
@@ -929,6 +1076,8 @@ impl PioneerDriver {
 
     /// Stops the arm, stops the ARMpac stream and closes the link (STOP, CLOSE).
     pub fn shutdown(&mut self) {
+        // A handshake still running on its thread closes what it opens.
+        self.connecting = None;
         let o = origin_internal();
         if self.hardware.arm
             && let Err(status) = self
