@@ -238,6 +238,7 @@ fn stats_json(s: &DriverStats) -> Value {
             "arm": s.hardware & hardware::ARM != 0,
             "gripper": s.hardware & hardware::GRIPPER != 0,
             "lift": s.hardware & hardware::LIFT != 0,
+            "lacks": hardware::lacking(s.hardware),
         },
         "loop": {
             "mode": if s.loop_mode == 2 { "spin" } else { "event" },

@@ -13,6 +13,7 @@ use limber_services::{Context, Domain, Role};
 mod demo;
 mod device;
 mod echo;
+mod lacks;
 pub mod emulator;
 mod layout;
 mod list;

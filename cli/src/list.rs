@@ -59,5 +59,30 @@ pub fn run(args: ListArgs) -> Result<(), CliError> {
             d.nodes
         )?;
     }
+    print_lacks(&domain)
+}
+
+/// One line per robot whose running driver found hardware missing: "robot pioneer has no
+/// arm (driver pioneer)".
+fn print_lacks(domain: &limber_services::Domain) -> Result<(), CliError> {
+    let robots = limber_services::diagnostics::list_drivers(domain)
+        .map_err(|e| CliError::new(exit::FAILURE, e.to_string()))?;
+    if robots.is_empty() {
+        return Ok(());
+    }
+    let ctx = crate::client_context()?;
+    for robot in robots {
+        let Some(l) = crate::lacks::of_robot(&ctx, &robot) else {
+            continue;
+        };
+        let missing = limber_interfaces::diagnostics::hardware::lacking(l.bits);
+        if !missing.is_empty() {
+            outln!(
+                "robot {robot} has no {} (driver {})",
+                missing.join(", no "),
+                l.driver
+            )?;
+        }
+    }
     Ok(())
 }

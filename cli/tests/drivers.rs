@@ -2,94 +2,12 @@
 //! on its pty in another, `limber simarm`; the shell verbs against them; SIGTERM ends
 //! each with exit 0.
 
-use std::io::{BufRead, BufReader};
-use std::process::{Child, Command, Stdio};
-use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use limber_services::Domain;
 
 mod common;
-use common::{LIMBER, limber, stderr, stdout};
-
-/// A background `limber` process; its stdout lines arrive on a channel.
-struct Bg(Child, Receiver<String>);
-
-impl Bg {
-    fn spawn(domain: &str, args: &[&str]) -> Bg {
-        let mut child = Command::new(LIMBER)
-            .args(args)
-            .env("LIMBER_DOMAIN", domain)
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .unwrap();
-        let out = child.stdout.take().unwrap();
-        let (tx, rx) = mpsc::channel();
-        std::thread::spawn(move || {
-            for line in BufReader::new(out).lines() {
-                let Ok(line) = line else { break };
-                if tx.send(line).is_err() {
-                    break;
-                }
-            }
-        });
-        Bg(child, rx)
-    }
-
-    /// The first stdout line satisfying `pred`, within 30 s.
-    fn line(&mut self, pred: impl Fn(&str) -> bool) -> String {
-        let timeout = Duration::from_secs(30);
-        let deadline = Instant::now() + timeout;
-        let mut seen = Vec::new();
-        loop {
-            match self
-                .1
-                .recv_timeout(deadline.saturating_duration_since(Instant::now()))
-            {
-                Ok(l) if pred(l.trim_end()) => return l.trim_end().to_string(),
-                Ok(l) => seen.push(l),
-                Err(RecvTimeoutError::Disconnected) => {
-                    panic!("process ended before the expected line; it printed {seen:?}")
-                }
-                Err(RecvTimeoutError::Timeout) => {
-                    panic!("no expected line within {timeout:?}; the process printed {seen:?}")
-                }
-            }
-        }
-    }
-
-    fn term(&mut self) -> Option<i32> {
-        self.end_with(libc::SIGTERM)
-    }
-
-    /// Sends `sig` (one that does not end the process).
-    fn signal(&self, sig: i32) {
-        // SAFETY: kill(2) on our own child; no memory is involved.
-        unsafe { libc::kill(self.0.id() as i32, sig) };
-    }
-
-    /// Sends `sig` and waits up to 10 s for the exit; the exit code.
-    fn end_with(&mut self, sig: i32) -> Option<i32> {
-        self.signal(sig);
-        let deadline = Instant::now() + Duration::from_secs(10);
-        while Instant::now() < deadline {
-            if let Ok(Some(s)) = self.0.try_wait() {
-                return s.code();
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        }
-        None
-    }
-}
-
-impl Drop for Bg {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
+use common::{Bg, limber, stderr, stdout};
 
 #[test]
 fn emulator_and_pioneer_as_separate_commands() {

@@ -110,6 +110,9 @@ extern "C" {
 #define LIMBER_HARDWARE_ARM 1 /* 5-DOF arm present */
 #define LIMBER_HARDWARE_GRIPPER 2 /* body gripper present */
 #define LIMBER_HARDWARE_LIFT 4 /* gripper lift present */
+#define LIMBER_HARDWARE_NO_ARM 256 /* the driver looked for an arm and the robot has none */
+#define LIMBER_HARDWARE_NO_GRIPPER 512 /* no body gripper (robot or configuration) */
+#define LIMBER_HARDWARE_NO_LIFT 1024 /* no gripper lift (robot or configuration) */
 
 /* DriverStats.loop_mode */
 #define LIMBER_LOOP_MODE_EVENT 1 /* event-driven */

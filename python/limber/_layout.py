@@ -99,6 +99,9 @@ GRIPPER_STATE_ERROR = 4  # error
 HARDWARE_ARM = 1  # 5-DOF arm present
 HARDWARE_GRIPPER = 2  # body gripper present
 HARDWARE_LIFT = 4  # gripper lift present
+HARDWARE_NO_ARM = 256  # the driver looked for an arm and the robot has none
+HARDWARE_NO_GRIPPER = 512  # no body gripper (robot or configuration)
+HARDWARE_NO_LIFT = 1024  # no gripper lift (robot or configuration)
 
 # DriverStats.loop_mode
 LOOP_MODE_EVENT = 1  # event-driven

@@ -31,6 +31,30 @@ pub fn service_name(robot: &str) -> Result<ServiceName, DiagnosticsError> {
         .map_err(|_| DiagnosticsError::Name(robot.to_string()))
 }
 
+/// The robots of `domain` whose driver publishes statistics (a `driver` channel), sorted.
+/// A driver that died is listed until its services are cleaned up.
+pub fn list_drivers(domain: &crate::Domain) -> Result<Vec<String>, crate::ListError> {
+    let mut out = Vec::new();
+    ipc::Service::list(domain.config(), |details| {
+        let name = details.static_details.name().as_str();
+        if let Some(robot) = name
+            .strip_prefix("limber/")
+            .and_then(|r| r.strip_suffix("/driver/0/data"))
+            && service_name(robot).is_ok()
+        {
+            out.push(robot.to_string());
+        }
+        CallbackProgression::Continue
+    })
+    .map_err(|e| crate::ListError::Transport {
+        domain: domain.name().to_string(),
+        source: e,
+    })?;
+    out.sort();
+    out.dedup();
+    Ok(out)
+}
+
 /// Opening or using the driver channel failed.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
 pub enum DiagnosticsError {

@@ -2,9 +2,10 @@
 
 #![allow(dead_code)]
 
-use std::process::{Command, Output};
-use std::sync::mpsc;
-use std::time::Duration;
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Output, Stdio};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
+use std::time::{Duration, Instant};
 
 use limber_services::testing::TestDriver;
 use limber_services::{Context, Domain, Role};
@@ -51,4 +52,83 @@ pub fn stdout(o: &Output) -> String {
 /// Stderr as text.
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).to_string()
+}
+
+/// A background `limber` process; its stdout lines arrive on a channel.
+pub struct Bg(pub Child, pub Receiver<String>);
+
+impl Bg {
+    pub fn spawn(domain: &str, args: &[&str]) -> Bg {
+        let mut child = Command::new(LIMBER)
+            .args(args)
+            .env("LIMBER_DOMAIN", domain)
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .unwrap();
+        let out = child.stdout.take().unwrap();
+        let (tx, rx) = mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(out).lines() {
+                let Ok(line) = line else { break };
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        Bg(child, rx)
+    }
+
+    /// The first stdout line satisfying `pred`, within 30 s.
+    pub fn line(&mut self, pred: impl Fn(&str) -> bool) -> String {
+        let timeout = Duration::from_secs(30);
+        let deadline = Instant::now() + timeout;
+        let mut seen = Vec::new();
+        loop {
+            match self
+                .1
+                .recv_timeout(deadline.saturating_duration_since(Instant::now()))
+            {
+                Ok(l) if pred(l.trim_end()) => return l.trim_end().to_string(),
+                Ok(l) => seen.push(l),
+                Err(RecvTimeoutError::Disconnected) => {
+                    panic!("process ended before the expected line; it printed {seen:?}")
+                }
+                Err(RecvTimeoutError::Timeout) => {
+                    panic!("no expected line within {timeout:?}; the process printed {seen:?}")
+                }
+            }
+        }
+    }
+
+    pub fn term(&mut self) -> Option<i32> {
+        self.end_with(libc::SIGTERM)
+    }
+
+    /// Sends `sig` (one that does not end the process).
+    pub fn signal(&self, sig: i32) {
+        // SAFETY: kill(2) on our own child; no memory is involved.
+        unsafe { libc::kill(self.0.id() as i32, sig) };
+    }
+
+    /// Sends `sig` and waits up to 10 s for the exit; the exit code.
+    pub fn end_with(&mut self, sig: i32) -> Option<i32> {
+        self.signal(sig);
+        let deadline = Instant::now() + Duration::from_secs(10);
+        while Instant::now() < deadline {
+            if let Ok(Some(s)) = self.0.try_wait() {
+                return s.code();
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        None
+    }
+}
+
+impl Drop for Bg {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
 }

@@ -1,0 +1,273 @@
+//! The driver's link as a user meets it, with `limber emulator` and `limber pioneer` as
+//! separate processes: a robot that falls silent (the emulator SIGSTOPped) does not freeze
+//! the driver (issue 12 item 4), a TCP endpoint held by another driver is said so (item 6),
+//! an arm that answers late is served, and what a robot lacks is said (issue 13 item 5).
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use limber_services::prelude::*;
+use limber_services::{Domain, Role};
+
+mod common;
+use common::{Bg, limber, stderr, stdout};
+
+const T: Duration = Duration::from_secs(10);
+
+/// A driver configuration with short timeouts (a silent robot is found in 0.4 s).
+fn config(name: &str) -> PathBuf {
+    let path = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("link-{name}.toml"));
+    std::fs::write(
+        &path,
+        "link_timeout_ms = 400\nreconnect_interval_ms = 100\narm_info_timeout_ms = 500\n",
+    )
+    .unwrap();
+    path
+}
+
+/// Starts `limber emulator` (`--pty` or `--tcp 0`, plus `extra`) and returns it with the
+/// `--port` value that reaches it.
+fn emulator(domain: &Domain, tcp: bool, extra: &[&str]) -> (Bg, String) {
+    let mut args = if tcp {
+        vec!["emulator", "--tcp", "0", "--ignore-stdin"]
+    } else {
+        vec!["emulator", "--pty", "--ignore-stdin"]
+    };
+    args.extend_from_slice(extra);
+    let mut emu = Bg::spawn(domain.name(), &args);
+    let first = emu.line(|l| !l.is_empty());
+    let port = if tcp { format!("tcp://{first}") } else { first };
+    (emu, port)
+}
+
+fn pioneer(domain: &Domain, port: &str, cfg: &str, extra: &[&str]) -> Bg {
+    let mut args = vec!["pioneer", "--port", port, "--config", cfg];
+    args.extend_from_slice(extra);
+    let mut d = Bg::spawn(domain.name(), &args);
+    d.line(|l| l.ends_with("ready"));
+    d
+}
+
+/// Waits (bounded) for a state sample whose LINK_UP flag is `up`.
+fn wait_link(arm: &mut ActArrayClient, up: bool, timeout: Duration) -> bool {
+    let deadline = Instant::now() + timeout;
+    while Instant::now() < deadline {
+        if let Ok(s) = arm.wait_state(Duration::from_millis(200))
+            && s.header.link_up() == up
+        {
+            return true;
+        }
+    }
+    false
+}
+
+/// Waits (bounded) for a state sample that satisfies `pred`; returns the last sample.
+fn wait_arm(
+    arm: &mut ActArrayClient,
+    timeout: Duration,
+    pred: impl Fn(&ActArrayData) -> bool,
+) -> (bool, ActArrayData) {
+    let deadline = Instant::now() + timeout;
+    let mut last = ActArrayData::default();
+    while Instant::now() < deadline {
+        if let Ok(s) = arm.wait_state(Duration::from_millis(200)) {
+            last = *s;
+            if pred(s) {
+                return (true, last);
+            }
+        }
+    }
+    (false, last)
+}
+
+/// Issue 12 item 4: with the robot SIGSTOPped, the driver answers requests, refuses
+/// commands ("link down") and ends on SIGTERM with exit 0; when the robot continues, the
+/// link recovers and the command refused meanwhile is not replayed.
+fn a_stopped_robot_does_not_freeze_the_driver(tcp: bool) {
+    let kind = if tcp { "tcp" } else { "pty" };
+    let d = Domain::unique_for_test();
+    let (mut emu, port) = emulator(&d, tcp, &[]);
+    let cfg = config(&format!("stopped-{kind}"));
+    let mut drv = pioneer(&d, &port, cfg.to_str().unwrap(), &[]);
+    let ctx = Context::new(&d, Role::Client, "link-test").unwrap();
+    let mut arm = ActArrayClient::connect_timeout(&ctx, "pioneer/actarray/0", T).unwrap();
+    assert!(wait_link(&mut arm, true, T));
+    for j in 0..6 {
+        arm.set_speed_config(j, 20.0).unwrap();
+    }
+    let j0 = arm.wait_state(T).unwrap().actuators[0].position;
+
+    emu.signal(libc::SIGSTOP);
+    assert!(
+        wait_link(&mut arm, false, T),
+        "{kind}: the silent robot was not detected"
+    );
+    // While the driver reconnects: a request is answered...
+    let t0 = Instant::now();
+    let o = limber(
+        d.name(),
+        &["actarray", "pioneer/actarray/0", "geom", "--timeout", "20"],
+    );
+    eprintln!("{kind}: geom with the robot stopped took {:?}", t0.elapsed());
+    assert!(o.status.success(), "{kind}: geom: {}", stderr(&o));
+    assert!(stdout(&o).contains("rotary"), "{}", stdout(&o));
+    // ... and a command refused, with its cause.
+    let o = limber(d.name(), &["actarray", "pioneer/actarray/0", "pos", "0", "0.5"]);
+    assert_eq!(o.status.code(), Some(5), "{kind}: {}", stderr(&o));
+    assert!(stderr(&o).contains("link"), "{kind}: {}", stderr(&o));
+
+    // The robot continues: the link comes back.
+    emu.signal(libc::SIGCONT);
+    assert!(
+        wait_link(&mut arm, true, Duration::from_secs(30)),
+        "{kind}: the link did not recover"
+    );
+    // The refused command is not replayed. The barrier: a later command on joint 1 that
+    // the robot carries out; a replay would have come before it, and joint 0 (as fast)
+    // would have moved by then.
+    let t = arm.move_to(1, 0.3).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
+    let (arrived, st) = wait_arm(&mut arm, T, |s| {
+        (s.actuators[1].position - 0.3).abs() < 0.02
+    });
+    assert!(arrived, "{kind}: joint 1 never arrived: {:?}", st.actuators[1]);
+    assert!(
+        (st.actuators[0].position - j0).abs() < 0.05,
+        "{kind}: the refused command was replayed: joint 0 at {} (was {j0})",
+        st.actuators[0].position
+    );
+
+    // Stopped again, SIGTERM ends the driver at once with exit 0, its link down. The arm
+    // was idle (the barrier above finished; commands since were refused), and a
+    // controller that lost its client parks the arm by its autopark watchdog.
+    emu.signal(libc::SIGSTOP);
+    assert!(wait_link(&mut arm, false, T), "{kind}: not detected twice");
+    let t0 = Instant::now();
+    assert_eq!(drv.term(), Some(0), "{kind}: exit status after SIGTERM");
+    eprintln!(
+        "{kind}: SIGTERM to exit with the robot stopped: {:?}",
+        t0.elapsed()
+    );
+    emu.signal(libc::SIGCONT);
+    assert_eq!(emu.term(), Some(0));
+}
+
+#[test]
+fn a_stopped_robot_on_a_pty_does_not_freeze_the_driver() {
+    a_stopped_robot_does_not_freeze_the_driver(false);
+}
+
+#[test]
+fn a_stopped_robot_over_tcp_does_not_freeze_the_driver() {
+    a_stopped_robot_does_not_freeze_the_driver(true);
+}
+
+/// Issue 12 item 6: a second driver (another robot name) on a TCP endpoint that serves one
+/// client at a time is told the endpoint is held, and the first driver's link is left
+/// alone (no reconnect, no fault).
+#[test]
+fn a_second_driver_on_a_held_tcp_endpoint_says_so_and_leaves_the_first_alone() {
+    let d = Domain::unique_for_test();
+    let (mut emu, port) = emulator(&d, true, &[]);
+    let cfg = config("held");
+    let mut first = pioneer(&d, &port, cfg.to_str().unwrap(), &[]);
+    let o = limber(
+        d.name(),
+        &[
+            "pioneer",
+            "--port",
+            &port,
+            "--config",
+            cfg.to_str().unwrap(),
+            "--robot",
+            "other",
+        ],
+    );
+    assert!(!o.status.success(), "the second driver started");
+    assert!(
+        stderr(&o).contains("held by another client"),
+        "{}",
+        stderr(&o)
+    );
+    let o = limber(
+        d.name(),
+        &["echo", "pioneer/driver", "--count", "1", "--json"],
+    );
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+    assert_eq!(
+        (v["link"]["reconnects"].as_u64(), v["link"]["faults"].as_u64()),
+        (Some(0), Some(0)),
+        "{v}"
+    );
+    let o = limber(d.name(), &["actarray", "pioneer/actarray/0", "pos", "0", "0.3"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(first.term(), Some(0));
+    assert_eq!(emu.term(), Some(0));
+}
+
+/// Issue 13 item 5: on a robot without an arm, the arm's devices are "not there because the
+/// robot has no arm", in `limber list` and in the verbs' exit-3 message.
+#[test]
+fn what_a_robot_lacks_is_said_by_list_and_by_the_verbs() {
+    let d = Domain::unique_for_test();
+    let (mut emu, port) = emulator(&d, false, &["--no-arm"]);
+    let cfg = config("armless");
+    let mut drv = pioneer(&d, &port, cfg.to_str().unwrap(), &[]);
+    let o = limber(d.name(), &["list"]);
+    assert!(
+        stdout(&o).contains("robot pioneer has no arm (driver pioneer)"),
+        "{}",
+        stdout(&o)
+    );
+    let o = limber(
+        d.name(),
+        &["actarray", "pioneer/actarray/0", "geom", "--timeout", "0.5"],
+    );
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("robot pioneer has no arm"),
+        "{}",
+        stderr(&o)
+    );
+    // A device of a robot nobody serves keeps the old message.
+    let o = limber(
+        d.name(),
+        &["actarray", "nobody/actarray/0", "geom", "--timeout", "0.2"],
+    );
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("is the driver running?"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(drv.term(), Some(0));
+    assert_eq!(emu.term(), Some(0));
+}
+
+/// Issue 12 item 5: a driver that started while the robot did not answer ARM_INFO serves
+/// the arm as soon as it answers: `limber list` shows it and a verb uses it.
+#[test]
+fn an_arm_that_answers_late_appears_in_list() {
+    let d = Domain::unique_for_test();
+    // The start's three ARM_INFO go unanswered; the loop's first retry is answered.
+    let (mut emu, port) = emulator(&d, true, &["--drop-arm-info", "3"]);
+    let cfg = config("late-arm");
+    let mut drv = pioneer(&d, &port, cfg.to_str().unwrap(), &[]);
+    let deadline = Instant::now() + Duration::from_secs(20);
+    loop {
+        let o = limber(d.name(), &["list"]);
+        let text = stdout(&o);
+        if text.contains("pioneer/actarray/0") && text.contains("pioneer/limb/0") {
+            assert!(!text.contains("has no arm"), "{text}");
+            break;
+        }
+        assert!(Instant::now() < deadline, "the arm never appeared: {text}");
+    }
+    let o = limber(
+        d.name(),
+        &["actarray", "pioneer/actarray/0", "pos", "0", "0.3", "--timeout", "10"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(drv.term(), Some(0));
+    assert_eq!(emu.term(), Some(0));
+}
