@@ -576,7 +576,7 @@ fn arm_info_lost_at_a_reconnect_is_retried_by_the_loop_and_the_arm_stream_restor
 }
 
 #[test]
-fn a_driver_that_started_without_an_answer_keeps_asking_for_the_arm() {
+fn a_driver_that_started_without_an_answer_serves_the_arm_when_it_answers() {
     let domain = Domain::unique_for_test();
     let emu = emulator_with(Faults {
         drop_arm_info_replies: 3,
@@ -586,11 +586,40 @@ fn a_driver_that_started_without_an_answer_keeps_asking_for_the_arm() {
     assert_eq!(emu.state().stats.arm_info_dropped, 3);
     assert!(!device_names(&domain).contains(&"pioneer/actarray/0".to_string()));
     // The loop asks again (in the background: the driver is ready meanwhile) and the robot
-    // answers.
+    // answers: the arm's devices are offered while the driver runs.
     let (ok, st) = emu.wait_for(Duration::from_secs(10), |s| s.stats.arm_info_out >= 1);
     assert!(ok, "the driver stopped asking for the arm: {:?}", st.stats);
-    // It keeps serving what it offered.
     let c = ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
+    assert!(wait_flag(&mut arm, true, T));
+    for dev in ["pioneer/limb/0", "pioneer/gripper/1"] {
+        assert!(device_names(&domain).contains(&dev.to_string()), "{dev}");
+    }
+    // The statistics say the robot has an arm now.
+    let mut stats = StatsReader::open(&c, "pioneer").unwrap();
+    let deadline = Instant::now() + T;
+    loop {
+        let s = *stats.wait(Duration::from_secs(3)).unwrap();
+        if s.hardware & hardware::ARM != 0 {
+            assert_eq!(s.hardware & hardware::NO_ARM, 0);
+            break;
+        }
+        assert!(Instant::now() < deadline, "hardware bits: {:#x}", s.hardware);
+    }
+    // The new devices wake the loop (their listeners were attached): a command is carried
+    // out, with the ARMpac stream started and the arm powered as at a start.
+    let (ok, st) = emu.wait_for(T, |s| s.robot.arm_status_mode == 2 && s.robot.arm_powered);
+    assert!(ok, "the arm was not set up: {:?}", st.robot);
+    let t = arm.move_to(0, 0.3).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
+    let cal = ArmCalibration::from(limber_emulator::default_arm_info());
+    let tick = cal
+        .radians_to_ticks(ArmJoint::new(1).unwrap(), 0.3)
+        .unwrap()
+        .tick;
+    let (ok, st) = emu.wait_for(T, |s| s.robot.servo_targets[0] == tick);
+    assert!(ok, "the command did not reach the arm: {:?}", st.robot);
+    // It keeps serving what it offered from the start.
     let mut grip = GripperClient::connect(&c, "pioneer/gripper/0").unwrap();
     let t = grip.close().unwrap();
     assert_eq!(grip.wait_outcome(t, T).unwrap(), Status::Ok);

@@ -685,3 +685,32 @@ fn controller_timing_by_default_and_the_handshake_copes() {
     );
     c.close().unwrap();
 }
+
+/// Like a P2OS simulator, the TCP endpoint serves one client at a time: a second client
+/// is closed before any reply (the handshake says the endpoint is held, it does not take it
+/// over), the first keeps its link, and once it leaves the next client is served.
+#[test]
+fn a_tcp_endpoint_serves_one_client_at_a_time() {
+    let emu = start(Wire::Tcp, fast_config());
+    let mut first = connect(&emu);
+    let err = Connection::open(&emu.link_target(), &opts()).unwrap_err();
+    assert!(
+        matches!(err, ConnectError::ClosedBeforeSync),
+        "unexpected {err:?}"
+    );
+    assert!(err.to_string().contains("held by another client"), "{err}");
+    let st = emu_wait(&emu, "the refusal counted", |s| {
+        s.stats.refused_clients == 1
+    });
+    assert_eq!(st.stats.connections, 1);
+    // The first client still has its link.
+    let before = emu.state().stats.sips_out;
+    wait_sip(&mut first, "a SIP after the refusal", |_| true);
+    assert!(emu.state().stats.sips_out > before);
+    first.close().unwrap();
+    // Gone: the next client is served.
+    emu_wait(&emu, "the first client gone", |s| !s.connected);
+    let second = connect(&emu);
+    assert_eq!(emu.state().stats.connections, 2);
+    second.close().unwrap();
+}

@@ -249,8 +249,8 @@ struct ReconnectLog {
 
 impl ReconnectLog {
     /// Notes a failed attempt; returns how long to wait before the next one (zero: the
-    /// configured interval).
-    fn failed(&mut self, port: &str, e: &ConnectError, now: Instant) -> Duration {
+    /// configured interval) and whether it was logged.
+    fn failed(&mut self, port: &str, e: &ConnectError, now: Instant) -> (Duration, bool) {
         self.failed += 1;
         let wait = if matches!(e, ConnectError::ClosedBeforeSync) {
             let w = self
@@ -282,7 +282,7 @@ impl ReconnectLog {
         } else {
             self.unlogged += 1;
         }
-        wait
+        (wait, due)
     }
 
     fn succeeded(&mut self) {
@@ -841,7 +841,7 @@ impl PioneerDriver {
                 }
                 Ok(Err(e)) => {
                     self.connecting = None;
-                    let wait = self.reconnect_log.failed(&self.robot.cfg.port, &e, now);
+                    let (wait, _) = self.reconnect_log.failed(&self.robot.cfg.port, &e, now);
                     let base = Duration::from_millis(self.robot.cfg.reconnect_interval_ms);
                     self.next_reconnect = now + wait.max(base);
                 }
@@ -1114,5 +1114,54 @@ impl From<&RobotPacket<'_>> for Owned {
             RobotPacket::ArmInfo(i) => Owned::ArmInfo(*i),
             _ => Owned::Other,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn no_sync() -> ConnectError {
+        ConnectError::NoSync {
+            attempts: 2,
+            bauds: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn failed_reconnects_are_logged_at_once_then_at_most_every_ten_seconds() {
+        let mut log = ReconnectLog::default();
+        let t0 = Instant::now();
+        let logged: Vec<bool> = (0..50u32)
+            .map(|i| {
+                log.failed("tcp://x:1", &no_sync(), t0 + Duration::from_millis(100) * i)
+                    .1
+            })
+            .collect();
+        // 5 s of attempts every 100 ms: the first only.
+        assert_eq!(logged.iter().filter(|&&l| l).count(), 1);
+        assert!(logged[0]);
+        assert_eq!(log.unlogged, 49);
+        let (_, l) = log.failed("tcp://x:1", &no_sync(), t0 + RECONNECT_LOG_EVERY);
+        assert!(l, "not logged again after {RECONNECT_LOG_EVERY:?}");
+        assert_eq!((log.unlogged, log.failed), (0, 51));
+        log.succeeded();
+        let (_, l) = log.failed("tcp://x:1", &no_sync(), t0 + RECONNECT_LOG_EVERY);
+        assert!(l, "a new outage is logged at once");
+    }
+
+    #[test]
+    fn a_held_endpoint_backs_off_doubling_up_to_the_limit() {
+        let mut log = ReconnectLog::default();
+        let t0 = Instant::now();
+        let waits: Vec<Duration> = (0..8)
+            .map(|_| log.failed("tcp://x:1", &ConnectError::ClosedBeforeSync, t0).0)
+            .collect();
+        assert_eq!(waits[0], Duration::from_secs(1));
+        assert_eq!(waits[1], Duration::from_secs(2));
+        assert!(waits.windows(2).all(|w| w[1] >= w[0]));
+        assert_eq!(*waits.last().unwrap(), TAKEN_BACKOFF_MAX);
+        // Any other failure: the configured interval again.
+        assert_eq!(log.failed("tcp://x:1", &no_sync(), t0).0, Duration::ZERO);
     }
 }
