@@ -136,7 +136,7 @@ fn serve(args: PioneerArgs, domain: &limber_services::Domain) -> Result<(), Pion
         noteln!("serving {r}/actarray/0 (arm), {r}/limb/0, {r}/gripper/1 (arm gripper)");
     } else {
         noteln!(
-            "no arm: the robot did not answer ARM_INFO; not serving {r}/actarray/0, {r}/limb/0, {r}/gripper/1"
+            "no arm: the robot did not answer ARM_INFO; not serving {r}/actarray/0, {r}/limb/0, {r}/gripper/1 (asking again: served if it answers)"
         );
     }
     if hw.gripper {

@@ -108,11 +108,17 @@ fn a_stopped_robot_does_not_freeze_the_driver(tcp: bool) {
         d.name(),
         &["actarray", "pioneer/actarray/0", "geom", "--timeout", "20"],
     );
-    eprintln!("{kind}: geom with the robot stopped took {:?}", t0.elapsed());
+    eprintln!(
+        "{kind}: geom with the robot stopped took {:?}",
+        t0.elapsed()
+    );
     assert!(o.status.success(), "{kind}: geom: {}", stderr(&o));
     assert!(stdout(&o).contains("rotary"), "{}", stdout(&o));
     // ... and a command refused, with its cause.
-    let o = limber(d.name(), &["actarray", "pioneer/actarray/0", "pos", "0", "0.5"]);
+    let o = limber(
+        d.name(),
+        &["actarray", "pioneer/actarray/0", "pos", "0", "0.5"],
+    );
     assert_eq!(o.status.code(), Some(5), "{kind}: {}", stderr(&o));
     assert!(stderr(&o).contains("link"), "{kind}: {}", stderr(&o));
 
@@ -130,7 +136,11 @@ fn a_stopped_robot_does_not_freeze_the_driver(tcp: bool) {
     let (arrived, st) = wait_arm(&mut arm, T, |s| {
         (s.actuators[1].position - 0.3).abs() < 0.02
     });
-    assert!(arrived, "{kind}: joint 1 never arrived: {:?}", st.actuators[1]);
+    assert!(
+        arrived,
+        "{kind}: joint 1 never arrived: {:?}",
+        st.actuators[1]
+    );
     assert!(
         (st.actuators[0].position - j0).abs() < 0.05,
         "{kind}: the refused command was replayed: joint 0 at {} (was {j0})",
@@ -195,11 +205,17 @@ fn a_second_driver_on_a_held_tcp_endpoint_says_so_and_leaves_the_first_alone() {
     );
     let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
     assert_eq!(
-        (v["link"]["reconnects"].as_u64(), v["link"]["faults"].as_u64()),
+        (
+            v["link"]["reconnects"].as_u64(),
+            v["link"]["faults"].as_u64()
+        ),
         (Some(0), Some(0)),
         "{v}"
     );
-    let o = limber(d.name(), &["actarray", "pioneer/actarray/0", "pos", "0", "0.3"]);
+    let o = limber(
+        d.name(),
+        &["actarray", "pioneer/actarray/0", "pos", "0", "0.3"],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(first.term(), Some(0));
     assert_eq!(emu.term(), Some(0));
@@ -265,7 +281,15 @@ fn an_arm_that_answers_late_appears_in_list() {
     }
     let o = limber(
         d.name(),
-        &["actarray", "pioneer/actarray/0", "pos", "0", "0.3", "--timeout", "10"],
+        &[
+            "actarray",
+            "pioneer/actarray/0",
+            "pos",
+            "0",
+            "0.3",
+            "--timeout",
+            "10",
+        ],
     );
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(drv.term(), Some(0));

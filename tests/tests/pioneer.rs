@@ -604,7 +604,11 @@ fn a_driver_that_started_without_an_answer_serves_the_arm_when_it_answers() {
             assert_eq!(s.hardware & hardware::NO_ARM, 0);
             break;
         }
-        assert!(Instant::now() < deadline, "hardware bits: {:#x}", s.hardware);
+        assert!(
+            Instant::now() < deadline,
+            "hardware bits: {:#x}",
+            s.hardware
+        );
     }
     // The new devices wake the loop (their listeners were attached): a command is carried
     // out, with the ARMpac stream started and the arm powered as at a start.

@@ -1155,7 +1155,10 @@ mod tests {
         let mut log = ReconnectLog::default();
         let t0 = Instant::now();
         let waits: Vec<Duration> = (0..8)
-            .map(|_| log.failed("tcp://x:1", &ConnectError::ClosedBeforeSync, t0).0)
+            .map(|_| {
+                log.failed("tcp://x:1", &ConnectError::ClosedBeforeSync, t0)
+                    .0
+            })
             .collect();
         assert_eq!(waits[0], Duration::from_secs(1));
         assert_eq!(waits[1], Duration::from_secs(2));
