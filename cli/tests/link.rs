@@ -159,6 +159,18 @@ fn a_stopped_robot_does_not_freeze_the_driver(tcp: bool) {
         t0.elapsed()
     );
     emu.signal(libc::SIGCONT);
+    // The arm was left still: a new driver finds every joint idle.
+    drop(arm);
+    let mut again = pioneer(&d, &port, cfg.to_str().unwrap(), &[]);
+    let mut arm = ActArrayClient::connect_timeout(&ctx, "pioneer/actarray/0", T).unwrap();
+    let (idle, st) = wait_arm(&mut arm, T, |s| {
+        s.header.link_up()
+            && s.actuators[..6]
+                .iter()
+                .all(|a| a.state & ActuatorFlags::MOVING.bits() == 0)
+    });
+    assert!(idle, "{kind}: the arm moves after the driver ended: {st:?}");
+    assert_eq!(again.term(), Some(0));
     assert_eq!(emu.term(), Some(0));
 }
 
