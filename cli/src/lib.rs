@@ -54,7 +54,8 @@ enum Command {
     /// C header and the Python classes are generated from.
     Layout(layout::LayoutArgs),
     /// List every device of the domain by its name robot/interface/index, with its driver
-    /// and whether the driver is alive.
+    /// and whether the driver is alive; then what each running driver found its robot
+    /// lacks ("robot pioneer has no arm").
     List(list::ListArgs),
     /// Print the live state of a device (one line per sample; --json for scripts).
     Echo(echo::EchoArgs),
