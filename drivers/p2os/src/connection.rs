@@ -74,9 +74,9 @@ pub enum ConnectError {
         /// Baud rates tried (empty over TCP).
         bauds: Vec<u32>,
     },
-    /// The other end closed the connection before answering the first SYNC0: over TCP,
-    /// a server of one client at a time (a simulator, the emulator) that serves another
-    /// client.
+    /// Over TCP, the other end closed the connection before answering the first SYNC0: a
+    /// server of one client at a time (a simulator, the emulator) that serves another
+    /// client. (A serial line that closes is [`ConnectError::Link`].)
     #[error(
         "the other end closed the connection before answering SYNC0 (a TCP endpoint that \
          serves one client at a time is held by another client)"
@@ -225,8 +225,10 @@ impl Connection {
         let mut close_sent = false;
         let mut attempts = 0;
         let mut answered = false;
+        // Over TCP only: a serial line that closes is a device gone, not a held endpoint.
+        let tcp = !link.is_serial();
         let closed_early = |e: LinkError, answered: bool| match e {
-            LinkError::Closed if !answered => ConnectError::ClosedBeforeSync,
+            LinkError::Closed if tcp && !answered => ConnectError::ClosedBeforeSync,
             e => ConnectError::Link(e),
         };
         for baud in bauds {
