@@ -308,6 +308,19 @@ pub fn other_owners(domain: &str) -> Vec<String> {
     out
 }
 
+/// Empty, or `"; domain D also exists for user NAME (uid N): its devices are theirs
+/// alone ..."` when other users have a domain of this name ([`other_owners`]).
+pub fn elsewhere_note(domain: &str) -> String {
+    let others = other_owners(domain);
+    if others.is_empty() {
+        return String::new();
+    }
+    format!(
+        "; domain {domain} also exists for {}: a domain's devices are its owner's alone, so run as that user (README, Security)",
+        others.join(", ")
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
