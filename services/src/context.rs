@@ -38,7 +38,7 @@ pub enum ContextError {
         domain: String,
         /// Why.
         #[source]
-        source: crate::domain_dir::DomainError,
+        source: Box<crate::domain_dir::DomainError>,
     },
     /// iceoryx2 was refused access to the domain's files (iceoryx2's
     /// `NodeCreationFailure::InsufficientPermissions`): they belong to another user.
@@ -137,9 +137,12 @@ impl Context {
         };
         let domain_err = |e| ContextError::Domain {
             domain: domain.name().to_string(),
-            source: e,
+            source: Box::new(e),
         };
         let config = domain.config().map_err(domain_err)?;
+        if role == Role::Driver {
+            crate::domain_dir::check_shm_space().map_err(domain_err)?;
+        }
         let prefix = domain.prefix().map_err(domain_err)?;
         let node = NodeBuilder::new()
             .name(&node_name)

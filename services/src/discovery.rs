@@ -40,7 +40,7 @@ pub enum ListError {
         domain: String,
         /// Why.
         #[source]
-        source: crate::domain_dir::DomainError,
+        source: Box<crate::domain_dir::DomainError>,
     },
     /// iceoryx2 could not read the service directory (permissions?).
     #[error("cannot list the services of domain {domain}: {source}")]
@@ -59,7 +59,7 @@ pub fn list_devices(domain: &Domain) -> Result<Vec<DeviceInfo>, ListError> {
     let mut out = Vec::new();
     let config = domain.config().map_err(|e| ListError::Domain {
         domain: domain.name().to_string(),
-        source: e,
+        source: Box::new(e),
     })?;
     ipc::Service::list(config, |details| {
         let name = details.static_details.name().as_str().to_string();

@@ -51,6 +51,17 @@ pub enum DomainError {
     /// The runtime directory is not a directory (a symbolic link, a file).
     #[error("{0} is not a directory (a symbolic link or a file): limber will not follow it")]
     NotADirectory(PathBuf),
+    /// `/dev/shm` has less room than a driver needs: its segments would fail later with
+    /// SIGBUS when first touched, so a driver refuses to start instead.
+    #[error(
+        "/dev/shm has {free} bytes free, a driver needs at least {need}: make it larger (e.g. docker run --shm-size=64m, or mount -o remount,size=64m /dev/shm)"
+    )]
+    ShmTooSmall {
+        /// Free bytes.
+        free: u64,
+        /// Bytes a driver needs at least ([`MIN_SHM_FREE`]).
+        need: u64,
+    },
     /// The token file does not hold a token.
     #[error(
         "{0} does not hold a domain token (16 hexadecimal digits); remove it to make a new one"
@@ -126,6 +137,25 @@ pub fn runtime_dir() -> PathBuf {
         Some(v) if !v.is_empty() => PathBuf::from(v),
         _ => PathBuf::from(format!("/tmp/limber-{}", euid())),
     }
+}
+
+/// The room in `/dev/shm` a driver needs at least: the Pioneer driver's segments take about
+/// 4 MiB (they are sparse, so a smaller tmpfs accepts them and the process dies with SIGBUS
+/// later); this leaves room for a second driver and the clients.
+pub const MIN_SHM_FREE: u64 = 16 << 20;
+
+/// Refuses to go on when `/dev/shm` has less than [`MIN_SHM_FREE`] bytes free.
+pub fn check_shm_space() -> Result<(), DomainError> {
+    let path = Path::new(SHM_DIR);
+    let st = rustix::fs::statvfs(path).map_err(|e| io_err("inspect", path)(e.into()))?;
+    let free = st.f_bavail.saturating_mul(st.f_frsize);
+    if free < MIN_SHM_FREE {
+        return Err(DomainError::ShmTooSmall {
+            free,
+            need: MIN_SHM_FREE,
+        });
+    }
+    Ok(())
 }
 
 /// What joining a domain needs: where iceoryx2 keeps its files and the prefix of its names.

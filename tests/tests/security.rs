@@ -258,11 +258,10 @@ fn a_node_counter_of_another_user_is_refused_with_its_owner_named() {
     let fresh = Domain::new(domain.name()).unwrap();
     let err = Context::new(&fresh, Role::Driver, "d").expect_err("a foreign counter is refused");
     let _ = std::fs::remove_file(&path);
-    let ContextError::Domain {
-        source: DomainError::ForeignOwner { owner, .. },
-        ..
-    } = &err
-    else {
+    let ContextError::Domain { source, .. } = &err else {
+        panic!("unexpected error: {err:?}");
+    };
+    let DomainError::ForeignOwner { owner, .. } = source.as_ref() else {
         panic!("unexpected error: {err:?}");
     };
     assert!(owner.contains(user), "{owner}");
