@@ -276,3 +276,45 @@ fn a_runtime_directory_that_cannot_be_written_is_a_clear_error_at_start() {
         "{err}"
     );
 }
+
+#[test]
+fn a_driver_killed_in_the_middle_of_a_request_is_reported_and_new_clients_find_its_successor() {
+    let domain = Domain::unique_for_test();
+    let mut driver = start_driver(&domain, &["--hold-first-request"]);
+    let d2 = domain.clone();
+    let (tx, rx) = std::sync::mpsc::channel();
+    let asker = std::thread::spawn(move || {
+        let c = ctx(&d2);
+        let mut arm = ActArrayClient::connect_timeout(&c, "test/actarray/0", T).unwrap();
+        // Far longer than the test's own bound below: the answer must come from noticing
+        // the driver's death, not from the request timing out.
+        arm.set_request_timeout(Duration::from_secs(120));
+        tx.send(()).unwrap();
+        arm.geometry()
+    });
+    rx.recv_timeout(T).unwrap();
+    assert!(driver.read_until(|l| l.starts_with("request ")).is_some());
+    driver.signal(libc::SIGKILL);
+    assert_eq!(driver.wait_timeout(T), None);
+    let deadline = Instant::now() + LIMIT;
+    while !asker.is_finished() {
+        assert!(
+            Instant::now() < deadline,
+            "the client did not notice the death"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let err = asker
+        .join()
+        .unwrap()
+        .expect_err("no answer from a dead driver");
+    assert!(
+        matches!(err, RequestError::DriverGone | RequestError::NoDriver),
+        "{err:?}"
+    );
+    // A new client process finds the restarted driver.
+    let _driver = start_driver(&domain, &[]);
+    let mut c = Proc::spawn(CLIENT, domain.name(), &["basic"]);
+    assert_eq!(c.wait_timeout(LIMIT), Some(0));
+    assert!(c.rest_of_stdout().contains("ok"));
+}

@@ -80,16 +80,18 @@ fn client(domain: Domain, seed: u64, stop: Arc<AtomicBool>) -> ClientCounts {
             return n;
         }
     };
-    let mut arm =
-        match ActArrayClient::connect_timeout(&ctx, "pioneer/actarray/0", Duration::from_secs(10))
-        {
-            Ok(a) => a,
-            Err(e) => {
-                eprintln!("client {seed}: cannot connect: {e}");
-                n.barrier_failed = true;
-                return n;
-            }
-        };
+    let mut arm = match ActArrayClient::connect_timeout(
+        &ctx,
+        "pioneer/actarray/0",
+        Duration::from_secs(10),
+    ) {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("client {seed}: cannot connect: {e}");
+            n.barrier_failed = true;
+            return n;
+        }
+    };
     let mut rng = Rng(seed | 1);
     let _ = arm.power(true);
     while !stop.load(Ordering::Relaxed) {
@@ -269,7 +271,11 @@ fn main() -> std::process::ExitCode {
     p50s.sort_unstable();
     let first = samples.first().copied().unwrap_or_default();
     let last = samples.last().copied().unwrap_or_default();
-    println!("--- summary: {epoch} epochs, {:.1} min, {} clients", t0.elapsed().as_secs_f64() / 60.0, a.clients);
+    println!(
+        "--- summary: {epoch} epochs, {:.1} min, {} clients",
+        t0.elapsed().as_secs_f64() / 60.0,
+        a.clients
+    );
     println!("crashes {crashes}, accounting mismatches {mismatches}");
     println!(
         "commands sent {sent} = handled {handled} (carried out {}, refused by the driver {refused}) + lost to a full queue and counted {lost}; refused by the client library before sending {local}",
