@@ -292,6 +292,24 @@ fn main() -> std::process::ExitCode {
         first.1, last.1, first.2, last.2, first.3, last.3, first.4, last.4
     );
     let _ = std::fs::remove_file(&cfg);
+    // The domain's leftovers: iceoryx2's node counter and limber's token (README, Security).
+    drop(ctx);
+    if let Ok(prefix) = domain.prefix() {
+        for e in std::fs::read_dir("/dev/shm")
+            .into_iter()
+            .flatten()
+            .flatten()
+        {
+            let n = e.file_name();
+            let n = n.to_string_lossy();
+            if n.starts_with(prefix) && n.ends_with(".global_mgmt") {
+                let _ = std::fs::remove_file(e.path());
+            }
+        }
+    }
+    let _ = std::fs::remove_file(
+        limber_services::domain_dir::runtime_dir().join(format!("{}.token", domain.name())),
+    );
     if crashes == 0 && mismatches == 0 && sent == handled + lost {
         std::process::ExitCode::SUCCESS
     } else {
