@@ -289,10 +289,12 @@ def _private_dir(path: str, mode: int) -> None:
 def _domain_token(directory: str, domain: str) -> str:
     path = os.path.join(directory, f"{domain}.token")
     if not os.path.lexists(path):
-        tmp = os.path.join(directory, f".{domain}.token.{os.getpid()}")
-        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+        token = os.urandom(8).hex()
+        # Unique to this attempt (several threads of a process may race too).
+        tmp = os.path.join(directory, f".{domain}.token.{os.getpid()}.{token}")
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
         with os.fdopen(fd, "w") as f:
-            f.write(os.urandom(8).hex() + "\n")
+            f.write(token + "\n")
         try:
             os.link(tmp, path)  # never replaces: the first process to make the token wins
         except FileExistsError:

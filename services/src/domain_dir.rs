@@ -215,12 +215,12 @@ fn valid_token(t: &str) -> bool {
 fn token(dir: &Path, domain: &str) -> Result<String, DomainError> {
     let path = dir.join(format!("{domain}.token"));
     if fs::symlink_metadata(&path).is_err() {
-        let tmp = dir.join(format!(".{domain}.token.{}", std::process::id()));
         let token = new_token()?;
+        // Unique to this attempt (several threads of a process may race too).
+        let tmp = dir.join(format!(".{domain}.token.{}.{token}", std::process::id()));
         let mut f = fs::OpenOptions::new()
             .write(true)
-            .create(true)
-            .truncate(true)
+            .create_new(true)
             .mode(0o600)
             .open(&tmp)
             .map_err(io_err("create", &tmp))?;
@@ -361,6 +361,24 @@ mod tests {
         assert!(valid_token(&t), "{t}");
         assert!(!valid_token("xyz"));
         assert!(!valid_token("0123456789abcdeg"));
+    }
+
+    #[test]
+    fn threads_racing_to_make_a_token_all_get_the_same_one() {
+        let dir = std::env::temp_dir().join(format!("limber-race-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        private_dir(&dir, 0o711).unwrap();
+        let tokens: Vec<String> = (0..8)
+            .map(|_| {
+                let d = dir.clone();
+                std::thread::spawn(move || token(&d, "raced").unwrap())
+            })
+            .collect::<Vec<_>>()
+            .into_iter()
+            .map(|t| t.join().unwrap())
+            .collect();
+        assert!(tokens.iter().all(|t| t == &tokens[0]), "{tokens:?}");
+        fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
