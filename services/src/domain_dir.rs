@@ -141,8 +141,8 @@ pub fn runtime_dir() -> PathBuf {
 
 /// The room in `/dev/shm` a driver needs at least: the Pioneer driver's segments take about
 /// 4 MiB (they are sparse, so a smaller tmpfs accepts them and the process dies with SIGBUS
-/// later); this leaves room for a second driver and the clients.
-pub const MIN_SHM_FREE: u64 = 16 << 20;
+/// later); this leaves room for its clients.
+pub const MIN_SHM_FREE: u64 = 8 << 20;
 
 /// Refuses to go on when `/dev/shm` has less than [`MIN_SHM_FREE`] bytes free.
 pub fn check_shm_space() -> Result<(), DomainError> {

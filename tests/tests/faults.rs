@@ -223,11 +223,11 @@ fn in_private_mounts(script: &str, domain: &Domain) -> Option<std::process::Outp
             .env("LIMBER_DOMAIN", domain.name()),
         LIMIT,
     );
-    if String::from_utf8_lossy(&out.stderr).contains("unshare failed") {
-        eprintln!(
-            "SKIPPED: no mount namespace here: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+    // unshare(1) or mount(8) refused (a container without CAP_SYS_ADMIN): the driver never
+    // ran.
+    let err = String::from_utf8_lossy(&out.stderr);
+    if err.contains("unshare failed") || err.starts_with("mount:") {
+        eprintln!("SKIPPED: no private mounts here: {err}");
         return None;
     }
     Some(out)
