@@ -267,3 +267,27 @@ fn a_node_counter_of_another_user_is_refused_with_its_owner_named() {
     assert!(owner.contains(user), "{owner}");
     assert!(err.to_string().contains(&path), "{err}");
 }
+
+#[test]
+fn a_damaged_node_counter_is_reported_with_what_to_do() {
+    // What another user could do before limber narrowed the counter's mode: 16 bytes of
+    // garbage in it. Done here by the owner, so the message can be checked.
+    let domain = Domain::unique_for_test();
+    drop(Context::new(&domain, Role::Client, "first").unwrap());
+    let prefix = domain.prefix().unwrap().to_string();
+    let counter = shm_files(&prefix)
+        .into_iter()
+        .find(|p| p.to_string_lossy().ends_with(".global_mgmt"))
+        .expect("the node counter");
+    std::fs::write(&counter, b"0123456789abcdef").unwrap();
+    let err = Context::new(&domain, Role::Client, "second").expect_err("a damaged counter");
+    let _ = std::fs::remove_file(&counter);
+    assert!(matches!(err, ContextError::NodeCounter { .. }), "{err:?}");
+    let text = err.to_string();
+    assert!(
+        text.contains(&prefix) && text.contains("remove it"),
+        "{text}"
+    );
+    // Once removed, the domain works again.
+    Context::new(&domain, Role::Client, "third").expect("a fresh counter");
+}
