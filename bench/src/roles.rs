@@ -111,11 +111,19 @@ pub fn write_histogram(
 /// A raw iceoryx2 node in `domain` (no signal handling: the parent kills children).
 pub fn raw_node(domain: &Domain) -> Result<Node<ipc::Service>, BenchError> {
     set_log_level_from_env_or(LogLevel::Error);
-    NodeBuilder::new()
-        .config(domain.config())
+    let config = domain
+        .config()
+        .map_err(|e| BenchError::transport("preparing the domain's files", e))?;
+    let node = NodeBuilder::new()
+        .config(config)
         .signal_handling_mode(SignalHandlingMode::Disabled)
         .create::<ipc::Service>()
-        .map_err(|e| BenchError::transport("creating an iceoryx2 node", e))
+        .map_err(|e| BenchError::transport("creating an iceoryx2 node", e))?;
+    if let Ok(prefix) = domain.prefix() {
+        limber_services::domain_dir::secure_shm(prefix)
+            .map_err(|e| BenchError::transport("securing the domain's node counter", e))?;
+    }
+    Ok(node)
 }
 
 /// Lines from stdin, read by a thread (so that waiting for them has a timeout).

@@ -38,8 +38,9 @@ pub fn run(args: ListArgs) -> Result<(), CliError> {
     }
     if devices.is_empty() {
         outln!(
-            "no devices in domain {} (start a driver, e.g. `limber pioneer --emulated`, or check --domain / LIMBER_DOMAIN)",
-            domain.name()
+            "no devices in domain {} (start a driver, e.g. `limber pioneer --emulated`, or check --domain / LIMBER_DOMAIN){}",
+            domain.name(),
+            limber_services::domain_dir::elsewhere_note(domain.name())
         )?;
         return Ok(());
     }

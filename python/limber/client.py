@@ -37,6 +37,7 @@ import math
 import operator
 import os
 import re
+import stat
 import sys
 import time
 import weakref
@@ -255,16 +256,98 @@ class UnexpectedReplyError(DecodeError):
 # ----- names -----------------------------------------------------------------------------
 
 
+RUNTIME_DIR_ENV = "LIMBER_RUNTIME_DIR"
+
+
+def _runtime_dir() -> str:
+    """``$LIMBER_RUNTIME_DIR``, else ``/tmp/limber-<uid>`` (as in Rust's ``domain_dir``)."""
+    return os.environ.get(RUNTIME_DIR_ENV) or f"/tmp/limber-{os.geteuid()}"
+
+
+def _foreign(path: str, uid: int) -> "TransportError":
+    return TransportError(
+        f"{path} belongs to uid {uid}, not to you (uid {os.geteuid()}): limber does not use "
+        "files another user controls; remove it, or set LIMBER_RUNTIME_DIR to a directory "
+        "of your own"
+    )
+
+
+def _private_dir(path: str, mode: int) -> None:
+    try:
+        os.mkdir(path, mode)
+    except FileExistsError:
+        pass
+    st = os.lstat(path)
+    if not stat.S_ISDIR(st.st_mode):
+        raise TransportError(f"{path} is not a directory (a symbolic link or a file)")
+    if st.st_uid != os.geteuid():
+        raise _foreign(path, st.st_uid)
+    if stat.S_IMODE(st.st_mode) != mode:
+        os.chmod(path, mode)
+
+
+def _domain_token(directory: str, domain: str) -> str:
+    path = os.path.join(directory, f"{domain}.token")
+    if not os.path.lexists(path):
+        token = os.urandom(8).hex()
+        # Unique to this attempt (several threads of a process may race too).
+        tmp = os.path.join(directory, f".{domain}.token.{os.getpid()}.{token}")
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        with os.fdopen(fd, "w") as f:
+            f.write(token + "\n")
+        try:
+            os.link(tmp, path)  # never replaces: the first process to make the token wins
+        except FileExistsError:
+            pass
+        finally:
+            os.unlink(tmp)
+    st = os.lstat(path)
+    if not stat.S_ISREG(st.st_mode):
+        raise TransportError(f"{path} does not hold a domain token")
+    if st.st_uid != os.geteuid():
+        raise _foreign(path, st.st_uid)
+    with open(path) as f:
+        token = f.read().strip()
+    if not re.fullmatch(r"[0-9a-fA-F]{16}", token):
+        raise TransportError(f"{path} does not hold a domain token (16 hexadecimal digits)")
+    return token
+
+
+def _global_mgmt_files(prefix: str):
+    try:
+        names = os.listdir("/dev/shm")
+    except OSError:
+        return []
+    return [
+        os.path.join("/dev/shm", n)
+        for n in names
+        if n.startswith(prefix) and n.endswith(".global_mgmt")
+    ]
+
+
+def _secure_shm(prefix: str) -> None:
+    """Refuses a node counter of the domain owned by someone else; narrows ours to 0600
+    (iceoryx2 makes it 0666)."""
+    for path in _global_mgmt_files(prefix):
+        st = os.lstat(path)
+        if st.st_uid != os.geteuid():
+            raise _foreign(path, st.st_uid)
+        if stat.S_IMODE(st.st_mode) & 0o077:
+            os.chmod(path, 0o600)
+
+
 class Domain:
     """A domain: the set of devices and clients that can see each other.
 
     ``Domain()`` is the domain named by ``LIMBER_DOMAIN`` (default ``limber``); ``Domain(name)``
-    a domain by name (1 to 48 characters of ``[A-Za-z0-9_-]``). It maps onto the iceoryx2
-    prefix ``"<name>_"`` on top of iceoryx2's built-in defaults (a ``./config/iceoryx2.toml``
-    is ignored, as in Rust).
+    a domain by name (1 to 48 characters of ``[A-Za-z0-9_-]``). As in Rust, its files live in
+    the owner's runtime directory (``$LIMBER_RUNTIME_DIR``, else ``/tmp/limber-<uid>``, mode
+    0711) under the iceoryx2 root path ``<runtime>/iceoryx2/`` with the prefix
+    ``limber_<token>_``, where the token is random and kept in ``<runtime>/<name>.token``
+    (0600), on top of iceoryx2's built-in defaults (a ``./config/iceoryx2.toml`` is ignored).
     """
 
-    __slots__ = ("_name",)
+    __slots__ = ("_name", "_prefix")
 
     def __init__(self, name: Optional[str] = None):
         if name is None:
@@ -272,6 +355,7 @@ class Domain:
         if not isinstance(name, str) or len(name) > MAX_DOMAIN_LEN or not _IDENT.match(name):
             raise ValueError(f"invalid domain {name!r}: use 1 to 48 characters of [A-Za-z0-9_-]")
         self._name = name
+        self._prefix = None
 
     @classmethod
     def from_env(cls) -> "Domain":
@@ -283,15 +367,32 @@ class Domain:
         return self._name
 
     @property
+    def root_path(self) -> str:
+        """The iceoryx2 root path of this domain (``<runtime>/iceoryx2/``)."""
+        return os.path.join(_runtime_dir(), "iceoryx2") + "/"
+
+    @property
     def prefix(self) -> str:
-        """The iceoryx2 prefix of this domain."""
-        return f"{self._name}_"
+        """The iceoryx2 prefix of this domain (``limber_<token>_``; prepares the files)."""
+        if self._prefix is None:
+            runtime = _runtime_dir()
+            _private_dir(runtime, 0o711)
+            prefix = f"limber_{_domain_token(runtime, self._name)}_"
+            for path in _global_mgmt_files(prefix):
+                st = os.lstat(path)
+                if st.st_uid != os.geteuid():
+                    raise _foreign(path, st.st_uid)
+            _private_dir(os.path.join(runtime, "iceoryx2"), 0o700)
+            self._prefix = prefix
+        return self._prefix
 
     def iceoryx2_config(self):
-        """A fresh iceoryx2 config for this domain (defaults plus the domain's prefix)."""
+        """A fresh iceoryx2 config for this domain (defaults plus its root path and prefix)."""
         iox2 = _iox2()
         cfg = iox2.config.default()
-        cfg.global_cfg.prefix = iox2.FileName.new(self.prefix)
+        prefix = self.prefix
+        cfg.global_cfg.prefix = iox2.FileName.new(prefix)
+        cfg.global_cfg.root_path = iox2.Path.new(self.root_path)
         return cfg
 
     def __str__(self) -> str:
@@ -532,6 +633,7 @@ class _Client:
             )
         except Exception as e:
             raise TransportError(f"cannot join domain {domain}: {e!r}") from None
+        _secure_shm(domain.prefix)
         self._closed = False
         _open_clients.add(self)
 

@@ -9,6 +9,7 @@ import itertools
 import json
 import math
 import os
+import re
 import select
 import signal
 import subprocess
@@ -74,7 +75,7 @@ _used_domains = []
 
 
 def unique_domain() -> str:
-    # `limber_t*`, like the Rust tests' domains (.ci/run removes /dev/shm/limber_t*global_mgmt).
+    # `limber_t*`, like the Rust tests' domains (.ci/run removes their leftovers).
     d = f"limber_tpy{os.getpid()}_{next(_domains)}"
     _used_domains.append(d)
     return d
@@ -84,8 +85,9 @@ def remove_global_mgmt(domain):
     """iceoryx2 leaves one 16-byte global_mgmt object per domain in /dev/shm: remove it once
     no node of the domain is left."""
     try:
+        prefix = limber.Domain(domain).prefix
         for f in os.listdir("/dev/shm"):
-            if f.startswith(domain + "_") and f.endswith("global_mgmt"):
+            if f.startswith(prefix) and f.endswith("global_mgmt"):
                 os.unlink(os.path.join("/dev/shm", f))
     except OSError:
         pass
@@ -438,7 +440,8 @@ def test_domain_from_env(monkeypatch):
     assert limber.Domain().name == "limber"
     monkeypatch.setenv("LIMBER_DOMAIN", "robot_7")
     assert limber.Domain().name == "robot_7"
-    assert limber.Domain().prefix == "robot_7_"
+    assert re.fullmatch(r"limber_[0-9a-f]{16}_", limber.Domain().prefix)
+    assert limber.Domain().prefix == limber.Domain("robot_7").prefix != limber.Domain("x").prefix
     assert limber.Domain("x").name == "x"
 
 

@@ -31,8 +31,45 @@ pub enum ContextError {
     /// The process name is not a valid node name (at most 100 ASCII characters).
     #[error("invalid process name {0:?}")]
     Name(String),
-    /// iceoryx2 could not create the node (permissions on /tmp/iceoryx2 or /dev/shm,
-    /// or a corrupted installation).
+    /// The domain's files could not be prepared, or belong to another user.
+    #[error("cannot join domain {domain}: {source}")]
+    Domain {
+        /// The domain.
+        domain: String,
+        /// Why.
+        #[source]
+        source: Box<crate::domain_dir::DomainError>,
+    },
+    /// iceoryx2 was refused access to the domain's files (iceoryx2's
+    /// `NodeCreationFailure::InsufficientPermissions`): they belong to another user.
+    #[error(
+        "cannot join domain {domain}: its files under {root} or in /dev/shm belong to another user; a domain is its owner's alone (README, Security): run as that user, or use a domain of your own (LIMBER_DOMAIN, LIMBER_RUNTIME_DIR)"
+    )]
+    Permission {
+        /// The domain.
+        domain: String,
+        /// The iceoryx2 root path of the domain.
+        root: String,
+        /// iceoryx2's error.
+        #[source]
+        source: NodeCreationFailure,
+    },
+    /// iceoryx2 could not number the new node (`UnableToGenerateUniqueNodeId`): the
+    /// domain's node counter in /dev/shm cannot be opened or was damaged.
+    #[error(
+        "cannot join domain {domain}: its node counter /dev/shm/{prefix}*.global_mgmt cannot be used (damaged, or made unreadable); stop the domain's processes and remove it"
+    )]
+    NodeCounter {
+        /// The domain.
+        domain: String,
+        /// The iceoryx2 prefix of the domain's files.
+        prefix: String,
+        /// iceoryx2's error.
+        #[source]
+        source: NodeCreationFailure,
+    },
+    /// iceoryx2 could not create the node for another reason (a corrupted installation,
+    /// files removed under a running domain).
     #[error("cannot join domain {domain}: {source}")]
     Node {
         /// The domain.
@@ -98,15 +135,40 @@ impl Context {
             }
             Role::Client => SignalHandlingMode::Disabled,
         };
+        let domain_err = |e| ContextError::Domain {
+            domain: domain.name().to_string(),
+            source: Box::new(e),
+        };
+        let config = domain.config().map_err(domain_err)?;
+        if role == Role::Driver {
+            crate::domain_dir::check_shm_space().map_err(domain_err)?;
+        }
+        let prefix = domain.prefix().map_err(domain_err)?;
         let node = NodeBuilder::new()
             .name(&node_name)
-            .config(domain.config())
+            .config(config)
             .signal_handling_mode(mode)
             .create::<ipc::Service>()
-            .map_err(|e: NodeCreationFailure| ContextError::Node {
-                domain: domain.name().to_string(),
-                source: e,
+            .map_err(|e: NodeCreationFailure| {
+                let domain = domain.name().to_string();
+                match e {
+                    NodeCreationFailure::InsufficientPermissions => ContextError::Permission {
+                        domain,
+                        root: config.global.root_path().to_string(),
+                        source: e,
+                    },
+                    NodeCreationFailure::UnableToGenerateUniqueNodeId => {
+                        ContextError::NodeCounter {
+                            domain,
+                            prefix: prefix.to_string(),
+                            source: e,
+                        }
+                    }
+                    _ => ContextError::Node { domain, source: e },
+                }
             })?;
+        // iceoryx2 makes the domain's node counter world-writable (0666).
+        crate::domain_dir::secure_shm(prefix).map_err(domain_err)?;
         Ok(Context {
             inner: Rc::new(Inner {
                 domain: domain.clone(),

@@ -33,6 +33,15 @@ impl DeviceInfo {
 /// Listing the devices failed.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
 pub enum ListError {
+    /// The domain's files could not be prepared or belong to another user.
+    #[error("cannot use domain {domain}: {source}")]
+    Domain {
+        /// The domain.
+        domain: String,
+        /// Why.
+        #[source]
+        source: Box<crate::domain_dir::DomainError>,
+    },
     /// iceoryx2 could not read the service directory (permissions?).
     #[error("cannot list the services of domain {domain}: {source}")]
     Transport {
@@ -48,7 +57,11 @@ pub enum ListError {
 /// alive until its services are cleaned up.
 pub fn list_devices(domain: &Domain) -> Result<Vec<DeviceInfo>, ListError> {
     let mut out = Vec::new();
-    ipc::Service::list(domain.config(), |details| {
+    let config = domain.config().map_err(|e| ListError::Domain {
+        domain: domain.name().to_string(),
+        source: Box::new(e),
+    })?;
+    ipc::Service::list(config, |details| {
         let name = details.static_details.name().as_str().to_string();
         if !matches!(
             details.static_details.messaging_pattern(),

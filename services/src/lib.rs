@@ -72,6 +72,7 @@ pub mod context;
 pub mod device_set;
 pub mod diagnostics;
 pub mod discovery;
+pub mod domain_dir;
 pub mod error;
 pub mod event_loop;
 pub mod host;
@@ -87,6 +88,7 @@ pub use client::{
 pub use context::{Context, ContextError, Role, monotonic_ns};
 pub use device_set::{DeviceError, DeviceSet, DeviceSetHandler};
 pub use discovery::{DeviceInfo, ListError, list_devices};
+pub use domain_dir::DomainError;
 pub use error::Iox2Error;
 pub use host::{
     Activity, CLIENT_SLOTS, DeviceHandler, DeviceHost, HostError, HostStats, Origin, ProcessError,

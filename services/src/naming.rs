@@ -4,17 +4,21 @@
 //! the iceoryx2 services `limber/<robot>/<interface>/<index>/<channel>` with channels
 //! `data` (state, pub/sub, history 1), `cmd` (commands, pub/sub, many clients), `req`
 //! (request/response), `wake` (event: clients → driver) and `notify` (event: driver →
-//! clients, new state or reply ready). A domain maps onto the iceoryx2 prefix, so
-//! robots and tests on one PC never meet.
+//! clients, new state or reply ready). A domain maps onto an iceoryx2 prefix and root
+//! path of its owner's (see [`crate::domain_dir`]), so robots and tests on one PC never
+//! meet and no other user can read, command or deny a domain.
 
 use core::fmt;
 use std::str::FromStr;
 use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::{Arc, OnceLock};
 
 use iceoryx2::config::Config;
-use iceoryx2::prelude::{FileName, SemanticString, ServiceName};
+use iceoryx2::prelude::{FileName, Path as IoxPath, SemanticString, ServiceName};
 use limber_interfaces::InterfaceKind;
 use thiserror::Error;
+
+use crate::domain_dir::{self, DomainError};
 
 /// The environment variable that selects the domain.
 pub const DOMAIN_ENV: &str = "LIMBER_DOMAIN";
@@ -52,7 +56,8 @@ fn valid_ident(s: &str, max: usize) -> bool {
 #[derive(Debug, Clone)]
 pub struct Domain {
     name: String,
-    config: Config,
+    /// The iceoryx2 configuration, made on first use (it needs the domain's files).
+    config: Arc<OnceLock<(Config, String)>>,
 }
 
 impl Domain {
@@ -61,15 +66,9 @@ impl Domain {
         if !valid_ident(name, MAX_DOMAIN_LEN) {
             return Err(NameError::Domain(name.to_string()));
         }
-        // Start from the built-in defaults so that a stray ./config/iceoryx2.toml does not
-        // change a robot's behaviour.
-        let mut config = Config::default();
-        let prefix = format!("{name}_");
-        config.global.prefix =
-            FileName::new(prefix.as_bytes()).map_err(|_| NameError::Domain(name.to_string()))?;
         Ok(Domain {
             name: name.to_string(),
-            config,
+            config: Arc::new(OnceLock::new()),
         })
     }
 
@@ -101,9 +100,40 @@ impl Domain {
         &self.name
     }
 
-    /// The iceoryx2 configuration of this domain.
-    pub fn config(&self) -> &Config {
-        &self.config
+    /// The iceoryx2 configuration of this domain: iceoryx2's built-in defaults (a stray
+    /// `./config/iceoryx2.toml` does not change a robot's behaviour) with the root path and
+    /// prefix of the domain's files, which are prepared (and checked) on the first call; see
+    /// [`crate::domain_dir`].
+    pub fn config(&self) -> Result<&Config, DomainError> {
+        Ok(&self.resolved()?.0)
+    }
+
+    /// The iceoryx2 prefix of this domain's files (`limber_<token>_`).
+    pub fn prefix(&self) -> Result<&str, DomainError> {
+        Ok(&self.resolved()?.1)
+    }
+
+    fn resolved(&self) -> Result<&(Config, String), DomainError> {
+        if let Some(c) = self.config.get() {
+            return Ok(c);
+        }
+        let files = domain_dir::prepare(&self.name)?;
+        let mut config = Config::default();
+        let bad = |what: &str| DomainError::Io {
+            what: "use",
+            path: files.root.clone(),
+            source: std::io::Error::new(std::io::ErrorKind::InvalidInput, what.to_string()).into(),
+        };
+        config.global.prefix = FileName::new(files.prefix.as_bytes())
+            .map_err(|_| bad("an invalid iceoryx2 prefix"))?;
+        let root = files
+            .root
+            .to_str()
+            .ok_or_else(|| bad("a path that is not UTF-8"))?;
+        config.global.set_root_path(
+            &IoxPath::new(root.as_bytes()).map_err(|_| bad("an invalid iceoryx2 root path"))?,
+        );
+        Ok(self.config.get_or_init(|| (config, files.prefix)))
     }
 }
 

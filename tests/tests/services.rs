@@ -277,7 +277,7 @@ fn many_clients_do_not_make_a_long_lived_client_look_lossy() {
     assert_eq!(driver.wait_timeout(T), Some(0));
     let out = driver.rest_of_stdout();
     assert!(
-        out.contains(&format!("stats commands={sent} overflows=0 ")),
+        out.contains(&format!("stats commands={sent} refused=0 overflows=0 ")),
         "{out}"
     );
 }

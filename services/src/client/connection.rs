@@ -113,6 +113,7 @@ impl<I: Interface> Client<I> {
                 ConnectError::NoDriver {
                     device: dev.clone(),
                     domain: domain.clone(),
+                    elsewhere: crate::domain_dir::elsewhere_note(&domain),
                 }
             } else if e.is_incompatible() {
                 ConnectError::Incompatible {

@@ -22,13 +22,16 @@ pub enum ConnectError {
     Context(#[from] ContextError),
     /// No driver offers this device in this domain.
     #[error(
-        "no driver offers {device} in domain {domain} (is the driver running? is LIMBER_DOMAIN the same?)"
+        "no driver offers {device} in domain {domain} (is the driver running? is LIMBER_DOMAIN the same?){elsewhere}"
     )]
     NoDriver {
         /// The device.
         device: String,
         /// The domain.
         domain: String,
+        /// Empty, or a sentence naming the other users who have a domain of this name on
+        /// this machine (a domain is its owner's alone: README, Security).
+        elsewhere: String,
     },
     /// The device is of another interface, or speaks another layout version.
     #[error("{device} is incompatible: {reason}")]

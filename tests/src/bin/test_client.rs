@@ -1,7 +1,11 @@
 //! A test client process. Modes:
 //! * `burst N`: send N position commands to `<robot>/actarray/0` as fast as possible;
 //! * `basic`: geometry, power, a move with its outcome, the state; prints `ok`;
-//! * `hold-request`: send a geometry request and wait (to be killed mid-request).
+//! * `hold-request`: send a geometry request and wait (to be killed mid-request);
+//! * `flood N`: send N position commands, joint `i % 8` of a 6-joint arm (so a quarter are
+//!   refused), then a request as a barrier; prints `sent N`;
+//! * `hold-samples`: borrow as many state samples as the service lets a subscriber hold,
+//!   print `holding K`, and keep them (to be killed or stopped).
 
 use std::time::Duration;
 
@@ -51,6 +55,39 @@ fn main() {
             let s = arm.wait_state(Duration::from_secs(5)).expect("state");
             assert_eq!(s.actuators[1].position, 0.25);
             println!("ok");
+        }
+        "flood" => {
+            for i in 0..a.n {
+                arm.move_to((i % 8) as usize, (i as f64) * 1e-4)
+                    .expect("send");
+            }
+            arm.geometry().expect("barrier request");
+            println!("sent {}", a.n);
+        }
+        "hold-samples" => {
+            let dev: DeviceName = dev.parse().expect("device name");
+            let sub = ctx
+                .node()
+                .service_builder(&dev.service_name(limber_services::Channel::Data))
+                .publish_subscribe::<ActArrayData>()
+                .open()
+                .expect("open the state service")
+                .subscriber_builder()
+                .create()
+                .expect("subscriber");
+            let mut held = Vec::new();
+            let deadline = std::time::Instant::now() + Duration::from_secs(10);
+            while held.len() < limber_services::qos::DATA_BORROWED {
+                assert!(std::time::Instant::now() < deadline, "no state samples");
+                match sub.receive().expect("receive") {
+                    Some(s) => held.push(s),
+                    None => std::thread::sleep(Duration::from_millis(5)),
+                }
+            }
+            println!("holding {}", held.len());
+            loop {
+                std::thread::sleep(Duration::from_secs(1));
+            }
         }
         "hold-request" => {
             println!("requesting");

@@ -91,8 +91,8 @@ fn main() {
     }
     let st = d.arm_host().stats();
     println!(
-        "stats commands={} overflows={} requests={} undelivered={}",
-        st.commands, st.overflows, st.requests, st.undelivered_replies
+        "stats commands={} refused={} overflows={} requests={} undelivered={}",
+        st.commands, st.refused, st.overflows, st.requests, st.undelivered_replies
     );
     match exit {
         Ok(e) => println!("exit {e:?}"),

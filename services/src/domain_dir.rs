@@ -1,0 +1,411 @@
+//! Where a domain's files live, and who may touch them.
+//!
+//! iceoryx2 0.10 keeps a domain's files in two places: its root path (static service
+//! configurations, node monitors, event sockets) and `/dev/shm` (segments, and one
+//! `<prefix>…_node.0_10_0.global_mgmt` counter that it creates world-writable, mode 0666,
+//! and never removes). With the default root path `/tmp/iceoryx2` and a prefix derived from
+//! the domain name, any local user could create those files first or write into the
+//! counter, and so stop every process of the domain from starting
+//! (`UnableToGenerateUniqueNodeId`).
+//!
+//! limber therefore gives every owner a private directory of its own, the *runtime
+//! directory* (`$LIMBER_RUNTIME_DIR`, else `/tmp/limber-<uid>`), created mode 0711 (others
+//! may look up a name in it, never list, read or create) and refused when it belongs to
+//! someone else. Each domain has a random token there
+//! (`<domain>.token`, mode 0600, made once); the iceoryx2 prefix is `limber_<token>_`, so no
+//! other user can predict the names in `/dev/shm`, and the iceoryx2 root path is
+//! `<runtime>/iceoryx2/`, which nobody else can enter. Before a process joins, a
+//! `global_mgmt` file of the domain owned by another user is refused; after it joined, the
+//! counter's mode is narrowed from 0666 to 0600.
+
+use std::fs;
+use std::io::{self, Write};
+use std::os::unix::fs::{DirBuilderExt, MetadataExt, OpenOptionsExt, PermissionsExt};
+use std::path::{Path, PathBuf};
+
+use thiserror::Error;
+
+/// The environment variable that names the runtime directory (default `/tmp/limber-<uid>`).
+pub const RUNTIME_DIR_ENV: &str = "LIMBER_RUNTIME_DIR";
+/// Where POSIX shared memory lives on Linux.
+const SHM_DIR: &str = "/dev/shm";
+/// The suffix iceoryx2 gives its per-domain node counter.
+const GLOBAL_MGMT_SUFFIX: &str = ".global_mgmt";
+
+/// The domain's directory or files could not be made safe to use.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum DomainError {
+    /// The runtime directory, the token or a shm file belongs to another user: limber will
+    /// not use files someone else can change.
+    #[error(
+        "{path} belongs to {owner}, not to you ({me}): limber does not use files another user controls (they could read or deny your domain). Remove it (as root or as {owner}), or set LIMBER_RUNTIME_DIR to a directory of your own"
+    )]
+    ForeignOwner {
+        /// The file or directory.
+        path: PathBuf,
+        /// Its owner, `name (uid N)`.
+        owner: String,
+        /// This process's user, `name (uid N)`.
+        me: String,
+    },
+    /// The runtime directory is not a directory (a symbolic link, a file).
+    #[error("{0} is not a directory (a symbolic link or a file): limber will not follow it")]
+    NotADirectory(PathBuf),
+    /// `/dev/shm` has less room than a driver needs: its segments would fail later with
+    /// SIGBUS when first touched, so a driver refuses to start instead.
+    #[error(
+        "/dev/shm has {free} bytes free, a driver needs at least {need}: make it larger (e.g. docker run --shm-size=64m, or mount -o remount,size=64m /dev/shm)"
+    )]
+    ShmTooSmall {
+        /// Free bytes.
+        free: u64,
+        /// Bytes a driver needs at least ([`MIN_SHM_FREE`]).
+        need: u64,
+    },
+    /// The token file does not hold a token.
+    #[error(
+        "{0} does not hold a domain token (16 hexadecimal digits); remove it to make a new one"
+    )]
+    BadToken(PathBuf),
+    /// A file or directory could not be created, read or given its mode.
+    #[error("cannot {what} {path}: {source}")]
+    Io {
+        /// What was being done ("create", "read", "change the mode of", ...).
+        what: &'static str,
+        /// The file or directory.
+        path: PathBuf,
+        /// The error of the system.
+        #[source]
+        source: IoError,
+    },
+}
+
+/// An [`io::Error`] that can be cloned and compared (by kind and raw OS code), kept as the
+/// source of [`DomainError::Io`].
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[error("{message}")]
+pub struct IoError {
+    /// The kind.
+    pub kind: io::ErrorKind,
+    /// The raw OS error code, when there is one (`EACCES`, `ENOSPC`, `EROFS`, ...).
+    pub raw_os_error: Option<i32>,
+    message: String,
+}
+
+impl From<io::Error> for IoError {
+    fn from(e: io::Error) -> Self {
+        IoError {
+            kind: e.kind(),
+            raw_os_error: e.raw_os_error(),
+            message: e.to_string(),
+        }
+    }
+}
+
+fn io_err<'a>(what: &'static str, path: &'a Path) -> impl FnOnce(io::Error) -> DomainError + 'a {
+    move |e| DomainError::Io {
+        what,
+        path: path.to_path_buf(),
+        source: e.into(),
+    }
+}
+
+/// The effective user id of this process.
+pub fn euid() -> u32 {
+    rustix::process::geteuid().as_raw()
+}
+
+/// `name (uid N)` for a user id (the name from /etc/passwd, when it is there).
+pub fn describe_user(uid: u32) -> String {
+    let name = fs::read_to_string("/etc/passwd").ok().and_then(|p| {
+        p.lines().find_map(|l| {
+            let mut f = l.split(':');
+            let name = f.next()?;
+            let id: u32 = f.nth(1)?.parse().ok()?;
+            (id == uid).then(|| name.to_string())
+        })
+    });
+    match name {
+        Some(n) => format!("user {n} (uid {uid})"),
+        None => format!("uid {uid}"),
+    }
+}
+
+/// The runtime directory of this process: `$LIMBER_RUNTIME_DIR`, else `/tmp/limber-<uid>`.
+pub fn runtime_dir() -> PathBuf {
+    match std::env::var_os(RUNTIME_DIR_ENV) {
+        Some(v) if !v.is_empty() => PathBuf::from(v),
+        _ => PathBuf::from(format!("/tmp/limber-{}", euid())),
+    }
+}
+
+/// The room in `/dev/shm` a driver needs at least: the Pioneer driver's segments take about
+/// 4 MiB (they are sparse, so a smaller tmpfs accepts them and the process dies with SIGBUS
+/// later); this leaves room for its clients.
+pub const MIN_SHM_FREE: u64 = 8 << 20;
+
+/// Refuses to go on when `/dev/shm` has less than [`MIN_SHM_FREE`] bytes free.
+pub fn check_shm_space() -> Result<(), DomainError> {
+    let path = Path::new(SHM_DIR);
+    let st = rustix::fs::statvfs(path).map_err(|e| io_err("inspect", path)(e.into()))?;
+    let free = st.f_bavail.saturating_mul(st.f_frsize);
+    if free < MIN_SHM_FREE {
+        return Err(DomainError::ShmTooSmall {
+            free,
+            need: MIN_SHM_FREE,
+        });
+    }
+    Ok(())
+}
+
+/// What joining a domain needs: where iceoryx2 keeps its files and the prefix of its names.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DomainFiles {
+    /// The iceoryx2 root path (`<runtime>/iceoryx2/`), with a trailing slash.
+    pub root: PathBuf,
+    /// The iceoryx2 prefix (`limber_<token>_`).
+    pub prefix: String,
+}
+
+fn foreign(path: &Path, uid: u32) -> DomainError {
+    DomainError::ForeignOwner {
+        path: path.to_path_buf(),
+        owner: describe_user(uid),
+        me: describe_user(euid()),
+    }
+}
+
+/// Makes sure `dir` is a directory of ours that others can neither list nor change
+/// (creating it with `mode` if missing, narrowing its mode to `mode` if it is ours and wider).
+fn private_dir(dir: &Path, mode: u32) -> Result<(), DomainError> {
+    match fs::DirBuilder::new().mode(mode).create(dir) {
+        Ok(()) => {}
+        Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {}
+        Err(e) => return Err(io_err("create", dir)(e)),
+    }
+    let md = fs::symlink_metadata(dir).map_err(io_err("inspect", dir))?;
+    if !md.file_type().is_dir() {
+        return Err(DomainError::NotADirectory(dir.to_path_buf()));
+    }
+    if md.uid() != euid() {
+        return Err(foreign(dir, md.uid()));
+    }
+    if md.mode() & 0o7777 != mode {
+        tracing::warn!(dir = %dir.display(), mode = format!("{:o}", md.mode() & 0o7777), "setting the mode of a runtime directory to {mode:o}");
+        fs::set_permissions(dir, fs::Permissions::from_mode(mode))
+            .map_err(io_err("change the mode of", dir))?;
+    }
+    Ok(())
+}
+
+fn new_token() -> Result<String, DomainError> {
+    let mut bytes = [0u8; 8];
+    let path = Path::new("/dev/urandom");
+    let mut f = fs::File::open(path).map_err(io_err("read", path))?;
+    io::Read::read_exact(&mut f, &mut bytes).map_err(io_err("read", path))?;
+    Ok(bytes.iter().map(|b| format!("{b:02x}")).collect())
+}
+
+fn valid_token(t: &str) -> bool {
+    t.len() == 16 && t.bytes().all(|b| b.is_ascii_hexdigit())
+}
+
+/// The token of `domain` in `dir`, made on first use (several processes may race: one wins,
+/// all read its token).
+fn token(dir: &Path, domain: &str) -> Result<String, DomainError> {
+    let path = dir.join(format!("{domain}.token"));
+    if fs::symlink_metadata(&path).is_err() {
+        let token = new_token()?;
+        // Unique to this attempt (several threads of a process may race too).
+        let tmp = dir.join(format!(".{domain}.token.{}.{token}", std::process::id()));
+        let mut f = fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .mode(0o600)
+            .open(&tmp)
+            .map_err(io_err("create", &tmp))?;
+        f.write_all(format!("{token}\n").as_bytes())
+            .map_err(io_err("write", &tmp))?;
+        drop(f);
+        // link(2) does not replace: the first process to make the token wins.
+        let linked = fs::hard_link(&tmp, &path);
+        let _ = fs::remove_file(&tmp);
+        match linked {
+            Ok(()) => {}
+            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {}
+            Err(e) => return Err(io_err("create", &path)(e)),
+        }
+    }
+    let md = fs::symlink_metadata(&path).map_err(io_err("inspect", &path))?;
+    if !md.file_type().is_file() {
+        return Err(DomainError::BadToken(path));
+    }
+    if md.uid() != euid() {
+        return Err(foreign(&path, md.uid()));
+    }
+    let text = fs::read_to_string(&path).map_err(io_err("read", &path))?;
+    let t = text.trim();
+    if !valid_token(t) {
+        return Err(DomainError::BadToken(path));
+    }
+    Ok(t.to_string())
+}
+
+/// Prepares the files of `domain` for this process (see the module documentation):
+/// the private runtime directory, the domain's token, and a check that no file of the
+/// domain in `/dev/shm` belongs to someone else.
+pub fn prepare(domain: &str) -> Result<DomainFiles, DomainError> {
+    let dir = runtime_dir();
+    private_dir(&dir, 0o711)?;
+    let token = token(&dir, domain)?;
+    let prefix = format!("limber_{token}_");
+    check_shm(&prefix)?;
+    let iox = dir.join("iceoryx2");
+    private_dir(&iox, 0o700)?;
+    let mut root = iox.into_os_string();
+    root.push("/");
+    Ok(DomainFiles {
+        root: PathBuf::from(root),
+        prefix,
+    })
+}
+
+/// The `global_mgmt` files of the domain with `prefix` in `/dev/shm`.
+fn global_mgmt_files(prefix: &str) -> Vec<PathBuf> {
+    let Ok(rd) = fs::read_dir(SHM_DIR) else {
+        return Vec::new();
+    };
+    rd.filter_map(Result::ok)
+        .filter(|e| {
+            let n = e.file_name();
+            let n = n.to_string_lossy();
+            n.starts_with(prefix) && n.ends_with(GLOBAL_MGMT_SUFFIX)
+        })
+        .map(|e| e.path())
+        .collect()
+}
+
+/// Refuses a `global_mgmt` file of the domain that belongs to another user.
+fn check_shm(prefix: &str) -> Result<(), DomainError> {
+    for path in global_mgmt_files(prefix) {
+        let md = fs::symlink_metadata(&path).map_err(io_err("inspect", &path))?;
+        if md.uid() != euid() {
+            return Err(foreign(&path, md.uid()));
+        }
+    }
+    Ok(())
+}
+
+/// Narrows the mode of the domain's `global_mgmt` files of ours to 0600 (iceoryx2 makes
+/// them 0666). Called after the node was created.
+pub fn secure_shm(prefix: &str) -> Result<(), DomainError> {
+    for path in global_mgmt_files(prefix) {
+        let md = fs::symlink_metadata(&path).map_err(io_err("inspect", &path))?;
+        if md.uid() != euid() {
+            return Err(foreign(&path, md.uid()));
+        }
+        if md.mode() & 0o077 != 0 {
+            fs::set_permissions(&path, fs::Permissions::from_mode(0o600))
+                .map_err(io_err("change the mode of", &path))?;
+        }
+    }
+    Ok(())
+}
+
+/// Other users on this machine whose runtime directory (`/tmp/limber-<uid>`) holds a domain
+/// named `domain`, as `user NAME (uid N)` (a runtime directory elsewhere is not seen).
+pub fn other_owners(domain: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let Ok(rd) = fs::read_dir("/tmp") else {
+        return out;
+    };
+    for e in rd.filter_map(Result::ok) {
+        let name = e.file_name();
+        let Some(uid) = name
+            .to_str()
+            .and_then(|n| n.strip_prefix("limber-"))
+            .and_then(|u| u.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if uid == euid() {
+            continue;
+        }
+        if fs::symlink_metadata(e.path().join(format!("{domain}.token"))).is_ok() {
+            out.push(describe_user(uid));
+        }
+    }
+    out
+}
+
+/// Empty, or `"; domain D also exists for user NAME (uid N): its devices are theirs
+/// alone ..."` when other users have a domain of this name ([`other_owners`]).
+pub fn elsewhere_note(domain: &str) -> String {
+    let others = other_owners(domain);
+    if others.is_empty() {
+        return String::new();
+    }
+    format!(
+        "; domain {domain} also exists for {}: a domain's devices are its owner's alone, so run as that user (README, Security)",
+        others.join(", ")
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tokens_are_hex_and_checked() {
+        let t = new_token().unwrap();
+        assert!(valid_token(&t), "{t}");
+        assert!(!valid_token("xyz"));
+        assert!(!valid_token("0123456789abcdeg"));
+    }
+
+    #[test]
+    fn threads_racing_to_make_a_token_all_get_the_same_one() {
+        let dir = std::env::temp_dir().join(format!("limber-race-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        private_dir(&dir, 0o711).unwrap();
+        let tokens: Vec<String> = (0..8)
+            .map(|_| {
+                let d = dir.clone();
+                std::thread::spawn(move || token(&d, "raced").unwrap())
+            })
+            .collect::<Vec<_>>()
+            .into_iter()
+            .map(|t| t.join().unwrap())
+            .collect();
+        assert!(tokens.iter().all(|t| t == &tokens[0]), "{tokens:?}");
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn the_token_is_made_once_and_kept() {
+        let dir = std::env::temp_dir().join(format!("limber-tok-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        private_dir(&dir, 0o711).unwrap();
+        assert_eq!(
+            fs::metadata(&dir).unwrap().mode() & 0o777,
+            0o711,
+            "a new runtime directory is private"
+        );
+        let a = token(&dir, "d").unwrap();
+        let b = token(&dir, "d").unwrap();
+        assert_eq!(a, b);
+        assert_ne!(a, token(&dir, "e").unwrap());
+        let md = fs::metadata(dir.join("d.token")).unwrap();
+        assert_eq!(md.mode() & 0o777, 0o600);
+        fs::write(dir.join("bad.token"), "nope").unwrap();
+        assert!(matches!(token(&dir, "bad"), Err(DomainError::BadToken(_))));
+        fs::set_permissions(&dir, fs::Permissions::from_mode(0o755)).unwrap();
+        private_dir(&dir, 0o711).unwrap();
+        assert_eq!(
+            fs::metadata(&dir).unwrap().mode() & 0o777,
+            0o711,
+            "narrowed"
+        );
+        fs::remove_dir_all(&dir).unwrap();
+    }
+}
