@@ -28,6 +28,8 @@ pub struct ChildSpec {
     pub out: Option<PathBuf>,
     /// A socket address to connect to.
     pub addr: Option<String>,
+    /// A file to map shared (the physical floor's page).
+    pub shm: Option<PathBuf>,
     /// The core to pin to.
     pub cpu: Option<usize>,
     /// Samples to discard before recording.
@@ -77,6 +79,9 @@ impl ChildProc {
         }
         if let Some(a) = &spec.addr {
             c.arg("--addr").arg(a);
+        }
+        if let Some(p) = &spec.shm {
+            c.arg("--shm").arg(p);
         }
         if let Some(cpu) = spec.cpu {
             c.arg("--cpu").arg(cpu.to_string());

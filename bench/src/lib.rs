@@ -197,6 +197,9 @@ pub struct BenchArgs {
     /// Internal: the socket address a child connects to.
     #[arg(long, hide = true)]
     pub addr: Option<String>,
+    /// Internal: the file a physical-floor child maps shared.
+    #[arg(long, hide = true)]
+    pub shm: Option<PathBuf>,
     /// Internal: the core a child pins itself to.
     #[arg(long, hide = true)]
     pub cpu: Option<usize>,
