@@ -28,6 +28,10 @@ pub struct ChildSpec {
     pub out: Option<PathBuf>,
     /// A socket address to connect to.
     pub addr: Option<String>,
+    /// A file to map shared (the physical floor's page).
+    pub shm: Option<PathBuf>,
+    /// How long an event-driven driver child keeps polling after activity.
+    pub linger: Option<Duration>,
     /// The core to pin to.
     pub cpu: Option<usize>,
     /// Samples to discard before recording.
@@ -77,6 +81,12 @@ impl ChildProc {
         }
         if let Some(a) = &spec.addr {
             c.arg("--addr").arg(a);
+        }
+        if let Some(p) = &spec.shm {
+            c.arg("--shm").arg(p);
+        }
+        if let Some(l) = spec.linger {
+            c.arg("--linger-us").arg(l.as_micros().to_string());
         }
         if let Some(cpu) = spec.cpu {
             c.arg("--cpu").arg(cpu.to_string());

@@ -197,6 +197,12 @@ pub struct BenchArgs {
     /// Internal: the socket address a child connects to.
     #[arg(long, hide = true)]
     pub addr: Option<String>,
+    /// Internal: the file a physical-floor child maps shared.
+    #[arg(long, hide = true)]
+    pub shm: Option<PathBuf>,
+    /// Internal: how long an event-driven driver child keeps polling after activity, µs.
+    #[arg(long, hide = true, default_value_t = 0)]
+    pub linger_us: u64,
     /// Internal: the core a child pins itself to.
     #[arg(long, hide = true)]
     pub cpu: Option<usize>,

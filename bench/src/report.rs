@@ -85,6 +85,55 @@ pub const RATIOS: &[RatioDef] = &[
         num: "command.spin.rtt",
         den: "floor.spin.rtt",
         pct: Pct::P50,
+        goal: Some(Goal::AtMost(1.2)),
+    },
+    RatioDef {
+        label: "command spin round trip / cache-line ping-pong round trip",
+        num: "command.spin.rtt",
+        den: "floor.cacheline.rtt",
+        pct: Pct::P50,
+        goal: None,
+    },
+    RatioDef {
+        label: "command event round trip / futex ping-pong round trip",
+        num: "command.event.rtt",
+        den: "floor.futex.rtt",
+        pct: Pct::P50,
+        goal: Some(Goal::AtMost(1.5)),
+    },
+    RatioDef {
+        label: "driver wake-up (command event one-way) / futex wake-up (one-way)",
+        num: "command.event.oneway",
+        den: "floor.futex.oneway",
+        pct: Pct::P50,
+        goal: Some(Goal::AtMost(1.5)),
+    },
+    RatioDef {
+        label: "command event round trip / UDS blocking round trip",
+        num: "command.event.rtt",
+        den: "peers.uds.blocking.rtt",
+        pct: Pct::P50,
+        goal: Some(Goal::AtMost(0.8)),
+    },
+    RatioDef {
+        label: "iceoryx2 event round trip / futex ping-pong round trip",
+        num: "floor.event.rtt",
+        den: "floor.futex.rtt",
+        pct: Pct::P50,
+        goal: None,
+    },
+    RatioDef {
+        label: "iceoryx2 spin round trip / cache-line ping-pong round trip",
+        num: "floor.spin.rtt",
+        den: "floor.cacheline.rtt",
+        pct: Pct::P50,
+        goal: None,
+    },
+    RatioDef {
+        label: "futex round trip / cache-line round trip (physical cost of blocking)",
+        num: "floor.futex.rtt",
+        den: "floor.cacheline.rtt",
+        pct: Pct::P50,
         goal: None,
     },
     RatioDef {
@@ -198,6 +247,11 @@ pub struct Row {
     pub floor_id: Option<String>,
     /// p50 of this row / p50 of its floor.
     pub x_floor_p50: Option<f64>,
+    /// The physical floor this row is compared with (futex for blocking, cache line for
+    /// spinning; same metric).
+    pub phys_id: Option<String>,
+    /// p50 of this row / p50 of its physical floor.
+    pub x_phys_p50: Option<f64>,
     /// The percentile curve (for plots).
     pub curve: Vec<CurvePoint>,
 }
@@ -238,15 +292,18 @@ pub struct Report {
     pub ratios: Vec<Ratio>,
 }
 
-fn floor_of(m: &Measurement) -> Option<String> {
-    if m.scenario == "floor" {
-        return None;
-    }
+/// The floor of `m` of one kind: `(spin, blocking)` name the floor's series for each
+/// strategy (e.g. `("spin", "event")` for iceoryx2, `("cacheline", "futex")` for the
+/// physical floors). None for a floor of that kind itself and for computations.
+fn floor_of(m: &Measurement, (spin, blocking): (&str, &str)) -> Option<String> {
     let k = match m.strategy {
-        Strategy::Spin => "spin",
-        Strategy::Blocking => "event",
+        Strategy::Spin => spin,
+        Strategy::Blocking => blocking,
         Strategy::Compute => return None,
     };
+    if m.id.starts_with(&format!("floor.{k}.")) {
+        return None;
+    }
     let what = match m.metric {
         Metric::RoundTrip => "rtt",
         Metric::OneWay if m.id.ends_with(".back") => "back",
@@ -254,6 +311,16 @@ fn floor_of(m: &Measurement) -> Option<String> {
         Metric::Solve => return None,
     };
     Some(format!("floor.{k}.{what}"))
+}
+
+/// The iceoryx2 floors.
+const IOX2_FLOOR: (&str, &str) = ("spin", "event");
+/// The physical floors.
+const PHYS_FLOOR: (&str, &str) = ("cacheline", "futex");
+
+/// A ratio in the table, or `-`.
+fn ratio_cell(x: Option<f64>) -> String {
+    x.map(|x| format!("{x:.2}")).unwrap_or_else(|| "-".into())
 }
 
 /// The percentiles of a curve: 0 to 99.999 on a "nines" scale.
@@ -298,11 +365,19 @@ impl Report {
             .iter()
             .map(|m| {
                 let s = Summary::of(&m.hist);
-                let floor_id = floor_of(m).filter(|f| find(f).is_some());
-                let x_floor_p50 = floor_id.as_deref().and_then(find).and_then(|f| {
-                    let fp = Summary::of(&f.hist).p50_ns;
-                    (fp > 0).then(|| s.p50_ns as f64 / fp as f64)
-                });
+                let x_p50 = |id: Option<&str>| {
+                    id.and_then(find).and_then(|f| {
+                        let fp = Summary::of(&f.hist).p50_ns;
+                        (fp > 0).then(|| s.p50_ns as f64 / fp as f64)
+                    })
+                };
+                // The physical floors are not compared with iceoryx2's.
+                let physical =
+                    m.id.starts_with("floor.cacheline.") || m.id.starts_with("floor.futex.");
+                let floor_id = floor_of(m, IOX2_FLOOR).filter(|f| !physical && find(f).is_some());
+                let x_floor_p50 = x_p50(floor_id.as_deref());
+                let phys_id = floor_of(m, PHYS_FLOOR).filter(|f| find(f).is_some());
+                let x_phys_p50 = x_p50(phys_id.as_deref());
                 Row {
                     scenario: m.scenario,
                     id: m.id.clone(),
@@ -314,6 +389,8 @@ impl Report {
                     summary: s,
                     floor_id,
                     x_floor_p50,
+                    phys_id,
+                    x_phys_p50,
                     curve: curve(m),
                 }
             })
@@ -373,11 +450,12 @@ impl Report {
         t.push_str(&self.machine.header());
         let _ = writeln!(
             t,
-            "{JITTER}; x floor = p50 / p50 of the iceoryx2 floor with the same strategy and metric\n"
+            "{JITTER}; x iox2 = p50 / p50 of the raw iceoryx2 floor, x phys = p50 / p50 of the \
+             physical floor (futex if blocking, cache line if spinning), same strategy and metric\n"
         );
         let _ = writeln!(
             t,
-            "{:<8} {:<34} {:<8} {:<10} {:>7} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>7}",
+            "{:<8} {:<34} {:<8} {:<10} {:>7} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>7} {:>7}",
             "scenario",
             "series",
             "strategy",
@@ -389,13 +467,14 @@ impl Report {
             "p99.9",
             "max",
             "jitter",
-            "x floor"
+            "x iox2",
+            "x phys"
         );
         for r in &self.measurements {
             let s = &r.summary;
             let _ = writeln!(
                 t,
-                "{:<8} {:<34} {:<8} {:<10} {:>7} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>7}",
+                "{:<8} {:<34} {:<8} {:<10} {:>7} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>7} {:>7}",
                 r.scenario,
                 r.label,
                 r.strategy.name(),
@@ -407,9 +486,8 @@ impl Report {
                 fmt_ns(s.p999_ns),
                 fmt_ns(s.max_ns),
                 fmt_ns(s.jitter_ns),
-                r.x_floor_p50
-                    .map(|x| format!("{x:.2}"))
-                    .unwrap_or_else(|| "-".into()),
+                ratio_cell(r.x_floor_p50),
+                ratio_cell(r.x_phys_p50),
             );
         }
         let others: Vec<&ScenarioOutcome> =

@@ -2,6 +2,7 @@
 //!
 //! | role | scenario | what it does |
 //! |---|---|---|
+//! | `futex-echo` / `cacheline-echo` | floor | no middleware: a shared page, `FUTEX_WAIT`/`FUTEX_WAKE` or spinning |
 //! | `pubsub-echo` | floor | raw iceoryx2: spins on the ping topic, answers on the pong topic |
 //! | `event-echo` | floor | the same, blocking on an event listener, notifying back |
 //! | `waitset-echo` | floor | the same, blocking in a WaitSet with the listener attached |
@@ -17,7 +18,7 @@ use std::time::{Duration, Instant};
 use iceoryx2::prelude::*;
 use limber_services::Domain;
 
-use crate::scenario::{command, floor, peers, state};
+use crate::scenario::{command, floor, peers, physical, state};
 use crate::{BenchArgs, BenchError};
 
 /// Runs `role`; on failure prints `error: <why>` on stdout for the parent, and returns it.
@@ -28,6 +29,8 @@ pub fn run_role(role: &str, args: &BenchArgs) -> Result<(), BenchError> {
         None => unpin(),
     }
     let r = match role {
+        "futex-echo" => physical::echo_role(args, physical::Wait::Futex),
+        "cacheline-echo" => physical::echo_role(args, physical::Wait::Spin),
         "pubsub-echo" => floor::echo_role(args, floor::Echo::Spin),
         "event-echo" => floor::echo_role(args, floor::Echo::Listener),
         "waitset-echo" => floor::echo_role(args, floor::Echo::WaitSet),

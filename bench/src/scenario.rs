@@ -11,6 +11,7 @@ pub mod command;
 pub mod floor;
 pub mod ik;
 pub mod peers;
+pub mod physical;
 pub mod pty_loop;
 pub mod request;
 pub mod state;

@@ -157,7 +157,7 @@ pub fn serialize(h: &Histogram<u64>) -> Result<Vec<u8>, BenchError> {
     let mut out = Vec::new();
     V2Serializer::new()
         .serialize(h, &mut out)
-        .map_err(|e| BenchError::Histogram(format!("{e:?}")))?;
+        .map_err(|e| BenchError::Histogram(e.to_string()))?;
     Ok(out)
 }
 
@@ -167,7 +167,7 @@ pub fn deserialize(bytes: &[u8]) -> Result<Histogram<u64>, BenchError> {
     let mut cursor = std::io::Cursor::new(bytes);
     Deserializer::new()
         .deserialize(&mut cursor)
-        .map_err(|e| BenchError::Histogram(format!("{e:?}")))
+        .map_err(|e| BenchError::Histogram(e.to_string()))
 }
 
 #[cfg(test)]

@@ -62,6 +62,10 @@ fn quick_run_writes_a_well_formed_report() {
         "floor.spin.oneway",
         "floor.event.rtt",
         "floor.event.oneway",
+        "floor.futex.rtt",
+        "floor.futex.oneway",
+        "floor.cacheline.rtt",
+        "floor.cacheline.oneway",
         "ik.pioneer.pose",
         "ik.chain6.pose",
         "loop.to_robot",
@@ -95,6 +99,23 @@ fn quick_run_writes_a_well_formed_report() {
             .unwrap()
             .iter()
             .any(|r| r["num"] == "floor.event.rtt")
+    );
+
+    // Blocking rows are compared with the futex floor, spinning rows with the cache line.
+    let row = |id: &str| ms.iter().find(|m| m["id"] == id).unwrap();
+    assert_eq!(row("floor.event.rtt")["phys_id"], "floor.futex.rtt");
+    assert_eq!(
+        row("floor.spin.oneway")["phys_id"],
+        "floor.cacheline.oneway"
+    );
+    assert!(row("floor.event.rtt")["x_phys_p50"].as_f64().unwrap() > 0.0);
+    assert!(row("floor.futex.rtt")["phys_id"].is_null());
+    assert!(
+        v["ratios"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|r| r["den"] == "floor.futex.rtt" && r["num"] == "floor.event.rtt")
     );
 
     let svg_text = std::fs::read_to_string(&svg).unwrap();

@@ -2,7 +2,7 @@
 //! simulated arm) in this process and runs the paper's pick-a-block program against it,
 //! showing each step with the live joint and gripper state.
 
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
@@ -16,6 +16,7 @@ use limber_services::diagnostics::StatsReader;
 use limber_services::prelude::*;
 use limber_services::{Domain, Role};
 
+use crate::out::outln;
 use crate::{CliError, exit};
 
 /// Which robot the demo drives.
@@ -118,7 +119,7 @@ fn start_pioneer(domain: &Domain) -> Result<Running, CliError> {
         })
         .map_err(|e| CliError::new(exit::FAILURE, e.to_string()))?;
     match rx.recv_timeout(Duration::from_secs(30)) {
-        Ok(Ok(path)) => println!("started the Pioneer emulator on {path} and the Pioneer driver"),
+        Ok(Ok(path)) => outln!("started the Pioneer emulator on {path} and the Pioneer driver")?,
         Ok(Err(e)) => return Err(CliError::new(exit::FAILURE, e)),
         Err(_) => {
             return Err(CliError::new(
@@ -175,7 +176,7 @@ fn start_simarm(domain: &Domain) -> Result<Running, CliError> {
         .map_err(|e| CliError::new(exit::FAILURE, e.to_string()))?;
     match rx.recv_timeout(Duration::from_secs(30)) {
         Ok(Ok(())) => {
-            println!("started simarm: the built-in 6-joint chain with its parallel gripper")
+            outln!("started simarm: the built-in 6-joint chain with its parallel gripper")?
         }
         Ok(Err(e)) => return Err(CliError::new(exit::FAILURE, e)),
         Err(_) => {
@@ -236,14 +237,14 @@ fn step_name(s: &Step) -> String {
 /// Runs `limber demo`.
 pub fn run(a: DemoArgs) -> Result<(), CliError> {
     let domain = crate::domain()?;
-    println!(
+    outln!(
         "limber demo: the paper's pick-a-block program on the {} (domain {}; watch it with `limber monitor` in another terminal)",
         match a.on {
             Robot::Pioneer => "Pioneer arm (emulated)",
             Robot::Simarm => "simulated 6-joint arm",
         },
         domain.name()
-    );
+    )?;
     let running = match a.on {
         Robot::Pioneer => start_pioneer(&domain)?,
         Robot::Simarm => start_simarm(&domain)?,
@@ -274,21 +275,38 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
         Duration::from_secs(5),
     )
     .map_err(crate::device::connect_err)?;
-    println!(
+    outln!(
         "devices: {} (joints), {} (end effector), {} (gripper)\n",
-        running.arm, running.limb, running.gripper
-    );
+        running.arm,
+        running.limb,
+        running.gripper
+    )?;
 
     let tty = std::io::stdout().is_terminal();
     let start = Instant::now();
     let mut step_start = Instant::now();
     let mut last_line = Instant::now();
     let mut n = 0;
+    // A closed stdout (`limber demo | head -3`) ends the demo quietly after the current
+    // step; the arm is stopped when the driver is dropped.
+    let mut closed = false;
+    let mut say = |args: std::fmt::Arguments<'_>| {
+        if closed {
+            return;
+        }
+        let written = crate::out::write(args).and_then(|()| {
+            std::io::Write::flush(&mut std::io::stdout()).map_err(crate::out::stdout_error)
+        });
+        if let Err(e) = written {
+            tracing::debug!("demo output stopped: {e}");
+            closed = true;
+        }
+    };
     let result = pick_block::run(&mut dev, &params, &mut |ev| match ev {
         Event::Start(s) => {
             n += 1;
             step_start = Instant::now();
-            println!("[{n:>2}/11] {} ...", step_name(&s));
+            say(format_args!("[{n:>2}/11] {} ...\n", step_name(&s)));
         }
         Event::Progress(l, g) => {
             if tty {
@@ -298,26 +316,25 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
                         .iter()
                         .map(|a| format!("{:+.2}", a.position))
                         .collect();
-                    print!(
+                    say(format_args!(
                         "\r        joints [{}] gripper {:<7} end effector {}   ",
                         joints.join(" "),
                         gripper_name(g),
                         fmt_v(l.position)
-                    );
-                    let _ = std::io::stdout().flush();
+                    ));
                 }
             } else if last_line.elapsed() > Duration::from_secs(1) {
                 last_line = Instant::now();
-                println!(
-                    "        moving: end effector {} gripper {}",
+                say(format_args!(
+                    "        moving: end effector {} gripper {}\n",
                     fmt_v(l.position),
                     gripper_name(g)
-                );
+                ));
             }
         }
         Event::Done(_, l, g) => {
             if tty {
-                print!("\r{:<100}\r", "");
+                say(format_args!("\r{:<100}\r", ""));
             }
             let joints: Vec<String> = arm
                 .state()
@@ -328,19 +345,22 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
                         .collect()
                 })
                 .unwrap_or_default();
-            println!(
-                "        done in {:.1} s: end effector {} approach {}; gripper {}; joints [{}]",
+            say(format_args!(
+                "        done in {:.1} s: end effector {} approach {}; gripper {}; joints [{}]\n",
                 step_start.elapsed().as_secs_f64(),
                 fmt_v(l.position),
                 fmt_v(l.approach),
                 gripper_name(g),
                 joints.join(" ")
-            );
+            ));
         }
     });
+    if closed {
+        return Err(CliError::stdout_closed());
+    }
     match result {
         Ok(s) => {
-            println!(
+            outln!(
                 "\npicked the block at ({:.2}, {:.2}) and put it down at ({:.2}, {:.2}): {} steps in {:.1} s{}",
                 params.block[0],
                 params.block[1],
@@ -353,12 +373,12 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
                 } else {
                     ""
                 }
-            );
+            )?;
             if a.on == Robot::Pioneer
                 && let Ok(mut stats) = StatsReader::open(&ctx, &running.robot)
                 && let Ok(st) = stats.wait(Duration::from_millis(1500))
             {
-                println!(
+                outln!(
                     "driver: {} {} {}; loop period p50 {:.2} ms p99 {:.2} ms; command to wire p50 {:.1} µs; {:.1} SIPs/s; {} commands, {} refused, {} requests; {} bad checksums",
                     get_text(&st.robot_name).unwrap_or("?"),
                     get_text(&st.robot_class).unwrap_or(""),
@@ -371,9 +391,9 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
                     st.refused,
                     st.requests,
                     st.bad_checksums
-                );
+                )?;
             }
-            println!("done.");
+            outln!("done.")?;
             Ok(())
         }
         Err(e) => Err(CliError::new(

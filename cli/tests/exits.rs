@@ -180,3 +180,16 @@ fn a_closed_stdout_ends_the_verb_quietly() {
         assert!(!err.contains("Broken pipe"), "{args:?}: {err}");
     }
 }
+
+/// `limber demo | head -1` ends the demo quietly too, on either robot (its driver, and so
+/// the arm, stopped with it).
+#[test]
+fn a_closed_stdout_ends_the_demo_quietly() {
+    for on in ["pioneer", "simarm"] {
+        let d = Domain::unique_for_test();
+        let args = ["demo", "--on", on];
+        let (code, err) = first_line_then_close(d.name(), &args);
+        assert_eq!(code, Some(0), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+}

@@ -220,3 +220,72 @@ where
         }
     }
 }
+
+/// After activity, keeps polling for more instead of going back to sleep at once: calls
+/// `poll` (which returns whether it found work) until it has found nothing for `budget`.
+/// A driver calls it after it processed its clients, so that a client's next command,
+/// sent within `budget`, is picked up without a wake-up; zero returns at once. Never
+/// longer than `budget` or 1 ms in all, whichever is longer, so that a flood of commands
+/// does not keep the loop from its timer and signals. Returns how many polls found work.
+pub fn linger(budget: Duration, mut poll: impl FnMut() -> bool) -> u64 {
+    if budget.is_zero() {
+        return 0;
+    }
+    let start = std::time::Instant::now();
+    let cap = budget.max(Duration::from_millis(1));
+    let mut found = 0;
+    let mut idle_since = start;
+    loop {
+        if poll() {
+            found += 1;
+            idle_since = std::time::Instant::now();
+        } else if idle_since.elapsed() >= budget {
+            return found;
+        } else {
+            core::hint::spin_loop();
+        }
+        if start.elapsed() >= cap {
+            return found;
+        }
+    }
+}
+
+#[cfg(test)]
+mod linger_tests {
+    use super::linger;
+    use core::time::Duration;
+
+    #[test]
+    fn zero_budget_does_not_poll() {
+        let mut polls = 0;
+        assert_eq!(
+            linger(Duration::ZERO, || {
+                polls += 1;
+                true
+            }),
+            0
+        );
+        assert_eq!(polls, 0);
+    }
+
+    #[test]
+    fn counts_the_polls_that_found_work_and_stops_when_idle() {
+        let mut left = 5;
+        let found = linger(Duration::from_micros(200), || {
+            if left > 0 {
+                left -= 1;
+                true
+            } else {
+                false
+            }
+        });
+        assert_eq!(found, 5);
+    }
+
+    /// A flood (work on every poll) does not keep the loop from its timer and signals.
+    #[test]
+    fn a_flood_ends_the_linger() {
+        let found = linger(Duration::from_micros(50), || true);
+        assert!(found > 0);
+    }
+}

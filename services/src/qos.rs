@@ -41,3 +41,40 @@ pub const EVENT_HELLO: usize = 3;
 pub const EVENT_STATE: usize = 1;
 /// Event id on `notify`: a reply was sent.
 pub const EVENT_REPLY: usize = 2;
+
+/// The spin budget of a client in event mode when nothing else is configured, on a machine
+/// with at least two cores (see [`default_spin_budget`]). Chosen by measurement
+/// (`limber bench --only command`): long enough to cover a driver that is awake answering
+/// (a few µs), short enough to cost little CPU when it is not.
+pub const SPIN_BUDGET: core::time::Duration = core::time::Duration::from_micros(30);
+
+/// The environment variable that sets the clients' spin budget in µs (`0`: block at once).
+pub const SPIN_BUDGET_ENV: &str = "LIMBER_SPIN_US";
+
+/// The default spin budget of a client in event mode: `LIMBER_SPIN_US` if set (µs), else
+/// [`SPIN_BUDGET`] on a machine with two or more cores and zero on one core (where a
+/// spinning client would only delay the driver it waits for).
+pub fn default_spin_budget() -> core::time::Duration {
+    static BUDGET: std::sync::OnceLock<core::time::Duration> = std::sync::OnceLock::new();
+    *BUDGET.get_or_init(|| {
+        if let Some(v) = std::env::var_os(SPIN_BUDGET_ENV) {
+            match v.to_str().and_then(|s| s.trim().parse::<u64>().ok()) {
+                Some(us) => return core::time::Duration::from_micros(us.min(1_000_000)),
+                None => tracing::warn!(
+                    "{SPIN_BUDGET_ENV}={v:?} is not a number of microseconds: using the default"
+                ),
+            }
+        }
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        if cores >= 2 {
+            SPIN_BUDGET
+        } else {
+            core::time::Duration::ZERO
+        }
+    })
+}
+
+/// How long a driver in event mode keeps polling its clients after activity before it goes
+/// back to sleep (see [`crate::event_loop::linger`]), so that a client's next command in a
+/// tight loop needs no wake-up. Chosen by measurement (`limber bench --only command`).
+pub const DRIVER_LINGER: core::time::Duration = core::time::Duration::from_micros(50);

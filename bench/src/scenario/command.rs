@@ -6,7 +6,13 @@
 //! * spin: the driver busy-polls `DeviceHost::process`; the client spins
 //!   (`WaitMode::Spin`, no wake-up events): the driver's `--spin` mode.
 //! * blocking: the driver waits in `event_loop::run` (WaitSet on the wake listener); the
-//!   client blocks on the notify listener (`WaitMode::Event`, the default).
+//!   client blocks on the notify listener (`WaitMode::Event`, the default). Four variants
+//!   show what the two spin-then-block budgets give:
+//!   * `event`: the defaults, the client busy-polls for its answer for
+//!     `qos::default_spin_budget()` after sending and the driver keeps polling for
+//!     `qos::DRIVER_LINGER` after activity (`event_loop::linger`);
+//!   * `event-block`: both zero: pure blocking, one wake-up per direction;
+//!   * `event-cspin`: only the client's spin; `event-linger`: only the driver's linger.
 //!
 //! Round trip: client clock before `move_to` to after `wait_outcome`. One-way
 //! client→driver: `MsgMeta.stamp_ns` (set in `Client::send`) against the driver's clock
@@ -44,11 +50,18 @@ impl Scenario for Command {
         "limber-services command -> driver -> published outcome seen by the client (DeviceHost/Client), spin and event-driven"
     }
     fn run(&self, ctx: &mut RunCtx) -> Result<(), BenchError> {
-        if ctx.spin_enabled() {
+        let can_spin = ctx.spin_enabled();
+        if can_spin {
             run_mode(ctx, true)?;
         }
         if ctx.blocking_enabled() {
-            run_mode(ctx, false)?;
+            for v in EventVariant::ALL {
+                // Spinning needs a second core: without one, only pure blocking runs.
+                if v != EventVariant::Block && !can_spin {
+                    continue;
+                }
+                run_event(ctx, v)?;
+            }
         }
         Ok(())
     }
@@ -61,14 +74,82 @@ fn ctx_err(what: &str) -> impl Fn(String) -> BenchError + '_ {
     }
 }
 
+/// The event-driven variants: which spin-then-block budgets are on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EventVariant {
+    /// Both defaults (the client's spin budget and the driver's linger).
+    Default,
+    /// Neither: pure blocking.
+    Block,
+    /// Only the client's spin budget.
+    ClientSpin,
+    /// Only the driver's linger.
+    Linger,
+}
+
+impl EventVariant {
+    /// Every variant, the default first.
+    pub const ALL: [EventVariant; 4] = [
+        EventVariant::Default,
+        EventVariant::Block,
+        EventVariant::ClientSpin,
+        EventVariant::Linger,
+    ];
+    fn key(self) -> &'static str {
+        match self {
+            EventVariant::Default => "event",
+            EventVariant::Block => "event-block",
+            EventVariant::ClientSpin => "event-cspin",
+            EventVariant::Linger => "event-linger",
+        }
+    }
+    fn label(self) -> &'static str {
+        match self {
+            EventVariant::Default => "",
+            EventVariant::Block => " (pure blocking)",
+            EventVariant::ClientSpin => " (client spin only)",
+            EventVariant::Linger => " (driver linger only)",
+        }
+    }
+    fn client_spin(self) -> Duration {
+        match self {
+            EventVariant::Default | EventVariant::ClientSpin => {
+                limber_services::qos::default_spin_budget()
+            }
+            _ => Duration::ZERO,
+        }
+    }
+    fn driver_linger(self) -> Duration {
+        match self {
+            EventVariant::Default | EventVariant::Linger => limber_services::qos::DRIVER_LINGER,
+            _ => Duration::ZERO,
+        }
+    }
+}
+
+fn run_event(ctx: &mut RunCtx, v: EventVariant) -> Result<(), BenchError> {
+    run_variant(ctx, None, Some(v))
+}
+
 fn run_mode(ctx: &mut RunCtx, spin: bool) -> Result<(), BenchError> {
+    run_variant(ctx, Some(spin), None)
+}
+
+fn run_variant(
+    ctx: &mut RunCtx,
+    spin: Option<bool>,
+    variant: Option<EventVariant>,
+) -> Result<(), BenchError> {
+    let spin = spin.unwrap_or(false);
+    let variant = variant.unwrap_or(EventVariant::Default);
     let domain = ctx.domain();
     let (warm, n) = if spin {
         (ctx.count(5_000, 1_000), ctx.count(100_000, 10_000))
     } else {
         (ctx.count(500, 100), ctx.count(5_000, 1_000))
     };
-    let key = if spin { "spin" } else { "event" };
+    let key = if spin { "spin" } else { variant.key() };
+    let label = if spin { "" } else { variant.label() };
     let out = ctx.tmp_file(&format!("command-{key}.hdr"));
     let mut child = ChildProc::spawn(&ChildSpec {
         role: format!("cmd-driver-{}", if spin { "spin" } else { "event" }),
@@ -77,6 +158,7 @@ fn run_mode(ctx: &mut RunCtx, spin: bool) -> Result<(), BenchError> {
         cpu: ctx.child_cpu(),
         warmup: warm,
         deadline: ctx.deadline_for(warm + n, Duration::from_micros(100)),
+        linger: (!spin).then(|| variant.driver_linger()),
         ..Default::default()
     })?;
     child.expect("ready", READY_TIMEOUT)?;
@@ -88,6 +170,8 @@ fn run_mode(ctx: &mut RunCtx, spin: bool) -> Result<(), BenchError> {
     if spin {
         client.set_wait_mode(WaitMode::Spin);
         client.set_wake_driver(false);
+    } else {
+        client.set_spin_budget(variant.client_spin());
     }
 
     let mut rtt = new_histogram()?;
@@ -137,7 +221,7 @@ fn run_mode(ctx: &mut RunCtx, spin: bool) -> Result<(), BenchError> {
     ctx.push(Measurement {
         scenario: "command",
         id: format!("command.{key}.rtt"),
-        label: "command→outcome".into(),
+        label: format!("command→outcome{label}"),
         strategy,
         metric: Metric::RoundTrip,
         bytes: Some(BYTES),
@@ -146,7 +230,7 @@ fn run_mode(ctx: &mut RunCtx, spin: bool) -> Result<(), BenchError> {
     ctx.push(Measurement {
         scenario: "command",
         id: format!("command.{key}.oneway"),
-        label: "command client→driver".into(),
+        label: format!("command client→driver{label}"),
         strategy,
         metric: Metric::OneWay,
         bytes: Some(BYTES),
@@ -155,7 +239,7 @@ fn run_mode(ctx: &mut RunCtx, spin: bool) -> Result<(), BenchError> {
     ctx.push(Measurement {
         scenario: "command",
         id: format!("command.{key}.back"),
-        label: "outcome driver→client".into(),
+        label: format!("outcome driver→client{label}"),
         strategy,
         metric: Metric::OneWay,
         bytes: Some(BYTES),
@@ -259,9 +343,25 @@ pub fn driver_role(args: &BenchArgs, spin: bool) -> Result<(), BenchError> {
         let listeners = [wake];
         roles::announce("ready");
         let mut failure = None;
+        let linger = Duration::from_micros(args.linger_us);
         event_loop::run(&listeners, Duration::from_millis(50), None, |_wake| {
             if let Err(e) = host.process(&mut arm) {
                 failure = Some(e.to_string());
+                return ControlFlow::Break(());
+            }
+            event_loop::linger(linger, || {
+                if arm.stop || failure.is_some() {
+                    return false;
+                }
+                match host.process_spin(&mut arm) {
+                    Ok(a) => a.commands + a.requests > 0,
+                    Err(e) => {
+                        failure = Some(e.to_string());
+                        false
+                    }
+                }
+            });
+            if failure.is_some() {
                 return ControlFlow::Break(());
             }
             if arm.stop || Instant::now() > deadline {

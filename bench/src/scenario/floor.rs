@@ -24,7 +24,7 @@ use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PsFactory
 use limber_interfaces::prelude::*;
 use limber_services::monotonic_ns;
 
-use super::{READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario};
+use super::{READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario, physical};
 use crate::child::{ChildProc, ChildSpec, read_histogram};
 use crate::progress::Progress;
 use crate::roles;
@@ -48,13 +48,15 @@ impl Scenario for Floor {
         "floor"
     }
     fn description(&self) -> &'static str {
-        "raw iceoryx2 ping-pong, 296 B out / 1336 B back, 2 processes: spinning, and event wake-up (notify -> blocking listener, or WaitSet on the echo side)"
+        "the floors, 2 processes: a futex and a spinning cache-line ping-pong in shared memory (no middleware), and raw iceoryx2, 296 B out / 1336 B back: spinning, and event wake-up (notify -> blocking listener, or WaitSet on the echo side)"
     }
     fn run(&self, ctx: &mut RunCtx) -> Result<(), BenchError> {
         if ctx.spin_enabled() {
+            physical::ping_pong(ctx, physical::Wait::Spin)?;
             ping_pong(ctx, Echo::Spin)?;
         }
         if ctx.blocking_enabled() {
+            physical::ping_pong(ctx, physical::Wait::Futex)?;
             ping_pong(ctx, Echo::Listener)?;
             ping_pong(ctx, Echo::WaitSet)?;
         }
@@ -437,8 +439,10 @@ pub fn echo_role(args: &BenchArgs, echo: Echo) -> Result<(), BenchError> {
                     (Some(ws), Some(g)) => {
                         ws.wait_and_process_once_with_timeout(
                             |id| {
-                                if id.has_event_from(g) {
-                                    let _ = l.try_wait(|_| {});
+                                if id.has_event_from(g)
+                                    && let Err(e) = l.try_wait(|_| {})
+                                {
+                                    tracing::debug!("echo: consuming the wake-up: {e}");
                                 }
                                 CallbackProgression::Continue
                             },

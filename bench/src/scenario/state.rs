@@ -111,7 +111,7 @@ fn fanout(ctx: &mut RunCtx, fan: usize) -> Result<(), BenchError> {
     for out in &outs {
         merged
             .add(read_histogram(out)?)
-            .map_err(|e| BenchError::Histogram(format!("{e:?}")))?;
+            .map_err(|e| BenchError::Histogram(e.to_string()))?;
     }
     ctx.push(Measurement {
         scenario: "state",

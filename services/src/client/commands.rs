@@ -40,6 +40,7 @@ impl<I: Interface> Client<I> {
         if self.wake_driver {
             self.wake_driver_with(qos::EVENT_COMMAND);
         }
+        self.sent();
         if receivers == 0 {
             return Err(CommandError::NoDriver);
         }

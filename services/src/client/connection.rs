@@ -53,6 +53,10 @@ pub struct Client<I: Interface> {
     pub(super) wake_driver: bool,
     pub(super) wait_mode: WaitMode,
     pub(super) request_timeout: Duration,
+    /// In [`WaitMode::Event`], how long to busy-poll after sending before blocking.
+    pub(super) spin_budget: Duration,
+    /// Busy-poll until then (set by a send), then block.
+    pub(super) spin_until: Option<std::time::Instant>,
 }
 
 impl<I: Interface> core::fmt::Debug for Client<I> {
@@ -201,6 +205,8 @@ impl<I: Interface> Client<I> {
             wake_driver: true,
             wait_mode: WaitMode::Event,
             request_timeout: DEFAULT_REQUEST_TIMEOUT,
+            spin_budget: crate::qos::default_spin_budget(),
+            spin_until: None,
         })
     }
 
@@ -222,6 +228,27 @@ impl<I: Interface> Client<I> {
     /// How to wait for states and replies (default [`WaitMode::Event`]).
     pub fn set_wait_mode(&mut self, mode: WaitMode) {
         self.wait_mode = mode;
+    }
+
+    /// In [`WaitMode::Event`], how long a wait for an outcome, a reply or a state that
+    /// follows a command or request busy-polls before it blocks (default
+    /// [`crate::qos::default_spin_budget`]; zero: block at once). The answer of a driver
+    /// that is awake then arrives without a wake-up of this process, at the price of up to
+    /// this much CPU time per exchange.
+    pub fn set_spin_budget(&mut self, budget: Duration) {
+        self.spin_budget = budget;
+    }
+
+    /// The spin budget (see [`Client::set_spin_budget`]).
+    pub fn spin_budget(&self) -> Duration {
+        self.spin_budget
+    }
+
+    /// Starts the busy-poll window of a send.
+    pub(super) fn sent(&mut self) {
+        if !self.spin_budget.is_zero() {
+            self.spin_until = Some(std::time::Instant::now() + self.spin_budget);
+        }
     }
 
     /// Whether each command and request also wakes the driver with an event (default yes;

@@ -43,6 +43,7 @@ impl<I: Interface> Client<I> {
         if self.wake_driver {
             self.wake_driver_with(qos::EVENT_REQUEST);
         }
+        self.sent();
         let deadline = Instant::now() + timeout;
         let mut next_check = Instant::now() + LIVENESS_PERIOD;
         loop {

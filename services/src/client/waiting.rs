@@ -184,6 +184,14 @@ impl<I: Interface> Client<I> {
                 Ok(())
             }
             WaitMode::Event => {
+                // Right after a send: busy-poll for the answer of a driver that is awake.
+                if let Some(spin_end) = self.spin_until {
+                    if Instant::now() < spin_end.min(until) {
+                        core::hint::spin_loop();
+                        return Ok(());
+                    }
+                    self.spin_until = None;
+                }
                 if self.notify.is_none() {
                     let l = self.notify_svc.listener_builder().create()?;
                     self.notify = Some(l);
