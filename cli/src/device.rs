@@ -227,7 +227,7 @@ pub enum GripperVerb {
 pub(crate) fn connect_err(e: ConnectError) -> CliError {
     // A device missing because the robot lacks its hardware is said so, not blamed on a
     // driver that is not running.
-    if let ConnectError::NoDriver { device, domain } = &e
+    if let ConnectError::NoDriver { device, domain, .. } = &e
         && let Some(msg) = crate::lacks::explain(device, domain)
     {
         return CliError::new(exit::NO_DRIVER, msg);

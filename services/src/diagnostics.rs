@@ -35,7 +35,11 @@ pub fn service_name(robot: &str) -> Result<ServiceName, DiagnosticsError> {
 /// A driver that died is listed until its services are cleaned up.
 pub fn list_drivers(domain: &crate::Domain) -> Result<Vec<String>, crate::ListError> {
     let mut out = Vec::new();
-    ipc::Service::list(domain.config(), |details| {
+    let config = domain.config().map_err(|e| crate::ListError::Domain {
+        domain: domain.name().to_string(),
+        source: Box::new(e),
+    })?;
+    ipc::Service::list(config, |details| {
         let name = details.static_details.name().as_str();
         if let Some(robot) = name
             .strip_prefix("limber/")
