@@ -45,6 +45,7 @@ use crate::pose::{FrameError, Pose, all_finite};
 
 mod fk;
 mod ik;
+mod nearest;
 mod position;
 mod vecmove;
 
@@ -52,6 +53,7 @@ pub use fk::PioneerFkError;
 pub use ik::{
     Branch, EXACT_ORIENTATION, EXACT_POSITION, Elbow, IkCandidate, IkCandidates, Shoulder, Wrist,
 };
+pub use nearest::{ADJUSTMENT_REPORTED, ADJUSTMENT_TIE, PoseSolution};
 pub use position::ApproachPreference;
 pub use vecmove::{VecMove, VecMoveError, VecMoveOptions, Waypoint};
 
