@@ -162,8 +162,8 @@ impl ArmModel {
                 if !(position.is_finite() && approach.is_finite() && orientation.is_finite()) {
                     return Err(Status::NotFinite);
                 }
-                self.powered()?;
                 let s = self.solve_setpose(position, approach, orientation, &current)?;
+                self.powered()?;
                 self.vecmove.active = false;
                 self.move_joints_together(&s.q, 0.0);
                 if s.adjustment > ADJUSTMENT_REPORTED {
