@@ -26,8 +26,8 @@
 //! the test, and so does a marker that covers no command.
 
 use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
 use std::os::unix::process::ExitStatusExt;
+use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
@@ -308,7 +308,9 @@ impl Session {
 
     fn background(&mut self, exe: &Path, args: &[String], what: &str) -> Result<(), String> {
         let mut job = Job::start(exe, args, self.domain.name(), what);
-        let driver = args.first().is_some_and(|a| a == "pioneer" || a == "simarm");
+        let driver = args
+            .first()
+            .is_some_and(|a| a == "pioneer" || a == "simarm");
         if driver {
             job.wait_line(|l| l.ends_with("ready"), START_TIMEOUT)
                 .map_err(|seen| format!("{what}: no \"ready\" line:\n{seen}"))?;
@@ -355,7 +357,11 @@ impl Session {
         };
         let words: Vec<&str> = cmd.split_whitespace().collect();
         let (exe, args) = program(&words).ok_or(format!("{cmd}: not a command this test runs"))?;
-        if !(args.first().is_some_and(|a| a == "pioneer" || a == "simarm") && background) {
+        if !(args
+            .first()
+            .is_some_and(|a| a == "pioneer" || a == "simarm")
+            && background)
+        {
             self.driver_for(cmd)?;
         }
         if background {
@@ -388,7 +394,9 @@ impl Session {
         if let Some(f) = to_file {
             let want = std::fs::read_to_string(repo().join(f)).map_err(|e| format!("{f}: {e}"))?;
             if stdout(&o) != want {
-                return Err(format!("{cmd}: its output differs from {f} (regenerate it)"));
+                return Err(format!(
+                    "{cmd}: its output differs from {f} (regenerate it)"
+                ));
             }
         }
         Ok(())
@@ -408,7 +416,9 @@ fn run_block(place: &str, commands: &[String]) -> Vec<String> {
 }
 
 fn covered(not_run: &[(String, String)], cmd: &str) -> bool {
-    not_run.iter().any(|(p, _)| p == "*" || cmd.starts_with(p.as_str()))
+    not_run
+        .iter()
+        .any(|(p, _)| p == "*" || cmd.starts_with(p.as_str()))
 }
 
 /// Runs every block of `files`; the number of commands run.
@@ -475,9 +485,12 @@ fn commands_are_read_as_a_shell_would() {
     assert_eq!(strip_comment("# a comment"), "");
     assert_eq!(strip_comment("echo 'a # b'"), "echo 'a # b'");
     assert_eq!(strip_comment("kill %1"), "kill %1");
-    let (exe, args) = program(&["cargo", "run", "--release", "--bin", "limber", "--", "demo"])
-        .unwrap();
-    assert_eq!((exe.to_str().unwrap(), args), (LIMBER, vec!["demo".to_string()]));
+    let (exe, args) =
+        program(&["cargo", "run", "--release", "--bin", "limber", "--", "demo"]).unwrap();
+    assert_eq!(
+        (exe.to_str().unwrap(), args),
+        (LIMBER, vec!["demo".to_string()])
+    );
     let (exe, _) = program(&["cargo", "run", "-p", "limber-cli", "--", "layout"]).unwrap();
     assert_eq!(exe.to_str().unwrap(), LIMBER);
     assert!(program(&["bash", ".ci/run"]).is_none());

@@ -423,7 +423,10 @@ fn manifest_describes_every_struct_without_padding() {
 fn every_status_code_decodes_to_itself_and_names_its_cause() {
     for (i, s) in Status::ALL.iter().enumerate() {
         if i > 0 {
-            assert!(Status::ALL[i - 1].code() < s.code(), "{s:?} out of code order");
+            assert!(
+                Status::ALL[i - 1].code() < s.code(),
+                "{s:?} out of code order"
+            );
         }
         assert_eq!(Status::try_from(s.code()), Ok(*s));
     }
@@ -442,9 +445,10 @@ fn every_status_code_decodes_to_itself_and_names_its_cause() {
     assert!(Status::Clamped.is_carried_out() && !Status::Clamped.is_ok());
     assert!(Status::Ok.is_carried_out());
     assert!(
-        Status::ALL[1..]
-            .iter()
-            .filter(|s| s.is_carried_out())
-            .eq([Status::Clamped, Status::Adjusted].iter())
+        Status::ALL[1..].iter().filter(|s| s.is_carried_out()).eq([
+            Status::Clamped,
+            Status::Adjusted
+        ]
+        .iter())
     );
 }

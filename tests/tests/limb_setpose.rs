@@ -161,7 +161,9 @@ fn reach_answers_where_the_arm_would_end_without_moving() {
         "{reach:?}"
     );
     assert!(reach.orientation_adjustment > 1e-3 && reach.orientation_adjustment < 3e-3);
-    let exact = limb.reach(README_P, DOWN, [0.939793, 0.341743, 0.0]).unwrap();
+    let exact = limb
+        .reach(README_P, DOWN, [0.939793, 0.341743, 0.0])
+        .unwrap();
     assert_eq!(exact.adjusted, 0, "{exact:?}");
     // Nothing moved: the arm is idle where it was, the last command's outcome unchanged.
     for _ in 0..5 {

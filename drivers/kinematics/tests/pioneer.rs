@@ -620,7 +620,12 @@ fn setpose_takes_the_readme_orientation_and_says_how_much_it_adjusted() {
     eprintln!("4 decimals: {s4:?}");
     assert!(s4.adjusted() && s4.adjustment < s.adjustment, "{s4:?}");
     // Six decimals: round-off, carried out as asked.
-    let s6 = setpose([0.38, 0.1, 0.22], [0.0, 0.0, -1.0], [0.939793, 0.341743, 0.0]).unwrap();
+    let s6 = setpose(
+        [0.38, 0.1, 0.22],
+        [0.0, 0.0, -1.0],
+        [0.939793, 0.341743, 0.0],
+    )
+    .unwrap();
     eprintln!("6 decimals: {s6:?}");
     assert!(!s6.adjusted(), "{s6:?}");
     // The achieved frame is the one reported: position and approach as asked.
@@ -681,6 +686,8 @@ fn setpose_nearest_honours_its_tolerances() {
         position_tolerance: 1e-6,
         ..pose_opts()
     };
-    let e = g.solve_setpose_nearest(&p, &a, &o, &[0.0; 5], &tight).unwrap_err();
+    let e = g
+        .solve_setpose_nearest(&p, &a, &o, &[0.0; 5], &tight)
+        .unwrap_err();
     assert!(matches!(e, PioneerIkError::OutOfReach { .. }), "{e:?}");
 }

@@ -126,11 +126,7 @@ impl Chain {
                 continue;
             }
             let adjustment = angle_between_rotations(&achieved.rotation, &target.rotation);
-            let distance: f64 = q
-                .iter()
-                .zip(seed)
-                .map(|(x, y)| (x - y) * (x - y))
-                .sum();
+            let distance: f64 = q.iter().zip(seed).map(|(x, y)| (x - y) * (x - y)).sum();
             let better = best.as_ref().is_none_or(|(adj, dist, _)| {
                 adjustment < adj - 1e-9 || (adjustment <= adj + 1e-9 && distance < *dist)
             });
@@ -228,4 +224,3 @@ impl Chain {
 fn angle(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
     a.cross(b).norm().atan2(a.dot(b))
 }
-

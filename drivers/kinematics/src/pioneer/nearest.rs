@@ -20,8 +20,8 @@
 
 use nalgebra::Vector3;
 
-use super::{PioneerGeometry, PioneerIkError, PioneerIkOptions, Theta, joint_distance};
 use super::{IkCandidate, vector_angle};
+use super::{PioneerGeometry, PioneerIkError, PioneerIkOptions, Theta, joint_distance};
 use crate::pose::Pose;
 
 /// Position (m) and approach (rad) errors up to this are round-off: the candidate
