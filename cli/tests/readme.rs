@@ -421,8 +421,8 @@ fn covered(not_run: &[(String, String)], cmd: &str) -> bool {
         .any(|(p, _)| p == "*" || cmd.starts_with(p.as_str()))
 }
 
-/// Runs every block of `files`; the number of commands run.
-fn check(files: &[String]) -> usize {
+/// Runs every block of `files`: the failures and the number of commands run.
+fn failures(files: &[String]) -> (Vec<String>, usize) {
     let blocks = documented(files);
     let mut failures = Vec::new();
     let mut ran = 0;
@@ -445,6 +445,12 @@ fn check(files: &[String]) -> usize {
         ran += run.len();
         failures.extend(run_block(&place, &run));
     }
+    (failures, ran)
+}
+
+/// Runs every block of `files`, failing on any failure; the number of commands run.
+fn check(files: &[String]) -> usize {
+    let (failures, ran) = failures(files);
     assert!(failures.is_empty(), "{}", failures.join("\n\n"));
     ran
 }
@@ -495,4 +501,35 @@ fn commands_are_read_as_a_shell_would() {
     assert_eq!(exe.to_str().unwrap(), LIMBER);
     assert!(program(&["bash", ".ci/run"]).is_none());
     assert!(program(&["cargo", "build", "--release"]).is_none());
+}
+
+#[test]
+fn a_command_neither_run_nor_marked_fails_and_so_does_a_stale_marker() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+    let write = |name: &str, text: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p.display().to_string()
+    };
+    let unmarked = write("unmarked.md", "```sh\nbash .ci/run\n```\n");
+    let (f, _) = failures(&[unmarked]);
+    assert!(
+        f.len() == 1 && f[0].contains("not a command this test runs"),
+        "{f:?}"
+    );
+    let failing = write("failing.md", "```sh\nlimber layout --bogus\n```\n");
+    let (f, _) = failures(&[failing]);
+    assert!(f.len() == 1 && f[0].contains("--bogus"), "{f:?}");
+    let stale = write(
+        "stale.md",
+        "<!-- not run by tests: cargo build | slow -->\n```sh\nlimber layout\n```\n",
+    );
+    let (f, ran) = failures(&[stale]);
+    assert!(f.len() == 1 && f[0].contains("covers no command"), "{f:?}");
+    assert_eq!(ran, 1);
+    let marked = write(
+        "marked.md",
+        "<!-- not run by tests: bash .ci/run | every test -->\n```sh\nbash .ci/run\n```\n",
+    );
+    assert_eq!(failures(&[marked]), (vec![], 0));
 }
