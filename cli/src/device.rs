@@ -165,6 +165,20 @@ pub enum LimbVerb {
         #[arg(long, num_args = 3, allow_negative_numbers = true, default_values_t = [0.0, 0.0, 1.0], value_names = ["OX", "OY", "OZ"])]
         orient: Vec<f64>,
     },
+    /// Where would this setpose end, and how much would it adjust the orientation?
+    /// Nothing moves (request). Exit 0 when the limb can get there, 5 (refused, with the
+    /// cause) when it cannot.
+    Reach {
+        /// x, y, z in m.
+        #[arg(num_args = 3, required = true, allow_negative_numbers = true, value_names = ["X", "Y", "Z"])]
+        position: Vec<f64>,
+        /// Approach vector (forward along the gripper).
+        #[arg(long, num_args = 3, allow_negative_numbers = true, default_values_t = [1.0, 0.0, 0.0], value_names = ["AX", "AY", "AZ"])]
+        approach: Vec<f64>,
+        /// Orientation vector ("up" from the gripper).
+        #[arg(long, num_args = 3, allow_negative_numbers = true, default_values_t = [0.0, 0.0, 1.0], value_names = ["OX", "OY", "OZ"])]
+        orient: Vec<f64>,
+    },
     /// Move the end effector to a position; the driver chooses the orientation.
     Setposition {
         /// x, y, z in m.
@@ -404,6 +418,38 @@ pub fn limb(a: LimbArgs) -> Result<(), CliError> {
         LimbVerb::Power { value } => return done(c.power(value.on())),
         LimbVerb::Brakes { value } => return done(c.brakes(value.on())),
         LimbVerb::Speed { speed } => return done(c.set_speed(speed)),
+        LimbVerb::Reach {
+            position,
+            approach,
+            orient,
+        } => {
+            let r = c
+                .reach(v3(&position), v3(&approach), v3(&orient))
+                .map_err(request_err)?;
+            let f = |v: Vec3| format!("({:.4}, {:.4}, {:.4})", v.x, v.y, v.z);
+            outln!(
+                "would end at {} m, approach {}, orientation {}",
+                f(r.position),
+                f(r.approach),
+                f(r.orientation)
+            )?;
+            if r.adjusted != 0 {
+                outln!(
+                    "orientation adjusted by {:.6} rad ({:.4} deg); position off by {:.6} m, approach by {:.6} rad",
+                    r.orientation_adjustment,
+                    r.orientation_adjustment.to_degrees(),
+                    r.position_error,
+                    r.approach_error
+                )?;
+            } else {
+                outln!(
+                    "as asked (position off by {:.6} m, approach by {:.6} rad)",
+                    r.position_error,
+                    r.approach_error
+                )?;
+            }
+            return Ok(());
+        }
         LimbVerb::Geom => {
             let g = c.geometry().map_err(request_err)?;
             outln!(

@@ -62,10 +62,16 @@ fn header_human(h: &StateHeader) -> String {
         s.push_str(" LINK DOWN");
     }
     if h.last_cmd.client_id != 0 && h.last_cmd.status != 0 {
-        let st = Status::try_from(h.last_cmd.status)
-            .map(|s| s.describe())
-            .unwrap_or("?");
-        let _ = write!(s, " [last command refused: {st}]");
+        match Status::try_from(h.last_cmd.status) {
+            // "ok, clamped to the limit", "ok, orientation adjusted": carried out.
+            Ok(st) if st.is_carried_out() => {
+                let _ = write!(s, " [last command: {st}]");
+            }
+            Ok(st) => {
+                let _ = write!(s, " [last command refused: {st}]");
+            }
+            Err(_) => s.push_str(" [last command refused: ?]"),
+        }
     }
     s
 }
@@ -123,8 +129,16 @@ fn limb_state_name(v: u32) -> &'static str {
 impl Show for LimbData {
     fn human(&self) -> String {
         let (p, a, o) = (self.position, self.approach, self.orientation);
+        let adjusted = if self.orientation_adjustment > 0.0 {
+            format!(
+                " (orientation adjusted by {:.6} rad)",
+                self.orientation_adjustment
+            )
+        } else {
+            String::new()
+        };
         format!(
-            "{} {:<12} pos ({:+.4}, {:+.4}, {:+.4}) approach ({:+.3}, {:+.3}, {:+.3}) orient ({:+.3}, {:+.3}, {:+.3})",
+            "{} {:<12} pos ({:+.4}, {:+.4}, {:+.4}) approach ({:+.3}, {:+.3}, {:+.3}) orient ({:+.3}, {:+.3}, {:+.3}){adjusted}",
             header_human(&self.header),
             limb_state_name(self.state),
             p.x,
@@ -145,6 +159,7 @@ impl Show for LimbData {
             "position": self.position.to_array(),
             "approach": self.approach.to_array(),
             "orientation": self.orientation.to_array(),
+            "orientation_adjustment": self.orientation_adjustment,
         })
     }
 }

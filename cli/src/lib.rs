@@ -72,9 +72,13 @@ enum Command {
     /// Example: limber actarray pioneer/actarray/0 pos 2 0.5
     Actarray(device::ActArrayArgs),
     /// Command a limb: home, stop, setpose, setposition, vecmove; requests power, brakes,
-    /// geom, speed.
+    /// geom, speed, reach (where would a setpose end, without moving).
     ///
-    /// Example: limber limb pioneer/limb/0 setpose 0.3 0 0.2 --approach 0 0 -1 --orient 1 0 0
+    /// On a 5-joint arm, setpose meets the position and the approach (within the driver's
+    /// tolerances) and turns the orientation to the nearest one the joints can hold: it
+    /// answers "ok, orientation adjusted" and the limb state says by how much.
+    ///
+    /// Example: limber limb pioneer/limb/0 setpose 0.4 0 0.2 --approach 0 0 -1 --orient 1 0 0
     Limb(device::LimbArgs),
     /// Command a gripper: open, close, stop, store, retrieve; request geom.
     ///

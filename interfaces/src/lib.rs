@@ -7,7 +7,7 @@
 //! * Wire structs are `#[repr(C)]`, have no implicit padding (explicit `_pad` fields,
 //!   checked at compile time), derive zerocopy's `FromBytes`/`IntoBytes`/`KnownLayout`/
 //!   `Immutable` and iceoryx2's `ZeroCopySend`, and carry a versioned type name
-//!   (`limber.v1.ActArrayData`). iceoryx2 only compares name, size and alignment when a
+//!   (`limber.v2.ActArrayData`). iceoryx2 only compares name, size and alignment when a
 //!   service is opened, so the version in the name changes whenever a layout changes.
 //! * Units are SI: m, rad, s, m/s, rad/s, A. No `bool` or Rust enum on the wire: `u32`
 //!   codes, decoded by typed views that reject unknown values with a [`DecodeError`].
@@ -58,7 +58,7 @@ pub use message::{Envelope, Message, ReplyBody, ReplyEnvelope};
 pub use wire::{WireField, WireStruct};
 
 /// The layout version carried in every type name.
-pub const LAYOUT_VERSION: u32 = 1;
+pub const LAYOUT_VERSION: u32 = 2;
 
 /// Everything a driver or client author needs, in one `use`.
 pub mod prelude {
@@ -79,8 +79,8 @@ pub mod prelude {
     };
     pub use crate::interface::{ActArray, Gripper, HasHeader, Interface, InterfaceKind, Limb};
     pub use crate::limb::{
-        LimbCmdMsg, LimbCommand, LimbData, LimbGeom, LimbReply, LimbReplyMsg, LimbReqMsg,
-        LimbRequest, LimbState,
+        LimbCmdMsg, LimbCommand, LimbData, LimbGeom, LimbReach, LimbReply, LimbReplyMsg,
+        LimbReqMsg, LimbRequest, LimbState,
     };
     pub use crate::message::{Envelope, Message, ReplyBody, ReplyEnvelope};
 }
@@ -130,8 +130,10 @@ pub fn manifest() -> Manifest {
         LimbPowerReq::LAYOUT,
         LimbBrakesReq::LAYOUT,
         LimbSpeedReq::LAYOUT,
+        LimbReachReq::LAYOUT,
         LimbReqMsg::LAYOUT,
         LimbGeom::LAYOUT,
+        LimbReach::LAYOUT,
         LimbReplyMsg::LAYOUT,
         // gripper
         GripperData::LAYOUT,

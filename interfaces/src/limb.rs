@@ -2,8 +2,19 @@
 //!
 //! State: [`LimbData`] (position, approach and orientation vectors in robot coordinates).
 //! Commands ([`LimbCommand`], envelope [`LimbCmdMsg`]): HOME, STOP, SETPOSE, SETPOSITION,
-//! VECMOVE. Requests ([`LimbRequest`], envelope [`LimbReqMsg`]): POWER, BRAKES, GEOM, SPEED;
-//! replies in [`LimbReplyMsg`] ([`LimbReply`]).
+//! VECMOVE. Requests ([`LimbRequest`], envelope [`LimbReqMsg`]): POWER, BRAKES, GEOM, SPEED,
+//! and REACH (limber's own: where would a SETPOSE end, without moving); replies in
+//! [`LimbReplyMsg`] ([`LimbReply`]).
+//!
+//! # SETPOSE on a limb with fewer than six joints
+//!
+//! Five joints cannot hold every frame: once the position and the approach are fixed,
+//! the orientation vector is fixed too (up to a few branches). A SETPOSE therefore puts
+//! the end effector at the position and the approach (within the driver's documented
+//! tolerances) and turns the orientation to the nearest one the joints can hold. The
+//! outcome is `Status::Adjusted` when that changed the orientation by more than round-off,
+//! and [`LimbData::orientation_adjustment`] says by how much (rad). Poses beyond the
+//! reach or the joint limits are refused with their cause.
 
 use crate::actarray::on_off;
 use crate::common::{MsgMeta, ReplyMeta, StateHeader, Status, Vec3, finite_vec};
@@ -37,6 +48,8 @@ pub mod req {
     pub const GEOM: u32 = 3;
     /// Set the end-effector speed.
     pub const SPEED: u32 = 4;
+    /// Where would a SETPOSE to this pose end? Nothing moves (limber's own).
+    pub const REACH: u32 = 5;
 }
 
 /// The limb's state (Player's `PLAYER_LIMB_STATE_*`): plain values, not bits.
@@ -76,7 +89,7 @@ impl TryFrom<u32> for LimbState {
 
 wire_struct! {
     /// The limb's state (channel `data`).
-    pub struct LimbData : "limber.v1.LimbData", size = 128, align = 8 {
+    pub struct LimbData : "limber.v2.LimbData", size = 136, align = 8 {
         /// Common header.
         pub header: StateHeader,
         /// End-effector position, robot coordinates, m.
@@ -89,12 +102,16 @@ wire_struct! {
         pub state: u32,
         /// Reserved, zero.
         pub _pad: u32,
+        /// How much the last SETPOSE turned the requested orientation to the nearest one
+        /// the joints can hold, rad (0 when it was held as asked; cleared by the next
+        /// limb command).
+        pub orientation_adjustment: f64,
     }
 }
 
 wire_struct! {
     /// CMD SETPOSE: move the end effector to a pose.
-    pub struct LimbSetPoseCmd : "limber.v1.LimbSetPoseCmd", size = 72, align = 8 {
+    pub struct LimbSetPoseCmd : "limber.v2.LimbSetPoseCmd", size = 72, align = 8 {
         /// Target position, robot coordinates, m.
         pub position: Vec3,
         /// Target approach vector (need not be unit length, must not be zero).
@@ -106,7 +123,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD SETPOSITION: move the end effector to a position, orientation left to the driver.
-    pub struct LimbSetPositionCmd : "limber.v1.LimbSetPositionCmd", size = 24, align = 8 {
+    pub struct LimbSetPositionCmd : "limber.v2.LimbSetPositionCmd", size = 24, align = 8 {
         /// Target position, robot coordinates, m.
         pub position: Vec3,
     }
@@ -114,7 +131,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD VECMOVE: move the end effector `length` m along `direction` in a straight line.
-    pub struct LimbVecMoveCmd : "limber.v1.LimbVecMoveCmd", size = 32, align = 8 {
+    pub struct LimbVecMoveCmd : "limber.v2.LimbVecMoveCmd", size = 32, align = 8 {
         /// Direction (need not be unit length, must not be zero).
         pub direction: Vec3,
         /// Distance, m.
@@ -124,7 +141,7 @@ wire_struct! {
 
 wire_struct! {
     /// The command envelope (channel `cmd`). HOME and STOP have an empty body.
-    pub struct LimbCmdMsg : "limber.v1.LimbCmdMsg", size = 104, align = 8 {
+    pub struct LimbCmdMsg : "limber.v2.LimbCmdMsg", size = 104, align = 8 {
         /// Sender, sequence, time, kind, body length.
         pub meta: MsgMeta,
         /// One of the `Limb*Cmd` structs.
@@ -134,7 +151,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ POWER: power on (1) or off (0).
-    pub struct LimbPowerReq : "limber.v1.LimbPowerReq", size = 4, align = 4 {
+    pub struct LimbPowerReq : "limber.v2.LimbPowerReq", size = 4, align = 4 {
         /// 0 off, 1 on.
         pub value: u32,
     }
@@ -142,7 +159,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ BRAKES: brakes on (1) or off (0).
-    pub struct LimbBrakesReq : "limber.v1.LimbBrakesReq", size = 4, align = 4 {
+    pub struct LimbBrakesReq : "limber.v2.LimbBrakesReq", size = 4, align = 4 {
         /// 0 off, 1 on.
         pub value: u32,
     }
@@ -150,37 +167,72 @@ wire_struct! {
 
 wire_struct! {
     /// REQ SPEED: the end-effector speed for later moves, m/s.
-    pub struct LimbSpeedReq : "limber.v1.LimbSpeedReq", size = 8, align = 8 {
+    pub struct LimbSpeedReq : "limber.v2.LimbSpeedReq", size = 8, align = 8 {
         /// Speed, m/s.
         pub speed: f64,
     }
 }
 
 wire_struct! {
+    /// REQ REACH: the pose a SETPOSE would ask for (same fields as [`LimbSetPoseCmd`]).
+    pub struct LimbReachReq : "limber.v2.LimbReachReq", size = 72, align = 8 {
+        /// Target position, robot coordinates, m.
+        pub position: Vec3,
+        /// Target approach vector (non-zero).
+        pub approach: Vec3,
+        /// Target orientation vector (non-zero).
+        pub orientation: Vec3,
+    }
+}
+
+wire_struct! {
     /// The request envelope (channel `req`). GEOM has an empty body.
-    pub struct LimbReqMsg : "limber.v1.LimbReqMsg", size = 40, align = 8 {
+    pub struct LimbReqMsg : "limber.v2.LimbReqMsg", size = 104, align = 8 {
         /// Sender, sequence, time, kind, body length.
         pub meta: MsgMeta,
         /// One of the `Limb*Req` structs.
-        pub body: [u8; 8],
+        pub body: [u8; 72],
     }
 }
 
 wire_struct! {
     /// The limb geometry (the GEOM reply).
-    pub struct LimbGeom : "limber.v1.LimbGeom", size = 24, align = 8 {
+    pub struct LimbGeom : "limber.v2.LimbGeom", size = 24, align = 8 {
         /// The limb base in robot coordinates, m.
         pub base_pos: Vec3,
     }
 }
 
 wire_struct! {
+    /// The REACH reply: where a SETPOSE to the requested pose would end (before the
+    /// joints are rounded to the hardware's resolution) and what it would change.
+    pub struct LimbReach : "limber.v2.LimbReach", size = 104, align = 8 {
+        /// End-effector position it would end at, robot coordinates, m.
+        pub position: Vec3,
+        /// Approach vector it would end with.
+        pub approach: Vec3,
+        /// Orientation vector it would end with.
+        pub orientation: Vec3,
+        /// How much the orientation would be turned to one the joints can hold, rad.
+        pub orientation_adjustment: f64,
+        /// Distance from the requested position, m.
+        pub position_error: f64,
+        /// Angle from the requested approach, rad.
+        pub approach_error: f64,
+        /// 1 when a SETPOSE would answer `ADJUSTED`, 0 when `OK`.
+        pub adjusted: u32,
+        /// Reserved, zero.
+        pub _pad: u32,
+    }
+}
+
+wire_struct! {
     /// The reply envelope (channel `req`).
-    pub struct LimbReplyMsg : "limber.v1.LimbReplyMsg", size = 56, align = 8 {
+    pub struct LimbReplyMsg : "limber.v2.LimbReplyMsg", size = 136, align = 8 {
         /// Client, sequence, time, kind, status.
         pub meta: ReplyMeta,
-        /// `LimbGeom` for GEOM, empty otherwise.
-        pub body: [u8; 24],
+        /// `LimbGeom` for GEOM, `LimbReach` for REACH, empty otherwise.
+        pub body: [u8; 104],
     }
 }
 
@@ -355,9 +407,27 @@ pub enum LimbRequest {
     Geom,
     /// Set the end-effector speed, m/s (finite).
     Speed(f64),
+    /// Where would a SETPOSE to this pose end? Nothing moves.
+    Reach {
+        /// Position, robot coordinates, m.
+        position: Vec3,
+        /// Approach vector (non-zero).
+        approach: Vec3,
+        /// Orientation vector (non-zero).
+        orientation: Vec3,
+    },
 }
 
 impl LimbRequest {
+    /// REQ REACH, validated like SETPOSE (finite, non-zero approach and orientation).
+    pub fn reach(position: Vec3, approach: Vec3, orientation: Vec3) -> Result<Self, ValueError> {
+        Ok(LimbRequest::Reach {
+            position: point("position", position)?,
+            approach: direction("approach", approach)?,
+            orientation: direction("orientation", orientation)?,
+        })
+    }
+
     /// REQ SPEED, validated.
     pub fn speed(speed: f64) -> Result<Self, ValueError> {
         if speed.is_finite() {
@@ -378,6 +448,7 @@ impl Message for LimbRequest {
             LimbRequest::Brakes(_) => req::BRAKES,
             LimbRequest::Geom => req::GEOM,
             LimbRequest::Speed(_) => req::SPEED,
+            LimbRequest::Reach { .. } => req::REACH,
         }
     }
 
@@ -391,6 +462,18 @@ impl Message for LimbRequest {
                 0
             }
             LimbRequest::Speed(speed) => message::put(b, &LimbSpeedReq { speed }),
+            LimbRequest::Reach {
+                position,
+                approach,
+                orientation,
+            } => message::put(
+                b,
+                &LimbReachReq {
+                    position,
+                    approach,
+                    orientation,
+                },
+            ),
         };
         raw.meta.kind = self.kind();
         raw.meta.body_len = len;
@@ -416,6 +499,10 @@ impl Message for LimbRequest {
                 let r: LimbSpeedReq = message::get(ch, k, b, n)?;
                 LimbRequest::speed(r.speed)?
             }
+            req::REACH => {
+                let r: LimbReachReq = message::get(ch, k, b, n)?;
+                LimbRequest::reach(r.position, r.approach, r.orientation)?
+            }
             _ => {
                 return Err(DecodeError::UnknownKind {
                     channel: ch,
@@ -433,6 +520,8 @@ pub enum LimbReply {
     Done,
     /// The geometry (GEOM).
     Geom(LimbGeom),
+    /// Where a SETPOSE would end (REACH).
+    Reach(LimbReach),
 }
 
 impl ReplyBody for LimbReply {
@@ -448,6 +537,10 @@ impl ReplyBody for LimbReply {
             Ok(LimbReply::Geom(g)) => {
                 raw.meta.status = Status::Ok.code();
                 message::put(&mut raw.body, g);
+            }
+            Ok(LimbReply::Reach(r)) => {
+                raw.meta.status = Status::Ok.code();
+                message::put(&mut raw.body, r);
             }
             Err(s) => {
                 raw.meta.status = s.code();
@@ -472,12 +565,42 @@ impl ReplyBody for LimbReply {
                 finite_vec("base_pos", g.base_pos)?;
                 Ok(Ok(LimbReply::Geom(g)))
             }
+            req::REACH => {
+                let r: LimbReach = message::get(
+                    "limb reply",
+                    req::REACH,
+                    &raw.body,
+                    core::mem::size_of::<LimbReach>() as u32,
+                )?;
+                r.validate()?;
+                Ok(Ok(LimbReply::Reach(r)))
+            }
             req::POWER | req::BRAKES | req::SPEED => Ok(Ok(LimbReply::Done)),
             k => Err(DecodeError::UnknownKind {
                 channel: "limb reply",
                 kind: k,
             }),
         }
+    }
+}
+
+impl LimbReach {
+    /// Checks that every number is finite and `adjusted` is 0 or 1.
+    pub fn validate(&self) -> Result<(), DecodeError> {
+        finite_vec("position", self.position)?;
+        finite_vec("approach", self.approach)?;
+        finite_vec("orientation", self.orientation)?;
+        for (field, v) in [
+            ("orientation_adjustment", self.orientation_adjustment),
+            ("position_error", self.position_error),
+            ("approach_error", self.approach_error),
+        ] {
+            if !v.is_finite() {
+                return Err(DecodeError::Value(ValueError::NotFinite { field }));
+            }
+        }
+        on_off("adjusted", self.adjusted)?;
+        Ok(())
     }
 }
 
@@ -493,6 +616,11 @@ impl LimbData {
         finite_vec("position", self.position)?;
         finite_vec("approach", self.approach)?;
         finite_vec("orientation", self.orientation)?;
+        if !self.orientation_adjustment.is_finite() {
+            return Err(DecodeError::Value(ValueError::NotFinite {
+                field: "orientation_adjustment",
+            }));
+        }
         Ok(())
     }
 }
@@ -552,6 +680,11 @@ pub(crate) const GROUPS: &[ConstantGroup] = &[
                 name: "SPEED",
                 value: 4,
                 doc: "LimbSpeedReq; reply empty",
+            },
+            Constant {
+                name: "REACH",
+                value: 5,
+                doc: "LimbReachReq; reply LimbReach (nothing moves)",
             },
         ],
     },

@@ -129,6 +129,7 @@ class Status(enum.IntEnum):
     POWERED_OFF = L.STATUS_POWERED_OFF
     UNREACHABLE_ORIENTATION = L.STATUS_UNREACHABLE_ORIENTATION
     CLAMPED = L.STATUS_CLAMPED
+    ADJUSTED = L.STATUS_ADJUSTED
 
     @property
     def is_ok(self) -> bool:
@@ -137,8 +138,9 @@ class Status(enum.IntEnum):
 
     @property
     def is_carried_out(self) -> bool:
-        """``OK`` or ``CLAMPED`` (carried out with a value clamped to the limit)."""
-        return self in (Status.OK, Status.CLAMPED)
+        """``OK``, ``CLAMPED`` (carried out with a value clamped to the limit) or
+        ``ADJUSTED`` (carried out with the orientation turned to one the joints can hold)."""
+        return self in (Status.OK, Status.CLAMPED, Status.ADJUSTED)
 
     def __str__(self) -> str:
         return self.name
@@ -163,6 +165,7 @@ _STATUS_TEXT = {
     Status.POWERED_OFF: "powered off",
     Status.UNREACHABLE_ORIENTATION: "orientation not attainable by this limb's joints",
     Status.CLAMPED: "ok, clamped to the limit",
+    Status.ADJUSTED: "ok, orientation adjusted",
 }
 
 
@@ -1203,6 +1206,24 @@ class LimbClient(_Client):
         if not _all_finite(g.base_pos.x, g.base_pos.y, g.base_pos.z):
             raise DecodeError("undecodable reply: base_pos is not finite")
         return g
+
+    def reach(self, position: Sequence[float], approach: Sequence[float],
+              orientation: Sequence[float], *, timeout: Optional[float] = None) -> "L.LimbReach":
+        """REQ REACH: where a SETPOSE to this pose would end (a ``LimbReach`` ctypes struct:
+        the pose, ``orientation_adjustment`` in rad, ``adjusted`` 0 or 1); nothing moves.
+        A pose the limb cannot get to raises :class:`NackError` with its cause."""
+        body = L.LimbReachReq(
+            position=_vec3("position", position),
+            approach=_direction("approach", approach),
+            orientation=_direction("orientation", orientation),
+        )
+        reply = self._request(L.LIMB_REQ_REACH, body, timeout)
+        r = _body(L.LimbReach, reply.body)
+        v = r.position, r.approach, r.orientation
+        if not _all_finite(*(c for p in v for c in (p.x, p.y, p.z)), r.orientation_adjustment,
+                           r.position_error, r.approach_error) or r.adjusted not in (0, 1):
+            raise DecodeError("undecodable reply: REACH values not finite or flag not 0/1")
+        return r
 
 
 # ----- gripper ---------------------------------------------------------------------------

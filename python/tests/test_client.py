@@ -326,6 +326,21 @@ def test_limb_out_of_reach_and_moves(limb):
     assert limb.wait_outcome(limb.stop(), T) is Status.OK
 
 
+def test_limb_reach_answers_without_moving(limb):
+    before = limb.wait_state(T).position
+    r = limb.reach([0.3, 0.1, 0.2], [0, 0, -1], [1, 0, 0])
+    assert isinstance(r, L.LimbReach)
+    assert (r.position.x, r.position.y, r.position.z) == (0.3, 0.1, 0.2)
+    assert r.adjusted == 0 and r.orientation_adjustment == 0.0
+    after = limb.wait_state(T).position
+    assert (after.x, after.y, after.z) == (before.x, before.y, before.z)
+    with pytest.raises(NackError) as e:
+        limb.reach([3.0, 0.0, 0.0], [0, 0, -1], [1, 0, 0])
+    assert e.value.status is Status.OUT_OF_REACH
+    with pytest.raises(ValueError):
+        limb.reach([0.3, 0.0, 0.2], [0, 0, 0], [1, 0, 0])
+
+
 def test_gripper_close_open_and_store(gripper):
     assert gripper.wait_outcome(gripper.close_gripper(), T) is Status.OK
     assert gripper.state().state == L.GRIPPER_STATE_CLOSED
@@ -530,7 +545,9 @@ def test_status_names_are_the_rust_names():
     assert Status.POWERED_OFF.describe() == "powered off"
     assert Status.CLAMPED.describe() == "ok, clamped to the limit"
     assert Status.CLAMPED.is_carried_out and not Status.CLAMPED.is_ok
-    assert [s for s in Status if s.is_carried_out] == [Status.OK, Status.CLAMPED]
+    assert [s for s in Status if s.is_carried_out] == [Status.OK, Status.CLAMPED, Status.ADJUSTED]
+    assert Status.ADJUSTED.describe() == "ok, orientation adjusted"
+    assert Status(16) is Status.ADJUSTED
 
 
 # ----- Python and Rust side by side ------------------------------------------------------

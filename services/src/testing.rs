@@ -193,6 +193,22 @@ impl DeviceHandler<Limb> for TestLimb {
             LimbRequest::Geom => Ok(LimbReply::Geom(LimbGeom::default())),
             LimbRequest::Power(_) | LimbRequest::Speed(_) => Ok(LimbReply::Done),
             LimbRequest::Brakes(_) => Err(Status::Unsupported),
+            // Any pose within reach is held exactly.
+            LimbRequest::Reach {
+                position,
+                approach,
+                orientation,
+            } => {
+                if position.norm() > REACH {
+                    return Err(Status::OutOfReach);
+                }
+                Ok(LimbReply::Reach(LimbReach {
+                    position: *position,
+                    approach: *approach,
+                    orientation: *orientation,
+                    ..LimbReach::default()
+                }))
+            }
         }
     }
 }

@@ -230,7 +230,6 @@ fn limb_refusals_name_their_cause_and_a_huge_direction_moves() {
         LimbState::OutOfReach
     );
     // Where the arm is, with its own approach, but the frame rolled about the approach:
-    // the 5-DOF wrist cannot follow.
     let s = wait_limb(&mut limb, "a state", |_| true);
     let (a, o) = (s.approach, s.orientation);
     let axo = Vec3::new(
@@ -244,15 +243,18 @@ fn limb_refusals_name_their_cause_and_a_huge_direction_moves() {
         o.y * c5 + axo.y * s5,
         o.z * c5 + axo.z * s5,
     ];
+    // the 5-DOF wrist cannot follow: it stays where it is (the nearest frame it can
+    // hold) and says by how much the orientation was adjusted (issue 13 item 6).
     let t = limb
         .set_pose(s.position.to_array(), a.to_array(), rolled)
         .unwrap();
-    assert_eq!(
-        limb.wait_outcome(t, T).unwrap(),
-        Status::UnreachableOrientation
-    );
-    assert_eq!(
-        limb.state().unwrap().limb_state().unwrap(),
-        LimbState::OutOfReach
+    assert_eq!(limb.wait_outcome(t, T).unwrap(), Status::Adjusted);
+    let s = wait_limb(&mut limb, "the adjustment", |s| {
+        s.orientation_adjustment > 0.0
+    });
+    assert!(
+        (s.orientation_adjustment - 0.5).abs() < 0.05,
+        "adjusted by {}",
+        s.orientation_adjustment
     );
 }

@@ -235,11 +235,9 @@ fn discovery_lists_devices_with_driver_and_liveness() {
     let devices = list_devices(&domain).unwrap();
     let names: Vec<String> = devices.iter().map(|d| d.name.to_string()).collect();
     assert_eq!(names, ["r2/actarray/0", "r2/limb/0", "r2/gripper/0"]);
-    assert!(
-        devices
-            .iter()
-            .all(|d| d.alive && d.driver == "testdriver" && d.layout == "1")
-    );
+    assert!(devices.iter().all(|d| d.alive
+        && d.driver == "testdriver"
+        && d.layout == limber_interfaces::LAYOUT_VERSION.to_string()));
     // Another domain sees nothing.
     assert!(list_devices(&Domain::unique_for_test()).unwrap().is_empty());
 }

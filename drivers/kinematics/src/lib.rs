@@ -30,9 +30,12 @@
 //!   rotation product `Rz(θ1)·Ry(−(θ2+θ3))·Rx(θ4)·Ry(−θ5)`, so the sign is right by
 //!   construction and checked against 40 reference vectors.
 //! * IK checks reach explicitly (an unreachable target is an error, never a clamped
-//!   arm pointing at it), checks that the requested orientation is achievable by a
-//!   5-DOF wrist (within a documented tolerance), checks limits in θ, and picks among
-//!   the exact solutions deterministically (nearest to the current joints).
+//!   arm pointing at it), checks limits in θ, and picks among the exact solutions
+//!   deterministically (nearest to the current joints). An orientation a 5-DOF wrist
+//!   cannot hold is either refused ([`pioneer::PioneerGeometry::solve_setpose`]) or
+//!   turned to the nearest one it can, with the adjustment reported
+//!   ([`pioneer::PioneerGeometry::solve_setpose_nearest`]); KineCalc spread the error
+//!   over position and approach without saying so.
 //! * No solver allocates; no solver panics or returns NaN on bad (NaN, infinite,
 //!   degenerate) input: such input is a typed error.
 

@@ -593,3 +593,101 @@ fn vecmove_direction_of_huge_components_is_normalised_without_overflow() {
     assert!((u - Vector3::new(1.0, -1.0, 1.0) / 3f64.sqrt()).norm() < 1e-15);
     assert_eq!(limber_kinematics::unit_direction(&Vector3::zeros()), None);
 }
+
+/// The SETPOSE tolerances the Pioneer driver uses by default (1 mm, 1°).
+fn pose_opts() -> PioneerIkOptions {
+    PioneerIkOptions {
+        position_tolerance: 1e-3,
+        orientation_tolerance: 1f64.to_radians(),
+        ..PioneerIkOptions::default()
+    }
+}
+
+fn setpose(p: [f64; 3], a: [f64; 3], o: [f64; 3]) -> Result<PoseSolution, PioneerIkError> {
+    geom().solve_setpose_nearest(&v(p), &v(a), &v(o), &[0.0; 5], &pose_opts())
+}
+
+#[test]
+fn setpose_takes_the_readme_orientation_and_says_how_much_it_adjusted() {
+    // The README's example: two decimals, about 1e-3 rad from a frame the arm can hold.
+    let s = setpose([0.38, 0.1, 0.22], [0.0, 0.0, -1.0], [0.94, 0.34, 0.0]).unwrap();
+    eprintln!("readme: {s:?}");
+    assert!(s.adjusted(), "{s:?}");
+    assert!(s.adjustment < 0.01, "{s:?}");
+    assert!(s.position_error < 1e-9 && s.approach_error < 1e-9, "{s:?}");
+    // Four decimals: still adjusted, by less.
+    let s4 = setpose([0.38, 0.1, 0.22], [0.0, 0.0, -1.0], [0.9398, 0.3417, 0.0]).unwrap();
+    eprintln!("4 decimals: {s4:?}");
+    assert!(s4.adjusted() && s4.adjustment < s.adjustment, "{s4:?}");
+    // Six decimals: round-off, carried out as asked.
+    let s6 = setpose(
+        [0.38, 0.1, 0.22],
+        [0.0, 0.0, -1.0],
+        [0.939793, 0.341743, 0.0],
+    )
+    .unwrap();
+    eprintln!("6 decimals: {s6:?}");
+    assert!(!s6.adjusted(), "{s6:?}");
+    // The achieved frame is the one reported: position and approach as asked.
+    assert!((s.achieved.position - v([0.38, 0.1, 0.22])).norm() < 1e-9);
+    assert!((s.achieved.approach() - v([0.0, 0.0, -1.0])).norm() < 1e-9);
+    // The `limber limb --help` example.
+    let h = setpose([0.4, 0.0, 0.2], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]).unwrap();
+    assert!(!h.adjusted(), "{h:?}");
+    // Straight down at 0.3 0 0.2 needs the elbow folded by about 130°: beyond its limit.
+    let e = setpose([0.3, 0.0, 0.2], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]).unwrap_err();
+    assert!(matches!(e, PioneerIkError::OutsideJointLimits), "{e:?}");
+}
+
+#[test]
+fn setpose_nearest_picks_the_nearest_orientation_not_the_flipped_wrist() {
+    // With limits that let the wrist roll half a turn, the opposite orientation is held
+    // by the other wrist, adjusted as little as the original.
+    let mut g = geom();
+    g.limits[3] = JointLimit::new(-PI, PI);
+    g.limits[4] = JointLimit::new(-PI, PI);
+    let (p, a) = (v([0.38, 0.1, 0.22]), v([0.0, 0.0, -1.0]));
+    let s = g
+        .solve_setpose_nearest(&p, &a, &v([-0.94, -0.34, 0.0]), &[0.0; 5], &pose_opts())
+        .unwrap();
+    assert!(s.adjusted() && s.adjustment < 0.01, "{s:?}");
+    let s2 = g
+        .solve_setpose_nearest(&p, &a, &v([0.94, 0.34, 0.0]), &[0.0; 5], &pose_opts())
+        .unwrap();
+    assert!(s2.adjustment < 0.01, "{s2:?}");
+    assert_ne!(s.candidate.branch.wrist, s2.candidate.branch.wrist);
+    // A quarter turn away: the adjustment is about π/2 whichever wrist.
+    let q = setpose([0.38, 0.1, 0.22], [0.0, 0.0, -1.0], [-0.34, 0.94, 0.0]).unwrap();
+    assert!((q.adjustment - FRAC_PI_2).abs() < 0.01, "{q:?}");
+}
+
+#[test]
+fn setpose_nearest_refuses_what_cannot_be_reached_with_its_cause() {
+    let e = setpose([1.5, 0.0, 0.3], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]).unwrap_err();
+    assert!(matches!(e, PioneerIkError::OutOfReach { .. }), "{e:?}");
+    // Behind the robot: reachable only with the base yawed beyond ±90°.
+    let e = setpose([-0.1, 0.0, 0.35], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]).unwrap_err();
+    assert!(matches!(e, PioneerIkError::OutsideJointLimits), "{e:?}");
+}
+
+#[test]
+fn setpose_nearest_honours_its_tolerances() {
+    let g = geom();
+    // Just beyond the stretched reach: within 1 mm accepted, with 1 µm refused.
+    let max = g.wrist_reach().1;
+    let base = g.base_offset;
+    let p = base + v([g.l1 + max + 0.0005 + g.l5, 0.0, 0.0]);
+    let (a, o) = (v([1.0, 0.0, 0.0]), v([0.0, 0.0, 1.0]));
+    let s = g
+        .solve_setpose_nearest(&p, &a, &o, &[0.0; 5], &pose_opts())
+        .unwrap();
+    assert!(s.position_error > 4e-4 && s.position_error <= 1e-3, "{s:?}");
+    let tight = PioneerIkOptions {
+        position_tolerance: 1e-6,
+        ..pose_opts()
+    };
+    let e = g
+        .solve_setpose_nearest(&p, &a, &o, &[0.0; 5], &tight)
+        .unwrap_err();
+    assert!(matches!(e, PioneerIkError::OutOfReach { .. }), "{e:?}");
+}

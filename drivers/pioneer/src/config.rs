@@ -85,6 +85,16 @@ pub struct PioneerConfig {
     pub limb_speed: f64,
     /// Largest deviation from the straight line allowed in VECMOVE, m.
     pub vecmove_deviation: f64,
+    /// SETPOSE (and the limb's REACH request): how far from the requested position the
+    /// end effector may end, m. The solver meets the position exactly whenever the arm
+    /// can; this admits poses at the edge of the reach and near a singularity. The
+    /// joints' resolution (one tick, about 1°) adds its own few millimetres.
+    pub setpose_position_tolerance: f64,
+    /// SETPOSE: how far from the requested approach vector the gripper may point,
+    /// degrees (also how far from perpendicular to the approach the orientation vector
+    /// may be). The orientation itself is turned to the nearest one the five joints can
+    /// hold, and the outcome says so (ADJUSTED).
+    pub setpose_approach_tolerance_deg: f64,
     /// How the two ARMpac status bytes are read: `"manual"` (the vendor's manuals: byte A
     /// servo power and arm connection, byte B the joints' moving bits; the default) or
     /// `"aria"` (ARIA's ArP2Arm: one little-endian word, moving bits first). The driver
@@ -151,6 +161,8 @@ impl Default for PioneerConfig {
             stall_timeout_ms: 2000,
             limb_speed: 0.1,
             vecmove_deviation: 0.002,
+            setpose_position_tolerance: 0.001,
+            setpose_approach_tolerance_deg: 1.0,
             armpac_layout: ArmpacLayout::default(),
             body_gripper: true,
             // The link timeout (1 s) and a reconnection or two, with room to spare.
@@ -184,6 +196,11 @@ impl PioneerConfig {
              # homes and powers off by itself (AUTOPARK, sent at every connection); 0 disables.\n{}",
             toml::to_string_pretty(self)
                 .unwrap_or_default()
+                .replacen(
+                    "setpose_position_tolerance =",
+                    "# SETPOSE: position (m) and approach (degrees) within these; the orientation is the\n# nearest one the five joints can hold (outcome ADJUSTED, the limb state says by how much)\nsetpose_position_tolerance =",
+                    1,
+                )
                 .replacen(
                     "armpac_layout =",
                     "# ARMpac status bytes: \"manual\" (the vendor's manuals, Player) or \"aria\" (ARIA's ArP2Arm)\narmpac_layout =",
@@ -220,6 +237,14 @@ impl PioneerConfig {
         }
         if !(self.vecmove_deviation > 0.0 && self.vecmove_deviation.is_finite()) {
             return bad("vecmove_deviation must be > 0");
+        }
+        if !(self.setpose_position_tolerance > 0.0 && self.setpose_position_tolerance <= 0.05) {
+            return bad("setpose_position_tolerance must be in (0, 0.05] m");
+        }
+        if !(self.setpose_approach_tolerance_deg > 0.0
+            && self.setpose_approach_tolerance_deg <= 10.0)
+        {
+            return bad("setpose_approach_tolerance_deg must be in (0, 10] degrees");
         }
         if self.tick_ms == 0 || self.tick_ms > 1000 {
             return bad("tick_ms must be 1..=1000");
@@ -274,5 +299,28 @@ mod tests {
         let e = PioneerConfig::from_toml("autopark_s = 1\npulse_interval_ms = 1000").unwrap_err();
         assert!(e.to_string().contains("autopark_s"), "{e}");
         assert!(PioneerConfig::from_toml("autopark_s = 70000").is_err());
+    }
+
+    #[test]
+    fn setpose_tolerances_default_to_a_millimetre_and_a_degree_and_are_checked() {
+        let c = PioneerConfig::default();
+        assert_eq!(c.setpose_position_tolerance, 0.001);
+        assert_eq!(c.setpose_approach_tolerance_deg, 1.0);
+        let text = c.to_toml();
+        assert!(text.contains("# SETPOSE: position"), "{text}");
+        let c = PioneerConfig::from_toml(
+            "setpose_position_tolerance = 0.0005\nsetpose_approach_tolerance_deg = 0.5",
+        )
+        .unwrap();
+        assert_eq!(c.setpose_position_tolerance, 0.0005);
+        for bad in [
+            "setpose_position_tolerance = 0.0",
+            "setpose_position_tolerance = nan",
+            "setpose_approach_tolerance_deg = -1.0",
+            "setpose_approach_tolerance_deg = 45.0",
+        ] {
+            let e = PioneerConfig::from_toml(bad).unwrap_err();
+            assert!(e.to_string().contains("setpose_"), "{bad}: {e}");
+        }
     }
 }

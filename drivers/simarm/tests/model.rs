@@ -364,3 +364,88 @@ fn refusals_name_their_cause_like_the_pioneer() {
     .unwrap();
     assert_eq!(m.limb_command(&far), Status::OutOfReach);
 }
+
+/// Issue 13 item 6 on a 5-joint chain (the Pioneer arm, relative to its base): the
+/// numeric IK follows the closed form's rules. Position and approach met, the
+/// orientation the nearest one the joints can hold, the adjustment in the outcome and
+/// the state; REACH answers without moving.
+#[test]
+fn a_five_joint_chain_adjusts_the_orientation_and_says_so() {
+    let mut m = model(Chain::pioneer5());
+    // The README's pose (0.38, 0.1, 0.22) in the robot frame, relative to the arm base.
+    let p = Vec3::new(0.38 - 0.105, 0.1, 0.22 - 0.3185);
+    let down = Vec3::new(0.0, 0.0, -1.0);
+    let pose = |o: Vec3| LimbCommand::set_pose(p, down, o).unwrap();
+    let started = std::time::Instant::now();
+    let st = m.limb_command(&pose(Vec3::new(0.94, 0.34, 0.0)));
+    eprintln!("5-joint SETPOSE, adjusted: {:?}", started.elapsed());
+    assert_eq!(st, Status::Adjusted);
+    run_until_idle(&mut m);
+    let mut s = LimbData::default();
+    m.limb_state(&mut s);
+    assert!(
+        s.orientation_adjustment > 1e-3 && s.orientation_adjustment < 3e-3,
+        "{s:?}"
+    );
+    let tool = m.tool_pose();
+    assert!((tool.position - Vector3::new(p.x, p.y, p.z)).norm() < 1e-6);
+    assert!((tool.approach() - Vector3::new(0.0, 0.0, -1.0)).norm() < 1e-6);
+    // Four decimals: adjusted, by less; six: as asked.
+    assert_eq!(
+        m.limb_command(&pose(Vec3::new(0.9398, 0.3417, 0.0))),
+        Status::Adjusted
+    );
+    run_until_idle(&mut m);
+    let started = std::time::Instant::now();
+    let st = m.limb_command(&pose(Vec3::new(0.939793, 0.341743, 0.0)));
+    eprintln!("5-joint SETPOSE, exact: {:?}", started.elapsed());
+    assert_eq!(st, Status::Ok);
+    m.limb_state(&mut s);
+    assert_eq!(s.orientation_adjustment, 0.0);
+    run_until_idle(&mut m);
+    // REACH: where it would end; nothing moves.
+    let q = m.q();
+    let reach = |m: &mut ArmModel, p: Vec3| {
+        m.limb_request(&LimbRequest::reach(p, down, Vec3::new(0.94, 0.34, 0.0)).unwrap())
+    };
+    let Ok(LimbReply::Reach(r)) = reach(&mut m, p) else {
+        panic!("no reach reply");
+    };
+    assert_eq!(r.adjusted, 1);
+    assert!(r.position_error < 1e-6 && r.approach_error < 1e-6, "{r:?}");
+    assert!(!moving(&m));
+    assert_eq!(m.q(), q);
+    // Beyond the reach, and beyond the joint limits (the elbow folded about 130°).
+    assert_eq!(
+        reach(&mut m, Vec3::new(2.0, 0.0, 0.0)),
+        Err(Status::OutOfReach)
+    );
+    let folded = LimbCommand::set_pose(
+        Vec3::new(0.3 - 0.105, 0.0, 0.2 - 0.3185),
+        down,
+        Vec3::new(1.0, 0.0, 0.0),
+    )
+    .unwrap();
+    let st = m.limb_command(&folded);
+    assert!(
+        matches!(st, Status::BeyondLimits | Status::OutOfReach),
+        "{st:?}"
+    );
+}
+
+/// The 6-joint arm holds the README's and the `--help` poses exactly.
+#[test]
+fn the_six_joint_arm_holds_the_documented_poses() {
+    let mut m = model(Chain::default_6dof());
+    let down = Vec3::new(0.0, 0.0, -1.0);
+    for (p, o) in [
+        (Vec3::new(0.38, 0.1, 0.22), Vec3::new(0.94, 0.34, 0.0)),
+        (Vec3::new(0.4, 0.0, 0.2), Vec3::new(1.0, 0.0, 0.0)),
+    ] {
+        assert_eq!(
+            m.limb_command(&LimbCommand::set_pose(p, down, o).unwrap()),
+            Status::Ok
+        );
+        run_until_idle(&mut m);
+    }
+}

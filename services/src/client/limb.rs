@@ -52,7 +52,22 @@ impl Client<Limb> {
     pub fn geometry(&mut self) -> Result<LimbGeom, RequestError> {
         match self.request(&LimbRequest::Geom)? {
             LimbReply::Geom(g) => Ok(g),
-            LimbReply::Done => Err(RequestError::Unexpected),
+            LimbReply::Done | LimbReply::Reach(_) => Err(RequestError::Unexpected),
+        }
+    }
+    /// REQ REACH: where a SETPOSE to this pose would end and how much its orientation
+    /// would be adjusted; nothing moves. A pose the limb cannot get to is refused with
+    /// its cause (`RequestError::Nack`).
+    pub fn reach(
+        &mut self,
+        position: [f64; 3],
+        approach: [f64; 3],
+        orientation: [f64; 3],
+    ) -> Result<LimbReach, RequestError> {
+        let req = LimbRequest::reach(position.into(), approach.into(), orientation.into())?;
+        match self.request(&req)? {
+            LimbReply::Reach(r) => Ok(r),
+            LimbReply::Done | LimbReply::Geom(_) => Err(RequestError::Unexpected),
         }
     }
 }

@@ -7,7 +7,7 @@ use super::*;
 impl Chain {
     /// Tool pose and the geometric Jacobian (rows: linear velocity, then angular
     /// velocity scaled by `w`; columns past `dof()` are zero).
-    fn fk_jacobian(&self, q: &[f64], w: f64, jac: &mut Jacobian) -> Pose {
+    pub(super) fn fk_jacobian(&self, q: &[f64], w: f64, jac: &mut Jacobian) -> Pose {
         let mut axes = [Vector3::zeros(); MAX_JOINTS];
         let mut points = [Vector3::zeros(); MAX_JOINTS];
         let tip = self.walk(q, |i, before, _| {
@@ -229,7 +229,7 @@ impl Chain {
 /// positive definite. Plain loops and a hand-written Cholesky: small, allocation-free
 /// and fast even in unoptimised builds.
 #[allow(clippy::needless_range_loop)]
-fn dls_step(
+pub(super) fn dls_step(
     jac: &Jacobian,
     e: &Vector6<f64>,
     lambda: f64,

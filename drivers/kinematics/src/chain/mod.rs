@@ -330,6 +330,8 @@ mod file;
 use file::{ARM6_TOML, ARM7_TOML, PIONEER5_TOML};
 mod ik;
 use ik::sample_range;
+mod nearest;
+pub use nearest::{NearestOptions, NearestSolution};
 
 type Jacobian = SMatrix<f64, 6, MAX_JOINTS>;
 impl Chain {

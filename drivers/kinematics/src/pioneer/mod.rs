@@ -18,7 +18,11 @@
 //! for SETPOSITION, the angle between the requested and the achieved approach vector).
 //! A 5-DOF arm reaches only frames whose normal `n` is perpendicular to its forearm; a
 //! request that misses that by more than the tolerance is
-//! [`PioneerIkError::UnreachableOrientation`], never silently approximated. The wrist
+//! [`PioneerIkError::UnreachableOrientation`] for [`PioneerGeometry::solve_setpose`],
+//! never silently approximated. [`PioneerGeometry::solve_setpose_nearest`] is SETPOSE as
+//! people write it (the driver's): the position and the approach within the tolerances,
+//! the orientation the nearest one the joints can hold, and the adjustment reported
+//! ([`PoseSolution`]). The wrist
 //! centre is accepted up to `position_tolerance` outside the annulus
 //! `|L2 − L4| ≤ d ≤ L2 + L4` (the acos argument is clamped only then). Joint limits are
 //! inclusive and accept round-off up to [`LIMIT_TOLERANCE`] (the returned angle is then
@@ -34,6 +38,8 @@
 //! * `ik`: the closed-form candidates, their selection and SETPOSE
 //!   ([`PioneerGeometry::pose_candidates`], [`PioneerGeometry::solve_pose`],
 //!   [`PioneerGeometry::solve_setpose`], [`PioneerGeometry::approach_candidates`]);
+//! * `nearest`: SETPOSE with the nearest attainable orientation
+//!   ([`PioneerGeometry::solve_setpose_nearest`]);
 //! * `position`: the SETPOSITION approach search ([`PioneerGeometry::solve_position`]);
 //! * `vecmove`: the straight-line VECMOVE planner ([`PioneerGeometry::vecmove`]).
 
@@ -45,6 +51,7 @@ use crate::pose::{FrameError, Pose, all_finite};
 
 mod fk;
 mod ik;
+mod nearest;
 mod position;
 mod vecmove;
 
@@ -52,6 +59,7 @@ pub use fk::PioneerFkError;
 pub use ik::{
     Branch, EXACT_ORIENTATION, EXACT_POSITION, Elbow, IkCandidate, IkCandidates, Shoulder, Wrist,
 };
+pub use nearest::{ADJUSTMENT_REPORTED, ADJUSTMENT_TIE, PoseSolution};
 pub use position::ApproachPreference;
 pub use vecmove::{VecMove, VecMoveError, VecMoveOptions, Waypoint};
 

@@ -7,7 +7,7 @@ use limber_services::Origin;
 use nalgebra::Vector3;
 
 use limber_kinematics::pioneer::{
-    ApproachPreference, PIONEER_DOF, Theta, VecMoveError, VecMoveOptions,
+    ApproachPreference, PIONEER_DOF, PoseSolution, Theta, VecMoveError, VecMoveOptions,
 };
 use limber_p2os::{ArmJoint, Command, JointSelection};
 
@@ -50,13 +50,19 @@ impl RobotModel {
         Ok(())
     }
 
-    /// A limb command.
+    /// A limb command. A SETPOSE whose orientation had to be turned to one the joints
+    /// can hold is carried out as `Status::Adjusted`, the amount in the limb state.
     pub fn limb_command(&mut self, cmd: &LimbCommand, from: &Origin) -> Status {
+        self.limb_adjustment = 0.0;
         let r = self.limb_command_inner(cmd, from);
         match r {
             Ok(()) => {
                 self.limb_oor = false;
-                Status::Ok
+                if self.limb_adjustment > 0.0 {
+                    Status::Adjusted
+                } else {
+                    Status::Ok
+                }
             }
             Err(e) => {
                 if cannot_get_there(e) {
@@ -95,17 +101,12 @@ impl RobotModel {
                 orientation,
             } => {
                 self.vecmove = None;
-                let c = self
-                    .geom
-                    .solve_setpose(
-                        &Vector3::from(position.to_array()),
-                        &Vector3::from(approach.to_array()),
-                        &Vector3::from(orientation.to_array()),
-                        &current,
-                        &self.ik,
-                    )
-                    .map_err(|e| ik_status(&e))?;
-                self.send_theta(&c.theta, from)
+                let s = self.solve_setpose(position, approach, orientation, &current)?;
+                self.send_theta(s.theta(), from)?;
+                if s.adjusted() {
+                    self.limb_adjustment = s.adjustment;
+                }
+                Ok(())
             }
             LimbCommand::SetPosition { position } => {
                 self.vecmove = None;
@@ -157,6 +158,60 @@ impl RobotModel {
                 self.stream_vecmove(from)
             }
         }
+    }
+
+    /// SETPOSE's solution (see `limber_kinematics::pioneer::PoseSolution`), its joints
+    /// checked against the limits in ticks.
+    fn solve_setpose(
+        &self,
+        position: Vec3,
+        approach: Vec3,
+        orientation: Vec3,
+        current: &Theta,
+    ) -> Result<PoseSolution, Status> {
+        let s = self
+            .geom
+            .solve_setpose_nearest(
+                &Vector3::from(position.to_array()),
+                &Vector3::from(approach.to_array()),
+                &Vector3::from(orientation.to_array()),
+                current,
+                &self.setpose_options(),
+            )
+            .map_err(|e| ik_status(&e))?;
+        let q = self.map.driver_from_theta(s.theta());
+        for (j, rad) in q.iter().enumerate() {
+            // BEYOND_LIMITS: the solution needs a joint past its limits.
+            self.joint_tick(j, *rad)?;
+        }
+        Ok(s)
+    }
+
+    /// REQ REACH: where a SETPOSE to this pose would end; nothing moves.
+    fn reach(
+        &self,
+        position: Vec3,
+        approach: Vec3,
+        orientation: Vec3,
+    ) -> Result<LimbReach, Status> {
+        self.calibration()?;
+        let current = self.theta().ok_or(Status::NotCalibrated)?;
+        let s = self.solve_setpose(position, approach, orientation, &current)?;
+        let (p, a, o) = (
+            s.achieved.position,
+            s.achieved.approach(),
+            s.achieved.orientation(),
+        );
+        Ok(LimbReach {
+            position: Vec3::new(p.x, p.y, p.z),
+            approach: Vec3::new(a.x, a.y, a.z),
+            orientation: Vec3::new(o.x, o.y, o.z),
+            orientation_adjustment: s.adjustment,
+            position_error: s.position_error,
+            approach_error: s.approach_error,
+            adjusted: u32::from(s.adjusted()),
+            _pad: 0,
+        })
     }
 
     /// Sends the next VECMOVE waypoint once the arm has reached the current one.
@@ -220,6 +275,13 @@ impl RobotModel {
                 Ok(LimbReply::Done)
             }
             LimbRequest::Brakes(_) => Err(Status::Unsupported),
+            LimbRequest::Reach {
+                position,
+                approach,
+                orientation,
+            } => self
+                .reach(position, approach, orientation)
+                .map(LimbReply::Reach),
         }
     }
 
@@ -246,6 +308,7 @@ impl RobotModel {
         } else {
             LimbState::Idle
         } as u32;
+        s.orientation_adjustment = self.limb_adjustment;
         s.header.stamp_ns = self.arm.stamp_ns;
     }
 }

@@ -219,6 +219,9 @@ pub struct RobotModel {
     pub arm: ArmModel,
     /// The last limb target was out of reach (cleared by the next valid limb command).
     pub limb_oor: bool,
+    /// How much the last SETPOSE adjusted the orientation, rad (0 after any other limb
+    /// command).
+    pub limb_adjustment: f64,
     /// A VECMOVE being streamed.
     pub vecmove: Option<Box<VecMovePlan>>,
     /// End-effector speed for limb motions, m/s.
@@ -305,6 +308,7 @@ impl RobotModel {
             },
             arm: ArmModel::default(),
             limb_oor: false,
+            limb_adjustment: 0.0,
             vecmove: None,
             limb_speed,
             lift,
@@ -313,6 +317,16 @@ impl RobotModel {
             armgrip_cmd: None,
             dirty: Dirty::default(),
             stats: LoopStats::default(),
+        }
+    }
+
+    /// The IK options of SETPOSE and REACH: the configured position and approach
+    /// tolerances.
+    pub fn setpose_options(&self) -> PioneerIkOptions {
+        PioneerIkOptions {
+            position_tolerance: self.cfg.setpose_position_tolerance,
+            orientation_tolerance: self.cfg.setpose_approach_tolerance_deg.to_radians(),
+            ..self.ik
         }
     }
 

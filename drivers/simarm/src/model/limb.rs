@@ -5,7 +5,8 @@
 use limber_interfaces::prelude::*;
 use nalgebra::Vector3;
 
-use limber_kinematics::chain::{ChainIkError, IkTarget, JointKind, JointVec};
+use limber_kinematics::chain::{ChainIkError, IkTarget, JointKind, JointVec, NearestSolution};
+use limber_kinematics::pioneer::ADJUSTMENT_REPORTED;
 use limber_kinematics::{Pose, fit_angle_to_limits, unit_direction};
 
 use super::{ArmModel, MAX_WAYPOINTS};
@@ -34,10 +35,15 @@ impl ArmModel {
     /// Carries out or refuses a limb command. OUT_OF_REACH sets the limb state to
     /// out-of-reach until the next valid limb command.
     pub fn limb_command(&mut self, cmd: &LimbCommand) -> Status {
+        self.limb_adjustment = 0.0;
         match self.limb_command_inner(cmd) {
             Ok(()) => {
                 self.limb_oor = false;
-                Status::Ok
+                if self.limb_adjustment > 0.0 {
+                    Status::Adjusted
+                } else {
+                    Status::Ok
+                }
             }
             Err(e) => {
                 // The limb cannot get there: beyond its reach, an orientation its joints
@@ -58,7 +64,42 @@ impl ArmModel {
             .chain
             .ik(target, seed, &self.options.ik)
             .map_err(|e| self.ik_status(&e))?;
-        let mut q = sol.q;
+        self.nearest_turns(sol.q, seed)
+    }
+
+    /// SETPOSE (and REACH): position and approach within the tolerances, the orientation
+    /// the nearest one the joints can hold.
+    fn solve_setpose(
+        &self,
+        position: Vec3,
+        approach: Vec3,
+        orientation: Vec3,
+        seed: &[f64],
+    ) -> Result<NearestSolution, Status> {
+        let pose = Pose::from_approach_orientation(
+            Vector3::from(position.to_array()),
+            Vector3::from(approach.to_array()),
+            Vector3::from(orientation.to_array()),
+            PERPENDICULAR_TOLERANCE,
+        )
+        .map_err(|e| match e {
+            limber_kinematics::FrameError::NonFinite => Status::NotFinite,
+            _ => Status::InvalidArgument,
+        })?;
+        let mut s = self
+            .chain
+            .ik_nearest_orientation(&pose, seed, &self.options.ik, &self.options.setpose)
+            .map_err(|e| match e {
+                // Position or approach not met within the tolerances.
+                ChainIkError::NotConverged { .. } => Status::OutOfReach,
+                e => self.ik_status(&e),
+            })?;
+        s.q = self.nearest_turns(s.q, seed)?;
+        Ok(s)
+    }
+
+    fn nearest_turns(&self, q: JointVec, seed: &[f64]) -> Result<JointVec, Status> {
+        let mut q = q;
         // Take the turn of each revolute joint nearest to the seed (less travel).
         for ((v, j), s) in q.iter_mut().zip(self.chain.joints()).zip(seed) {
             if j.kind == JointKind::Rotary
@@ -118,20 +159,16 @@ impl ArmModel {
                 approach,
                 orientation,
             } => {
-                let pose = Pose::from_approach_orientation(
-                    Vector3::from(position.to_array()),
-                    Vector3::from(approach.to_array()),
-                    Vector3::from(orientation.to_array()),
-                    PERPENDICULAR_TOLERANCE,
-                )
-                .map_err(|e| match e {
-                    limber_kinematics::FrameError::NonFinite => Status::NotFinite,
-                    _ => Status::InvalidArgument,
-                })?;
+                if !(position.is_finite() && approach.is_finite() && orientation.is_finite()) {
+                    return Err(Status::NotFinite);
+                }
+                let s = self.solve_setpose(position, approach, orientation, &current)?;
                 self.powered()?;
-                let q = self.ik_to(&IkTarget::Pose(pose), &current)?;
                 self.vecmove.active = false;
-                self.move_joints_together(&q, 0.0);
+                self.move_joints_together(&s.q, 0.0);
+                if s.adjustment > ADJUSTMENT_REPORTED {
+                    self.limb_adjustment = s.adjustment;
+                }
                 Ok(())
             }
             LimbCommand::SetPosition { position } => {
@@ -254,6 +291,28 @@ impl ArmModel {
                 Ok(LimbReply::Done)
             }
             LimbRequest::Brakes(_) => Err(Status::Unsupported),
+            LimbRequest::Reach {
+                position,
+                approach,
+                orientation,
+            } => {
+                let s = self.solve_setpose(position, approach, orientation, &self.q())?;
+                let (p, a, o) = (
+                    s.achieved.position,
+                    s.achieved.approach(),
+                    s.achieved.orientation(),
+                );
+                Ok(LimbReply::Reach(LimbReach {
+                    position: Vec3::new(p.x, p.y, p.z),
+                    approach: Vec3::new(a.x, a.y, a.z),
+                    orientation: Vec3::new(o.x, o.y, o.z),
+                    orientation_adjustment: s.adjustment,
+                    position_error: s.position_error,
+                    approach_error: s.approach_error,
+                    adjusted: u32::from(s.adjustment > ADJUSTMENT_REPORTED),
+                    _pad: 0,
+                }))
+            }
         }
     }
 
@@ -265,6 +324,7 @@ impl ArmModel {
         s.position = Vec3::new(p.x, p.y, p.z);
         s.approach = Vec3::new(a.x, a.y, a.z);
         s.orientation = Vec3::new(o.x, o.y, o.z);
+        s.orientation_adjustment = self.limb_adjustment;
         s.state = if self.limb_oor {
             LimbState::OutOfReach
         } else if self.limb_moving() {

@@ -55,6 +55,9 @@ pub struct ArmModel {
     /// configured speeds).
     limb_speed: Option<f64>,
     limb_oor: bool,
+    /// How much the last SETPOSE adjusted the orientation, rad (0 after any other limb
+    /// command).
+    limb_adjustment: f64,
     powered: bool,
     vecmove: VecMovePlan,
     object: Option<SimObject>,
@@ -112,6 +115,7 @@ impl ArmModel {
             gripper_cmd: GripperCmd::Open,
             limb_speed: None,
             limb_oor: false,
+            limb_adjustment: 0.0,
             powered: true,
             vecmove: VecMovePlan {
                 waypoints: Vec::with_capacity(MAX_WAYPOINTS),

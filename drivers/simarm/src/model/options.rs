@@ -1,7 +1,7 @@
 //! What the simulation is configured with: [`SimArmOptions`], the [`SimObject`] to grasp
 //! and [`OptionsError`], the reason [`ArmModel::new`](super::ArmModel::new) refuses them.
 
-use limber_kinematics::chain::NumericIkOptions;
+use limber_kinematics::chain::{NearestOptions, NumericIkOptions};
 
 /// An object the gripper can close on: it stops the fingers at its width, the gripper's
 /// beam (bit 0) sees it while it is between the fingers, and it follows the tool while
@@ -43,6 +43,9 @@ pub struct SimArmOptions {
     pub object: Option<SimObject>,
     /// Options of the numeric inverse kinematics.
     pub ik: NumericIkOptions,
+    /// SETPOSE on a chain that cannot hold the requested frame: position and approach
+    /// tolerances (1 mm, 1°), the orientation the nearest one the joints can hold.
+    pub setpose: NearestOptions,
 }
 
 impl Default for SimArmOptions {
@@ -54,6 +57,7 @@ impl Default for SimArmOptions {
             vecmove_step: 0.005,
             object: None,
             ik: NumericIkOptions::default(),
+            setpose: NearestOptions::default(),
         }
     }
 }
