@@ -156,11 +156,17 @@ pub enum Status {
     /// joint's maximum runs at the maximum). Counts as carried out
     /// ([`Status::is_carried_out`]).
     Clamped = 13,
+    /// The motion this command started was cut short by another client's command (a new
+    /// motion of the same joints, or a stop) before it finished: it did not complete.
+    Preempted = 14,
+    /// Another client holds the device (a control lease): commands and requests that
+    /// change the device are refused until it releases it or its lease ends.
+    Leased = 15,
 }
 
 impl Status {
     /// Every status, in code order.
-    pub const ALL: [Status; 14] = [
+    pub const ALL: [Status; 16] = [
         Status::Ok,
         Status::Unsupported,
         Status::UnknownJoint,
@@ -175,6 +181,8 @@ impl Status {
         Status::PoweredOff,
         Status::UnreachableOrientation,
         Status::Clamped,
+        Status::Preempted,
+        Status::Leased,
     ];
 
     /// The wire code.
@@ -211,6 +219,8 @@ impl Status {
             Status::PoweredOff => "powered off",
             Status::UnreachableOrientation => "orientation not attainable by this limb's joints",
             Status::Clamped => "ok, clamped to the limit",
+            Status::Preempted => "preempted by another client",
+            Status::Leased => "held by another client",
         }
     }
 }
@@ -244,8 +254,10 @@ pub mod device_flag {
     pub const SIMULATED: u32 = 4;
     /// The hardware reported this device as absent (e.g. no arm fitted).
     pub const ABSENT: u32 = 8;
+    /// A client holds the device with a control lease (see the `lease` channel).
+    pub const LEASED: u32 = 16;
     /// Every defined bit.
-    pub const ALL: u32 = LINK_UP | CALIBRATED | SIMULATED | ABSENT;
+    pub const ALL: u32 = LINK_UP | CALIBRATED | SIMULATED | ABSENT | LEASED;
 }
 
 pub(crate) const STATUS_GROUP: ConstantGroup = ConstantGroup {
@@ -322,6 +334,16 @@ pub(crate) const STATUS_GROUP: ConstantGroup = ConstantGroup {
             value: 13,
             doc: "carried out, a value clamped to the limit",
         },
+        Constant {
+            name: "PREEMPTED",
+            value: 14,
+            doc: "the motion was cut short by another client's command",
+        },
+        Constant {
+            name: "LEASED",
+            value: 15,
+            doc: "another client holds the device",
+        },
     ],
 };
 
@@ -348,6 +370,11 @@ pub(crate) const DEVICE_FLAG_GROUP: ConstantGroup = ConstantGroup {
             name: "ABSENT",
             value: 8,
             doc: "hardware reports the device absent",
+        },
+        Constant {
+            name: "LEASED",
+            value: 16,
+            doc: "a client holds the device with a control lease",
         },
     ],
 };

@@ -38,6 +38,7 @@
 pub mod actarray;
 pub mod codegen;
 pub mod common;
+pub mod control;
 pub mod diagnostics;
 pub mod error;
 pub mod gripper;
@@ -58,7 +59,11 @@ pub use message::{Envelope, Message, ReplyBody, ReplyEnvelope};
 pub use wire::{WireField, WireStruct};
 
 /// The layout version carried in every type name.
-pub const LAYOUT_VERSION: u32 = 1;
+///
+/// Version 2 added the `outcome` and `lease` channels ([`control::OutcomeMsg`],
+/// [`control::LeaseReq`], [`control::LeaseReply`]) and the statuses `PREEMPTED` and
+/// `LEASED`; the structs of version 1 kept their layouts and their names.
+pub const LAYOUT_VERSION: u32 = 2;
 
 /// Everything a driver or client author needs, in one `use`.
 pub mod prelude {
@@ -71,6 +76,7 @@ pub mod prelude {
         Bbox3, CmdOutcome, MAX_ACTUATORS, MsgMeta, Orientation3, Pose3, ReplyMeta, StateHeader,
         Status, Vec3, device_flag,
     };
+    pub use crate::control::{LeaseReply, LeaseReq, OutcomeMsg, lease_op};
     pub use crate::diagnostics::DriverStats;
     pub use crate::error::{DecodeError, ValueError};
     pub use crate::gripper::{
@@ -141,6 +147,10 @@ pub fn manifest() -> Manifest {
         GripperReplyMsg::LAYOUT,
         // diagnostics
         diagnostics::DriverStats::LAYOUT,
+        // control (layout version 2)
+        control::OutcomeMsg::LAYOUT,
+        control::LeaseReq::LAYOUT,
+        control::LeaseReply::LAYOUT,
     ];
     let mut constants = vec![
         common::LIMITS_GROUP,
@@ -151,6 +161,7 @@ pub fn manifest() -> Manifest {
     constants.extend_from_slice(limb::GROUPS);
     constants.extend_from_slice(gripper::GROUPS);
     constants.extend_from_slice(diagnostics::GROUPS);
+    constants.push(control::LEASE_OP_GROUP);
     Manifest {
         layout_version: LAYOUT_VERSION,
         structs,

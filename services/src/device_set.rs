@@ -56,6 +56,17 @@ pub trait DeviceSetHandler {
         let _ = (index, cmd, from, state);
         Status::Unsupported
     }
+    /// Whether `cmd` cuts short a running motion of `actarray/<index>`; see
+    /// [`DeviceHandler::preempts`]. Default: never.
+    fn actarray_preempts(&mut self, index: u16, cmd: &ActArrayCommand, state: &ActArrayData) -> bool {
+        let _ = (index, cmd, state);
+        false
+    }
+    /// Stops every motion of `actarray/<index>` (the deadman); see [`DeviceHandler::stop`].
+    fn actarray_stop(&mut self, index: u16, state: &mut ActArrayData) -> Status {
+        let _ = (index, state);
+        Status::Unsupported
+    }
     /// A validated request for `actarray/<index>`; see [`DeviceHandler::request`].
     fn actarray_request(
         &mut self,
@@ -78,6 +89,17 @@ pub trait DeviceSetHandler {
         let _ = (index, cmd, from, state);
         Status::Unsupported
     }
+    /// Whether `cmd` cuts short a running motion of `limb/<index>`; see
+    /// [`DeviceHandler::preempts`]. Default: never.
+    fn limb_preempts(&mut self, index: u16, cmd: &LimbCommand, state: &LimbData) -> bool {
+        let _ = (index, cmd, state);
+        false
+    }
+    /// Stops every motion of `limb/<index>` (the deadman); see [`DeviceHandler::stop`].
+    fn limb_stop(&mut self, index: u16, state: &mut LimbData) -> Status {
+        let _ = (index, state);
+        Status::Unsupported
+    }
     /// A validated request for `limb/<index>`; see [`DeviceHandler::request`].
     fn limb_request(
         &mut self,
@@ -98,6 +120,17 @@ pub trait DeviceSetHandler {
         state: &mut GripperData,
     ) -> Status {
         let _ = (index, cmd, from, state);
+        Status::Unsupported
+    }
+    /// Whether `cmd` cuts short a running motion of `gripper/<index>`; see
+    /// [`DeviceHandler::preempts`]. Default: never.
+    fn gripper_preempts(&mut self, index: u16, cmd: &GripperCommand, state: &GripperData) -> bool {
+        let _ = (index, cmd, state);
+        false
+    }
+    /// Stops every motion of `gripper/<index>` (the deadman); see [`DeviceHandler::stop`].
+    fn gripper_stop(&mut self, index: u16, state: &mut GripperData) -> Status {
+        let _ = (index, state);
         Status::Unsupported
     }
     /// A validated request for `gripper/<index>`; see [`DeviceHandler::request`].
@@ -131,6 +164,12 @@ struct At<'a, H: ?Sized> {
 }
 
 impl<H: DeviceSetHandler + ?Sized> DeviceHandler<ActArray> for At<'_, H> {
+    fn preempts(&mut self, cmd: &ActArrayCommand, s: &ActArrayData) -> bool {
+        self.handler.actarray_preempts(self.index, cmd, s)
+    }
+    fn stop(&mut self, s: &mut ActArrayData) -> Status {
+        self.handler.actarray_stop(self.index, s)
+    }
     fn command(&mut self, cmd: &ActArrayCommand, from: &Origin, s: &mut ActArrayData) -> Status {
         self.handler.actarray_command(self.index, cmd, from, s)
     }
@@ -145,6 +184,12 @@ impl<H: DeviceSetHandler + ?Sized> DeviceHandler<ActArray> for At<'_, H> {
 }
 
 impl<H: DeviceSetHandler + ?Sized> DeviceHandler<Limb> for At<'_, H> {
+    fn preempts(&mut self, cmd: &LimbCommand, s: &LimbData) -> bool {
+        self.handler.limb_preempts(self.index, cmd, s)
+    }
+    fn stop(&mut self, s: &mut LimbData) -> Status {
+        self.handler.limb_stop(self.index, s)
+    }
     fn command(&mut self, cmd: &LimbCommand, from: &Origin, s: &mut LimbData) -> Status {
         self.handler.limb_command(self.index, cmd, from, s)
     }
@@ -159,6 +204,12 @@ impl<H: DeviceSetHandler + ?Sized> DeviceHandler<Limb> for At<'_, H> {
 }
 
 impl<H: DeviceSetHandler + ?Sized> DeviceHandler<Gripper> for At<'_, H> {
+    fn preempts(&mut self, cmd: &GripperCommand, s: &GripperData) -> bool {
+        self.handler.gripper_preempts(self.index, cmd, s)
+    }
+    fn stop(&mut self, s: &mut GripperData) -> Status {
+        self.handler.gripper_stop(self.index, s)
+    }
     fn command(&mut self, cmd: &GripperCommand, from: &Origin, s: &mut GripperData) -> Status {
         self.handler.gripper_command(self.index, cmd, from, s)
     }

@@ -82,15 +82,16 @@ pub mod testing;
 
 pub use client::{
     ActArrayClient, Client, CommandError, ConnectError, DriverStatus, Freshness, GripperClient,
-    Incompatibility, LimbClient, RequestError, Ticket, WaitError, WaitMode,
+    Incompatibility, LeaseError, LeaseHolder, LimbClient, Outcome, RequestError, Ticket, WaitError,
+    WaitMode,
 };
 pub use context::{Context, ContextError, Role, monotonic_ns};
 pub use device_set::{DeviceError, DeviceSet, DeviceSetHandler};
 pub use discovery::{DeviceInfo, ListError, list_devices};
 pub use error::Iox2Error;
 pub use host::{
-    Activity, CLIENT_SLOTS, DeviceHandler, DeviceHost, HostError, HostStats, Origin, ProcessError,
-    PublishError,
+    Activity, CLIENT_SLOTS, DeviceHandler, DeviceHost, HostError, HostStats, Holder, Origin,
+    ProcessError, PublishError,
 };
 pub use naming::{Channel, DeviceName, Domain, NameError};
 
