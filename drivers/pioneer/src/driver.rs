@@ -213,6 +213,40 @@ impl core::fmt::Debug for PioneerDriver {
 struct Serve<'a>(&'a mut RobotModel);
 
 impl DeviceSetHandler for Serve<'_> {
+    fn actarray_preempts(&mut self, index: u16, cmd: &ActArrayCommand, _s: &ActArrayData) -> bool {
+        if index == 0 {
+            self.0.arm_preempts(cmd)
+        } else {
+            self.0.lift_preempts()
+        }
+    }
+    fn actarray_stop(&mut self, index: u16, _s: &mut ActArrayData) -> Status {
+        if index == 0 {
+            self.0.arm_stop()
+        } else {
+            self.0.lift_stop()
+        }
+    }
+    fn limb_preempts(&mut self, _index: u16, cmd: &LimbCommand, _s: &LimbData) -> bool {
+        self.0.limb_preempts(cmd)
+    }
+    fn limb_stop(&mut self, _index: u16, _s: &mut LimbData) -> Status {
+        self.0.arm_stop()
+    }
+    fn gripper_preempts(&mut self, index: u16, _cmd: &GripperCommand, _s: &GripperData) -> bool {
+        if index == 0 {
+            self.0.gripper_preempts()
+        } else {
+            self.0.armgrip_preempts()
+        }
+    }
+    fn gripper_stop(&mut self, index: u16, _s: &mut GripperData) -> Status {
+        if index == 0 {
+            self.0.gripper_stop()
+        } else {
+            self.0.armgrip_stop()
+        }
+    }
     fn actarray_command(
         &mut self,
         index: u16,

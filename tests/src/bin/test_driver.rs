@@ -46,6 +46,14 @@ impl DeviceHandler<ActArray> for Holding<'_> {
         self.0.command(cmd, from, state)
     }
 
+    fn preempts(&mut self, cmd: &ActArrayCommand, state: &ActArrayData) -> bool {
+        self.0.preempts(cmd, state)
+    }
+
+    fn stop(&mut self, state: &mut ActArrayData) -> Status {
+        self.0.stop(state)
+    }
+
     fn request(
         &mut self,
         req: &ActArrayRequest,
