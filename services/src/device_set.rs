@@ -37,7 +37,7 @@ use thiserror::Error;
 
 use crate::context::Context;
 use crate::host::{
-    Activity, DeviceHandler, DeviceHost, HostError, HostStats, Origin, ProcessError, PublishError,
+    Activity, DeviceHandler, Motion, DeviceHost, HostError, HostStats, Origin, ProcessError, PublishError,
 };
 use crate::naming::DeviceName;
 
@@ -56,11 +56,11 @@ pub trait DeviceSetHandler {
         let _ = (index, cmd, from, state);
         Status::Unsupported
     }
-    /// Whether `cmd` cuts short a running motion of `actarray/<index>`; see
-    /// [`DeviceHandler::preempts`]. Default: never.
-    fn actarray_preempts(&mut self, index: u16, cmd: &ActArrayCommand, state: &ActArrayData) -> bool {
+    /// What `cmd` drives on `actarray/<index>` and which of it still moves; see
+    /// [`DeviceHandler::motion`]. Default: nothing.
+    fn actarray_motion(&mut self, index: u16, cmd: &ActArrayCommand, state: &ActArrayData) -> Motion {
         let _ = (index, cmd, state);
-        false
+        Motion::NONE
     }
     /// Stops every motion of `actarray/<index>` (the deadman); see [`DeviceHandler::stop`].
     fn actarray_stop(&mut self, index: u16, state: &mut ActArrayData) -> Status {
@@ -89,11 +89,11 @@ pub trait DeviceSetHandler {
         let _ = (index, cmd, from, state);
         Status::Unsupported
     }
-    /// Whether `cmd` cuts short a running motion of `limb/<index>`; see
-    /// [`DeviceHandler::preempts`]. Default: never.
-    fn limb_preempts(&mut self, index: u16, cmd: &LimbCommand, state: &LimbData) -> bool {
+    /// What `cmd` drives on `limb/<index>` and which of it still moves; see
+    /// [`DeviceHandler::motion`]. Default: nothing.
+    fn limb_motion(&mut self, index: u16, cmd: &LimbCommand, state: &LimbData) -> Motion {
         let _ = (index, cmd, state);
-        false
+        Motion::NONE
     }
     /// Stops every motion of `limb/<index>` (the deadman); see [`DeviceHandler::stop`].
     fn limb_stop(&mut self, index: u16, state: &mut LimbData) -> Status {
@@ -122,11 +122,11 @@ pub trait DeviceSetHandler {
         let _ = (index, cmd, from, state);
         Status::Unsupported
     }
-    /// Whether `cmd` cuts short a running motion of `gripper/<index>`; see
-    /// [`DeviceHandler::preempts`]. Default: never.
-    fn gripper_preempts(&mut self, index: u16, cmd: &GripperCommand, state: &GripperData) -> bool {
+    /// What `cmd` drives on `gripper/<index>` and which of it still moves; see
+    /// [`DeviceHandler::motion`]. Default: nothing.
+    fn gripper_motion(&mut self, index: u16, cmd: &GripperCommand, state: &GripperData) -> Motion {
         let _ = (index, cmd, state);
-        false
+        Motion::NONE
     }
     /// Stops every motion of `gripper/<index>` (the deadman); see [`DeviceHandler::stop`].
     fn gripper_stop(&mut self, index: u16, state: &mut GripperData) -> Status {
@@ -164,8 +164,8 @@ struct At<'a, H: ?Sized> {
 }
 
 impl<H: DeviceSetHandler + ?Sized> DeviceHandler<ActArray> for At<'_, H> {
-    fn preempts(&mut self, cmd: &ActArrayCommand, s: &ActArrayData) -> bool {
-        self.handler.actarray_preempts(self.index, cmd, s)
+    fn motion(&mut self, cmd: &ActArrayCommand, s: &ActArrayData) -> Motion {
+        self.handler.actarray_motion(self.index, cmd, s)
     }
     fn stop(&mut self, s: &mut ActArrayData) -> Status {
         self.handler.actarray_stop(self.index, s)
@@ -184,8 +184,8 @@ impl<H: DeviceSetHandler + ?Sized> DeviceHandler<ActArray> for At<'_, H> {
 }
 
 impl<H: DeviceSetHandler + ?Sized> DeviceHandler<Limb> for At<'_, H> {
-    fn preempts(&mut self, cmd: &LimbCommand, s: &LimbData) -> bool {
-        self.handler.limb_preempts(self.index, cmd, s)
+    fn motion(&mut self, cmd: &LimbCommand, s: &LimbData) -> Motion {
+        self.handler.limb_motion(self.index, cmd, s)
     }
     fn stop(&mut self, s: &mut LimbData) -> Status {
         self.handler.limb_stop(self.index, s)
@@ -204,8 +204,8 @@ impl<H: DeviceSetHandler + ?Sized> DeviceHandler<Limb> for At<'_, H> {
 }
 
 impl<H: DeviceSetHandler + ?Sized> DeviceHandler<Gripper> for At<'_, H> {
-    fn preempts(&mut self, cmd: &GripperCommand, s: &GripperData) -> bool {
-        self.handler.gripper_preempts(self.index, cmd, s)
+    fn motion(&mut self, cmd: &GripperCommand, s: &GripperData) -> Motion {
+        self.handler.gripper_motion(self.index, cmd, s)
     }
     fn stop(&mut self, s: &mut GripperData) -> Status {
         self.handler.gripper_stop(self.index, s)

@@ -52,13 +52,14 @@ pub trait DeviceHandler<I: Interface> {
         state: &mut I::Data,
     ) -> Result<I::Reply, Status>;
 
-    /// Asked before `cmd` is carried out, when the last motion was started by another
-    /// client: true if that motion is still running and `cmd` cuts it short (a new motion
-    /// of the same joints, a stop). The host then tells the other client its command was
-    /// `Preempted`. Default: never (the device has no motion that runs on by itself).
-    fn preempts(&mut self, cmd: &I::Command, state: &I::Data) -> bool {
+    /// Asked before `cmd` is carried out: which parts of the device it drives, and which
+    /// of those are still moving from an earlier command (a new motion of the same joints
+    /// or a stop cuts that one short). The host remembers which client's command drives
+    /// each part and tells a client whose motion another client's command cut short that
+    /// it was [`Status::Preempted`]. Default: [`Motion::NONE`] (nothing runs on by itself).
+    fn motion(&mut self, cmd: &I::Command, state: &I::Data) -> Motion {
         let _ = (cmd, state);
-        false
+        Motion::NONE
     }
 
     /// Stops every motion of the device now (the deadman: the holder of the device's
@@ -67,6 +68,30 @@ pub trait DeviceHandler<I: Interface> {
     fn stop(&mut self, state: &mut I::Data) -> Status {
         let _ = state;
         Status::Unsupported
+    }
+}
+
+/// The parts of a device a command drives, and those of them still moving
+/// ([`DeviceHandler::motion`]). Bit i is a part that moves on its own: joint i of an arm;
+/// a limb's joints; bit 0 for a gripper.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Motion {
+    /// The parts the command drives (a new target, a speed, a stop).
+    pub drives: u64,
+    /// Those of them still moving now: the command cuts their motion short.
+    pub cuts: u64,
+}
+
+impl Motion {
+    /// Drives nothing that runs on by itself.
+    pub const NONE: Motion = Motion { drives: 0, cuts: 0 };
+
+    /// `drives`, of which the parts in `running` are still moving.
+    pub const fn of(drives: u64, running: u64) -> Motion {
+        Motion {
+            drives,
+            cuts: drives & running,
+        }
     }
 }
 
@@ -317,8 +342,9 @@ pub struct DeviceHost<I: Interface> {
     lease_server: Server<ipc::Service, LeaseReq, (), LeaseReply, ()>,
     lease: Option<Holder>,
     next_holder_check_ns: u64,
-    /// The last motion carried out: (client, command seq, kind).
-    motion: Option<(u64, u64, u32)>,
+    /// Per part of the device (bit i of [`Motion`]): the command that drives it now
+    /// (client, command seq, kind); client 0: none.
+    drivers: [(u64, u64, u32); 64],
     state: I::Data,
     seq: u64,
     outcome: CmdOutcome,
@@ -525,7 +551,7 @@ impl<I: Interface> DeviceHost<I> {
             lease_server,
             lease: None,
             next_holder_check_ns: 0,
-            motion: None,
+            drivers: [(0, 0, 0); 64],
             state: I::Data::default(),
             seq: 0,
             outcome: CmdOutcome::default(),
@@ -764,21 +790,31 @@ impl<I: Interface> DeviceHost<I> {
         origin: &Origin,
         kind: u32,
     ) -> Status {
-        let preempted = match self.motion {
-            Some(m) if m.0 != origin.client_id && handler.preempts(cmd, &self.state) => Some(m),
-            _ => None,
-        };
+        let motion = handler.motion(cmd, &self.state);
         let status = handler.command(cmd, origin, &mut self.state);
-        if status.is_carried_out() {
-            if let Some(m) = preempted {
-                self.stats.preempted += 1;
-                let name = self
-                    .lease
-                    .filter(|l| l.client_id == origin.client_id)
-                    .map(|l| l.name);
-                self.publish_outcome(m, Status::Preempted, origin.client_id, name.as_ref());
+        if !status.is_carried_out() {
+            return status;
+        }
+        let name = self
+            .lease
+            .filter(|l| l.client_id == origin.client_id)
+            .map(|l| l.name);
+        // Each other client's command whose motion this one cut short, told once.
+        for bit in 0..64 {
+            if motion.cuts & (1 << bit) == 0 {
+                continue;
             }
-            self.motion = Some((origin.client_id, origin.seq, kind));
+            let cut = self.drivers[bit];
+            let told_already = (0..bit).any(|b| motion.cuts & (1 << b) != 0 && self.drivers[b] == cut);
+            if cut.0 != 0 && cut.0 != origin.client_id && !told_already {
+                self.stats.preempted += 1;
+                self.publish_outcome(cut, Status::Preempted, origin.client_id, name.as_ref());
+            }
+        }
+        for bit in 0..64 {
+            if motion.drives & (1 << bit) != 0 {
+                self.drivers[bit] = (origin.client_id, origin.seq, kind);
+            }
         }
         status
     }
@@ -842,7 +878,7 @@ impl<I: Interface> DeviceHost<I> {
             stop = %status, "lease ended because {why}: device stopped");
         self.stats.deadman_stops += 1;
         self.lease = None;
-        self.motion = None;
+        self.drivers = [(0, 0, 0); 64];
         self.publish()?;
         Ok(())
     }

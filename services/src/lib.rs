@@ -90,7 +90,7 @@ pub use device_set::{DeviceError, DeviceSet, DeviceSetHandler};
 pub use discovery::{DeviceInfo, ListError, list_devices};
 pub use error::Iox2Error;
 pub use host::{
-    Activity, CLIENT_SLOTS, DeviceHandler, DeviceHost, HostError, HostStats, Holder, Origin,
+    Activity, CLIENT_SLOTS, DeviceHandler, DeviceHost, HostError, HostStats, Holder, Motion, Origin,
     ProcessError, PublishError,
 };
 pub use naming::{Channel, DeviceName, Domain, NameError};
@@ -104,7 +104,7 @@ pub mod prelude {
     pub use crate::context::{Context, Role, monotonic_ns};
     pub use crate::device_set::{DeviceSet, DeviceSetHandler};
     pub use crate::discovery::{DeviceInfo, list_devices};
-    pub use crate::host::{DeviceHandler, DeviceHost, Origin};
+    pub use crate::host::{DeviceHandler, DeviceHost, Motion, Origin};
     pub use crate::naming::{DeviceName, Domain};
     pub use limber_interfaces::prelude::*;
 }

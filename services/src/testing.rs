@@ -11,7 +11,9 @@ use thiserror::Error;
 use crate::context::{Context, monotonic_ns};
 use crate::device_set::{DeviceError, DeviceSet, DeviceSetHandler};
 use crate::event_loop::{self, LoopError, LoopExit, Wake};
-use crate::host::{DeviceHandler, DeviceHost, HostError, Origin, ProcessError, PublishError};
+use crate::host::{
+    DeviceHandler, DeviceHost, HostError, Motion, Origin, ProcessError, PublishError,
+};
 
 /// Joint limits of the test arm, rad.
 pub const JOINT_LIMIT: f64 = core::f64::consts::PI;
@@ -135,18 +137,18 @@ impl DeviceHandler<ActArray> for TestArm {
         r.err().unwrap_or(Status::Ok)
     }
 
-    fn preempts(&mut self, cmd: &ActArrayCommand, _state: &ActArrayData) -> bool {
+    fn motion(&mut self, cmd: &ActArrayCommand, _state: &ActArrayData) -> Motion {
         let mask = match *cmd {
             ActArrayCommand::Position { joint, .. }
             | ActArrayCommand::Speed { joint, .. }
-            | ActArrayCommand::Home(JointSel::One(joint)) => 1u32.checked_shl(joint as u32),
+            | ActArrayCommand::Home(JointSel::One(joint)) => 1u64.checked_shl(joint as u32),
             ActArrayCommand::MultiPosition(v) | ActArrayCommand::MultiSpeed(v) => {
-                Some(1u32.checked_shl(v.len() as u32).map_or(u32::MAX, |b| b - 1))
+                Some(1u64.checked_shl(v.len() as u32).map_or(u64::MAX, |b| b - 1))
             }
-            ActArrayCommand::Home(JointSel::All) => Some(u32::MAX),
+            ActArrayCommand::Home(JointSel::All) => Some(u64::MAX),
             _ => None,
         };
-        mask.is_some_and(|m| m & self.moving != 0)
+        Motion::of(mask.unwrap_or(0), self.moving as u64)
     }
 
     fn stop(&mut self, state: &mut ActArrayData) -> Status {
@@ -293,8 +295,8 @@ struct Handlers<'a> {
 }
 
 impl DeviceSetHandler for Handlers<'_> {
-    fn actarray_preempts(&mut self, _: u16, cmd: &ActArrayCommand, state: &ActArrayData) -> bool {
-        self.arm.preempts(cmd, state)
+    fn actarray_motion(&mut self, _: u16, cmd: &ActArrayCommand, state: &ActArrayData) -> Motion {
+        self.arm.motion(cmd, state)
     }
     fn actarray_stop(&mut self, _: u16, state: &mut ActArrayData) -> Status {
         self.arm.stop(state)

@@ -238,7 +238,7 @@ fn discovery_lists_devices_with_driver_and_liveness() {
     assert!(
         devices
             .iter()
-            .all(|d| d.alive && d.driver == "testdriver" && d.layout == "1")
+            .all(|d| d.alive && d.driver == "testdriver" && d.layout == "2")
     );
     // Another domain sees nothing.
     assert!(list_devices(&Domain::unique_for_test()).unwrap().is_empty());

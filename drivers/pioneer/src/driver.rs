@@ -8,7 +8,9 @@ use limber_interfaces::diagnostics::{self, DriverStats, hardware, loop_mode};
 use limber_interfaces::prelude::*;
 use limber_services::diagnostics::StatsPublisher;
 use limber_services::event_loop::{self, FdSource, LoopExit, Wake};
-use limber_services::{Context, DeviceSet, DeviceSetHandler, HostError, Origin, monotonic_ns};
+use limber_services::{
+    Context, DeviceSet, DeviceSetHandler, HostError, Motion, Origin, monotonic_ns,
+};
 use thiserror::Error;
 
 use limber_p2os::{
@@ -213,11 +215,11 @@ impl core::fmt::Debug for PioneerDriver {
 struct Serve<'a>(&'a mut RobotModel);
 
 impl DeviceSetHandler for Serve<'_> {
-    fn actarray_preempts(&mut self, index: u16, cmd: &ActArrayCommand, _s: &ActArrayData) -> bool {
+    fn actarray_motion(&mut self, index: u16, cmd: &ActArrayCommand, _s: &ActArrayData) -> Motion {
         if index == 0 {
-            self.0.arm_preempts(cmd)
+            self.0.arm_motion(cmd)
         } else {
-            self.0.lift_preempts()
+            self.0.lift_motion()
         }
     }
     fn actarray_stop(&mut self, index: u16, _s: &mut ActArrayData) -> Status {
@@ -227,17 +229,17 @@ impl DeviceSetHandler for Serve<'_> {
             self.0.lift_stop()
         }
     }
-    fn limb_preempts(&mut self, _index: u16, cmd: &LimbCommand, _s: &LimbData) -> bool {
-        self.0.limb_preempts(cmd)
+    fn limb_motion(&mut self, _index: u16, cmd: &LimbCommand, _s: &LimbData) -> Motion {
+        self.0.limb_motion(cmd)
     }
     fn limb_stop(&mut self, _index: u16, _s: &mut LimbData) -> Status {
         self.0.arm_stop()
     }
-    fn gripper_preempts(&mut self, index: u16, _cmd: &GripperCommand, _s: &GripperData) -> bool {
+    fn gripper_motion(&mut self, index: u16, _cmd: &GripperCommand, _s: &GripperData) -> Motion {
         if index == 0 {
-            self.0.gripper_preempts()
+            self.0.gripper_motion()
         } else {
-            self.0.armgrip_preempts()
+            self.0.armgrip_motion()
         }
     }
     fn gripper_stop(&mut self, index: u16, _s: &mut GripperData) -> Status {

@@ -1,7 +1,10 @@
 //! A test client process. Modes:
 //! * `burst N`: send N position commands to `<robot>/actarray/0` as fast as possible;
 //! * `basic`: geometry, power, a move with its outcome, the state; prints `ok`;
-//! * `hold-request`: send a geometry request and wait (to be killed mid-request).
+//! * `hold-request`: send a geometry request and wait (to be killed mid-request);
+//! * `own`: power on, take the arm's lease as `--name` with a heartbeat of
+//!   `--heartbeat-ms`, move joint 0 at 0.1 rad/s, print `owning <client id>`, then renew
+//!   the lease (unless `--no-renew`) until killed or stdin closes.
 
 use std::time::Duration;
 
@@ -18,6 +21,15 @@ struct Args {
     /// Count for `burst`.
     #[arg(default_value_t = 64)]
     n: u64,
+    /// `own`: the holder's name.
+    #[arg(long, default_value = "test-holder")]
+    name: String,
+    /// `own`: the lease's heartbeat timeout, ms.
+    #[arg(long, default_value_t = 1000)]
+    heartbeat_ms: u64,
+    /// `own`: never renew the lease (to miss the heartbeat).
+    #[arg(long)]
+    no_renew: bool,
 }
 
 fn main() {
@@ -55,6 +67,28 @@ fn main() {
         "hold-request" => {
             println!("requesting");
             let _ = arm.request_with_timeout(&ActArrayRequest::GetGeom, Duration::from_secs(60));
+        }
+        "own" => {
+            arm.power(true).expect("power");
+            arm.acquire(&a.name, Duration::from_millis(a.heartbeat_ms))
+                .expect("acquire");
+            let t = arm.move_at_speed(0, 0.1).expect("move");
+            let st = arm.wait_outcome(t, Duration::from_secs(5)).expect("outcome");
+            assert!(st.is_carried_out(), "{st}");
+            println!("owning {}", arm.client_id());
+            // Until stdin closes (the test gone) or the process is killed.
+            let (tx, rx) = std::sync::mpsc::channel::<()>();
+            std::thread::spawn(move || {
+                let mut s = String::new();
+                let _ = std::io::stdin().read_line(&mut s);
+                let _ = tx.send(());
+            });
+            while rx.try_recv().is_err() {
+                if !a.no_renew {
+                    arm.keep_lease().expect("renew");
+                }
+                std::thread::sleep(Duration::from_millis(10));
+            }
         }
         m => panic!("unknown mode {m}"),
     }

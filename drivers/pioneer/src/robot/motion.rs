@@ -5,7 +5,7 @@ use std::time::{Duration, Instant};
 
 use limber_interfaces::prelude::*;
 use limber_p2os::{ArmJoint, PaddleState};
-use limber_services::Origin;
+use limber_services::{Motion, Origin};
 
 use super::*;
 
@@ -20,21 +20,26 @@ const DEADMAN: Origin = Origin {
 const LIMB_JOINTS: u8 = 0b1_1111;
 
 impl RobotModel {
-    /// True when one of the arm joints in `mask` (bit j = joint j) is still moving toward
-    /// a commanded target, or a VECMOVE (which drives the limb joints) is being streamed.
-    fn joints_running(&self, mask: u8) -> bool {
-        if self.vecmove.is_some() && mask & LIMB_JOINTS != 0 {
-            return true;
-        }
+    /// The arm joints still moving toward a commanded target (bit j = joint j); every
+    /// limb joint while a VECMOVE is being streamed.
+    fn joints_running(&self) -> u64 {
         let now = Instant::now();
         let stall = Duration::from_millis(self.cfg.stall_timeout_ms);
-        (0..ARM_JOINTS)
-            .filter(|j| mask & (1 << j) != 0)
-            .any(|j| self.arm.flags(j, now, stall).contains(ActuatorFlags::MOVING))
+        let mut bits = if self.vecmove.is_some() {
+            LIMB_JOINTS as u64
+        } else {
+            0
+        };
+        for j in 0..ARM_JOINTS {
+            if self.arm.flags(j, now, stall).contains(ActuatorFlags::MOVING) {
+                bits |= 1 << j;
+            }
+        }
+        bits
     }
 
-    /// Whether an arm actarray command cuts short a motion still running on its joints.
-    pub fn arm_preempts(&self, cmd: &ActArrayCommand) -> bool {
+    /// What an arm actarray command drives, and which of its joints still move.
+    pub fn arm_motion(&self, cmd: &ActArrayCommand) -> Motion {
         let all = (1u8 << ARM_JOINTS) - 1;
         let first = |n: usize| ((1u16 << n.min(ARM_JOINTS)) - 1) as u8;
         let one = |j: u16| if (j as usize) < ARM_JOINTS { 1u8 << j } else { 0 };
@@ -47,31 +52,34 @@ impl RobotModel {
             ActArrayCommand::Home(JointSel::One(j)) => one(j),
             ActArrayCommand::Current { .. } | ActArrayCommand::MultiCurrent(_) => 0,
         };
-        self.joints_running(mask)
+        Motion::of(mask as u64, self.joints_running())
     }
 
-    /// Whether a limb command (any: a new target or a stop) cuts short a running limb
-    /// motion (SETPOSE, SETPOSITION, VECMOVE, HOME, or joints of the arm moving).
-    pub fn limb_preempts(&self, _cmd: &LimbCommand) -> bool {
-        self.joints_running(LIMB_JOINTS)
+    /// What a limb command drives (any: a new target or a stop drives every limb joint),
+    /// and which limb joints still move (SETPOSE, SETPOSITION, VECMOVE, HOME).
+    pub fn limb_motion(&self, _cmd: &LimbCommand) -> Motion {
+        Motion::of(LIMB_JOINTS as u64, self.joints_running())
     }
 
-    /// Whether a command of the arm gripper cuts short its running motion.
-    pub fn armgrip_preempts(&self) -> bool {
-        self.joints_running(1 << ArmJoint::GRIPPER.index())
+    /// A command of the arm gripper drives it (bit 0); still moving or not.
+    pub fn armgrip_motion(&self) -> Motion {
+        let moving = self.joints_running() >> ArmJoint::GRIPPER.index() & 1;
+        Motion::of(1, moving)
     }
 
-    /// Whether a command of the body gripper cuts short its running motion (the paddles
-    /// are between their end switches, moving).
-    pub fn gripper_preempts(&self) -> bool {
-        self.sip
+    /// A command of the body gripper drives it (bit 0); moving while the paddles are
+    /// between their end switches.
+    pub fn gripper_motion(&self) -> Motion {
+        let moving = self
+            .sip
             .as_ref()
-            .is_some_and(|s| s.gripper_switches().paddles() == PaddleState::Moving)
+            .is_some_and(|s| s.gripper_switches().paddles() == PaddleState::Moving);
+        Motion::of(1, moving as u64)
     }
 
-    /// Whether a command of the lift cuts short its running motion.
-    pub fn lift_preempts(&self) -> bool {
-        self.lift.moving.is_some()
+    /// A command of the lift drives it (bit 0); still moving or not.
+    pub fn lift_motion(&self) -> Motion {
+        Motion::of(1, self.lift.moving.is_some() as u64)
     }
 
     /// The deadman's stop of the arm actarray and the limb: every arm joint stops.

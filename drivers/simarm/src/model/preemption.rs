@@ -3,23 +3,28 @@
 
 use limber_interfaces::prelude::*;
 
+use limber_services::Motion;
+
 use super::ArmModel;
 
 impl ArmModel {
-    /// True when actuator `j` (a joint, or `dof` = the gripper) is moving; a VECMOVE in
-    /// progress counts for every joint.
-    fn actuator_running(&self, j: usize) -> bool {
-        if j < self.n {
-            self.vecmove.active || self.joints[j].moving
-        } else if j == self.n {
-            self.gripper.moving
-        } else {
-            false
+    /// The actuators still moving (bit j: joint j, bit `dof`: the gripper); every joint
+    /// while a VECMOVE is in progress.
+    fn running(&self) -> u64 {
+        let mut bits = 0u64;
+        for j in 0..self.n {
+            if self.vecmove.active || self.joints[j].moving {
+                bits |= 1 << j;
+            }
         }
+        if self.gripper.moving {
+            bits |= 1 << self.n;
+        }
+        bits
     }
 
-    /// Whether an actarray command cuts short a motion still running on its actuators.
-    pub fn arm_preempts(&self, cmd: &ActArrayCommand) -> bool {
+    /// What an actarray command drives, and which of its actuators still move.
+    pub fn arm_motion(&self, cmd: &ActArrayCommand) -> Motion {
         let (first, count) = match *cmd {
             ActArrayCommand::Position { joint, .. }
             | ActArrayCommand::Speed { joint, .. }
@@ -37,17 +42,20 @@ impl ArmModel {
             | ActArrayCommand::MultiCurrent(v) => (0, v.len()),
             ActArrayCommand::Home(JointSel::All) => (0, self.n + 1),
         };
-        (first..first + count).any(|j| self.actuator_running(j))
+        let drives = (first..(first + count).min(64)).fold(0u64, |m, j| m | 1 << j);
+        Motion::of(drives, self.running())
     }
 
-    /// Whether a limb command (a new target or a stop) cuts short a running limb motion.
-    pub fn limb_preempts(&self) -> bool {
-        self.limb_moving()
+    /// What a limb command (a new target or a stop) drives: every joint; and which still
+    /// move.
+    pub fn limb_motion(&self) -> Motion {
+        let joints = (1u64 << self.n) - 1;
+        Motion::of(joints, self.running() & joints)
     }
 
-    /// Whether a gripper command cuts short the gripper's running motion.
-    pub fn gripper_preempts(&self) -> bool {
-        self.gripper.moving
+    /// A gripper command drives the gripper (bit 0); still moving or not.
+    pub fn gripper_motion(&self) -> Motion {
+        Motion::of(1, self.gripper.moving as u64)
     }
 
     /// The deadman's stop of the actarray: every joint and the gripper stop where they are.
