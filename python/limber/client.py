@@ -128,6 +128,8 @@ class Status(enum.IntEnum):
     POWERED_OFF = L.STATUS_POWERED_OFF
     UNREACHABLE_ORIENTATION = L.STATUS_UNREACHABLE_ORIENTATION
     CLAMPED = L.STATUS_CLAMPED
+    PREEMPTED = L.STATUS_PREEMPTED
+    LEASED = L.STATUS_LEASED
 
     @property
     def is_ok(self) -> bool:
@@ -162,6 +164,8 @@ _STATUS_TEXT = {
     Status.POWERED_OFF: "powered off",
     Status.UNREACHABLE_ORIENTATION: "orientation not attainable by this limb's joints",
     Status.CLAMPED: "ok, clamped to the limit",
+    Status.PREEMPTED: "preempted by another client",
+    Status.LEASED: "held by another client",
 }
 
 
