@@ -391,8 +391,12 @@ pub fn actarray(a: ActArrayArgs) -> Result<(), CliError> {
         ActArrayVerb::Multicurrent { currents } => c.set_current_multi(&currents),
         ActArrayVerb::Power { value } => return done(&mut c, |c| c.power(value.on())),
         ActArrayVerb::Brakes { value } => return done(&mut c, |c| c.brakes(value.on())),
-        ActArrayVerb::Speedcfg { joint, speed } => return done(&mut c, |c| c.set_speed_config(joint, speed)),
-        ActArrayVerb::Accel { joint, accel } => return done(&mut c, |c| c.set_accel_config(joint, accel)),
+        ActArrayVerb::Speedcfg { joint, speed } => {
+            return done(&mut c, |c| c.set_speed_config(joint, speed));
+        }
+        ActArrayVerb::Accel { joint, accel } => {
+            return done(&mut c, |c| c.set_accel_config(joint, accel));
+        }
         ActArrayVerb::Geom => {
             let g = c.geometry().map_err(request_err)?;
             outln!(

@@ -414,8 +414,8 @@ fn the_monitor_shows_who_holds_a_device() {
     let domain = Domain::unique_for_test();
     let _stop = driver(domain.name());
     let ctx = Context::new(&domain, Role::Client, "holder").unwrap();
-    let mut holder = ActArrayClient::connect_timeout(&ctx, "cli/actarray/0", Duration::from_secs(5))
-        .unwrap();
+    let mut holder =
+        ActArrayClient::connect_timeout(&ctx, "cli/actarray/0", Duration::from_secs(5)).unwrap();
     holder.acquire("alice", Duration::from_secs(30)).unwrap();
     let mut app = monitor(&domain);
     let deadline = Instant::now() + Duration::from_secs(10);

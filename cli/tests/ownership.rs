@@ -17,7 +17,10 @@ fn own_takes_the_device_and_a_held_device_refuses_others_naming_its_holder() {
     let _stop = driver(d.name());
     let dom = d.name();
     // As README shows it: the device taken for the command, and free again after it.
-    let o = limber(dom, &["actarray", "cli/actarray/0", "pos", "2", "0.5", "--own"]);
+    let o = limber(
+        dom,
+        &["actarray", "cli/actarray/0", "pos", "2", "0.5", "--own"],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(stdout(&o), "ok\n");
 
@@ -46,7 +49,10 @@ fn own_takes_the_device_and_a_held_device_refuses_others_naming_its_holder() {
     assert_eq!(alice.wait_outcome(t, T).unwrap(), Status::Ok);
 
     alice.release().unwrap();
-    let o = limber(dom, &["actarray", "cli/actarray/0", "pos", "2", "0.1", "--own"]);
+    let o = limber(
+        dom,
+        &["actarray", "cli/actarray/0", "pos", "2", "0.1", "--own"],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
@@ -60,7 +66,9 @@ fn a_lease_ends_with_its_holder_client_and_with_a_missed_heartbeat() {
     // A heartbeat outside the allowed range is refused.
     assert_eq!(
         a.acquire("a", Duration::from_millis(1)),
-        Err(limber_services::LeaseError::Refused(Status::InvalidArgument))
+        Err(limber_services::LeaseError::Refused(
+            Status::InvalidArgument
+        ))
     );
     // Dropping the holder releases.
     a.acquire("a", Duration::from_secs(30)).unwrap();
@@ -128,7 +136,15 @@ fn the_cli_never_misses_its_outcome_under_contention() {
             let dom = dom.clone();
             std::thread::spawn(move || {
                 let pos = format!("0.{i}");
-                let args = ["actarray", "cli/actarray/0", "pos", "0", &pos, "--timeout", "10"];
+                let args = [
+                    "actarray",
+                    "cli/actarray/0",
+                    "pos",
+                    "0",
+                    &pos,
+                    "--timeout",
+                    "10",
+                ];
                 limber(&dom, &args)
             })
         })
@@ -141,4 +157,30 @@ fn the_cli_never_misses_its_outcome_under_contention() {
     stop_tx.send(()).unwrap();
     let sent = flood.join().unwrap();
     assert!(sent > 240);
+}
+
+/// README, "Concurrent use and ownership", as written against `limber pioneer --emulated`:
+/// `--own` carries the command out, and refuses naming the holder while another holds it.
+#[test]
+fn the_readme_own_example_runs_as_written() {
+    let d = Domain::unique_for_test();
+    let _p = common::pioneer_emulated(d.name());
+    let dom = d.name();
+    let example = ["actarray", "pioneer/actarray/0", "pos", "2", "0.5", "--own"];
+    let o = limber(dom, &["actarray", "pioneer/actarray/0", "power", "on"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = limber(dom, &example);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(stdout(&o), "ok\n");
+
+    let ctx = Context::new(&d, Role::Client, "alice").unwrap();
+    let mut alice = ActArrayClient::connect_timeout(&ctx, "pioneer/actarray/0", T).unwrap();
+    alice.acquire("alice", Duration::from_secs(30)).unwrap();
+    let o = limber(dom, &example);
+    assert_eq!(o.status.code(), Some(5), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("refused: held by another client (alice)"),
+        "{}",
+        stderr(&o)
+    );
 }

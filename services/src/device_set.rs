@@ -37,7 +37,8 @@ use thiserror::Error;
 
 use crate::context::Context;
 use crate::host::{
-    Activity, DeviceHandler, Motion, DeviceHost, HostError, HostStats, Origin, ProcessError, PublishError,
+    Activity, DeviceHandler, DeviceHost, HostError, HostStats, Motion, Origin, ProcessError,
+    PublishError,
 };
 use crate::naming::DeviceName;
 
@@ -58,7 +59,12 @@ pub trait DeviceSetHandler {
     }
     /// What `cmd` drives on `actarray/<index>` and which of it still moves; see
     /// [`DeviceHandler::motion`]. Default: nothing.
-    fn actarray_motion(&mut self, index: u16, cmd: &ActArrayCommand, state: &ActArrayData) -> Motion {
+    fn actarray_motion(
+        &mut self,
+        index: u16,
+        cmd: &ActArrayCommand,
+        state: &ActArrayData,
+    ) -> Motion {
         let _ = (index, cmd, state);
         Motion::NONE
     }

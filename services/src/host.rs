@@ -4,9 +4,9 @@
 use core::marker::PhantomData;
 
 use iceoryx2::active_request::ActiveRequest;
+use iceoryx2::node::NodeView;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
-use iceoryx2::node::NodeView;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::server::Server;
 use iceoryx2::port::subscriber::Subscriber;
@@ -805,7 +805,8 @@ impl<I: Interface> DeviceHost<I> {
                 continue;
             }
             let cut = self.drivers[bit];
-            let told_already = (0..bit).any(|b| motion.cuts & (1 << b) != 0 && self.drivers[b] == cut);
+            let told_already =
+                (0..bit).any(|b| motion.cuts & (1 << b) != 0 && self.drivers[b] == cut);
             if cut.0 != 0 && cut.0 != origin.client_id && !told_already {
                 self.stats.preempted += 1;
                 self.publish_outcome(cut, Status::Preempted, origin.client_id, name.as_ref());

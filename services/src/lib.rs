@@ -90,8 +90,8 @@ pub use device_set::{DeviceError, DeviceSet, DeviceSetHandler};
 pub use discovery::{DeviceInfo, ListError, list_devices};
 pub use error::Iox2Error;
 pub use host::{
-    Activity, CLIENT_SLOTS, DeviceHandler, DeviceHost, HostError, HostStats, Holder, Motion, Origin,
-    ProcessError, PublishError,
+    Activity, CLIENT_SLOTS, DeviceHandler, DeviceHost, Holder, HostError, HostStats, Motion,
+    Origin, ProcessError, PublishError,
 };
 pub use naming::{Channel, DeviceName, Domain, NameError};
 

@@ -93,17 +93,15 @@ impl DeviceHandler<ActArray> for TestArm {
                     state.actuators[joint as usize].position = position;
                 })
             }
-            ActArrayCommand::Speed { joint, speed } => {
-                self.check(joint as usize, 0.0).map(|()| {
-                    let j = joint as usize;
-                    self.halt(j, state);
-                    if speed != 0.0 {
-                        self.moving |= 1 << j;
-                        state.actuators[j].speed = speed;
-                        state.actuators[j].state = ActuatorFlags::MOVING.bits();
-                    }
-                })
-            }
+            ActArrayCommand::Speed { joint, speed } => self.check(joint as usize, 0.0).map(|()| {
+                let j = joint as usize;
+                self.halt(j, state);
+                if speed != 0.0 {
+                    self.moving |= 1 << j;
+                    state.actuators[j].speed = speed;
+                    state.actuators[j].state = ActuatorFlags::MOVING.bits();
+                }
+            }),
             ActArrayCommand::MultiPosition(v) => {
                 if v.len() > self.joints {
                     Err(Status::UnknownJoint)

@@ -71,7 +71,10 @@ fn wait_free(a: &mut ActArrayClient) -> Duration {
             Ok(Some(_)) => {}
             Err(e) => panic!("cannot ask who holds the arm: {e}"),
         }
-        assert!(start.elapsed() < Duration::from_secs(10), "the lease never ended");
+        assert!(
+            start.elapsed() < Duration::from_secs(10),
+            "the lease never ended"
+        );
         std::thread::sleep(Duration::from_millis(20));
     }
 }
@@ -147,11 +150,7 @@ fn the_deadman_stops_the_joint_when_the_holder_misses_its_heartbeat() {
     let domain = Domain::unique_for_test();
     let _d = start(&domain, "own-heartbeat");
     let mut me = arm(&domain, "watcher");
-    let mut h = holder(
-        &domain,
-        "sleepy",
-        &["--heartbeat-ms", "400", "--no-renew"],
-    );
+    let mut h = holder(&domain, "sleepy", &["--heartbeat-ms", "400", "--no-renew"]);
     wait_free(&mut me);
     wait_joint(&mut me, 0, ActuatorFlags::IDLE, "stopped");
     // The holder is alive: its heartbeat, not its death, ended the lease.

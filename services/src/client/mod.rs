@@ -20,9 +20,7 @@ mod waiting;
 pub use commands::Ticket;
 use connection::OUTCOME_SLOTS;
 pub use connection::{ActArrayClient, Client, GripperClient, LimbClient};
-pub use error::{
-    CommandError, ConnectError, Incompatibility, LeaseError, RequestError, WaitError,
-};
+pub use error::{CommandError, ConnectError, Incompatibility, LeaseError, RequestError, WaitError};
 pub use ownership::{LeaseHolder, Outcome};
 pub use waiting::{DriverStatus, Freshness, WaitMode};
 

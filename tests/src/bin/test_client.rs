@@ -73,7 +73,9 @@ fn main() {
             arm.acquire(&a.name, Duration::from_millis(a.heartbeat_ms))
                 .expect("acquire");
             let t = arm.move_at_speed(0, 0.1).expect("move");
-            let st = arm.wait_outcome(t, Duration::from_secs(5)).expect("outcome");
+            let st = arm
+                .wait_outcome(t, Duration::from_secs(5))
+                .expect("outcome");
             assert!(st.is_carried_out(), "{st}");
             println!("owning {}", arm.client_id());
             // Until stdin closes (the test gone) or the process is killed.

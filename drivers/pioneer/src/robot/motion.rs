@@ -31,7 +31,11 @@ impl RobotModel {
             0
         };
         for j in 0..ARM_JOINTS {
-            if self.arm.flags(j, now, stall).contains(ActuatorFlags::MOVING) {
+            if self
+                .arm
+                .flags(j, now, stall)
+                .contains(ActuatorFlags::MOVING)
+            {
                 bits |= 1 << j;
             }
         }
@@ -42,7 +46,13 @@ impl RobotModel {
     pub fn arm_motion(&self, cmd: &ActArrayCommand) -> Motion {
         let all = (1u8 << ARM_JOINTS) - 1;
         let first = |n: usize| ((1u16 << n.min(ARM_JOINTS)) - 1) as u8;
-        let one = |j: u16| if (j as usize) < ARM_JOINTS { 1u8 << j } else { 0 };
+        let one = |j: u16| {
+            if (j as usize) < ARM_JOINTS {
+                1u8 << j
+            } else {
+                0
+            }
+        };
         let mask = match *cmd {
             ActArrayCommand::Position { joint, .. } | ActArrayCommand::Speed { joint, .. } => {
                 one(joint)
