@@ -480,6 +480,63 @@ impl DeviceSet {
         s
     }
 
+    /// [`DeviceHost::check_lease`] on every device (the deadman), for a driver that
+    /// processes its clients only when they wake it: call it on every tick. Every device is
+    /// checked even if one fails; the first failure is returned.
+    pub fn check_leases<H: DeviceSetHandler + ?Sized>(
+        &mut self,
+        handler: &mut H,
+    ) -> Result<(), DeviceError<ProcessError>> {
+        fn one<I: Interface, D: DeviceHandler<I>>(
+            host: &mut DeviceHost<I>,
+            handler: &mut D,
+            first: &mut Option<DeviceError<ProcessError>>,
+        ) {
+            if let Err(source) = host.check_lease(handler) {
+                tracing::warn!(device = %host.device(), error = %source, "deadman check failed");
+                first.get_or_insert_with(|| DeviceError {
+                    device: host.device().clone(),
+                    source,
+                });
+            }
+        }
+        let mut first = None;
+        for h in &mut self.actarrays {
+            let index = h.device().index();
+            one::<ActArray, _>(
+                h,
+                &mut At {
+                    handler: &mut *handler,
+                    index,
+                },
+                &mut first,
+            );
+        }
+        for h in &mut self.limbs {
+            let index = h.device().index();
+            one::<Limb, _>(
+                h,
+                &mut At {
+                    handler: &mut *handler,
+                    index,
+                },
+                &mut first,
+            );
+        }
+        for h in &mut self.grippers {
+            let index = h.device().index();
+            one::<Gripper, _>(
+                h,
+                &mut At {
+                    handler: &mut *handler,
+                    index,
+                },
+                &mut first,
+            );
+        }
+        first.map_or(Ok(()), Err)
+    }
+
     /// [`DeviceHost::cleanup_dead`] on every device (a 1 Hz housekeeping tick).
     pub fn cleanup_dead(&self) {
         self.actarrays.iter().for_each(|h| h.cleanup_dead());

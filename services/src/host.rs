@@ -854,9 +854,15 @@ impl<I: Interface> DeviceHost<I> {
         }
     }
 
-    /// The deadman: ends the lease and stops the device when its holder's node died or
-    /// its heartbeat is overdue. Cheap unless a lease is held.
-    fn check_lease<H: DeviceHandler<I>>(&mut self, handler: &mut H) -> Result<(), ProcessError> {
+    /// The deadman: ends the lease and stops the device (with [`DeviceHandler::stop`]) when
+    /// its holder's node died or its heartbeat is overdue. [`DeviceHost::process`] calls
+    /// it; a driver that processes only when clients wake it calls it on its ticks too.
+    /// Cheap unless a lease is held (then the holder's node is looked up at most every
+    /// [`HOLDER_CHECK_NS`]).
+    pub fn check_lease<H: DeviceHandler<I>>(
+        &mut self,
+        handler: &mut H,
+    ) -> Result<(), ProcessError> {
         let Some(l) = self.lease else {
             return Ok(());
         };

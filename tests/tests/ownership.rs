@@ -133,9 +133,10 @@ fn the_deadman_stops_the_joint_when_the_holder_is_killed_mid_motion() {
     wait_joint(&mut me, 0, ActuatorFlags::MOVING, "moving");
 
     h.signal(libc::SIGKILL);
-    let freed = wait_free(&mut me);
+    // Reading states only (nothing that wakes the driver): its own ticks find the death.
     let stopped = wait_joint(&mut me, 0, ActuatorFlags::IDLE, "stopped");
-    eprintln!("lease free {freed:?}, joint idle {stopped:?} after the SIGKILL");
+    let freed = wait_free(&mut me);
+    eprintln!("joint idle {stopped:?}, then the lease free within {freed:?} after the SIGKILL");
     // The joint stays where it stopped (it is not still driven toward its limit).
     let p0 = me.wait_state(T).unwrap().actuators[0].position;
     let p1 = me.wait_state(T).unwrap().actuators[0].position;
@@ -151,8 +152,9 @@ fn the_deadman_stops_the_joint_when_the_holder_misses_its_heartbeat() {
     let _d = start(&domain, "own-heartbeat");
     let mut me = arm(&domain, "watcher");
     let mut h = holder(&domain, "sleepy", &["--heartbeat-ms", "400", "--no-renew"]);
-    wait_free(&mut me);
+    // Reading states only (nothing that wakes the driver): its own ticks find it.
     wait_joint(&mut me, 0, ActuatorFlags::IDLE, "stopped");
+    wait_free(&mut me);
     // The holder is alive: its heartbeat, not its death, ended the lease.
     assert!(h.child.try_wait().unwrap().is_none(), "the holder died");
     let t = me.move_to(0, 0.0).unwrap();

@@ -838,6 +838,11 @@ impl PioneerDriver {
         if self.robot.lift.moving.is_some() {
             self.robot.dirty.body = true;
         }
+        // The deadman: a lease whose holder died or fell silent ends and stops its device
+        // (clients wake the loop only when they send).
+        if let Err(e) = self.hosts.check_leases(&mut Serve(&mut self.robot)) {
+            self.failures.note(Failure::Process, &e);
+        }
         // Housekeeping (allocates inside iceoryx2): resources of crashed clients.
         if now.duration_since(self.last_cleanup) > Duration::from_secs(60) {
             self.last_cleanup = now;
