@@ -186,10 +186,41 @@ fn a_client_whose_motion_is_cut_short_by_another_is_told_preempted() {
             break p;
         }
         assert!(start.elapsed() < T, "A was never told it was preempted");
+        // A timeout only means: look again.
         let _ = a.wait_state(Duration::from_millis(50));
     };
     assert_eq!(p.status, Status::Preempted);
     assert_eq!(p.other_client, b.client_id());
     // B's own outcome is its own: ok, never A's preemption.
     assert_eq!(b.preempted(tb).unwrap(), None);
+}
+
+/// The reproduction: another client's STOP cancels a running VECMOVE. Its sender
+/// was told "ok"; now it is told its VECMOVE was preempted, and by whom.
+#[test]
+fn a_vecmove_stopped_by_another_client_is_told_preempted() {
+    let domain = Domain::unique_for_test();
+    let _d = start(&domain, "own-vecmove");
+    let c = Context::new(&domain, Role::Client, "limbs").unwrap();
+    let mut a = LimbClient::connect_timeout(&c, "pioneer/limb/0", T).unwrap();
+    let mut b = LimbClient::connect_timeout(&c, "pioneer/limb/0", T).unwrap();
+    a.power(true).unwrap();
+    let t = a.vec_move([1.0, 1.0, 0.0], 0.05).unwrap();
+    assert_eq!(a.wait_outcome(t, T).unwrap(), Status::Ok);
+    let start = Instant::now();
+    while a.wait_state(T).unwrap().state != LimbState::Moving as u32 {
+        assert!(start.elapsed() < T, "the VECMOVE never ran");
+    }
+    let tb = b.stop().unwrap();
+    assert_eq!(b.wait_outcome(tb, T).unwrap(), Status::Ok);
+    let start = Instant::now();
+    let p = loop {
+        if let Some(p) = a.preempted(t).unwrap() {
+            break p;
+        }
+        assert!(start.elapsed() < T, "A was never told its VECMOVE was preempted");
+        // A timeout only means: look again.
+        let _ = a.wait_state(Duration::from_millis(50));
+    };
+    assert_eq!((p.status, p.other_client), (Status::Preempted, b.client_id()));
 }
