@@ -218,9 +218,15 @@ fn a_vecmove_stopped_by_another_client_is_told_preempted() {
         if let Some(p) = a.preempted(t).unwrap() {
             break p;
         }
-        assert!(start.elapsed() < T, "A was never told its VECMOVE was preempted");
+        assert!(
+            start.elapsed() < T,
+            "A was never told its VECMOVE was preempted"
+        );
         // A timeout only means: look again.
         let _ = a.wait_state(Duration::from_millis(50));
     };
-    assert_eq!((p.status, p.other_client), (Status::Preempted, b.client_id()));
+    assert_eq!(
+        (p.status, p.other_client),
+        (Status::Preempted, b.client_id())
+    );
 }
