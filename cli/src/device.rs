@@ -5,7 +5,7 @@ use std::time::Duration;
 
 use clap::{Args, Subcommand, ValueEnum};
 use limber_services::prelude::*;
-use limber_services::{CommandError, ConnectError, RequestError, WaitError};
+use limber_services::{CommandError, ConnectError, LeaseError, RequestError, WaitError};
 
 use crate::out::outln;
 use crate::{CliError, exit};
@@ -21,6 +21,10 @@ pub struct Common {
     /// Send commands without waiting for their outcome.
     #[arg(long, global = true)]
     no_wait: bool,
+    /// Take the device for this command (a control lease, released when it ends): refused
+    /// with the holder's name if another client holds it. Without it, the last writer wins.
+    #[arg(long, global = true)]
+    own: bool,
 }
 
 impl Common {
@@ -289,12 +293,41 @@ pub(crate) fn wait_err(e: WaitError) -> CliError {
     CliError::new(code, e.to_string())
 }
 
-fn connect<I: Interface>(device: &str, timeout: Duration) -> Result<Client<I>, CliError> {
+fn connect<I: Interface>(device: &str, common: &Common) -> Result<Client<I>, CliError> {
     let ctx = crate::client_context()?;
+    let timeout = common.timeout();
     // A driver that is starting gets the whole --timeout to appear.
     let mut c = Client::<I>::connect_timeout(&ctx, device, timeout).map_err(connect_err)?;
     c.set_request_timeout(timeout);
+    if common.own {
+        // Held while this command runs (released when the client is dropped); the
+        // heartbeat outlasts the longest wait of the command.
+        let name = format!("limber-cli pid {}", std::process::id());
+        c.acquire(&name, timeout.max(Duration::from_secs(1)) * 2)
+            .map_err(lease_err)?;
+    }
     Ok(c)
+}
+
+/// The refusal of a device held by another client, naming the holder.
+fn held_by(name: &str) -> CliError {
+    let who = if name.is_empty() { "unnamed" } else { name };
+    CliError::new(
+        exit::REFUSED,
+        format!("refused: {} ({who})", Status::Leased),
+    )
+}
+
+fn lease_err(e: LeaseError) -> CliError {
+    let code = match &e {
+        LeaseError::Held { name, .. } => return held_by(name),
+        LeaseError::Refused(_) => exit::REFUSED,
+        LeaseError::Timeout(_) => exit::TIMEOUT,
+        LeaseError::NoDriver => exit::NO_DRIVER,
+        LeaseError::DriverGone => exit::DRIVER_GONE,
+        _ => exit::FAILURE,
+    };
+    CliError::new(code, e.to_string())
 }
 
 /// Sends a command and reports its outcome.
@@ -308,14 +341,19 @@ fn finish<I: Interface>(
         outln!("sent")?;
         return Ok(());
     }
-    match c.wait_outcome(ticket, common.timeout()) {
+    match c.wait_outcome_detail(ticket, common.timeout()) {
         // "ok", or "ok, clamped to the limit": carried out either way.
-        Ok(s) if s.is_carried_out() => {
-            outln!("{s}")?;
+        Ok(o) if o.status.is_carried_out() => {
+            outln!("{}", o.status)?;
             Ok(())
         }
+        // Another client holds the device: "refused: held by another client (its name)".
+        Ok(o) if o.status == Status::Leased => Err(held_by(o.other_name())),
         // The cause in words: "refused: powered off", "refused: out of reach", ...
-        Ok(s) => Err(CliError::new(exit::REFUSED, format!("refused: {s}"))),
+        Ok(o) => Err(CliError::new(
+            exit::REFUSED,
+            format!("refused: {}", o.status),
+        )),
         Err(WaitError::Missed { .. }) => {
             outln!("ok (applied; outcome overwritten by a later command)")?;
             Ok(())
@@ -336,15 +374,34 @@ fn joint_sel(s: &str) -> Result<Option<usize>, CliError> {
     })
 }
 
-fn done(r: Result<(), RequestError>) -> Result<(), CliError> {
-    r.map_err(request_err)?;
-    outln!("ok")?;
-    Ok(())
+/// Sends a request that changes the device and reports the answer.
+fn done<I: Interface>(
+    c: &mut Client<I>,
+    request: impl FnOnce(&mut Client<I>) -> Result<(), RequestError>,
+) -> Result<(), CliError> {
+    match request(c) {
+        Ok(()) => {
+            outln!("ok")?;
+            Ok(())
+        }
+        Err(RequestError::Nack(Status::Leased)) => {
+            let name = match c.holder() {
+                Ok(Some(h)) => h.name,
+                Ok(None) => String::new(),
+                Err(e) => {
+                    tracing::debug!(error = %e, "cannot ask who holds the device");
+                    String::new()
+                }
+            };
+            Err(held_by(&name))
+        }
+        Err(e) => Err(request_err(e)),
+    }
 }
 
 /// Runs `limber actarray`.
 pub fn actarray(a: ActArrayArgs) -> Result<(), CliError> {
-    let mut c = connect::<ActArray>(&a.device, a.common.timeout())?;
+    let mut c = connect::<ActArray>(&a.device, &a.common)?;
     let sent = match a.cmd {
         ActArrayVerb::Pos { joint, position } => c.move_to(joint, position),
         ActArrayVerb::Multipos { positions } => c.move_to_multi(&positions),
@@ -353,10 +410,14 @@ pub fn actarray(a: ActArrayArgs) -> Result<(), CliError> {
         ActArrayVerb::Home { joint } => c.home(joint_sel(&joint)?),
         ActArrayVerb::Current { joint, current } => c.set_current(joint_sel(&joint)?, current),
         ActArrayVerb::Multicurrent { currents } => c.set_current_multi(&currents),
-        ActArrayVerb::Power { value } => return done(c.power(value.on())),
-        ActArrayVerb::Brakes { value } => return done(c.brakes(value.on())),
-        ActArrayVerb::Speedcfg { joint, speed } => return done(c.set_speed_config(joint, speed)),
-        ActArrayVerb::Accel { joint, accel } => return done(c.set_accel_config(joint, accel)),
+        ActArrayVerb::Power { value } => return done(&mut c, |c| c.power(value.on())),
+        ActArrayVerb::Brakes { value } => return done(&mut c, |c| c.brakes(value.on())),
+        ActArrayVerb::Speedcfg { joint, speed } => {
+            return done(&mut c, |c| c.set_speed_config(joint, speed));
+        }
+        ActArrayVerb::Accel { joint, accel } => {
+            return done(&mut c, |c| c.set_accel_config(joint, accel));
+        }
         ActArrayVerb::Geom => {
             let g = c.geometry().map_err(request_err)?;
             outln!(
@@ -404,7 +465,7 @@ fn v3(v: &[f64]) -> [f64; 3] {
 
 /// Runs `limber limb`.
 pub fn limb(a: LimbArgs) -> Result<(), CliError> {
-    let mut c = connect::<Limb>(&a.device, a.common.timeout())?;
+    let mut c = connect::<Limb>(&a.device, &a.common)?;
     let sent = match a.cmd {
         LimbVerb::Home => c.home(),
         LimbVerb::Stop => c.stop(),
@@ -415,9 +476,9 @@ pub fn limb(a: LimbArgs) -> Result<(), CliError> {
         } => c.set_pose(v3(&position), v3(&approach), v3(&orient)),
         LimbVerb::Setposition { position } => c.set_position(v3(&position)),
         LimbVerb::Vecmove { args } => c.vec_move(v3(&args), args[3]),
-        LimbVerb::Power { value } => return done(c.power(value.on())),
-        LimbVerb::Brakes { value } => return done(c.brakes(value.on())),
-        LimbVerb::Speed { speed } => return done(c.set_speed(speed)),
+        LimbVerb::Power { value } => return done(&mut c, |c| c.power(value.on())),
+        LimbVerb::Brakes { value } => return done(&mut c, |c| c.brakes(value.on())),
+        LimbVerb::Speed { speed } => return done(&mut c, |c| c.set_speed(speed)),
         LimbVerb::Reach {
             position,
             approach,
@@ -466,7 +527,7 @@ pub fn limb(a: LimbArgs) -> Result<(), CliError> {
 
 /// Runs `limber gripper`.
 pub fn gripper(a: GripperArgs) -> Result<(), CliError> {
-    let mut c = connect::<Gripper>(&a.device, a.common.timeout())?;
+    let mut c = connect::<Gripper>(&a.device, &a.common)?;
     let sent = match a.cmd {
         GripperVerb::Open => c.open(),
         GripperVerb::Close => c.close(),

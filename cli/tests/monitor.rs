@@ -406,3 +406,34 @@ fn the_binary_prints_one_frame_with_once_or_when_stdout_is_not_a_terminal() {
     assert!(text.lines().all(|l| l.chars().count() <= 80), "{text}");
     assert!(text.contains("cli/gripper/0"), "{text}");
 }
+
+/// Issue 12, item 12: the monitor shows who holds a device, and stops showing it when the
+/// lease ends.
+#[test]
+fn the_monitor_shows_who_holds_a_device() {
+    let domain = Domain::unique_for_test();
+    let _stop = driver(domain.name());
+    let ctx = Context::new(&domain, Role::Client, "holder").unwrap();
+    let mut holder =
+        ActArrayClient::connect_timeout(&ctx, "cli/actarray/0", Duration::from_secs(5)).unwrap();
+    holder.acquire("alice", Duration::from_secs(30)).unwrap();
+    let mut app = monitor(&domain);
+    let deadline = Instant::now() + Duration::from_secs(10);
+    let held = |app: &App| {
+        line_with(&ui::render_text(app, 140), "cli/actarray/0").contains("held by alice")
+    };
+    while !held(&app) {
+        assert!(Instant::now() < deadline, "{}", ui::render_text(&app, 140));
+        app.tick();
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    // Only the held device says so.
+    assert!(!line_with(&ui::render_text(&app, 140), "cli/limb/0").contains("held by"));
+    holder.release().unwrap();
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while held(&app) {
+        assert!(Instant::now() < deadline, "{}", ui::render_text(&app, 140));
+        app.tick();
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}

@@ -49,7 +49,10 @@ fn actarray_verbs() {
     let o = limber(dom, &["actarray", "cli/actarray/0", "brakes", "on"]);
     assert_eq!(o.status.code(), Some(5));
     assert!(stderr(&o).contains("unsupported"));
-    let o = limber(dom, &["actarray", "cli/actarray/0", "speed", "1", "0.1"]);
+    let o = limber(
+        dom,
+        &["actarray", "cli/actarray/0", "current", "all", "0.1"],
+    );
     assert_eq!(o.status.code(), Some(5));
     // Bad input never reaches the driver.
     let o = limber(dom, &["actarray", "cli/actarray/0", "pos", "1", "nan"]);

@@ -37,6 +37,8 @@ extern "C" {
 #define LIMBER_STATUS_POWERED_OFF 11 /* the arm is powered off */
 #define LIMBER_STATUS_UNREACHABLE_ORIENTATION 12 /* the orientation is not attainable by the limb's joints */
 #define LIMBER_STATUS_CLAMPED 13 /* carried out, a value clamped to the limit */
+#define LIMBER_STATUS_PREEMPTED 14 /* the motion was cut short by another client's command */
+#define LIMBER_STATUS_LEASED 15 /* another client holds the device */
 #define LIMBER_STATUS_ADJUSTED 16 /* carried out, the orientation adjusted to one the limb's joints can hold */
 
 /* Bits of StateHeader.flags */
@@ -44,6 +46,7 @@ extern "C" {
 #define LIMBER_DEVICE_FLAG_CALIBRATED 2 /* calibration known */
 #define LIMBER_DEVICE_FLAG_SIMULATED 4 /* simulated or emulated device */
 #define LIMBER_DEVICE_FLAG_ABSENT 8 /* hardware reports the device absent */
+#define LIMBER_DEVICE_FLAG_LEASED 16 /* a client holds the device with a control lease */
 
 /* actarray command kinds (MsgMeta.kind on the cmd channel) */
 #define LIMBER_ACTARRAY_CMD_POS 1 /* ActArrayPositionCmd */
@@ -119,6 +122,12 @@ extern "C" {
 /* DriverStats.loop_mode */
 #define LIMBER_LOOP_MODE_EVENT 1 /* event-driven */
 #define LIMBER_LOOP_MODE_SPIN 2 /* busy-polling */
+
+/* LeaseReq.op codes */
+#define LIMBER_LEASE_OP_ACQUIRE 1 /* take the device, or refresh one's own lease */
+#define LIMBER_LEASE_OP_RENEW 2 /* heartbeat of the holder */
+#define LIMBER_LEASE_OP_RELEASE 3 /* give the device back */
+#define LIMBER_LEASE_OP_QUERY 4 /* who holds the device */
 
 /* limber.v2.Vec3 (size 24, align 8) */
 typedef struct limber_vec3 {
@@ -768,6 +777,73 @@ LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, commands) == 320, "limber_dri
 LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, refused) == 328, "limber_driver_stats.refused offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, requests) == 336, "limber_driver_stats.requests offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, cmd_overflows) == 344, "limber_driver_stats.cmd_overflows offset");
+
+/* limber.v2.OutcomeMsg (size 72, align 8) */
+typedef struct limber_outcome_msg {
+    uint64_t client_id;
+    uint64_t cmd_seq;
+    uint64_t other_client;
+    uint64_t stamp_ns;
+    uint32_t kind;
+    uint32_t status;
+    uint8_t other_name[32];
+} limber_outcome_msg;
+#define LIMBER_OUTCOME_MSG_TYPE_NAME "limber.v2.OutcomeMsg"
+LIMBER_STATIC_ASSERT(sizeof(limber_outcome_msg) == 72, "limber_outcome_msg size");
+LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_outcome_msg) == 8, "limber_outcome_msg alignment");
+LIMBER_STATIC_ASSERT(offsetof(limber_outcome_msg, client_id) == 0, "limber_outcome_msg.client_id offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_outcome_msg, cmd_seq) == 8, "limber_outcome_msg.cmd_seq offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_outcome_msg, other_client) == 16, "limber_outcome_msg.other_client offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_outcome_msg, stamp_ns) == 24, "limber_outcome_msg.stamp_ns offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_outcome_msg, kind) == 32, "limber_outcome_msg.kind offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_outcome_msg, status) == 36, "limber_outcome_msg.status offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_outcome_msg, other_name) == 40, "limber_outcome_msg.other_name offset");
+
+/* limber.v2.LeaseReq (size 80, align 8) */
+typedef struct limber_lease_req {
+    uint64_t client_id;
+    uint64_t seq;
+    uint64_t node_lo;
+    uint64_t node_hi;
+    uint64_t timeout_ns;
+    uint32_t op;
+    uint32_t _pad;
+    uint8_t name[32];
+} limber_lease_req;
+#define LIMBER_LEASE_REQ_TYPE_NAME "limber.v2.LeaseReq"
+LIMBER_STATIC_ASSERT(sizeof(limber_lease_req) == 80, "limber_lease_req size");
+LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_lease_req) == 8, "limber_lease_req alignment");
+LIMBER_STATIC_ASSERT(offsetof(limber_lease_req, client_id) == 0, "limber_lease_req.client_id offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_lease_req, seq) == 8, "limber_lease_req.seq offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_lease_req, node_lo) == 16, "limber_lease_req.node_lo offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_lease_req, node_hi) == 24, "limber_lease_req.node_hi offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_lease_req, timeout_ns) == 32, "limber_lease_req.timeout_ns offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_lease_req, op) == 40, "limber_lease_req.op offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_lease_req, _pad) == 44, "limber_lease_req._pad offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_lease_req, name) == 48, "limber_lease_req.name offset");
+
+/* limber.v2.LeaseReply (size 80, align 8) */
+typedef struct limber_lease_reply {
+    uint64_t holder_client;
+    uint64_t seq;
+    uint64_t holder_node_lo;
+    uint64_t holder_node_hi;
+    uint64_t timeout_ns;
+    uint32_t status;
+    uint32_t _pad;
+    uint8_t holder_name[32];
+} limber_lease_reply;
+#define LIMBER_LEASE_REPLY_TYPE_NAME "limber.v2.LeaseReply"
+LIMBER_STATIC_ASSERT(sizeof(limber_lease_reply) == 80, "limber_lease_reply size");
+LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_lease_reply) == 8, "limber_lease_reply alignment");
+LIMBER_STATIC_ASSERT(offsetof(limber_lease_reply, holder_client) == 0, "limber_lease_reply.holder_client offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_lease_reply, seq) == 8, "limber_lease_reply.seq offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_lease_reply, holder_node_lo) == 16, "limber_lease_reply.holder_node_lo offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_lease_reply, holder_node_hi) == 24, "limber_lease_reply.holder_node_hi offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_lease_reply, timeout_ns) == 32, "limber_lease_reply.timeout_ns offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_lease_reply, status) == 40, "limber_lease_reply.status offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_lease_reply, _pad) == 44, "limber_lease_reply._pad offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_lease_reply, holder_name) == 48, "limber_lease_reply.holder_name offset");
 
 #ifdef __cplusplus
 }

@@ -156,6 +156,12 @@ pub enum Status {
     /// joint's maximum runs at the maximum). Counts as carried out
     /// ([`Status::is_carried_out`]).
     Clamped = 13,
+    /// The motion this command started was cut short by another client's command (a new
+    /// motion of the same joints, or a stop) before it finished: it did not complete.
+    Preempted = 14,
+    /// Another client holds the device (a control lease): commands and requests that
+    /// change the device are refused until it releases it or its lease ends.
+    Leased = 15,
     /// Carried out, with the orientation adjusted to the nearest one the limb's joints can
     /// hold (a 5-joint arm asked for a full pose; the limb state's
     /// `orientation_adjustment` says by how much). Counts as carried out
@@ -165,7 +171,7 @@ pub enum Status {
 
 impl Status {
     /// Every status, in code order.
-    pub const ALL: [Status; 15] = [
+    pub const ALL: [Status; 17] = [
         Status::Ok,
         Status::Unsupported,
         Status::UnknownJoint,
@@ -180,6 +186,8 @@ impl Status {
         Status::PoweredOff,
         Status::UnreachableOrientation,
         Status::Clamped,
+        Status::Preempted,
+        Status::Leased,
         Status::Adjusted,
     ];
 
@@ -218,6 +226,8 @@ impl Status {
             Status::PoweredOff => "powered off",
             Status::UnreachableOrientation => "orientation not attainable by this limb's joints",
             Status::Clamped => "ok, clamped to the limit",
+            Status::Preempted => "preempted by another client",
+            Status::Leased => "held by another client",
             Status::Adjusted => "ok, orientation adjusted",
         }
     }
@@ -253,8 +263,10 @@ pub mod device_flag {
     pub const SIMULATED: u32 = 4;
     /// The hardware reported this device as absent (e.g. no arm fitted).
     pub const ABSENT: u32 = 8;
+    /// A client holds the device with a control lease (see the `lease` channel).
+    pub const LEASED: u32 = 16;
     /// Every defined bit.
-    pub const ALL: u32 = LINK_UP | CALIBRATED | SIMULATED | ABSENT;
+    pub const ALL: u32 = LINK_UP | CALIBRATED | SIMULATED | ABSENT | LEASED;
 }
 
 pub(crate) const STATUS_GROUP: ConstantGroup = ConstantGroup {
@@ -332,6 +344,16 @@ pub(crate) const STATUS_GROUP: ConstantGroup = ConstantGroup {
             doc: "carried out, a value clamped to the limit",
         },
         Constant {
+            name: "PREEMPTED",
+            value: 14,
+            doc: "the motion was cut short by another client's command",
+        },
+        Constant {
+            name: "LEASED",
+            value: 15,
+            doc: "another client holds the device",
+        },
+        Constant {
             name: "ADJUSTED",
             value: 16,
             doc: "carried out, the orientation adjusted to one the limb's joints can hold",
@@ -362,6 +384,11 @@ pub(crate) const DEVICE_FLAG_GROUP: ConstantGroup = ConstantGroup {
             name: "ABSENT",
             value: 8,
             doc: "hardware reports the device absent",
+        },
+        Constant {
+            name: "LEASED",
+            value: 16,
+            doc: "a client holds the device with a control lease",
         },
     ],
 };

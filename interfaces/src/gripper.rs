@@ -195,6 +195,10 @@ impl Message for GripperRequest {
     type Raw = GripperReqMsg;
     const CHANNEL: &'static str = "gripper request";
 
+    fn is_read_only(&self) -> bool {
+        matches!(self, GripperRequest::GetGeom)
+    }
+
     fn kind(&self) -> u32 {
         req::GET_GEOM
     }

@@ -38,6 +38,7 @@
 pub mod actarray;
 pub mod codegen;
 pub mod common;
+pub mod control;
 pub mod diagnostics;
 pub mod error;
 pub mod gripper;
@@ -58,6 +59,11 @@ pub use message::{Envelope, Message, ReplyBody, ReplyEnvelope};
 pub use wire::{WireField, WireStruct};
 
 /// The layout version carried in every type name.
+///
+/// Version 2 added the `outcome` and `lease` channels ([`control::OutcomeMsg`],
+/// [`control::LeaseReq`], [`control::LeaseReply`]), the statuses `PREEMPTED`, `LEASED` and
+/// `ADJUSTED`, the limb state's `orientation_adjustment` and the limb's REACH request;
+/// every type name carries the version.
 pub const LAYOUT_VERSION: u32 = 2;
 
 /// Everything a driver or client author needs, in one `use`.
@@ -71,6 +77,7 @@ pub mod prelude {
         Bbox3, CmdOutcome, MAX_ACTUATORS, MsgMeta, Orientation3, Pose3, ReplyMeta, StateHeader,
         Status, Vec3, device_flag,
     };
+    pub use crate::control::{LeaseReply, LeaseReq, OutcomeMsg, lease_op};
     pub use crate::diagnostics::DriverStats;
     pub use crate::error::{DecodeError, ValueError};
     pub use crate::gripper::{
@@ -143,6 +150,10 @@ pub fn manifest() -> Manifest {
         GripperReplyMsg::LAYOUT,
         // diagnostics
         diagnostics::DriverStats::LAYOUT,
+        // control (layout version 2)
+        control::OutcomeMsg::LAYOUT,
+        control::LeaseReq::LAYOUT,
+        control::LeaseReply::LAYOUT,
     ];
     let mut constants = vec![
         common::LIMITS_GROUP,
@@ -153,6 +164,7 @@ pub fn manifest() -> Manifest {
     constants.extend_from_slice(limb::GROUPS);
     constants.extend_from_slice(gripper::GROUPS);
     constants.extend_from_slice(diagnostics::GROUPS);
+    constants.push(control::LEASE_OP_GROUP);
     Manifest {
         layout_version: LAYOUT_VERSION,
         structs,

@@ -442,6 +442,10 @@ impl Message for LimbRequest {
     type Raw = LimbReqMsg;
     const CHANNEL: &'static str = "limb request";
 
+    fn is_read_only(&self) -> bool {
+        matches!(self, LimbRequest::Geom)
+    }
+
     fn kind(&self) -> u32 {
         match self {
             LimbRequest::Power(_) => req::POWER,

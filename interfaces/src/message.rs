@@ -36,6 +36,12 @@ pub trait Message: Sized + Copy {
     fn write(&self, raw: &mut Self::Raw);
     /// Decodes and validates `raw`.
     fn read(raw: &Self::Raw) -> Result<Self, DecodeError>;
+    /// True when the message only reads the device (e.g. a geometry request): allowed
+    /// while another client holds the device's control lease. Default: it changes the
+    /// device.
+    fn is_read_only(&self) -> bool {
+        false
+    }
 }
 
 /// A typed reply body (the payload of an ACK) carried in envelope `Raw`.

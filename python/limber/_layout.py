@@ -26,6 +26,8 @@ STATUS_INVALID_ARGUMENT = 10  # malformed argument (e.g. parallel approach and o
 STATUS_POWERED_OFF = 11  # the arm is powered off
 STATUS_UNREACHABLE_ORIENTATION = 12  # the orientation is not attainable by the limb's joints
 STATUS_CLAMPED = 13  # carried out, a value clamped to the limit
+STATUS_PREEMPTED = 14  # the motion was cut short by another client's command
+STATUS_LEASED = 15  # another client holds the device
 STATUS_ADJUSTED = 16  # carried out, the orientation adjusted to one the limb's joints can hold
 
 # Bits of StateHeader.flags
@@ -33,6 +35,7 @@ DEVICE_FLAG_LINK_UP = 1  # link to the hardware up
 DEVICE_FLAG_CALIBRATED = 2  # calibration known
 DEVICE_FLAG_SIMULATED = 4  # simulated or emulated device
 DEVICE_FLAG_ABSENT = 8  # hardware reports the device absent
+DEVICE_FLAG_LEASED = 16  # a client holds the device with a control lease
 
 # actarray command kinds (MsgMeta.kind on the cmd channel)
 ACTARRAY_CMD_POS = 1  # ActArrayPositionCmd
@@ -108,6 +111,12 @@ HARDWARE_NO_LIFT = 1024  # no gripper lift (robot or configuration)
 # DriverStats.loop_mode
 LOOP_MODE_EVENT = 1  # event-driven
 LOOP_MODE_SPIN = 2  # busy-polling
+
+# LeaseReq.op codes
+LEASE_OP_ACQUIRE = 1  # take the device, or refresh one's own lease
+LEASE_OP_RENEW = 2  # heartbeat of the holder
+LEASE_OP_RELEASE = 3  # give the device back
+LEASE_OP_QUERY = 4  # who holds the device
 
 
 class Vec3(ctypes.Structure):
@@ -772,6 +781,62 @@ class DriverStats(ctypes.Structure):
         return "limber.v2.DriverStats"
 
 
+class OutcomeMsg(ctypes.Structure):
+    """limber.v2.OutcomeMsg (size 72, align 8)."""
+
+    _fields_ = [
+        ("client_id", ctypes.c_uint64),
+        ("cmd_seq", ctypes.c_uint64),
+        ("other_client", ctypes.c_uint64),
+        ("stamp_ns", ctypes.c_uint64),
+        ("kind", ctypes.c_uint32),
+        ("status", ctypes.c_uint32),
+        ("other_name", ctypes.c_uint8 * 32),
+    ]
+
+    @staticmethod
+    def type_name():
+        return "limber.v2.OutcomeMsg"
+
+
+class LeaseReq(ctypes.Structure):
+    """limber.v2.LeaseReq (size 80, align 8)."""
+
+    _fields_ = [
+        ("client_id", ctypes.c_uint64),
+        ("seq", ctypes.c_uint64),
+        ("node_lo", ctypes.c_uint64),
+        ("node_hi", ctypes.c_uint64),
+        ("timeout_ns", ctypes.c_uint64),
+        ("op", ctypes.c_uint32),
+        ("_pad", ctypes.c_uint32),
+        ("name", ctypes.c_uint8 * 32),
+    ]
+
+    @staticmethod
+    def type_name():
+        return "limber.v2.LeaseReq"
+
+
+class LeaseReply(ctypes.Structure):
+    """limber.v2.LeaseReply (size 80, align 8)."""
+
+    _fields_ = [
+        ("holder_client", ctypes.c_uint64),
+        ("seq", ctypes.c_uint64),
+        ("holder_node_lo", ctypes.c_uint64),
+        ("holder_node_hi", ctypes.c_uint64),
+        ("timeout_ns", ctypes.c_uint64),
+        ("status", ctypes.c_uint32),
+        ("_pad", ctypes.c_uint32),
+        ("holder_name", ctypes.c_uint8 * 32),
+    ]
+
+    @staticmethod
+    def type_name():
+        return "limber.v2.LeaseReply"
+
+
 STRUCTS = [
     Vec3,
     Orientation3,
@@ -818,4 +883,7 @@ STRUCTS = [
     GripperGeom,
     GripperReplyMsg,
     DriverStats,
+    OutcomeMsg,
+    LeaseReq,
+    LeaseReply,
 ]

@@ -5,7 +5,8 @@ sends commands and makes requests, with the same wire messages and the same sema
 the Rust ``Client<I>``:
 
 * commands are fire-and-forget; each returns a :class:`Ticket` whose outcome the driver
-  publishes in a later state sample (``header.last_cmd``); :meth:`wait_outcome` waits for it;
+  publishes on the device's ``outcome`` channel (each client keeps its own) and in a later
+  state sample (``header.last_cmd``); :meth:`wait_outcome` waits for it;
 * requests wait for the driver's reply (ACK with a typed result, or NACK with a
   :class:`Status`), with a timeout and a liveness check of the driver;
 * invalid values (NaN, a joint index outside the array capacity, too many values, a zero
@@ -94,6 +95,8 @@ _LAYOUT_ATTR = "limber.layout"
 _EVENT_COMMAND = 1  # on `wake`
 _EVENT_REQUEST = 2  # on `wake`
 _OUTCOME_SLOTS = 16
+# Outcomes buffered on the `outcome` channel per client (Rust `qos::OUTCOME_BUFFER`).
+_OUTCOME_BUFFER = 256
 _IDENT = re.compile(r"^[A-Za-z0-9_-]+$")
 
 
@@ -129,6 +132,8 @@ class Status(enum.IntEnum):
     POWERED_OFF = L.STATUS_POWERED_OFF
     UNREACHABLE_ORIENTATION = L.STATUS_UNREACHABLE_ORIENTATION
     CLAMPED = L.STATUS_CLAMPED
+    PREEMPTED = L.STATUS_PREEMPTED
+    LEASED = L.STATUS_LEASED
     ADJUSTED = L.STATUS_ADJUSTED
 
     @property
@@ -165,6 +170,8 @@ _STATUS_TEXT = {
     Status.POWERED_OFF: "powered off",
     Status.UNREACHABLE_ORIENTATION: "orientation not attainable by this limb's joints",
     Status.CLAMPED: "ok, clamped to the limit",
+    Status.PREEMPTED: "preempted by another client",
+    Status.LEASED: "held by another client",
     Status.ADJUSTED: "ok, orientation adjusted",
 }
 
@@ -699,6 +706,18 @@ class _Client:
         except Exception as e:
             raise fail("wake", e) from None
         try:
+            # Every outcome of the device, each client keeping its own (layout version 2):
+            # an outcome is never lost because other clients' commands came in between.
+            out_svc = (
+                self._node.service_builder(iox2.ServiceName.new(name("outcome")))
+                .publish_subscribe(L.OutcomeMsg)
+                .open_with_attributes(layout)
+            )
+            self._outcome_sub = out_svc.subscriber_builder().buffer_size(_OUTCOME_BUFFER).create()
+            del out_svc
+        except Exception as e:
+            raise fail("outcome", e) from None
+        try:
             self._notify_svc = (
                 self._node.service_builder(iox2.ServiceName.new(name("notify")))
                 .event()
@@ -711,7 +730,7 @@ class _Client:
 
     def close(self) -> None:
         """Releases every port and the node (idempotent). The client is unusable afterwards."""
-        for attr in ("_notify", "_wake", "_requests", "_commands", "_states"):
+        for attr in ("_notify", "_wake", "_requests", "_commands", "_outcome_sub", "_states"):
             port = self.__dict__.get(attr)
             if port is not None:
                 try:
@@ -791,7 +810,27 @@ class _Client:
                 s.delete()
         if last is not None:
             self._latest = last
+        self._take_outcomes()
         return got
+
+    def _take_outcomes(self) -> None:
+        """Takes the outcomes that arrived on the ``outcome`` channel, keeping this
+        client's own (a ``PREEMPTED`` one is a second outcome of a command carried out, not
+        its first)."""
+        while True:
+            try:
+                s = self._outcome_sub.receive()
+            except Exception as e:
+                raise TransportError(f"receiving failed: {e!r}") from None
+            if s is None:
+                return
+            try:
+                o = L.OutcomeMsg.from_address(s.payload_ptr)
+                if o.client_id == self._client_id and o.status != L.STATUS_PREEMPTED:
+                    seq = o.cmd_seq
+                    self._outcomes[seq % _OUTCOME_SLOTS] = (seq, o.status)
+            finally:
+                s.delete()
 
     def state(self):
         """The latest state, after taking what arrived: a *copy* of the ``*Data`` ctypes

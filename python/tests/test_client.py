@@ -257,14 +257,30 @@ def test_multi_position_and_home(arm):
     assert arm.positions() == [0.0] * 6
 
 
+def test_each_client_gets_its_own_outcome_under_contention(driver, arm):
+    # Another client's burst, longer than the state channel's buffer, between A's command
+    # and A's wait: A's outcome comes on the outcome channel, not only in a state header
+    # that the burst's states push out.
+    with ActArrayClient.connect(driver.dev("actarray"), driver.domain, timeout=T) as other:
+        for _ in range(5):
+            mine = arm.move_to(1, 0.25)
+            burst = [other.move_to(2, 0.1) for _ in range(64)]
+            bad = arm.move_to(0, 4.0)
+            assert arm.wait_outcome(mine, T) is Status.OK
+            assert arm.wait_outcome(bad, T) is Status.BEYOND_LIMITS
+            assert other.wait_outcome(burst[-1], T) is Status.OK
+
+
 def test_refusals_carry_the_reason(arm):
     before = arm.wait_state(T).actuators[0].position
     # Joint 6 is within the array capacity (so it is sent) but this arm has 6 joints.
     assert arm.wait_outcome(arm.move_to(6, 0.0), T) is Status.UNKNOWN_JOINT
     assert arm.wait_outcome(arm.move_to(0, 4.0), T) is Status.BEYOND_LIMITS
     assert arm.wait_outcome(arm.move_to_multi([0.0] * 7), T) is Status.UNKNOWN_JOINT
-    # The test arm has no speed or current control.
-    assert arm.wait_outcome(arm.move_at_speed(0, 0.1), T) is Status.UNSUPPORTED
+    # The test arm moves one joint at a speed until stopped (it does not integrate the
+    # position); it has no multi-joint speed and no current control.
+    assert arm.wait_outcome(arm.move_at_speed(0, 0.1), T) is Status.OK
+    assert arm.wait_outcome(arm.move_at_speed(0, 0.0), T) is Status.OK
     assert arm.wait_outcome(arm.move_at_speed_multi([0.1]), T) is Status.UNSUPPORTED
     assert arm.wait_outcome(arm.set_current(None, 0.5), T) is Status.UNSUPPORTED
     assert arm.wait_outcome(arm.set_current(1, 0.5), T) is Status.UNSUPPORTED

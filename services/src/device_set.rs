@@ -41,7 +41,8 @@ use thiserror::Error;
 
 use crate::context::Context;
 use crate::host::{
-    Activity, DeviceHandler, DeviceHost, HostError, HostStats, Origin, ProcessError, PublishError,
+    Activity, DeviceHandler, DeviceHost, HostError, HostStats, Motion, Origin, ProcessError,
+    PublishError,
 };
 use crate::naming::DeviceName;
 
@@ -58,6 +59,22 @@ pub trait DeviceSetHandler {
         state: &mut ActArrayData,
     ) -> Status {
         let _ = (index, cmd, from, state);
+        Status::Unsupported
+    }
+    /// What `cmd` drives on `actarray/<index>` and which of it still moves; see
+    /// [`DeviceHandler::motion`]. Default: nothing.
+    fn actarray_motion(
+        &mut self,
+        index: u16,
+        cmd: &ActArrayCommand,
+        state: &ActArrayData,
+    ) -> Motion {
+        let _ = (index, cmd, state);
+        Motion::NONE
+    }
+    /// Stops every motion of `actarray/<index>` (the deadman); see [`DeviceHandler::stop`].
+    fn actarray_stop(&mut self, index: u16, state: &mut ActArrayData) -> Status {
+        let _ = (index, state);
         Status::Unsupported
     }
     /// A validated request for `actarray/<index>`; see [`DeviceHandler::request`].
@@ -82,6 +99,17 @@ pub trait DeviceSetHandler {
         let _ = (index, cmd, from, state);
         Status::Unsupported
     }
+    /// What `cmd` drives on `limb/<index>` and which of it still moves; see
+    /// [`DeviceHandler::motion`]. Default: nothing.
+    fn limb_motion(&mut self, index: u16, cmd: &LimbCommand, state: &LimbData) -> Motion {
+        let _ = (index, cmd, state);
+        Motion::NONE
+    }
+    /// Stops every motion of `limb/<index>` (the deadman); see [`DeviceHandler::stop`].
+    fn limb_stop(&mut self, index: u16, state: &mut LimbData) -> Status {
+        let _ = (index, state);
+        Status::Unsupported
+    }
     /// A validated request for `limb/<index>`; see [`DeviceHandler::request`].
     fn limb_request(
         &mut self,
@@ -102,6 +130,17 @@ pub trait DeviceSetHandler {
         state: &mut GripperData,
     ) -> Status {
         let _ = (index, cmd, from, state);
+        Status::Unsupported
+    }
+    /// What `cmd` drives on `gripper/<index>` and which of it still moves; see
+    /// [`DeviceHandler::motion`]. Default: nothing.
+    fn gripper_motion(&mut self, index: u16, cmd: &GripperCommand, state: &GripperData) -> Motion {
+        let _ = (index, cmd, state);
+        Motion::NONE
+    }
+    /// Stops every motion of `gripper/<index>` (the deadman); see [`DeviceHandler::stop`].
+    fn gripper_stop(&mut self, index: u16, state: &mut GripperData) -> Status {
+        let _ = (index, state);
         Status::Unsupported
     }
     /// A validated request for `gripper/<index>`; see [`DeviceHandler::request`].
@@ -135,6 +174,12 @@ struct At<'a, H: ?Sized> {
 }
 
 impl<H: DeviceSetHandler + ?Sized> DeviceHandler<ActArray> for At<'_, H> {
+    fn motion(&mut self, cmd: &ActArrayCommand, s: &ActArrayData) -> Motion {
+        self.handler.actarray_motion(self.index, cmd, s)
+    }
+    fn stop(&mut self, s: &mut ActArrayData) -> Status {
+        self.handler.actarray_stop(self.index, s)
+    }
     fn command(&mut self, cmd: &ActArrayCommand, from: &Origin, s: &mut ActArrayData) -> Status {
         self.handler.actarray_command(self.index, cmd, from, s)
     }
@@ -149,6 +194,12 @@ impl<H: DeviceSetHandler + ?Sized> DeviceHandler<ActArray> for At<'_, H> {
 }
 
 impl<H: DeviceSetHandler + ?Sized> DeviceHandler<Limb> for At<'_, H> {
+    fn motion(&mut self, cmd: &LimbCommand, s: &LimbData) -> Motion {
+        self.handler.limb_motion(self.index, cmd, s)
+    }
+    fn stop(&mut self, s: &mut LimbData) -> Status {
+        self.handler.limb_stop(self.index, s)
+    }
     fn command(&mut self, cmd: &LimbCommand, from: &Origin, s: &mut LimbData) -> Status {
         self.handler.limb_command(self.index, cmd, from, s)
     }
@@ -163,6 +214,12 @@ impl<H: DeviceSetHandler + ?Sized> DeviceHandler<Limb> for At<'_, H> {
 }
 
 impl<H: DeviceSetHandler + ?Sized> DeviceHandler<Gripper> for At<'_, H> {
+    fn motion(&mut self, cmd: &GripperCommand, s: &GripperData) -> Motion {
+        self.handler.gripper_motion(self.index, cmd, s)
+    }
+    fn stop(&mut self, s: &mut GripperData) -> Status {
+        self.handler.gripper_stop(self.index, s)
+    }
     fn command(&mut self, cmd: &GripperCommand, from: &Origin, s: &mut GripperData) -> Status {
         self.handler.gripper_command(self.index, cmd, from, s)
     }
@@ -442,6 +499,63 @@ impl DeviceSet {
         self.limbs.iter().for_each(|h| s += h.stats());
         self.grippers.iter().for_each(|h| s += h.stats());
         s
+    }
+
+    /// [`DeviceHost::check_lease`] on every device (the deadman), for a driver that
+    /// processes its clients only when they wake it: call it on every tick. Every device is
+    /// checked even if one fails; the first failure is returned.
+    pub fn check_leases<H: DeviceSetHandler + ?Sized>(
+        &mut self,
+        handler: &mut H,
+    ) -> Result<(), DeviceError<ProcessError>> {
+        fn one<I: Interface, D: DeviceHandler<I>>(
+            host: &mut DeviceHost<I>,
+            handler: &mut D,
+            first: &mut Option<DeviceError<ProcessError>>,
+        ) {
+            if let Err(source) = host.check_lease(handler) {
+                tracing::warn!(device = %host.device(), error = %source, "deadman check failed");
+                first.get_or_insert_with(|| DeviceError {
+                    device: host.device().clone(),
+                    source,
+                });
+            }
+        }
+        let mut first = None;
+        for h in &mut self.actarrays {
+            let index = h.device().index();
+            one::<ActArray, _>(
+                h,
+                &mut At {
+                    handler: &mut *handler,
+                    index,
+                },
+                &mut first,
+            );
+        }
+        for h in &mut self.limbs {
+            let index = h.device().index();
+            one::<Limb, _>(
+                h,
+                &mut At {
+                    handler: &mut *handler,
+                    index,
+                },
+                &mut first,
+            );
+        }
+        for h in &mut self.grippers {
+            let index = h.device().index();
+            one::<Gripper, _>(
+                h,
+                &mut At {
+                    handler: &mut *handler,
+                    index,
+                },
+                &mut first,
+            );
+        }
+        first.map_or(Ok(()), Err)
     }
 
     /// [`DeviceHost::cleanup_dead`] on every device (a 1 Hz housekeeping tick).

@@ -4,6 +4,7 @@
 use core::marker::PhantomData;
 
 use iceoryx2::active_request::ActiveRequest;
+use iceoryx2::node::NodeView;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
@@ -13,6 +14,7 @@ use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::port::{LoanError, ReceiveError, SendError};
 use iceoryx2::prelude::*;
 use iceoryx2::service::attribute::{AttributeKey, AttributeValue};
+use limber_interfaces::control::{get_name, put_name};
 use limber_interfaces::prelude::*;
 use thiserror::Error;
 
@@ -49,7 +51,78 @@ pub trait DeviceHandler<I: Interface> {
         from: &Origin,
         state: &mut I::Data,
     ) -> Result<I::Reply, Status>;
+
+    /// Asked before `cmd` is carried out: which parts of the device it drives, and which
+    /// of those are still moving from an earlier command (a new motion of the same joints
+    /// or a stop cuts that one short). The host remembers which client's command drives
+    /// each part and tells a client whose motion another client's command cut short that
+    /// it was [`Status::Preempted`]. Default: [`Motion::NONE`] (nothing runs on by itself).
+    fn motion(&mut self, cmd: &I::Command, state: &I::Data) -> Motion {
+        let _ = (cmd, state);
+        Motion::NONE
+    }
+
+    /// Stops every motion of the device now (the deadman: the holder of the device's
+    /// lease died or missed its heartbeat). Must not block. Default: unsupported (logged
+    /// by the host); every driver of moving hardware implements it.
+    fn stop(&mut self, state: &mut I::Data) -> Status {
+        let _ = state;
+        Status::Unsupported
+    }
 }
+
+/// The parts of a device a command drives, and those of them still moving
+/// ([`DeviceHandler::motion`]). Bit i is a part that moves on its own: joint i of an arm;
+/// a limb's joints; bit 0 for a gripper.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Motion {
+    /// The parts the command drives (a new target, a speed, a stop).
+    pub drives: u64,
+    /// Those of them still moving now: the command cuts their motion short.
+    pub cuts: u64,
+}
+
+impl Motion {
+    /// Drives nothing that runs on by itself.
+    pub const NONE: Motion = Motion { drives: 0, cuts: 0 };
+
+    /// `drives`, of which the parts in `running` are still moving.
+    pub const fn of(drives: u64, running: u64) -> Motion {
+        Motion {
+            drives,
+            cuts: drives & running,
+        }
+    }
+}
+
+/// Who holds a device's control lease ([`DeviceHost::holder`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Holder {
+    /// The holder's client id (its commands carry it).
+    pub client_id: u64,
+    /// The holder's iceoryx2 node id (when that node dies, the lease ends).
+    pub node_id: u128,
+    /// The heartbeat timeout (ns): no renewal for this long ends the lease.
+    pub timeout_ns: u64,
+    /// When the holder last renewed (`CLOCK_MONOTONIC` ns).
+    pub last_renewal_ns: u64,
+    name: [u8; 32],
+}
+
+impl Holder {
+    /// The holder's name, as it gave it (empty if it is not UTF-8).
+    pub fn name(&self) -> &str {
+        get_name(&self.name).unwrap_or("")
+    }
+}
+
+/// The shortest heartbeat timeout a lease may ask for.
+pub const MIN_LEASE_TIMEOUT_NS: u64 = 10_000_000;
+/// The longest heartbeat timeout a lease may ask for (one hour).
+pub const MAX_LEASE_TIMEOUT_NS: u64 = 3_600_000_000_000;
+/// How often the host looks whether the holder's node is still alive (listing the nodes
+/// of a service costs tens of microseconds: not on every cycle).
+pub const HOLDER_CHECK_NS: u64 = 20_000_000;
 
 /// Offering a device failed ([`DeviceHost::new`], [`crate::DeviceSet::new`]).
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
@@ -86,7 +159,8 @@ pub enum HostError {
     Transport {
         /// The device.
         device: String,
-        /// The channel (`data`, `cmd`, `req`, `wake`, `notify`, or `attributes`).
+        /// The channel (`data`, `cmd`, `req`, `wake`, `notify`, `outcome`, `lease`, or
+        /// `attributes`).
         channel: &'static str,
         /// iceoryx2's error.
         #[source]
@@ -139,6 +213,17 @@ pub struct HostStats {
     /// Failed attempts to connect the state publisher to new clients (retried at the
     /// next publication or `process` call).
     pub failed_connection_updates: u64,
+    /// Outcomes that could not be published on the `outcome` channel (that client then
+    /// waits for it in vain, up to its timeout).
+    pub failed_outcomes: u64,
+    /// Commands whose motion another client's command cut short (told `Preempted`).
+    pub preempted: u64,
+    /// Commands and requests refused because another client held the device.
+    pub leased_refusals: u64,
+    /// Lease requests answered.
+    pub lease_requests: u64,
+    /// Deadman stops: the holder of the lease died or missed its heartbeat.
+    pub deadman_stops: u64,
 }
 
 impl core::ops::AddAssign for HostStats {
@@ -151,6 +236,11 @@ impl core::ops::AddAssign for HostStats {
         self.published += o.published;
         self.failed_notifies += o.failed_notifies;
         self.failed_connection_updates += o.failed_connection_updates;
+        self.failed_outcomes += o.failed_outcomes;
+        self.preempted += o.preempted;
+        self.leased_refusals += o.leased_refusals;
+        self.lease_requests += o.lease_requests;
+        self.deadman_stops += o.deadman_stops;
     }
 }
 
@@ -241,6 +331,20 @@ pub struct DeviceHost<I: Interface> {
     server: Server<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()>,
     wake: Option<Listener<ipc::Service>>,
     notify: Notifier<ipc::Service>,
+    outcomes: Publisher<ipc::Service, OutcomeMsg, ()>,
+    lease_svc: iceoryx2::service::port_factory::request_response::PortFactory<
+        ipc::Service,
+        LeaseReq,
+        (),
+        LeaseReply,
+        (),
+    >,
+    lease_server: Server<ipc::Service, LeaseReq, (), LeaseReply, ()>,
+    lease: Option<Holder>,
+    next_holder_check_ns: u64,
+    /// Per part of the device (bit i of [`Motion`]): the command that drives it now
+    /// (client, command seq, kind); client 0: none.
+    drivers: [(u64, u64, u32); 64],
     state: I::Data,
     seq: u64,
     outcome: CmdOutcome,
@@ -401,6 +505,39 @@ impl<I: Interface> DeviceHost<I> {
             .create()
             .map_err(|e| transport("notify", e.into()))?;
 
+        let outcomes = node
+            .service_builder(&device.service_name(Channel::Outcome))
+            .publish_subscribe::<OutcomeMsg>()
+            .history_size(0)
+            .subscriber_max_buffer_size(qos::OUTCOME_BUFFER)
+            .subscriber_max_borrowed_samples(2)
+            .max_publishers(qos::DATA_PUBLISHERS)
+            .max_subscribers(qos::MAX_CLIENTS)
+            .max_nodes(qos::MAX_NODES)
+            .enable_safe_overflow(true)
+            .open_or_create_with_attributes(&verifier)
+            .map_err(|e| transport("outcome", e.into()))?
+            .publisher_builder()
+            .max_loaned_samples(1)
+            .create()
+            .map_err(|e| transport("outcome", e.into()))?;
+
+        let lease_svc = node
+            .service_builder(&device.service_name(Channel::Lease))
+            .request_response::<LeaseReq, LeaseReply>()
+            .max_clients(qos::MAX_CLIENTS)
+            .max_servers(qos::REQ_SERVERS)
+            .max_nodes(qos::MAX_NODES)
+            .max_active_requests_per_client(qos::MAX_ACTIVE_REQUESTS)
+            .max_response_buffer_size(2)
+            .enable_fire_and_forget_requests(false)
+            .open_or_create_with_attributes(&verifier)
+            .map_err(|e| transport("lease", e.into()))?;
+        let lease_server = lease_svc
+            .server_builder()
+            .create()
+            .map_err(|e| transport("lease", e.into()))?;
+
         Ok(DeviceHost {
             device: device.clone(),
             data_svc,
@@ -409,6 +546,12 @@ impl<I: Interface> DeviceHost<I> {
             server,
             wake: Some(wake),
             notify,
+            outcomes,
+            lease_svc,
+            lease_server,
+            lease: None,
+            next_holder_check_ns: 0,
+            drivers: [(0, 0, 0); 64],
             state: I::Data::default(),
             seq: 0,
             outcome: CmdOutcome::default(),
@@ -458,6 +601,11 @@ impl<I: Interface> DeviceHost<I> {
         self.stats
     }
 
+    /// Who holds the device's control lease, if anybody.
+    pub fn holder(&self) -> Option<&Holder> {
+        self.lease.as_ref()
+    }
+
     /// The listener that a client's command or request wakes, while the host owns it.
     pub fn wake_listener(&self) -> Option<&Listener<ipc::Service>> {
         self.wake.as_ref()
@@ -501,7 +649,12 @@ impl<I: Interface> DeviceHost<I> {
             h.stamp_ns = monotonic_ns();
         }
         h.last_cmd = self.outcome;
-        h.flags = self.flags;
+        h.flags = self.flags
+            | if self.lease.is_some() {
+                device_flag::LEASED
+            } else {
+                0
+            };
         h.cmd_overflows = self.stats.overflows.min(u32::MAX as u64) as u32;
         let sample = self.publisher.loan_uninit().map_err(PublishError::Loan)?;
         let sample = sample.write_payload(self.state);
@@ -527,6 +680,10 @@ impl<I: Interface> DeviceHost<I> {
             self.stats.failed_connection_updates += 1;
             tracing::debug!(device = %self.device, error = %e, "cannot connect new clients");
         }
+        if let Err(e) = self.outcomes.update_connections() {
+            self.stats.failed_connection_updates += 1;
+            tracing::debug!(device = %self.device, error = %e, "cannot connect new clients");
+        }
     }
 
     /// Drains every pending command (in arrival order, per client in sending order) and
@@ -538,8 +695,9 @@ impl<I: Interface> DeviceHost<I> {
         // New clients get the latest state (history 1) now rather than at the next
         // publication; cheap when no client came or went.
         self.update_connections();
+        self.check_lease(handler)?;
         let commands = self.process_commands(handler)?;
-        let requests = self.process_requests(handler)?;
+        let requests = self.process_requests(handler)? + self.process_leases()?;
         Ok(Activity { commands, requests })
     }
 
@@ -554,7 +712,8 @@ impl<I: Interface> DeviceHost<I> {
         let commands = self.process_commands(handler)?;
         let requests = if self.spin_calls.is_multiple_of(SPIN_REQUEST_EVERY) {
             self.update_connections();
-            self.process_requests(handler)?
+            self.check_lease(handler)?;
+            self.process_requests(handler)? + self.process_leases()?
         } else {
             0
         };
@@ -582,13 +741,28 @@ impl<I: Interface> DeviceHost<I> {
                 sent_ns: meta.stamp_ns,
             };
             self.stats.overflows += self.clients.record(meta.client_id, meta.seq);
+            let holder = self.lease.filter(|l| l.client_id != meta.client_id);
             let status = match I::Command::read(raw) {
                 Ok(cmd) => {
                     drop(sample);
-                    handler.command(&cmd, &origin, &mut self.state)
+                    if holder.is_some() {
+                        self.stats.leased_refusals += 1;
+                        Status::Leased
+                    } else {
+                        self.apply(handler, &cmd, &origin, meta.kind)
+                    }
                 }
                 Err(e) => e.status(),
             };
+            match (status, holder) {
+                (Status::Leased, Some(h)) => self.publish_outcome(
+                    (meta.client_id, meta.seq, meta.kind),
+                    status,
+                    h.client_id,
+                    Some(&h.name),
+                ),
+                _ => self.publish_outcome((meta.client_id, meta.seq, meta.kind), status, 0, None),
+            }
             self.stats.commands += 1;
             if !status.is_carried_out() {
                 self.stats.refused += 1;
@@ -605,6 +779,237 @@ impl<I: Interface> DeviceHost<I> {
             }
         }
         Ok(n)
+    }
+
+    /// Carries out one decoded command of a client allowed to command the device, and
+    /// tells the client whose running motion it cuts short that it was preempted.
+    fn apply<H: DeviceHandler<I>>(
+        &mut self,
+        handler: &mut H,
+        cmd: &I::Command,
+        origin: &Origin,
+        kind: u32,
+    ) -> Status {
+        let motion = handler.motion(cmd, &self.state);
+        let status = handler.command(cmd, origin, &mut self.state);
+        if !status.is_carried_out() {
+            return status;
+        }
+        let name = self
+            .lease
+            .filter(|l| l.client_id == origin.client_id)
+            .map(|l| l.name);
+        // Each other client's command whose motion this one cut short, told once.
+        for bit in 0..64 {
+            if motion.cuts & (1 << bit) == 0 {
+                continue;
+            }
+            let cut = self.drivers[bit];
+            let told_already =
+                (0..bit).any(|b| motion.cuts & (1 << b) != 0 && self.drivers[b] == cut);
+            if cut.0 != 0 && cut.0 != origin.client_id && !told_already {
+                self.stats.preempted += 1;
+                self.publish_outcome(cut, Status::Preempted, origin.client_id, name.as_ref());
+            }
+        }
+        for bit in 0..64 {
+            if motion.drives & (1 << bit) != 0 {
+                self.drivers[bit] = (origin.client_id, origin.seq, kind);
+            }
+        }
+        status
+    }
+
+    /// Publishes one outcome on the `outcome` channel; a failure is counted and logged
+    /// (that client then waits up to its timeout), never fatal to the loop.
+    fn publish_outcome(
+        &mut self,
+        (client_id, cmd_seq, kind): (u64, u64, u32),
+        status: Status,
+        other_client: u64,
+        other_name: Option<&[u8; 32]>,
+    ) {
+        let sent = match self.outcomes.loan_uninit() {
+            Ok(loan) => {
+                let mut msg = OutcomeMsg {
+                    client_id,
+                    cmd_seq,
+                    other_client,
+                    stamp_ns: monotonic_ns(),
+                    kind,
+                    status: status.code(),
+                    ..OutcomeMsg::default()
+                };
+                if let Some(n) = other_name {
+                    msg.other_name = *n;
+                }
+                loan.write_payload(msg).send().map_err(Iox2Error::from)
+            }
+            Err(e) => Err(e.into()),
+        };
+        if let Err(e) = sent {
+            self.stats.failed_outcomes += 1;
+            tracing::warn!(device = %self.device, client = client_id, seq = cmd_seq,
+                error = %e, "cannot publish an outcome");
+        }
+    }
+
+    /// The deadman: ends the lease and stops the device (with [`DeviceHandler::stop`]) when
+    /// its holder's node died or its heartbeat is overdue. [`DeviceHost::process`] calls
+    /// it; a driver that processes only when clients wake it calls it on its ticks too.
+    /// Cheap unless a lease is held (then the holder's node is looked up at most every
+    /// [`HOLDER_CHECK_NS`]).
+    pub fn check_lease<H: DeviceHandler<I>>(
+        &mut self,
+        handler: &mut H,
+    ) -> Result<(), ProcessError> {
+        let Some(l) = self.lease else {
+            return Ok(());
+        };
+        let now = monotonic_ns();
+        let overdue = now.saturating_sub(l.last_renewal_ns) > l.timeout_ns;
+        let dead = !overdue && now >= self.next_holder_check_ns && {
+            self.next_holder_check_ns = now + HOLDER_CHECK_NS;
+            self.holder_node_gone(l.node_id)
+        };
+        if !(overdue || dead) {
+            return Ok(());
+        }
+        let why = if dead {
+            "its process died"
+        } else {
+            "it missed its heartbeat"
+        };
+        let status = handler.stop(&mut self.state);
+        tracing::warn!(device = %self.device, holder = l.name(), client = l.client_id,
+            stop = %status, "lease ended because {why}: device stopped");
+        self.stats.deadman_stops += 1;
+        self.lease = None;
+        self.drivers = [(0, 0, 0); 64];
+        self.publish()?;
+        Ok(())
+    }
+
+    /// True when the node `id` is dead or no longer attached to the lease channel.
+    fn holder_node_gone(&self, id: u128) -> bool {
+        use iceoryx2::service::port_factory::PortFactory;
+        let (mut alive, mut dead) = (false, false);
+        if let Err(e) = self.lease_svc.nodes(|n| {
+            match &n {
+                NodeState::Alive(v) if v.id().value() == id => alive = true,
+                NodeState::Dead(v) if v.id().value() == id => dead = true,
+                NodeState::Inaccessible(n) | NodeState::Undefined(n) if n.value() == id => {
+                    alive = true
+                }
+                _ => {}
+            }
+            CallbackProgression::Continue
+        }) {
+            // Not known to be dead: the heartbeat timeout still ends the lease.
+            tracing::warn!(device = %self.device, error = %e, "cannot list the holder's node");
+            return false;
+        }
+        dead || !alive
+    }
+
+    /// Answers every pending lease request (acquire, renew, release, query).
+    fn process_leases(&mut self) -> Result<usize, ProcessError> {
+        let mut n = 0;
+        let mut changed = false;
+        loop {
+            let active = match self.lease_server.receive() {
+                Ok(Some(a)) => a,
+                Ok(None) => break,
+                Err(e) => return Err(ProcessError::Receive(e)),
+            };
+            let req: LeaseReq = *active.payload();
+            let before = self.lease.map(|l| l.client_id);
+            let status = self.lease_op(&req);
+            changed |= before != self.lease.map(|l| l.client_id);
+            let mut reply = LeaseReply {
+                seq: req.seq,
+                status: status.code(),
+                ..LeaseReply::default()
+            };
+            if let Some(l) = &self.lease {
+                reply.holder_client = l.client_id;
+                reply.set_holder_node(l.node_id);
+                reply.timeout_ns = l.timeout_ns;
+                reply.holder_name = l.name;
+            }
+            let sent = match active.loan_uninit() {
+                Ok(loan) => loan.write_payload(reply).send().map_err(Iox2Error::from),
+                Err(e) => Err(e.into()),
+            };
+            if let Err(e) = sent {
+                self.stats.undelivered_replies += 1;
+                tracing::debug!(device = %self.device, client = req.client_id, error = %e,
+                    "lease reply not delivered");
+            }
+            self.stats.lease_requests += 1;
+            n += 1;
+        }
+        if n > 0 {
+            self.notify_clients(qos::EVENT_REPLY);
+        }
+        // The LEASED flag of the state follows the lease at once.
+        if changed {
+            self.publish()?;
+        }
+        Ok(n)
+    }
+
+    /// Applies one lease request.
+    fn lease_op(&mut self, req: &LeaseReq) -> Status {
+        let now = monotonic_ns();
+        let other = self.lease.is_some_and(|l| l.client_id != req.client_id);
+        match req.op {
+            lease_op::ACQUIRE => {
+                if other {
+                    return Status::Leased;
+                }
+                if req.client_id == 0
+                    || req.node_id() == 0
+                    || !(MIN_LEASE_TIMEOUT_NS..=MAX_LEASE_TIMEOUT_NS).contains(&req.timeout_ns)
+                    || get_name(&req.name).is_err()
+                {
+                    return Status::InvalidArgument;
+                }
+                let mut name = [0u8; 32];
+                put_name(&mut name, get_name(&req.name).unwrap_or(""));
+                self.lease = Some(Holder {
+                    client_id: req.client_id,
+                    node_id: req.node_id(),
+                    timeout_ns: req.timeout_ns,
+                    last_renewal_ns: now,
+                    name,
+                });
+                tracing::info!(device = %self.device, holder = get_name(&name).unwrap_or(""),
+                    client = req.client_id, "lease acquired");
+                Status::Ok
+            }
+            lease_op::RENEW => {
+                if other {
+                    return Status::Leased;
+                }
+                // Not held (ended or never taken): the reply names no holder.
+                if let Some(l) = self.lease.as_mut() {
+                    l.last_renewal_ns = now;
+                }
+                Status::Ok
+            }
+            lease_op::RELEASE => {
+                if other {
+                    return Status::Leased;
+                }
+                if self.lease.take().is_some() {
+                    tracing::info!(device = %self.device, client = req.client_id, "lease released");
+                }
+                Status::Ok
+            }
+            lease_op::QUERY => Status::Ok,
+            _ => Status::InvalidArgument,
+        }
     }
 
     /// Answers every pending request. A request that does not decode is NACKed with the
@@ -628,7 +1033,12 @@ impl<I: Interface> DeviceHost<I> {
                 seq: meta.seq,
                 sent_ns: meta.stamp_ns,
             };
+            let holder = self.lease.filter(|l| l.client_id != meta.client_id);
             let reply = match I::Request::read(raw) {
+                Ok(req) if holder.is_some() && !req.is_read_only() => {
+                    self.stats.leased_refusals += 1;
+                    Err(Status::Leased)
+                }
                 Ok(req) => handler.request(&req, &origin, &mut self.state),
                 Err(e) => Err(e.status()),
             };
@@ -673,6 +1083,7 @@ impl<I: Interface> DeviceHost<I> {
     pub fn cleanup_dead(&self) {
         use iceoryx2::service::port_factory::PortFactory;
         self.data_svc.try_cleanup_dead_nodes();
+        self.lease_svc.try_cleanup_dead_nodes();
     }
 }
 

@@ -83,7 +83,8 @@ pub mod testing;
 
 pub use client::{
     ActArrayClient, Client, CommandError, ConnectError, DriverStatus, Freshness, GripperClient,
-    Incompatibility, LimbClient, RequestError, Ticket, WaitError, WaitMode,
+    Incompatibility, LeaseError, LeaseHolder, LimbClient, Outcome, RequestError, Ticket, WaitError,
+    WaitMode,
 };
 pub use context::{Context, ContextError, Role, monotonic_ns};
 pub use device_set::{DeviceError, DeviceSet, DeviceSetHandler};
@@ -91,8 +92,8 @@ pub use discovery::{DeviceInfo, ListError, list_devices};
 pub use domain_dir::DomainError;
 pub use error::Iox2Error;
 pub use host::{
-    Activity, CLIENT_SLOTS, DeviceHandler, DeviceHost, HostError, HostStats, Origin, ProcessError,
-    PublishError,
+    Activity, CLIENT_SLOTS, DeviceHandler, DeviceHost, Holder, HostError, HostStats, Motion,
+    Origin, ProcessError, PublishError,
 };
 pub use naming::{Channel, DeviceName, Domain, NameError};
 
@@ -105,7 +106,7 @@ pub mod prelude {
     pub use crate::context::{Context, Role, monotonic_ns};
     pub use crate::device_set::{DeviceSet, DeviceSetHandler};
     pub use crate::discovery::{DeviceInfo, list_devices};
-    pub use crate::host::{DeviceHandler, DeviceHost, Origin};
+    pub use crate::host::{DeviceHandler, DeviceHost, Motion, Origin};
     pub use crate::naming::{DeviceName, Domain};
     pub use limber_interfaces::prelude::*;
 }

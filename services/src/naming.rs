@@ -156,6 +156,11 @@ pub enum Channel {
     Wake,
     /// Wake-up of the clients (event, driver → clients: new state, reply ready).
     Notify,
+    /// The outcome of every command, driver → clients (publish-subscribe; each client
+    /// keeps its own).
+    Outcome,
+    /// The control lease: acquire, renew, release, query (request-response).
+    Lease,
 }
 
 impl Channel {
@@ -167,6 +172,8 @@ impl Channel {
             Channel::Req => "req",
             Channel::Wake => "wake",
             Channel::Notify => "notify",
+            Channel::Outcome => "outcome",
+            Channel::Lease => "lease",
         }
     }
 }

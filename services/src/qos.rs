@@ -20,6 +20,10 @@ pub const DATA_BUFFER: usize = 16;
 pub const DATA_BORROWED: usize = 2;
 /// Commands buffered per client for the driver: a burst this long is never lost.
 pub const CMD_BUFFER: usize = 256;
+/// Outcomes buffered per client (every client sees every outcome of the device and keeps
+/// its own): this many commands of all clients may be decided between two looks of a
+/// waiting client before its outcome is overwritten (safe overflow).
+pub const OUTCOME_BUFFER: usize = 256;
 /// Subscribers of `cmd`: the driver, a dead driver not yet cleaned up, and observers.
 pub const CMD_SUBSCRIBERS: usize = 4;
 /// Servers of `req`: the driver plus one dead driver not yet cleaned up.

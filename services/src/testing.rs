@@ -11,7 +11,9 @@ use thiserror::Error;
 use crate::context::{Context, monotonic_ns};
 use crate::device_set::{DeviceError, DeviceSet, DeviceSetHandler};
 use crate::event_loop::{self, LoopError, LoopExit, Wake};
-use crate::host::{DeviceHandler, DeviceHost, HostError, Origin, ProcessError, PublishError};
+use crate::host::{
+    DeviceHandler, DeviceHost, HostError, Motion, Origin, ProcessError, PublishError,
+};
 
 /// Joint limits of the test arm, rad.
 pub const JOINT_LIMIT: f64 = core::f64::consts::PI;
@@ -28,6 +30,9 @@ pub struct TestArm {
     pub log: Vec<(u64, u64, u32)>,
     /// Sleep this long in each request (to test clients that die mid-request).
     pub reply_delay: Duration,
+    /// Joints moving at a speed (bit j = joint j): a SPEED command starts a motion that
+    /// runs until a SPEED 0, another command of that joint, or a stop.
+    pub moving: u32,
 }
 
 impl TestArm {
@@ -37,6 +42,7 @@ impl TestArm {
             joints: joints.min(MAX_ACTUATORS),
             log: Vec::with_capacity(100_000),
             reply_delay: Duration::ZERO,
+            moving: 0,
         }
     }
 
@@ -47,6 +53,15 @@ impl TestArm {
             Err(Status::BeyondLimits)
         } else {
             Ok(())
+        }
+    }
+
+    /// Stops joint `j` if it moves at a speed.
+    fn halt(&mut self, j: usize, state: &mut ActArrayData) {
+        if self.moving & (1 << j) != 0 {
+            self.moving &= !(1 << j);
+            state.actuators[j].speed = 0.0;
+            state.actuators[j].state = ActuatorFlags::IDLE.bits();
         }
     }
 
@@ -74,9 +89,19 @@ impl DeviceHandler<ActArray> for TestArm {
         let r = match *cmd {
             ActArrayCommand::Position { joint, position } => {
                 self.check(joint as usize, position).map(|()| {
+                    self.halt(joint as usize, state);
                     state.actuators[joint as usize].position = position;
                 })
             }
+            ActArrayCommand::Speed { joint, speed } => self.check(joint as usize, 0.0).map(|()| {
+                let j = joint as usize;
+                self.halt(j, state);
+                if speed != 0.0 {
+                    self.moving |= 1 << j;
+                    state.actuators[j].speed = speed;
+                    state.actuators[j].state = ActuatorFlags::MOVING.bits();
+                }
+            }),
             ActArrayCommand::MultiPosition(v) => {
                 if v.len() > self.joints {
                     Err(Status::UnknownJoint)
@@ -87,24 +112,49 @@ impl DeviceHandler<ActArray> for TestArm {
                         .try_for_each(|(j, p)| self.check(j, *p))
                         .map(|()| {
                             for (j, p) in v.as_slice().iter().enumerate() {
+                                self.halt(j, state);
                                 state.actuators[j].position = *p;
                             }
                         })
                 }
             }
             ActArrayCommand::Home(JointSel::All) => {
+                self.stop(state);
                 for a in &mut state.actuators[..self.joints] {
                     a.position = 0.0;
                 }
                 Ok(())
             }
             ActArrayCommand::Home(JointSel::One(j)) => self.check(j as usize, 0.0).map(|()| {
+                self.halt(j as usize, state);
                 state.actuators[j as usize].position = 0.0;
             }),
             _ => Err(Status::Unsupported),
         };
         state.header.stamp_ns = monotonic_ns();
         r.err().unwrap_or(Status::Ok)
+    }
+
+    fn motion(&mut self, cmd: &ActArrayCommand, _state: &ActArrayData) -> Motion {
+        let mask = match *cmd {
+            ActArrayCommand::Position { joint, .. }
+            | ActArrayCommand::Speed { joint, .. }
+            | ActArrayCommand::Home(JointSel::One(joint)) => 1u64.checked_shl(joint as u32),
+            ActArrayCommand::MultiPosition(v) | ActArrayCommand::MultiSpeed(v) => {
+                Some(1u64.checked_shl(v.len() as u32).map_or(u64::MAX, |b| b - 1))
+            }
+            ActArrayCommand::Home(JointSel::All) => Some(u64::MAX),
+            _ => None,
+        };
+        Motion::of(mask.unwrap_or(0), self.moving as u64)
+    }
+
+    fn stop(&mut self, state: &mut ActArrayData) -> Status {
+        for j in 0..self.joints {
+            self.halt(j, state);
+        }
+        state.header.stamp_ns = monotonic_ns();
+        Status::Ok
     }
 
     fn request(
@@ -157,6 +207,11 @@ fn cmd_kind(cmd: &ActArrayCommand) -> u32 {
 pub struct TestLimb;
 
 impl DeviceHandler<Limb> for TestLimb {
+    fn stop(&mut self, _state: &mut LimbData) -> Status {
+        // Reaches its targets at once: nothing runs on to stop.
+        Status::Ok
+    }
+
     fn command(&mut self, cmd: &LimbCommand, _from: &Origin, state: &mut LimbData) -> Status {
         let target = match *cmd {
             LimbCommand::Home => Vec3::new(0.5, 0.0, 0.0),
@@ -228,6 +283,11 @@ impl DeviceHandler<Gripper> for TestGripper {
         Status::Ok
     }
 
+    fn stop(&mut self, _state: &mut GripperData) -> Status {
+        // Opens and closes at once: nothing runs on to stop.
+        Status::Ok
+    }
+
     fn request(
         &mut self,
         _req: &GripperRequest,
@@ -249,6 +309,18 @@ struct Handlers<'a> {
 }
 
 impl DeviceSetHandler for Handlers<'_> {
+    fn actarray_motion(&mut self, _: u16, cmd: &ActArrayCommand, state: &ActArrayData) -> Motion {
+        self.arm.motion(cmd, state)
+    }
+    fn actarray_stop(&mut self, _: u16, state: &mut ActArrayData) -> Status {
+        self.arm.stop(state)
+    }
+    fn limb_stop(&mut self, _: u16, state: &mut LimbData) -> Status {
+        self.limb.stop(state)
+    }
+    fn gripper_stop(&mut self, _: u16, state: &mut GripperData) -> Status {
+        self.gripper.stop(state)
+    }
     fn actarray_command(
         &mut self,
         _: u16,

@@ -23,9 +23,10 @@ struct Rig {
 }
 
 impl Rig {
-    /// One control cycle: 4 commands sent (4 samples), the driver publishes 3 states and
-    /// one outcome state per command (7 samples), the client reads 3 states.
-    const SAMPLES_PER_CYCLE: u64 = 11;
+    /// One control cycle: 4 commands sent (4 samples), the driver publishes 3 states,
+    /// one outcome state per command and one sample on the `outcome` channel per command
+    /// (11 samples), the client reads 3 states and its 4 outcomes.
+    const SAMPLES_PER_CYCLE: u64 = 15;
 
     fn cycle(&mut self, i: u64) {
         let p = (i % 100) as f64 * 1e-3;

@@ -132,6 +132,23 @@ impl Conn {
         }
     }
 
+    /// The name of the client holding the device (a request: waits up to
+    /// [`REQUEST_TIMEOUT`]).
+    fn holder_name(&mut self) -> String {
+        let h = match self {
+            Conn::ActArray { client, .. } => client.holder(),
+            Conn::Limb { client, .. } => client.holder(),
+            Conn::Gripper { client, .. } => client.holder(),
+        };
+        match h {
+            Ok(Some(h)) if h.name.is_empty() => format!("client {:x}", h.client_id),
+            Ok(Some(h)) => h.name,
+            // Released between the state and the question.
+            Ok(None) => "nobody now".to_string(),
+            Err(e) => format!("? ({e})"),
+        }
+    }
+
     fn driver_status(&self) -> DriverStatus {
         match self {
             Conn::ActArray { client, .. } => client.driver_status(),
@@ -150,6 +167,9 @@ pub struct Device {
     geometry_tries: u32,
     /// When the last new state arrived (or the connection was made).
     last_new: Instant,
+    /// Who holds the device's control lease (asked while its state says it is held).
+    pub holder: Option<String>,
+    holder_asked: Option<Instant>,
 }
 
 impl Device {
@@ -343,10 +363,25 @@ impl App {
             self.discover();
         }
         for d in &mut self.devices {
-            if let Ok(c) = &mut d.conn
-                && c.refresh()
-            {
-                d.last_new = Instant::now();
+            if let Ok(c) = &mut d.conn {
+                if c.refresh() {
+                    d.last_new = Instant::now();
+                }
+                // The state says whether the device is held; who holds it is a request,
+                // asked when it becomes held and once per rediscovery period after.
+                let held = c
+                    .header()
+                    .is_some_and(|h| h.flags & device_flag::LEASED != 0);
+                if !held {
+                    d.holder = None;
+                    d.holder_asked = None;
+                } else if d
+                    .holder_asked
+                    .is_none_or(|t| t.elapsed() >= REDISCOVER_EVERY)
+                {
+                    d.holder_asked = Some(Instant::now());
+                    d.holder = Some(c.holder_name());
+                }
             }
         }
         for r in self.robots.values_mut() {
@@ -423,6 +458,8 @@ impl App {
                     info,
                     geometry_tries: 0,
                     last_new: Instant::now(),
+                    holder: None,
+                    holder_asked: None,
                 },
             };
             if dev.alive()

@@ -379,6 +379,12 @@ fn draw_device(frame: &mut Frame, area: Rect, d: &Device, selected: bool) {
         {
             title.push(Span::raw(" · lift"));
         }
+        if let Some(holder) = &d.holder {
+            title.push(Span::styled(
+                format!(" · held by {holder}"),
+                Style::new().fg(Color::Yellow),
+            ));
+        }
     }
     title.push(Span::raw(" "));
     let inner_width = area.width.saturating_sub(2);

@@ -9,7 +9,9 @@ use limber_interfaces::diagnostics::{self, DriverStats, hardware, loop_mode};
 use limber_interfaces::prelude::*;
 use limber_services::diagnostics::StatsPublisher;
 use limber_services::event_loop::{self, FdSource, LoopExit, Wake};
-use limber_services::{Context, DeviceSet, DeviceSetHandler, HostError, Origin, monotonic_ns};
+use limber_services::{
+    Context, DeviceSet, DeviceSetHandler, HostError, Motion, Origin, monotonic_ns,
+};
 use thiserror::Error;
 
 use limber_p2os::{
@@ -304,6 +306,40 @@ impl core::fmt::Debug for PioneerDriver {
 struct Serve<'a>(&'a mut RobotModel);
 
 impl DeviceSetHandler for Serve<'_> {
+    fn actarray_motion(&mut self, index: u16, cmd: &ActArrayCommand, _s: &ActArrayData) -> Motion {
+        if index == 0 {
+            self.0.arm_motion(cmd)
+        } else {
+            self.0.lift_motion()
+        }
+    }
+    fn actarray_stop(&mut self, index: u16, _s: &mut ActArrayData) -> Status {
+        if index == 0 {
+            self.0.arm_stop()
+        } else {
+            self.0.lift_stop()
+        }
+    }
+    fn limb_motion(&mut self, _index: u16, cmd: &LimbCommand, _s: &LimbData) -> Motion {
+        self.0.limb_motion(cmd)
+    }
+    fn limb_stop(&mut self, _index: u16, _s: &mut LimbData) -> Status {
+        self.0.arm_stop()
+    }
+    fn gripper_motion(&mut self, index: u16, _cmd: &GripperCommand, _s: &GripperData) -> Motion {
+        if index == 0 {
+            self.0.gripper_motion()
+        } else {
+            self.0.armgrip_motion()
+        }
+    }
+    fn gripper_stop(&mut self, index: u16, _s: &mut GripperData) -> Status {
+        if index == 0 {
+            self.0.gripper_stop()
+        } else {
+            self.0.armgrip_stop()
+        }
+    }
     fn actarray_command(
         &mut self,
         index: u16,
@@ -944,6 +980,11 @@ impl PioneerDriver {
         // Time-based lift estimate and stall detection move without packets.
         if self.robot.lift.moving.is_some() {
             self.robot.dirty.body = true;
+        }
+        // The deadman: a lease whose holder died or fell silent ends and stops its device
+        // (clients wake the loop only when they send).
+        if let Err(e) = self.hosts.check_leases(&mut Serve(&mut self.robot)) {
+            self.failures.note(Failure::Process, &e);
         }
         // Housekeeping (allocates inside iceoryx2): resources of crashed clients.
         if now.duration_since(self.last_cleanup) > Duration::from_secs(60) {

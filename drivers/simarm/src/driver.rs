@@ -44,6 +44,30 @@ pub enum SimArmError {
 struct Serve<'a>(&'a mut ArmModel);
 
 impl DeviceSetHandler for Serve<'_> {
+    fn actarray_motion(&mut self, _: u16, cmd: &ActArrayCommand, _: &ActArrayData) -> Motion {
+        self.0.arm_motion(cmd)
+    }
+    fn actarray_stop(&mut self, _: u16, state: &mut ActArrayData) -> Status {
+        let s = self.0.stop_arm();
+        self.0.arm_state(state);
+        s
+    }
+    fn limb_motion(&mut self, _: u16, _: &LimbCommand, _: &LimbData) -> Motion {
+        self.0.limb_motion()
+    }
+    fn limb_stop(&mut self, _: u16, state: &mut LimbData) -> Status {
+        let s = self.0.stop_limb();
+        self.0.limb_state(state);
+        s
+    }
+    fn gripper_motion(&mut self, _: u16, _: &GripperCommand, _: &GripperData) -> Motion {
+        self.0.gripper_motion()
+    }
+    fn gripper_stop(&mut self, _: u16, state: &mut GripperData) -> Status {
+        let s = self.0.stop_gripper();
+        self.0.gripper_state(state);
+        s
+    }
     fn actarray_command(
         &mut self,
         _: u16,

@@ -64,6 +64,10 @@ impl Message for ActArrayRequest {
     type Raw = ActArrayReqMsg;
     const CHANNEL: &'static str = "actarray request";
 
+    fn is_read_only(&self) -> bool {
+        matches!(self, ActArrayRequest::GetGeom)
+    }
+
     fn kind(&self) -> u32 {
         match self {
             ActArrayRequest::Power(_) => req::POWER,

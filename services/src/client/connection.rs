@@ -16,13 +16,24 @@ use iceoryx2::service::attribute::{AttributeKey, AttributeValue};
 use iceoryx2::service::port_factory::PortFactory;
 use limber_interfaces::prelude::*;
 
-use super::{ConnectError, DEFAULT_REQUEST_TIMEOUT, DriverStatus, Incompatibility, WaitMode};
+use super::{
+    ConnectError, DEFAULT_REQUEST_TIMEOUT, DriverStatus, Incompatibility, Outcome, WaitMode,
+};
 use crate::context::Context;
 use crate::error::Iox2Error;
 use crate::naming::{Channel, DRIVER_NODE_PREFIX, DeviceName, attr};
 use crate::qos;
 
 pub(super) const OUTCOME_SLOTS: usize = 16;
+
+/// The lease port of a client and the lease it holds.
+pub(super) struct LeaseSide {
+    pub(super) port: IoxClient<ipc::Service, LeaseReq, (), LeaseReply, ()>,
+    pub(super) seq: u64,
+    /// The heartbeat timeout and the time of the last renewal, while this client holds
+    /// the device.
+    pub(super) held: Option<(Duration, Instant)>,
+}
 
 type DataSvc<I> = iceoryx2::service::port_factory::publish_subscribe::PortFactory<
     ipc::Service,
@@ -48,8 +59,11 @@ pub struct Client<I: Interface> {
     pub(super) notify: Option<Listener<ipc::Service>>,
     pub(super) cmd_seq: u64,
     pub(super) req_seq: u64,
-    pub(super) outcomes: [(u64, u32); OUTCOME_SLOTS],
+    pub(super) outcome_sub: Subscriber<ipc::Service, OutcomeMsg, ()>,
+    pub(super) outcomes: [Outcome; OUTCOME_SLOTS],
+    pub(super) preemptions: [Outcome; OUTCOME_SLOTS],
     pub(super) max_seen_seq: u64,
+    pub(super) lease: Option<LeaseSide>,
     pub(super) wake_driver: bool,
     pub(super) wait_mode: WaitMode,
     pub(super) request_timeout: Duration,
@@ -176,6 +190,15 @@ impl<I: Interface> Client<I> {
             .notifier_builder()
             .create()
             .map_err(|e| map("wake", e.into()))?;
+        let outcome_sub = node
+            .service_builder(&device.service_name(Channel::Outcome))
+            .publish_subscribe::<OutcomeMsg>()
+            .open_with_attributes(&layout)
+            .map_err(|e| map("outcome", e.into()))?
+            .subscriber_builder()
+            .buffer_size(qos::OUTCOME_BUFFER)
+            .create()
+            .map_err(|e| map("outcome", e.into()))?;
         let notify_svc = node
             .service_builder(&device.service_name(Channel::Notify))
             .event()
@@ -200,8 +223,11 @@ impl<I: Interface> Client<I> {
             notify: None,
             cmd_seq: 0,
             req_seq: 0,
-            outcomes: [(0, 0); OUTCOME_SLOTS],
+            outcome_sub,
+            outcomes: [Outcome::NONE; OUTCOME_SLOTS],
+            preemptions: [Outcome::NONE; OUTCOME_SLOTS],
             max_seen_seq: 0,
+            lease: None,
             wake_driver: true,
             wait_mode: WaitMode::Event,
             request_timeout: DEFAULT_REQUEST_TIMEOUT,

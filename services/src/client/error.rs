@@ -141,3 +141,37 @@ pub enum WaitError {
     #[error("receiving failed: {0}")]
     Transport(#[source] Iox2Error),
 }
+
+/// A lease operation failed ([`super::Client::acquire`], `renew`, `release`, `holder`).
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum LeaseError {
+    /// Another client holds the device.
+    #[error("held by another client ({})", if .name.is_empty() { "unnamed" } else { .name.as_str() })]
+    Held {
+        /// The holder's client id.
+        client_id: u64,
+        /// The holder's name.
+        name: String,
+    },
+    /// The lease ended (its heartbeat was missed): the driver stopped the device.
+    #[error("the lease was lost (heartbeat missed)")]
+    Lost,
+    /// The driver refused the request (e.g. a heartbeat out of range).
+    #[error("refused: {0}")]
+    Refused(Status),
+    /// No reply within the request timeout.
+    #[error("no reply within {0:?}")]
+    Timeout(Duration),
+    /// No driver serves the device's lease channel.
+    #[error("no driver serves leases")]
+    NoDriver,
+    /// The driver is gone.
+    #[error("the driver is gone")]
+    DriverGone,
+    /// The reply does not decode.
+    #[error("undecodable reply: {0}")]
+    Decode(#[source] DecodeError),
+    /// iceoryx2 failed.
+    #[error("lease transport failed: {0}")]
+    Transport(#[source] Iox2Error),
+}

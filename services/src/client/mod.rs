@@ -13,13 +13,15 @@ mod connection;
 mod error;
 mod gripper;
 mod limb;
+mod ownership;
 mod requests;
 mod waiting;
 
 pub use commands::Ticket;
 use connection::OUTCOME_SLOTS;
 pub use connection::{ActArrayClient, Client, GripperClient, LimbClient};
-pub use error::{CommandError, ConnectError, Incompatibility, RequestError, WaitError};
+pub use error::{CommandError, ConnectError, Incompatibility, LeaseError, RequestError, WaitError};
+pub use ownership::{LeaseHolder, Outcome};
 pub use waiting::{DriverStatus, Freshness, WaitMode};
 
 /// Default time a request waits for its reply.

@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use limber_interfaces::prelude::*;
 
-use super::{Client, LIVENESS_PERIOD, OUTCOME_SLOTS, Ticket, WaitError};
+use super::{Client, LIVENESS_PERIOD, OUTCOME_SLOTS, Outcome, Ticket, WaitError};
 use crate::context::monotonic_ns;
 use crate::error::Iox2Error;
 
@@ -52,20 +52,48 @@ impl<I: Interface> Client<I> {
         loop {
             match self.states.receive() {
                 Ok(Some(s)) => {
-                    let d: &I::Data = &s;
-                    let h = d.header();
-                    if h.last_cmd.client_id == self.client_id {
-                        let slot = (h.last_cmd.cmd_seq as usize) % OUTCOME_SLOTS;
-                        self.outcomes[slot] = (h.last_cmd.cmd_seq, h.last_cmd.status);
-                        self.max_seen_seq = self.max_seen_seq.max(h.last_cmd.cmd_seq);
-                    }
                     self.latest = Some(s);
                     got = true;
                 }
-                Ok(None) => return Ok(got),
+                Ok(None) => break,
                 Err(e) => return Err(WaitError::Transport(e.into())),
             }
         }
+        self.take_outcomes()?;
+        Ok(got)
+    }
+
+    /// Takes the outcomes that arrived, keeping this client's own.
+    fn take_outcomes(&mut self) -> Result<(), WaitError> {
+        loop {
+            match self.outcome_sub.receive() {
+                Ok(Some(s)) => {
+                    let m: &OutcomeMsg = &s;
+                    if m.client_id != self.client_id {
+                        continue;
+                    }
+                    let o = Outcome::from_msg(m);
+                    let slot = (m.cmd_seq as usize) % OUTCOME_SLOTS;
+                    if m.status == Status::Preempted.code() {
+                        self.preemptions[slot] = o;
+                    } else {
+                        self.outcomes[slot] = o;
+                        self.max_seen_seq = self.max_seen_seq.max(m.cmd_seq);
+                    }
+                }
+                Ok(None) => return Ok(()),
+                Err(e) => return Err(WaitError::Transport(e.into())),
+            }
+        }
+    }
+
+    /// Whether the motion that the command of `ticket` started was cut short by another
+    /// client's command (the outcome says which client, and its name if it held the
+    /// device). Looks at what arrived; remembers the last [`OUTCOME_SLOTS`] commands.
+    pub fn preempted(&mut self, ticket: Ticket) -> Result<Option<Outcome>, WaitError> {
+        self.refresh()?;
+        let p = self.preemptions[(ticket.seq as usize) % OUTCOME_SLOTS];
+        Ok((p.seq == ticket.seq).then_some(p))
     }
 
     /// The latest state (read in place from shared memory), after taking what arrived.
@@ -142,17 +170,23 @@ impl<I: Interface> Client<I> {
 
     /// Waits for the outcome of the command of `ticket`, as published by the driver.
     pub fn wait_outcome(&mut self, ticket: Ticket, timeout: Duration) -> Result<Status, WaitError> {
+        self.wait_outcome_detail(ticket, timeout).map(|o| o.status)
+    }
+
+    /// Waits for the outcome of the command of `ticket`, with the other client involved
+    /// (the holder of the device when it is refused as [`Status::Leased`]).
+    pub fn wait_outcome_detail(
+        &mut self,
+        ticket: Ticket,
+        timeout: Duration,
+    ) -> Result<Outcome, WaitError> {
         let deadline = Instant::now() + timeout;
         let mut next_check = Instant::now() + LIVENESS_PERIOD;
         loop {
             self.refresh()?;
-            let (seq, status) = self.outcomes[(ticket.seq as usize) % OUTCOME_SLOTS];
-            if seq == ticket.seq {
-                return Ok(Status::try_from(status).unwrap_or_else(|e| {
-                    // A driver of another build: the outcome is not one we know.
-                    tracing::warn!(device = %self.device, error = %e, "unknown outcome status");
-                    Status::InvalidArgument
-                }));
+            let o = self.outcomes[(ticket.seq as usize) % OUTCOME_SLOTS];
+            if o.seq == ticket.seq {
+                return Ok(o);
             }
             // Commands of one client are applied in order: an outcome of a later one
             // means this one was applied too, its sample overwritten before it was read.

@@ -6,6 +6,9 @@
 //!   refused), then a request as a barrier; prints `sent N`;
 //! * `hold-samples`: borrow as many state samples as the service lets a subscriber hold,
 //!   print `holding K`, and keep them (to be killed or stopped).
+//! * `own`: power on, take the arm's lease as `--name` with a heartbeat of
+//!   `--heartbeat-ms`, move joint 0 at 0.1 rad/s, print `owning <client id>`, then renew
+//!   the lease (unless `--no-renew`) until killed or stdin closes.
 
 use std::time::Duration;
 
@@ -22,6 +25,15 @@ struct Args {
     /// Count for `burst`.
     #[arg(default_value_t = 64)]
     n: u64,
+    /// `own`: the holder's name.
+    #[arg(long, default_value = "test-holder")]
+    name: String,
+    /// `own`: the lease's heartbeat timeout, ms.
+    #[arg(long, default_value_t = 1000)]
+    heartbeat_ms: u64,
+    /// `own`: never renew the lease (to miss the heartbeat).
+    #[arg(long)]
+    no_renew: bool,
 }
 
 fn main() {
@@ -92,6 +104,30 @@ fn main() {
         "hold-request" => {
             println!("requesting");
             let _ = arm.request_with_timeout(&ActArrayRequest::GetGeom, Duration::from_secs(60));
+        }
+        "own" => {
+            arm.power(true).expect("power");
+            arm.acquire(&a.name, Duration::from_millis(a.heartbeat_ms))
+                .expect("acquire");
+            let t = arm.move_at_speed(0, 0.1).expect("move");
+            let st = arm
+                .wait_outcome(t, Duration::from_secs(5))
+                .expect("outcome");
+            assert!(st.is_carried_out(), "{st}");
+            println!("owning {}", arm.client_id());
+            // Until stdin closes (the test gone) or the process is killed.
+            let (tx, rx) = std::sync::mpsc::channel::<()>();
+            std::thread::spawn(move || {
+                let mut s = String::new();
+                let _ = std::io::stdin().read_line(&mut s);
+                let _ = tx.send(());
+            });
+            while rx.try_recv().is_err() {
+                if !a.no_renew {
+                    arm.keep_lease().expect("renew");
+                }
+                std::thread::sleep(Duration::from_millis(10));
+            }
         }
         m => panic!("unknown mode {m}"),
     }

@@ -9,7 +9,7 @@ use std::time::Duration;
 
 use clap::Parser;
 use limber_interfaces::prelude::*;
-use limber_services::host::{DeviceHandler, Origin};
+use limber_services::host::{DeviceHandler, Motion, Origin};
 use limber_services::testing::{TestArm, TestDriver};
 use limber_services::{Context, Domain, Role};
 
@@ -44,6 +44,14 @@ impl DeviceHandler<ActArray> for Holding<'_> {
         state: &mut ActArrayData,
     ) -> Status {
         self.0.command(cmd, from, state)
+    }
+
+    fn motion(&mut self, cmd: &ActArrayCommand, state: &ActArrayData) -> Motion {
+        self.0.motion(cmd, state)
+    }
+
+    fn stop(&mut self, state: &mut ActArrayData) -> Status {
+        self.0.stop(state)
     }
 
     fn request(

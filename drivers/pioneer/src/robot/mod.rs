@@ -9,6 +9,7 @@ mod arm;
 mod grippers;
 mod lift;
 mod limb;
+mod motion;
 
 pub use lift::LiftModel;
 

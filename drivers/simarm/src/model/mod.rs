@@ -22,6 +22,7 @@ mod gripper;
 mod limb;
 mod motion;
 mod options;
+mod preemption;
 
 use gripper::GripperCmd;
 use limb::VecMovePlan;
