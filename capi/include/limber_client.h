@@ -300,6 +300,12 @@ const char *limber_last_error(void);
 uint32_t limber_last_refusal(void);
 
 /*
+ Returns the text of a driver's `LIMBER_STATUS_*` (e.g. "the position lies beyond the
+ limb's reach"), or "unknown status" for a value that is none. Never NULL.
+ */
+const char *limber_status_text(uint32_t status);
+
+/*
  Returns the layout version this library speaks (`LIMBER_LAYOUT_VERSION` of limber.h).
  */
 uint32_t limber_layout_version(void);

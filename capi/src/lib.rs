@@ -25,6 +25,7 @@ use core::time::Duration;
 use std::cell::{Cell, RefCell};
 use std::ffi::CString;
 use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::OnceLock;
 
 use limber_interfaces::prelude::*;
 use limber_services::client::{
@@ -183,6 +184,22 @@ pub extern "C" fn limber_last_error() -> *const c_char {
 #[unsafe(no_mangle)]
 pub extern "C" fn limber_last_refusal() -> u32 {
     LAST_REFUSAL.with(Cell::get)
+}
+
+/// Returns the text of a driver's `LIMBER_STATUS_*` (e.g. "the position lies beyond the
+/// limb's reach"), or "unknown status" for a value that is none. Never NULL.
+#[unsafe(no_mangle)]
+pub extern "C" fn limber_status_text(status: u32) -> *const c_char {
+    static TEXTS: OnceLock<Vec<CString>> = OnceLock::new();
+    let texts = TEXTS.get_or_init(|| {
+        Status::ALL
+            .iter()
+            .map(|s| CString::new(s.describe()).unwrap_or_default())
+            .collect()
+    });
+    texts
+        .get(status as usize)
+        .map_or(c"unknown status".as_ptr(), |t| t.as_ptr())
 }
 
 /// Returns the layout version this library speaks (`LIMBER_LAYOUT_VERSION` of limber.h).
