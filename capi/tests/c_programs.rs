@@ -210,25 +210,52 @@ fn near(a: [f64; 3], b: [f64; 3], tol: f64) -> bool {
     a.iter().zip(b).all(|(x, y)| (x - y).abs() < tol)
 }
 
+/// Runs the build lines of the `sh` block of an example's README as written, from the
+/// workspace root, in a shell: `capi/install.sh "$HOME/..."`, `export PKG_CONFIG_PATH=...`,
+/// `make -C examples/...`. HOME is the scratch directory `dir`, the library that
+/// install.sh takes from `$CARGO_TARGET_DIR/release` is this test's, and `OUT` (which the
+/// Makefiles honour) puts the binary in `dir`. Not run: the `cargo build` line (cargo built
+/// the library for this test), `limber pioneer --emulated &` (the driver runs on a thread
+/// here), and the program itself (run by the test with its domain).
+fn run_readme_build_lines(readme: &str, dir: &Path) {
+    let readme = std::fs::read_to_string(root().join(readme)).unwrap();
+    let sh = fenced(&readme, "sh");
+    let script: Vec<&str> = sh
+        .lines()
+        .filter(|l| {
+            l.starts_with("capi/install.sh") || l.starts_with("export ") || l.starts_with("make ")
+        })
+        .collect();
+    assert_eq!(script.len(), 3, "{sh}");
+    assert!(
+        sh.starts_with("cargo build --release -p limber-c\n"),
+        "{sh}"
+    );
+    let target = dir.join("target");
+    std::fs::create_dir_all(&target).unwrap();
+    std::os::unix::fs::symlink(lib_dir(), target.join("release")).unwrap();
+    let mut cmd = Command::new("sh");
+    cmd.arg("-ec")
+        .arg(script.join("\n"))
+        .current_dir(root())
+        .env("HOME", dir)
+        .env("CARGO_TARGET_DIR", &target)
+        .env("OUT", dir)
+        .env_remove("PKG_CONFIG_PATH");
+    run_ok(cmd, &script.join("; "));
+    assert!(dir.join(".local/limber/lib/pkgconfig/limber.pc").is_file());
+}
+
 #[test]
-fn the_examples_build_with_their_makefiles_and_pick_a_block_in_c_and_cpp() {
+fn the_examples_build_as_their_readmes_say_and_pick_a_block_in_c_and_cpp() {
     let dir = scratch("examples");
-    let prefix = install(&dir);
-    let pc = prefix.join("lib/pkgconfig");
-    for (sub, exe) in [("c", "pick_block"), ("cpp", "pick_block_cpp")] {
-        // The README's `make -C examples/<sub>`, with the binary in the scratch directory.
-        let mut make = Command::new("make");
-        make.arg("-C")
-            .arg(root().join("examples").join(sub))
-            .arg(format!("OUT={}", dir.display()))
-            .env("PKG_CONFIG_PATH", &pc);
-        run_ok(make, &format!("make -C examples/{sub}"));
-        assert!(dir.join(exe).is_file());
-    }
+    run_readme_build_lines("examples/c/README.md", &dir.join("c"));
+    run_readme_build_lines("examples/cpp/README.md", &dir.join("cpp"));
+    let (c, cpp) = (dir.join("c/pick_block"), dir.join("cpp/pick_block_cpp"));
     let p = Pioneer::start();
 
     // C: every step, the block gripped, put down where asked.
-    let o = run_in(&p, &dir.join("pick_block"), &[]);
+    let o = run_in(&p, &c, &[]);
     let out = text(&o.stdout);
     assert!(o.status.success(), "{out}\n{}", text(&o.stderr));
     assert!(out.contains("grip: gripper closed"), "{out}");
@@ -252,7 +279,7 @@ fn the_examples_build_with_their_makefiles_and_pick_a_block_in_c_and_cpp() {
     );
 
     // C++ (the paper's Listing 2): the same, in the paper's words.
-    let o = run_in(&p, &dir.join("pick_block_cpp"), &[]);
+    let o = run_in(&p, &cpp, &[]);
     let out = text(&o.stdout);
     assert!(o.status.success(), "{out}\n{}", text(&o.stderr));
     assert_eq!(out.matches("gripper closed").count(), 1, "{out}");
@@ -262,9 +289,10 @@ fn the_examples_build_with_their_makefiles_and_pick_a_block_in_c_and_cpp() {
     );
 
     // A block beyond reach: both say so, go home and exit 2.
-    for exe in ["pick_block", "pick_block_cpp"] {
-        let o = run_in(&p, &dir.join(exe), &["2.0", "0.0"]);
+    for exe in [&c, &cpp] {
+        let o = run_in(&p, exe, &["2.0", "0.0"]);
         let out = text(&o.stdout);
+        let exe = exe.display();
         assert_eq!(
             o.status.code(),
             Some(2),
@@ -279,13 +307,20 @@ fn the_examples_build_with_their_makefiles_and_pick_a_block_in_c_and_cpp() {
     }
 }
 
+/// The first fenced block of `lang` in `text`.
+fn fenced(text: &str, lang: &str) -> String {
+    let fence = format!("```{lang}\n");
+    let start = text.find(&fence).expect("the block") + fence.len();
+    let len = text[start..].find("```").expect("its end");
+    text[start..start + len].to_string()
+}
+
 /// The fenced block of `lang` in README.md's "C and C++" section.
 fn readme_block(readme: &str, lang: &str) -> String {
-    let section = &readme[readme.find("## C and C++").expect("the section")..];
-    let fence = format!("```{lang}\n");
-    let start = section.find(&fence).expect("the block") + fence.len();
-    let len = section[start..].find("```").expect("its end");
-    section[start..start + len].to_string()
+    fenced(
+        &readme[readme.find("## C and C++").expect("the section")..],
+        lang,
+    )
 }
 
 #[test]

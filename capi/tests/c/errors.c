@@ -60,6 +60,12 @@ int main(void) {
     bad |= check("borrow twice", limber_actarray_borrow(arm, 0, &p), LIMBER_CODE_BORROWED, NULL);
     bad |= check("release", limber_actarray_release(arm), LIMBER_CODE_OK, NULL);
     bad |= check("state after release", limber_actarray_state(arm, 0, &d), LIMBER_CODE_OK, NULL);
+    bad |= check("brakes on an arm without", limber_actarray_brakes(arm, true, 2000), LIMBER_CODE_REFUSED,
+                 "unsupported");
+    if (limber_last_refusal() != LIMBER_STATUS_UNSUPPORTED) {
+        fprintf(stderr, "FAIL refusal: %u\n", limber_last_refusal());
+        bad = 1;
+    }
     limber_ticket never = {1000000, 1};
     uint32_t status;
     bad |= check("outcome of a command never sent", limber_actarray_wait_outcome(arm, never, 50, &status),

@@ -11,6 +11,13 @@ int main() try {
     limber::ActArrayProxy arm("pioneer/actarray/0");
     limber::GripperProxy gripper("pioneer/gripper/1");
     auto count = arm.RequestGeometry().actuators_count;
+    try {
+        arm.SetBrakesConfig(true);
+        std::cerr << "watch: brakes on an arm without brakes were not refused" << std::endl;
+        return 1;
+    } catch (const limber::Error& e) {
+        if (e.code() != LIMBER_CODE_REFUSED || e.refusal() != LIMBER_STATUS_UNSUPPORTED) throw;
+    }
     std::cout << "watching; the arm has " << count << " actuators" << std::endl;
     bool closed = false;
     auto deadline = std::chrono::steady_clock::now() + 60s;
