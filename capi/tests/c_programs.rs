@@ -251,6 +251,8 @@ fn the_examples_build_as_their_readmes_say_and_pick_a_block_in_c_and_cpp() {
     let dir = scratch("examples");
     run_readme_build_lines("examples/c/README.md", &dir.join("c"));
     run_readme_build_lines("examples/cpp/README.md", &dir.join("cpp"));
+    run_readme_build_lines("capi/README.md", &dir.join("capi"));
+    assert!(dir.join("capi/pick_block").is_file());
     let (c, cpp) = (dir.join("c/pick_block"), dir.join("cpp/pick_block_cpp"));
     let p = Pioneer::start();
 
