@@ -17,6 +17,7 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use limber_emulator::{Emulator, EmulatorConfig};
+use limber_interfaces::prelude::ActArrayData;
 use limber_pioneer::{PioneerConfig, PioneerDriver, RunOptions};
 use limber_services::prelude::*;
 use limber_services::{Domain, Role};
@@ -545,4 +546,51 @@ fn rust_c_and_cpp_clients_work_on_one_driver_at_once() {
         z_max - z_min > 0.04,
         "the limb did not move: z {z_min}..{z_max}"
     );
+}
+
+#[test]
+fn a_handle_sees_its_driver_go() {
+    // Through the library's Rust face (the same functions C calls): alive while the
+    // driver runs, then gone, and waiting for a state says so instead of timing out.
+    use limber::*;
+    let p = Pioneer::start();
+    let domain = std::ffi::CString::new(p.name()).unwrap();
+    let mut h: *mut LimberActArray = std::ptr::null_mut();
+    let mut live = LimberLiveness::NoData;
+    let mut data = ActArrayData::default();
+    // SAFETY: valid strings, and pointers to locals that outlive the calls.
+    unsafe {
+        let c = limber_actarray_connect(
+            c"pioneer/actarray/0".as_ptr(),
+            domain.as_ptr(),
+            5000,
+            &mut h,
+        );
+        assert_eq!(c, LimberCode::Ok);
+        assert_eq!(limber_actarray_state(h, 5000, &mut data), LimberCode::Ok);
+        assert_eq!(limber_actarray_liveness(h, 5000, &mut live), LimberCode::Ok);
+    }
+    assert_eq!(live, LimberLiveness::Alive);
+    drop(p);
+    // SAFETY: as above; the handle is live until disconnected.
+    unsafe {
+        // The states published as it stopped, then the news that it is gone.
+        let mut c = LimberCode::Ok;
+        for _ in 0..100 {
+            c = limber_actarray_wait_state(h, 10_000, &mut data);
+            if c != LimberCode::Ok {
+                break;
+            }
+        }
+        assert_eq!(c, LimberCode::DriverGone);
+        assert_eq!(limber_actarray_liveness(h, 0, &mut live), LimberCode::Ok);
+        let mut status = LimberDriverStatus::Alive;
+        assert_eq!(
+            limber_actarray_driver_status(h, &mut status),
+            LimberCode::Ok
+        );
+        assert_ne!(status, LimberDriverStatus::Alive);
+        limber_actarray_disconnect(h);
+    }
+    assert_eq!(live, LimberLiveness::Gone);
 }
