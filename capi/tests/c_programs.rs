@@ -594,3 +594,47 @@ fn a_handle_sees_its_driver_go() {
     }
     assert_eq!(live, LimberLiveness::Gone);
 }
+
+/// What the Pioneer driver answers to each call of `tests/c/commands.c`: carried out, or
+/// the cause it names for what the Pioneer cannot do (no current control, no brakes, no
+/// acceleration setting, no store/retrieve on the arm gripper).
+const PIONEER_VERDICTS: &str = "\
+actarray move_to: ok
+actarray move_to_multi: ok
+actarray move_at_speed: ok
+actarray move_at_speed_multi: ok
+actarray set_current: unsupported by this device
+actarray set_current_multi: unsupported by this device
+actarray home: ok
+actarray power: ok
+actarray brakes: refused: unsupported by this device
+actarray set_speed_config: ok
+actarray set_accel_config: refused: unsupported by this device
+actarray geometry: ok
+limb set_pose: ok
+limb set_position: ok
+limb vec_move: ok
+limb stop: ok
+limb home: ok
+limb power: ok
+limb brakes: refused: unsupported by this device
+limb set_speed: ok
+limb geometry: ok
+gripper open: ok
+gripper close: ok
+gripper stop: ok
+gripper store: unsupported by this device
+gripper retrieve: unsupported by this device
+gripper geometry: ok
+";
+
+#[test]
+fn every_command_and_request_reaches_the_driver_as_itself() {
+    let dir = scratch("commands");
+    let exe = dir.join("commands");
+    compile("commands.c", &exe, &[]);
+    let p = Pioneer::start();
+    let o = run_in(&p, &exe, &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(text(&o.stdout), PIONEER_VERDICTS);
+}

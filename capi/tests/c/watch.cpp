@@ -4,6 +4,7 @@
 #include <limber.hpp>
 
 #include <iostream>
+#include <stdexcept>
 
 using namespace std::chrono_literals;
 
@@ -18,6 +19,19 @@ int main() try {
     } catch (const limber::Error& e) {
         if (e.code() != LIMBER_CODE_REFUSED || e.refusal() != LIMBER_STATUS_UNSUPPORTED) throw;
     }
+    {
+        // A state in place, without a copy: while it is held, reading states is refused.
+        auto held = gripper.Borrow();
+        try {
+            gripper.GetData();
+            std::cerr << "watch: GetData while a state is borrowed was not refused" << std::endl;
+            return 1;
+        } catch (const limber::Error& e) {
+            if (e.code() != LIMBER_CODE_BORROWED) throw;
+        }
+        if (held->header.seq == 0) throw std::runtime_error("a borrowed state without a sequence number");
+    }
+    gripper.GetData();  // released by the destructor
     std::cout << "watching; the arm has " << count << " actuators" << std::endl;
     bool closed = false;
     auto deadline = std::chrono::steady_clock::now() + 60s;
