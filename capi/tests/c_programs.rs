@@ -105,13 +105,31 @@ fn lib_dir() -> PathBuf {
     dir
 }
 
-/// A fresh scratch directory for one test.
-fn scratch(name: &str) -> PathBuf {
+/// A fresh scratch directory for one test, removed when dropped (it holds copies of the
+/// library: hundreds of MB in a debug build).
+struct Scratch(PathBuf);
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        if let Err(e) = std::fs::remove_dir_all(&self.0) {
+            eprintln!("cannot remove {}: {e}", self.0.display());
+        }
+    }
+}
+
+fn scratch(name: &str) -> Scratch {
     let d =
         Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("capi-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).expect("a scratch directory");
-    d
+    Scratch(d)
 }
 
 fn text(b: &[u8]) -> String {
@@ -347,7 +365,7 @@ fn the_readme_clients_compile_and_run_as_written() {
         let mut cmd = Command::new("sh");
         cmd.arg("-c")
             .arg(line)
-            .current_dir(&dir)
+            .current_dir(&*dir)
             .env("PKG_CONFIG_PATH", prefix.join("lib/pkgconfig"));
         run_ok(cmd, line);
     }
