@@ -40,12 +40,12 @@
 #include "limber.h"
 
 /*
- Longest device name kept in [`LimberDeviceInfo::name`], with its NUL.
+ Longest device name kept in `limber_device_info.name`, with its NUL.
  */
 #define LIMBER_DEVICE_NAME_CAPACITY 96
 
 /*
- Longest driver name kept in [`LimberDeviceInfo::driver`], with its NUL.
+ Longest driver name kept in `limber_device_info.driver`, with its NUL.
  */
 #define LIMBER_DRIVER_NAME_CAPACITY 64
 

@@ -7,9 +7,9 @@ use limber_services::list_devices;
 
 use crate::{Fail, LimberCode, arg, domain_of, guard, opt_str};
 
-/// Longest device name kept in [`LimberDeviceInfo::name`], with its NUL.
+/// Longest device name kept in `limber_device_info.name`, with its NUL.
 pub const LIMBER_DEVICE_NAME_CAPACITY: usize = 96;
-/// Longest driver name kept in [`LimberDeviceInfo::driver`], with its NUL.
+/// Longest driver name kept in `limber_device_info.driver`, with its NUL.
 pub const LIMBER_DRIVER_NAME_CAPACITY: usize = 64;
 
 /// Which interface a device offers.
