@@ -22,13 +22,11 @@ static limber_limb_data WaitForLimb(limber::LimbProxy& Limb, limber_ticket Ticke
     } catch (const limber::Error& e) {
         if (e.code() != LIMBER_CODE_OUTCOME_MISSED) throw;  // missed: applied, then superseded
     }
+    // The state published with the outcome: out of reach shows as LIMBER_LIMB_STATE_OOR.
     limber_limb_data Data = Limb.GetData();
-    if (Status != LIMBER_STATUS_OK && Status != LIMBER_STATUS_CLAMPED) {
-        if (Status != LIMBER_STATUS_OUT_OF_REACH)
-            throw std::runtime_error("limb command refused: " + limber::StatusText(Status));
-        Data.state = LIMBER_LIMB_STATE_OOR;
-        return Data;
-    }
+    if (Status == LIMBER_STATUS_OUT_OF_REACH) return Data;
+    if (Status != LIMBER_STATUS_OK && Status != LIMBER_STATUS_CLAMPED)
+        throw std::runtime_error("limb command refused: " + limber::StatusText(Status));
     auto Deadline = std::chrono::steady_clock::now() + 30s;
     while (Data.state == LIMBER_LIMB_STATE_MOVING) {
         if (std::chrono::steady_clock::now() > Deadline)
