@@ -1,0 +1,335 @@
+/* limber.hpp: the limber client API for C++17, header-only, over the C API of
+ * limber_client.h (link with `pkg-config --cflags --libs limber`).
+ *
+ * RAII proxies named like Player's: limber::ActArrayProxy, limber::LimbProxy and
+ * limber::GripperProxy connect in their constructor and disconnect in their destructor.
+ * Every failure throws limber::Error, which carries the limber_code (code()), its message
+ * with the detail (what()) and, for a request the driver refused, the driver's
+ * LIMBER_STATUS_* (refusal()). Timeouts are std::chrono durations.
+ *
+ * Commands return a limber_ticket at once; WaitOutcome(ticket, timeout) returns the
+ * driver's verdict, a LIMBER_STATUS_* (limber::StatusText() describes it).
+ *
+ * Thread-safety: as the C API's. A proxy is used by one thread at a time (it may be moved
+ * to another thread between calls); different proxies work in different threads at once.
+ */
+#ifndef LIMBER_HPP
+#define LIMBER_HPP
+
+#include <chrono>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "limber_client.h"
+
+namespace limber {
+
+/// A timeout or an age (converted to whole milliseconds, rounded up).
+using Duration = std::chrono::nanoseconds;
+
+/// How long connecting waits for a driver by default.
+inline constexpr Duration kConnectTimeout = std::chrono::seconds(5);
+/// How long a request waits for its reply by default.
+inline constexpr Duration kRequestTimeout = std::chrono::seconds(2);
+/// How long reading a state waits for a first one by default.
+inline constexpr Duration kStateTimeout = std::chrono::seconds(2);
+
+/// A failed call: its limber_code, message and detail, and the driver's reason if it
+/// refused a request.
+class Error : public std::runtime_error {
+public:
+    Error(limber_code code, const std::string& what, uint32_t refusal)
+        : std::runtime_error(what), code_(code), refusal_(refusal) {}
+    /// The limber_code (LIMBER_CODE_*).
+    limber_code code() const noexcept { return code_; }
+    /// The driver's LIMBER_STATUS_* when code() is LIMBER_CODE_REFUSED, else LIMBER_STATUS_OK.
+    uint32_t refusal() const noexcept { return refusal_; }
+
+private:
+    limber_code code_;
+    uint32_t refusal_;
+};
+
+/// The text of a driver's LIMBER_STATUS_*.
+inline std::string StatusText(uint32_t status) { return limber_status_text(status); }
+
+namespace detail {
+inline uint64_t Millis(Duration d) {
+    if (d.count() <= 0) return 0;
+    return static_cast<uint64_t>(std::chrono::ceil<std::chrono::milliseconds>(d).count());
+}
+
+/// Throws limber::Error for anything but LIMBER_CODE_OK.
+inline void Check(limber_code code) {
+    if (code == LIMBER_CODE_OK) return;
+    std::string what = limber_strerror(code);
+    std::string detail = limber_last_error();
+    if (!detail.empty()) what += ": " + detail;
+    throw Error(code, what, code == LIMBER_CODE_REFUSED ? limber_last_refusal() : LIMBER_STATUS_OK);
+}
+
+#define LIMBER_HPP_TRAITS(Name, prefix, Data, Geom)                                           \
+    struct Name {                                                                             \
+        using Handle = limber_##prefix;                                                       \
+        using DataType = Data;                                                                \
+        using GeomType = Geom;                                                                \
+        static constexpr auto connect = limber_##prefix##_connect;                            \
+        static constexpr auto disconnect = limber_##prefix##_disconnect;                      \
+        static constexpr auto state = limber_##prefix##_state;                                \
+        static constexpr auto borrow = limber_##prefix##_borrow;                              \
+        static constexpr auto release = limber_##prefix##_release;                            \
+        static constexpr auto wait_state = limber_##prefix##_wait_state;                      \
+        static constexpr auto wait_outcome = limber_##prefix##_wait_outcome;                  \
+        static constexpr auto liveness = limber_##prefix##_liveness;                          \
+        static constexpr auto driver_status = limber_##prefix##_driver_status;                \
+        static constexpr auto geometry = limber_##prefix##_geometry;                          \
+    }
+LIMBER_HPP_TRAITS(ActArrayTraits, actarray, limber_actarray_data, limber_actarray_geom);
+LIMBER_HPP_TRAITS(LimbTraits, limb, limber_limb_data, limber_limb_geom);
+LIMBER_HPP_TRAITS(GripperTraits, gripper, limber_gripper_data, limber_gripper_geom);
+#undef LIMBER_HPP_TRAITS
+}  // namespace detail
+
+/// A state lent in place from shared memory (no copy) until this object is destroyed.
+/// While it lives, the proxy's calls that read states throw LIMBER_CODE_BORROWED.
+template <class T>
+class Borrowed {
+public:
+    Borrowed(typename T::Handle* h, const typename T::DataType* data) : h_(h), data_(data) {}
+    Borrowed(const Borrowed&) = delete;
+    Borrowed& operator=(const Borrowed&) = delete;
+    Borrowed(Borrowed&& o) noexcept : h_(std::exchange(o.h_, nullptr)), data_(o.data_) {}
+    Borrowed& operator=(Borrowed&&) = delete;
+    ~Borrowed() {
+        if (h_ != nullptr) T::release(h_);
+    }
+    const typename T::DataType& operator*() const noexcept { return *data_; }
+    const typename T::DataType* operator->() const noexcept { return data_; }
+
+private:
+    typename T::Handle* h_;
+    const typename T::DataType* data_;
+};
+
+/// What every proxy does: connect, read and wait for states, wait for outcomes, liveness.
+template <class T>
+class BasicProxy {
+public:
+    /// The state struct of limber.h.
+    using Data = typename T::DataType;
+    /// The geometry struct of limber.h.
+    using Geom = typename T::GeomType;
+
+    /// Connects to `device` ("robot/interface/index") in `domain` (empty: LIMBER_DOMAIN,
+    /// or "limber"), waiting up to `timeout` for a driver to offer it.
+    explicit BasicProxy(const std::string& device, Duration timeout = kConnectTimeout,
+                        const std::string& domain = "") {
+        detail::Check(T::connect(device.c_str(), domain.empty() ? nullptr : domain.c_str(),
+                                 detail::Millis(timeout), &h_));
+    }
+    BasicProxy(const BasicProxy&) = delete;
+    BasicProxy& operator=(const BasicProxy&) = delete;
+    BasicProxy(BasicProxy&& o) noexcept : h_(std::exchange(o.h_, nullptr)), geom_(o.geom_) {}
+    BasicProxy& operator=(BasicProxy&& o) noexcept {
+        std::swap(h_, o.h_);
+        std::swap(geom_, o.geom_);
+        return *this;
+    }
+    ~BasicProxy() { T::disconnect(h_); }
+
+    /// The latest state (a copy), waiting up to `timeout` for a first one.
+    Data GetData(Duration timeout = kStateTimeout) {
+        Data d{};
+        detail::Check(T::state(h_, detail::Millis(timeout), &d));
+        return d;
+    }
+    /// The latest state in place, without a copy, until the returned object is destroyed.
+    Borrowed<T> Borrow(Duration timeout = kStateTimeout) {
+        const Data* p = nullptr;
+        detail::Check(T::borrow(h_, detail::Millis(timeout), &p));
+        return Borrowed<T>(h_, p);
+    }
+    /// Waits up to `timeout` for a state newer than the latest one taken.
+    Data WaitForData(Duration timeout) {
+        Data d{};
+        detail::Check(T::wait_state(h_, detail::Millis(timeout), &d));
+        return d;
+    }
+    /// Waits up to `timeout` for the outcome of a command: a LIMBER_STATUS_*.
+    uint32_t WaitOutcome(limber_ticket ticket, Duration timeout) {
+        uint32_t status = LIMBER_STATUS_OK;
+        detail::Check(T::wait_outcome(h_, ticket, detail::Millis(timeout), &status));
+        return status;
+    }
+    /// Alive (a state younger than `max_age`), stale, gone, or no data yet.
+    limber_liveness Liveness(Duration max_age) {
+        limber_liveness l = LIMBER_LIVENESS_NO_DATA;
+        detail::Check(T::liveness(h_, detail::Millis(max_age), &l));
+        return l;
+    }
+    /// Whether the driver's process lives.
+    limber_driver_status DriverStatus() {
+        limber_driver_status s = LIMBER_DRIVER_STATUS_ABSENT;
+        detail::Check(T::driver_status(h_, &s));
+        return s;
+    }
+    /// Asks the driver for the geometry (and keeps it for GetGeom()).
+    const Geom& RequestGeometry(Duration timeout = kRequestTimeout) {
+        detail::Check(T::geometry(h_, detail::Millis(timeout), &geom_));
+        return geom_;
+    }
+    /// The geometry of the last RequestGeometry() (zeros before).
+    const Geom& GetGeom() const noexcept { return geom_; }
+    /// The C handle, for the C API.
+    typename T::Handle* get() const noexcept { return h_; }
+
+protected:
+    typename T::Handle* h_ = nullptr;
+    Geom geom_{};
+};
+
+/// Player's ActArrayProxy: an actuator array.
+class ActArrayProxy : public BasicProxy<detail::ActArrayTraits> {
+public:
+    using BasicProxy::BasicProxy;
+    /// CMD POS: moves `joint` to `position` (rad or m).
+    limber_ticket MoveTo(uint32_t joint, double position) {
+        limber_ticket t{};
+        detail::Check(limber_actarray_move_to(h_, joint, position, &t));
+        return t;
+    }
+    /// CMD MULTI_POS: moves joints 0..n to `positions`.
+    limber_ticket MoveToMulti(const std::vector<double>& positions) {
+        limber_ticket t{};
+        detail::Check(limber_actarray_move_to_multi(h_, positions.data(), positions.size(), &t));
+        return t;
+    }
+    /// CMD SPEED: moves `joint` at `speed` (rad/s or m/s).
+    limber_ticket MoveAtSpeed(uint32_t joint, double speed) {
+        limber_ticket t{};
+        detail::Check(limber_actarray_move_at_speed(h_, joint, speed, &t));
+        return t;
+    }
+    /// CMD MULTI_SPEED: moves joints 0..n at `speeds`.
+    limber_ticket MoveAtSpeedMulti(const std::vector<double>& speeds) {
+        limber_ticket t{};
+        detail::Check(limber_actarray_move_at_speed_multi(h_, speeds.data(), speeds.size(), &t));
+        return t;
+    }
+    /// CMD HOME: homes `joint`, or every joint if negative (the default).
+    limber_ticket MoveHome(int32_t joint = -1) {
+        limber_ticket t{};
+        detail::Check(limber_actarray_home(h_, joint, &t));
+        return t;
+    }
+    /// CMD CURRENT: drives `joint` (every joint if negative) with `current` A.
+    limber_ticket SetActuatorCurrent(int32_t joint, double current) {
+        limber_ticket t{};
+        detail::Check(limber_actarray_set_current(h_, joint, current, &t));
+        return t;
+    }
+    /// CMD MULTI_CURRENT: drives joints 0..n with `currents` A.
+    limber_ticket SetActuatorCurrentMulti(const std::vector<double>& currents) {
+        limber_ticket t{};
+        detail::Check(limber_actarray_set_current_multi(h_, currents.data(), currents.size(), &t));
+        return t;
+    }
+    /// REQ POWER.
+    void SetPowerConfig(bool on, Duration timeout = kRequestTimeout) {
+        detail::Check(limber_actarray_power(h_, on, detail::Millis(timeout)));
+    }
+    /// REQ BRAKES.
+    void SetBrakesConfig(bool on, Duration timeout = kRequestTimeout) {
+        detail::Check(limber_actarray_brakes(h_, on, detail::Millis(timeout)));
+    }
+    /// REQ SPEED: the speed of `joint` for later position moves.
+    void SetSpeedConfig(uint32_t joint, double speed, Duration timeout = kRequestTimeout) {
+        detail::Check(limber_actarray_set_speed_config(h_, joint, speed, detail::Millis(timeout)));
+    }
+    /// REQ ACCEL: the acceleration of `joint` for later position moves.
+    void SetAccelerationConfig(uint32_t joint, double accel, Duration timeout = kRequestTimeout) {
+        detail::Check(limber_actarray_set_accel_config(h_, joint, accel, detail::Millis(timeout)));
+    }
+};
+
+/// Player's LimbProxy: a limb, commanded by end-effector poses.
+class LimbProxy : public BasicProxy<detail::LimbTraits> {
+public:
+    using BasicProxy::BasicProxy;
+    /// CMD HOME.
+    limber_ticket MoveHome() {
+        limber_ticket t{};
+        detail::Check(limber_limb_home(h_, &t));
+        return t;
+    }
+    /// CMD STOP: stops every joint now.
+    limber_ticket Stop() {
+        limber_ticket t{};
+        detail::Check(limber_limb_stop(h_, &t));
+        return t;
+    }
+    /// CMD SETPOSE: end effector at (px, py, pz), approach vector (ax, ay, az),
+    /// orientation vector (ox, oy, oz), in the robot frame (m). Beyond reach: the outcome
+    /// is LIMBER_STATUS_OUT_OF_REACH and the state LIMBER_LIMB_STATE_OOR.
+    limber_ticket SetPose(double px, double py, double pz, double ax, double ay, double az,
+                          double ox, double oy, double oz) {
+        limber_ticket t{};
+        detail::Check(limber_limb_set_pose(h_, limber_vec3{px, py, pz}, limber_vec3{ax, ay, az},
+                                           limber_vec3{ox, oy, oz}, &t));
+        return t;
+    }
+    /// CMD SETPOSITION: end effector at (x, y, z), orientation chosen by the driver.
+    limber_ticket SetPosition(double x, double y, double z) {
+        limber_ticket t{};
+        detail::Check(limber_limb_set_position(h_, limber_vec3{x, y, z}, &t));
+        return t;
+    }
+    /// CMD VECMOVE: moves `length` m along (x, y, z) in a straight line.
+    limber_ticket VectorMove(double x, double y, double z, double length) {
+        limber_ticket t{};
+        detail::Check(limber_limb_vec_move(h_, limber_vec3{x, y, z}, length, &t));
+        return t;
+    }
+    /// REQ POWER.
+    void SetPowerConfig(bool on, Duration timeout = kRequestTimeout) {
+        detail::Check(limber_limb_power(h_, on, detail::Millis(timeout)));
+    }
+    /// REQ BRAKES.
+    void SetBrakesConfig(bool on, Duration timeout = kRequestTimeout) {
+        detail::Check(limber_limb_brakes(h_, on, detail::Millis(timeout)));
+    }
+    /// REQ SPEED: the end effector's speed (m/s).
+    void SetSpeedConfig(double speed, Duration timeout = kRequestTimeout) {
+        detail::Check(limber_limb_set_speed(h_, speed, detail::Millis(timeout)));
+    }
+};
+
+/// Player's GripperProxy: a gripper.
+class GripperProxy : public BasicProxy<detail::GripperTraits> {
+public:
+    using BasicProxy::BasicProxy;
+    /// CMD OPEN.
+    limber_ticket Open() { return Send(limber_gripper_open); }
+    /// CMD CLOSE.
+    limber_ticket Close() { return Send(limber_gripper_close); }
+    /// CMD STOP.
+    limber_ticket Stop() { return Send(limber_gripper_stop); }
+    /// CMD STORE.
+    limber_ticket Store() { return Send(limber_gripper_store); }
+    /// CMD RETRIEVE.
+    limber_ticket Retrieve() { return Send(limber_gripper_retrieve); }
+
+private:
+    limber_ticket Send(limber_code (*cmd)(limber_gripper*, limber_ticket*)) {
+        limber_ticket t{};
+        detail::Check(cmd(h_, &t));
+        return t;
+    }
+};
+
+}  // namespace limber
+
+#endif /* LIMBER_HPP */

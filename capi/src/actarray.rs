@@ -1,0 +1,443 @@
+//! `limber_actarray_*`: Player's `ActArrayProxy` for C, one function per client call.
+
+use core::ffi::c_char;
+
+use limber_interfaces::prelude::*;
+
+use crate::{
+    Fail, Handle, LimberCode, LimberDriverStatus, LimberLiveness, LimberTicket, arg, guard,
+    opt_str, req_str, sent,
+};
+
+/// A connection to an actuator array (opaque). Use it from one thread at a time.
+pub struct LimberActArray(Handle<ActArray>);
+
+/// The values of a `*_multi` call.
+///
+/// # Safety
+/// `p` is NULL (then `count` must be 0) or points to `count` readable doubles.
+unsafe fn values<'a>(p: *const f64, count: usize) -> Result<&'a [f64], Fail> {
+    if count == 0 {
+        return Ok(&[]);
+    }
+    if p.is_null() {
+        return Err(Fail::new(LimberCode::NullArgument, "the values are NULL"));
+    }
+    // SAFETY: not NULL, and the caller promises `count` readable doubles.
+    Ok(unsafe { core::slice::from_raw_parts(p, count) })
+}
+
+/// Connects to the actuator array `device` ("robot/actarray/index") in `domain` (NULL:
+/// the `LIMBER_DOMAIN` environment variable, or "limber"), waiting up to `timeout_ms` for a
+/// driver to offer it. On success `*out` is the new handle; free it with
+/// `limber_actarray_disconnect`.
+///
+/// # Safety
+/// `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_connect(
+    device: *const c_char,
+    domain: *const c_char,
+    timeout_ms: u64,
+    out: *mut *mut LimberActArray,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the arguments, checked for NULL here.
+        let (device, domain, out) = unsafe {
+            (
+                req_str(device, "device")?,
+                opt_str(domain, "domain")?,
+                arg(out, "out")?,
+            )
+        };
+        let h = Handle::connect(device, domain, timeout_ms)?;
+        *out = Box::into_raw(Box::new(LimberActArray(h)));
+        Ok(())
+    })
+}
+
+/// Closes the connection and frees the handle (and any state borrowed from it). NULL is
+/// ignored.
+///
+/// # Safety
+/// `h` is NULL or a handle of `limber_actarray_connect` not yet disconnected.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_disconnect(h: *mut LimberActArray) {
+    if !h.is_null() {
+        // SAFETY: the handle came from Box::into_raw in limber_actarray_connect and is
+        // freed once.
+        let h = unsafe { Box::from_raw(h) };
+        let _ = guard(move || {
+            drop(h);
+            Ok(())
+        });
+    }
+}
+
+/// Copies the latest state into `*out`, waiting up to `timeout_ms` for a first one
+/// (`LIMBER_CODE_TIMEOUT` if none came).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_state(
+    h: *mut LimberActArray,
+    timeout_ms: u64,
+    out: *mut ActArrayData,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        h.0.state(timeout_ms, out)
+    })
+}
+
+/// Lends the latest state in place, without a copy (waiting up to `timeout_ms` for a
+/// first one): `*out` points into shared memory and stays valid and unchanged until
+/// `limber_actarray_release` (or disconnect). Meanwhile the calls that read states
+/// (state, borrow, wait_state, wait_outcome, liveness) fail with `LIMBER_CODE_BORROWED`;
+/// commands and requests work.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_borrow(
+    h: *mut LimberActArray,
+    timeout_ms: u64,
+    out: *mut *const ActArrayData,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        *out = h.0.borrow(timeout_ms)?;
+        Ok(())
+    })
+}
+
+/// Ends the loan of `limber_actarray_borrow` (the pointer it gave is invalid from now on).
+/// Releasing with nothing borrowed is harmless.
+///
+/// # Safety
+/// `h` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_release(h: *mut LimberActArray) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the handle, checked for NULL here.
+        let h = unsafe { arg(h, "handle")? };
+        h.0.release();
+        Ok(())
+    })
+}
+
+/// Waits up to `timeout_ms` for a state newer than the latest one taken and copies it into
+/// `*out` (NULL: not copied).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_wait_state(
+    h: *mut LimberActArray,
+    timeout_ms: u64,
+    out: *mut ActArrayData,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, out.as_mut()) };
+        h.0.wait_state(timeout_ms, out)
+    })
+}
+
+/// Waits up to `timeout_ms` for the outcome of the command of `ticket`; `*status` is the
+/// driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `status` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_wait_outcome(
+    h: *mut LimberActArray,
+    ticket: LimberTicket,
+    timeout_ms: u64,
+    status: *mut u32,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, status) = unsafe { (arg(h, "handle")?, arg(status, "status")?) };
+        *status = h.0.wait_outcome(&ticket, timeout_ms)?;
+        Ok(())
+    })
+}
+
+/// Whether the driver publishes: `LIMBER_LIVENESS_ALIVE` if the latest state is younger
+/// than `max_age_ms`, `STALE` if older but the driver lives, `GONE`, or `NO_DATA`.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_liveness(
+    h: *mut LimberActArray,
+    max_age_ms: u64,
+    out: *mut LimberLiveness,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        *out = h.0.liveness(max_age_ms)?;
+        Ok(())
+    })
+}
+
+/// Whether the driver's process lives (costs tens of microseconds).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_driver_status(
+    h: *mut LimberActArray,
+    out: *mut LimberDriverStatus,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        *out = h.0.driver_status();
+        Ok(())
+    })
+}
+
+/// CMD POS: moves `joint` to `position` (rad or m). `*ticket` (NULL: not written) is for
+/// `limber_actarray_wait_outcome`. Returns at once.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `ticket` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_move_to(
+    h: *mut LimberActArray,
+    joint: u32,
+    position: f64,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, ticket) = unsafe { (arg(h, "handle")?, ticket.as_mut()) };
+        sent(h.0.client.move_to(joint as usize, position), ticket)
+    })
+}
+
+/// CMD MULTI_POS: moves joints 0..count to `positions[0..count]`.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `positions` points to `count` doubles (or is NULL with
+/// `count` 0); `ticket` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_move_to_multi(
+    h: *mut LimberActArray,
+    positions: *const f64,
+    count: usize,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, v, ticket) = unsafe {
+            (
+                arg(h, "handle")?,
+                values(positions, count)?,
+                ticket.as_mut(),
+            )
+        };
+        sent(h.0.client.move_to_multi(v), ticket)
+    })
+}
+
+/// CMD SPEED: moves `joint` at `speed` (rad/s or m/s).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `ticket` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_move_at_speed(
+    h: *mut LimberActArray,
+    joint: u32,
+    speed: f64,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, ticket) = unsafe { (arg(h, "handle")?, ticket.as_mut()) };
+        sent(h.0.client.move_at_speed(joint as usize, speed), ticket)
+    })
+}
+
+/// CMD MULTI_SPEED: moves joints 0..count at `speeds[0..count]`.
+///
+/// # Safety
+/// As `limber_actarray_move_to_multi`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_move_at_speed_multi(
+    h: *mut LimberActArray,
+    speeds: *const f64,
+    count: usize,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, v, ticket) =
+            unsafe { (arg(h, "handle")?, values(speeds, count)?, ticket.as_mut()) };
+        sent(h.0.client.move_at_speed_multi(v), ticket)
+    })
+}
+
+/// CMD HOME: homes `joint`, or every joint if `joint` is negative.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `ticket` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_home(
+    h: *mut LimberActArray,
+    joint: i32,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, ticket) = unsafe { (arg(h, "handle")?, ticket.as_mut()) };
+        sent(h.0.client.home(usize::try_from(joint).ok()), ticket)
+    })
+}
+
+/// CMD CURRENT: drives `joint` (every joint if negative) with `current` A.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `ticket` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_set_current(
+    h: *mut LimberActArray,
+    joint: i32,
+    current: f64,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, ticket) = unsafe { (arg(h, "handle")?, ticket.as_mut()) };
+        sent(
+            h.0.client.set_current(usize::try_from(joint).ok(), current),
+            ticket,
+        )
+    })
+}
+
+/// CMD MULTI_CURRENT: drives joints 0..count with `currents[0..count]` A.
+///
+/// # Safety
+/// As `limber_actarray_move_to_multi`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_set_current_multi(
+    h: *mut LimberActArray,
+    currents: *const f64,
+    count: usize,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, v, ticket) =
+            unsafe { (arg(h, "handle")?, values(currents, count)?, ticket.as_mut()) };
+        sent(h.0.client.set_current_multi(v), ticket)
+    })
+}
+
+/// REQ POWER: power on (`on` true) or off; waits up to `timeout_ms` for the reply.
+///
+/// # Safety
+/// `h` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_power(
+    h: *mut LimberActArray,
+    on: bool,
+    timeout_ms: u64,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the handle, checked for NULL here.
+        let h = unsafe { arg(h, "handle")? };
+        h.0.request(&ActArrayRequest::Power(on), timeout_ms)
+            .map(drop)
+    })
+}
+
+/// REQ BRAKES: brakes on or off; waits up to `timeout_ms` for the reply.
+///
+/// # Safety
+/// `h` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_brakes(
+    h: *mut LimberActArray,
+    on: bool,
+    timeout_ms: u64,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the handle, checked for NULL here.
+        let h = unsafe { arg(h, "handle")? };
+        h.0.request(&ActArrayRequest::Brakes(on), timeout_ms)
+            .map(drop)
+    })
+}
+
+/// REQ SPEED: the speed of `joint` for later position moves.
+///
+/// # Safety
+/// `h` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_set_speed_config(
+    h: *mut LimberActArray,
+    joint: u32,
+    speed: f64,
+    timeout_ms: u64,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the handle, checked for NULL here.
+        let h = unsafe { arg(h, "handle")? };
+        let req = ActArrayRequest::speed(i64::from(joint), speed)?;
+        h.0.request(&req, timeout_ms).map(drop)
+    })
+}
+
+/// REQ ACCEL: the acceleration of `joint` for later position moves.
+///
+/// # Safety
+/// `h` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_set_accel_config(
+    h: *mut LimberActArray,
+    joint: u32,
+    accel: f64,
+    timeout_ms: u64,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the handle, checked for NULL here.
+        let h = unsafe { arg(h, "handle")? };
+        let req = ActArrayRequest::accel(i64::from(joint), accel)?;
+        h.0.request(&req, timeout_ms).map(drop)
+    })
+}
+
+/// REQ GET_GEOM: copies the geometry (kinds, limits, home positions of every actuator)
+/// into `*out`; waits up to `timeout_ms` for the reply.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_actarray_geometry(
+    h: *mut LimberActArray,
+    timeout_ms: u64,
+    out: *mut ActArrayGeom,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        match h.0.request(&ActArrayRequest::GetGeom, timeout_ms)? {
+            ActArrayReply::Geom(g) => {
+                *out = g;
+                Ok(())
+            }
+            ActArrayReply::Done => Err(Fail::new(
+                LimberCode::BadReply,
+                "the driver answered GET_GEOM without a geometry",
+            )),
+        }
+    })
+}

@@ -1,0 +1,94 @@
+//! `limber_list_devices`: the devices of a domain, with whether their driver lives.
+
+use core::ffi::c_char;
+
+use limber_interfaces::InterfaceKind;
+use limber_services::list_devices;
+
+use crate::{Fail, LimberCode, arg, domain_of, guard, opt_str};
+
+/// Longest device name kept in `limber_device_info.name`, with its NUL.
+pub const LIMBER_DEVICE_NAME_CAPACITY: usize = 96;
+/// Longest driver name kept in `limber_device_info.driver`, with its NUL.
+pub const LIMBER_DRIVER_NAME_CAPACITY: usize = 64;
+
+/// Which interface a device offers.
+#[repr(i32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LimberInterface {
+    /// An actuator array (`limber_actarray_connect`).
+    Actarray = 0,
+    /// A limb (`limber_limb_connect`).
+    Limb = 1,
+    /// A gripper (`limber_gripper_connect`).
+    Gripper = 2,
+}
+
+/// One device found by `limber_list_devices`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct LimberDeviceInfo {
+    /// Its name, `robot/interface/index`, NUL-terminated.
+    pub name: [c_char; LIMBER_DEVICE_NAME_CAPACITY],
+    /// The driver that offers it, NUL-terminated (cut to fit).
+    pub driver: [c_char; LIMBER_DRIVER_NAME_CAPACITY],
+    /// Its interface.
+    pub interface: LimberInterface,
+    /// True while the driver's process lives.
+    pub alive: bool,
+    /// Processes attached to its state channel (the driver and the clients).
+    pub nodes: u32,
+}
+
+/// Copies `s` into `dst` as a NUL-terminated string, cut to fit.
+fn copy_str(dst: &mut [c_char], s: &str) {
+    let n = s.len().min(dst.len() - 1);
+    for (d, b) in dst.iter_mut().zip(s.as_bytes()[..n].iter()) {
+        *d = *b as c_char;
+    }
+    dst[n] = 0;
+}
+
+/// Lists the devices of `domain` (NULL: `LIMBER_DOMAIN`, or "limber"), sorted by name:
+/// writes the first `capacity` into `out[]` and the number found into `*count` (which
+/// may exceed `capacity`: call again with a larger array). `out` may be NULL when
+/// `capacity` is 0.
+///
+/// # Safety
+/// `domain` is NULL or a NUL-terminated string; `out` points to `capacity` writable
+/// entries (or is NULL with `capacity` 0); `count` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_list_devices(
+    domain: *const c_char,
+    out: *mut LimberDeviceInfo,
+    capacity: usize,
+    count: *mut usize,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (domain, count) = unsafe { (opt_str(domain, "domain")?, arg(count, "count")?) };
+        if out.is_null() && capacity > 0 {
+            return Err(Fail::new(LimberCode::NullArgument, "out is NULL"));
+        }
+        let devices = list_devices(&domain_of(domain)?)?;
+        *count = devices.len();
+        for (i, d) in devices.iter().take(capacity).enumerate() {
+            let mut info = LimberDeviceInfo {
+                name: [0; LIMBER_DEVICE_NAME_CAPACITY],
+                driver: [0; LIMBER_DRIVER_NAME_CAPACITY],
+                interface: match d.interface() {
+                    InterfaceKind::ActArray => LimberInterface::Actarray,
+                    InterfaceKind::Limb => LimberInterface::Limb,
+                    InterfaceKind::Gripper => LimberInterface::Gripper,
+                },
+                alive: d.alive,
+                nodes: u32::try_from(d.nodes).unwrap_or(u32::MAX),
+            };
+            copy_str(&mut info.name, &d.name.to_string());
+            copy_str(&mut info.driver, &d.driver);
+            // SAFETY: i < capacity, and `out` points to `capacity` writable entries.
+            unsafe { out.add(i).write(info) };
+        }
+        Ok(())
+    })
+}

@@ -1,0 +1,291 @@
+//! `limber_gripper_*`: Player's `GripperProxy` for C, one function per client call.
+
+use core::ffi::c_char;
+
+use limber_interfaces::prelude::*;
+
+use crate::{
+    Handle, LimberCode, LimberDriverStatus, LimberLiveness, LimberTicket, arg, guard, opt_str,
+    req_str, sent,
+};
+
+/// A connection to a gripper (opaque). Use it from one thread at a time.
+pub struct LimberGripper(Handle<Gripper>);
+
+/// Connects to the gripper `device` ("robot/gripper/index") in `domain` (NULL:
+/// the `LIMBER_DOMAIN` environment variable, or "limber"), waiting up to `timeout_ms` for a
+/// driver to offer it. On success `*out` is the new handle; free it with
+/// `limber_gripper_disconnect`.
+///
+/// # Safety
+/// `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_gripper_connect(
+    device: *const c_char,
+    domain: *const c_char,
+    timeout_ms: u64,
+    out: *mut *mut LimberGripper,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the arguments, checked for NULL here.
+        let (device, domain, out) = unsafe {
+            (
+                req_str(device, "device")?,
+                opt_str(domain, "domain")?,
+                arg(out, "out")?,
+            )
+        };
+        let h = Handle::connect(device, domain, timeout_ms)?;
+        *out = Box::into_raw(Box::new(LimberGripper(h)));
+        Ok(())
+    })
+}
+
+/// Closes the connection and frees the handle (and any state borrowed from it). NULL is
+/// ignored.
+///
+/// # Safety
+/// `h` is NULL or a handle of `limber_gripper_connect` not yet disconnected.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_gripper_disconnect(h: *mut LimberGripper) {
+    if !h.is_null() {
+        // SAFETY: the handle came from Box::into_raw in limber_gripper_connect and is
+        // freed once.
+        let h = unsafe { Box::from_raw(h) };
+        let _ = guard(move || {
+            drop(h);
+            Ok(())
+        });
+    }
+}
+
+/// Copies the latest state into `*out`, waiting up to `timeout_ms` for a first one
+/// (`LIMBER_CODE_TIMEOUT` if none came).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_gripper_state(
+    h: *mut LimberGripper,
+    timeout_ms: u64,
+    out: *mut GripperData,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        h.0.state(timeout_ms, out)
+    })
+}
+
+/// Lends the latest state in place, without a copy (waiting up to `timeout_ms` for a
+/// first one): `*out` points into shared memory and stays valid and unchanged until
+/// `limber_gripper_release` (or disconnect). Meanwhile the calls that read states
+/// (state, borrow, wait_state, wait_outcome, liveness) fail with `LIMBER_CODE_BORROWED`;
+/// commands and requests work.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_gripper_borrow(
+    h: *mut LimberGripper,
+    timeout_ms: u64,
+    out: *mut *const GripperData,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        *out = h.0.borrow(timeout_ms)?;
+        Ok(())
+    })
+}
+
+/// Ends the loan of `limber_gripper_borrow` (the pointer it gave is invalid from now on).
+/// Releasing with nothing borrowed is harmless.
+///
+/// # Safety
+/// `h` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_gripper_release(h: *mut LimberGripper) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the handle, checked for NULL here.
+        let h = unsafe { arg(h, "handle")? };
+        h.0.release();
+        Ok(())
+    })
+}
+
+/// Waits up to `timeout_ms` for a state newer than the latest one taken and copies it into
+/// `*out` (NULL: not copied).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_gripper_wait_state(
+    h: *mut LimberGripper,
+    timeout_ms: u64,
+    out: *mut GripperData,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, out.as_mut()) };
+        h.0.wait_state(timeout_ms, out)
+    })
+}
+
+/// Waits up to `timeout_ms` for the outcome of the command of `ticket`; `*status` is the
+/// driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `status` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_gripper_wait_outcome(
+    h: *mut LimberGripper,
+    ticket: LimberTicket,
+    timeout_ms: u64,
+    status: *mut u32,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, status) = unsafe { (arg(h, "handle")?, arg(status, "status")?) };
+        *status = h.0.wait_outcome(&ticket, timeout_ms)?;
+        Ok(())
+    })
+}
+
+/// Whether the driver publishes: `LIMBER_LIVENESS_ALIVE` if the latest state is younger
+/// than `max_age_ms`, `STALE` if older but the driver lives, `GONE`, or `NO_DATA`.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_gripper_liveness(
+    h: *mut LimberGripper,
+    max_age_ms: u64,
+    out: *mut LimberLiveness,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        *out = h.0.liveness(max_age_ms)?;
+        Ok(())
+    })
+}
+
+/// Whether the driver's process lives (costs tens of microseconds).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_gripper_driver_status(
+    h: *mut LimberGripper,
+    out: *mut LimberDriverStatus,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        *out = h.0.driver_status();
+        Ok(())
+    })
+}
+
+/// CMD OPEN: opens the gripper. `*ticket` (NULL: not written) is for
+/// `limber_gripper_wait_outcome`. Returns at once.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `ticket` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_gripper_open(
+    h: *mut LimberGripper,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, ticket) = unsafe { (arg(h, "handle")?, ticket.as_mut()) };
+        sent(h.0.client.open(), ticket)
+    })
+}
+
+/// CMD CLOSE: closes the gripper (on an object: the state becomes closed, the beams see it).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `ticket` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_gripper_close(
+    h: *mut LimberGripper,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, ticket) = unsafe { (arg(h, "handle")?, ticket.as_mut()) };
+        sent(h.0.client.close(), ticket)
+    })
+}
+
+/// CMD STOP: stops the gripper where it is.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `ticket` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_gripper_stop(
+    h: *mut LimberGripper,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, ticket) = unsafe { (arg(h, "handle")?, ticket.as_mut()) };
+        sent(h.0.client.stop(), ticket)
+    })
+}
+
+/// CMD STORE: stores the held object.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `ticket` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_gripper_store(
+    h: *mut LimberGripper,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, ticket) = unsafe { (arg(h, "handle")?, ticket.as_mut()) };
+        sent(h.0.client.store(), ticket)
+    })
+}
+
+/// CMD RETRIEVE: retrieves a stored object.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `ticket` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_gripper_retrieve(
+    h: *mut LimberGripper,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, ticket) = unsafe { (arg(h, "handle")?, ticket.as_mut()) };
+        sent(h.0.client.retrieve(), ticket)
+    })
+}
+
+/// REQ GET_GEOM: copies the gripper's geometry into `*out`; waits up to `timeout_ms`
+/// for the reply.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_gripper_geometry(
+    h: *mut LimberGripper,
+    timeout_ms: u64,
+    out: *mut GripperGeom,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        match h.0.request(&GripperRequest::GetGeom, timeout_ms)? {
+            GripperReply::Geom(g) => *out = g,
+        }
+        Ok(())
+    })
+}

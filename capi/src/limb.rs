@@ -1,0 +1,363 @@
+//! `limber_limb_*`: Player's `LimbProxy` for C, one function per client call.
+
+use core::ffi::c_char;
+
+use limber_interfaces::prelude::*;
+
+use crate::{
+    Fail, Handle, LimberCode, LimberDriverStatus, LimberLiveness, LimberTicket, arg, guard,
+    opt_str, req_str, sent,
+};
+
+/// A connection to a limb (opaque). Use it from one thread at a time.
+pub struct LimberLimb(Handle<Limb>);
+
+/// Connects to the limb `device` ("robot/limb/index") in `domain` (NULL:
+/// the `LIMBER_DOMAIN` environment variable, or "limber"), waiting up to `timeout_ms` for a
+/// driver to offer it. On success `*out` is the new handle; free it with
+/// `limber_limb_disconnect`.
+///
+/// # Safety
+/// `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_connect(
+    device: *const c_char,
+    domain: *const c_char,
+    timeout_ms: u64,
+    out: *mut *mut LimberLimb,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the arguments, checked for NULL here.
+        let (device, domain, out) = unsafe {
+            (
+                req_str(device, "device")?,
+                opt_str(domain, "domain")?,
+                arg(out, "out")?,
+            )
+        };
+        let h = Handle::connect(device, domain, timeout_ms)?;
+        *out = Box::into_raw(Box::new(LimberLimb(h)));
+        Ok(())
+    })
+}
+
+/// Closes the connection and frees the handle (and any state borrowed from it). NULL is
+/// ignored.
+///
+/// # Safety
+/// `h` is NULL or a handle of `limber_limb_connect` not yet disconnected.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_disconnect(h: *mut LimberLimb) {
+    if !h.is_null() {
+        // SAFETY: the handle came from Box::into_raw in limber_limb_connect and is
+        // freed once.
+        let h = unsafe { Box::from_raw(h) };
+        let _ = guard(move || {
+            drop(h);
+            Ok(())
+        });
+    }
+}
+
+/// Copies the latest state into `*out`, waiting up to `timeout_ms` for a first one
+/// (`LIMBER_CODE_TIMEOUT` if none came).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_state(
+    h: *mut LimberLimb,
+    timeout_ms: u64,
+    out: *mut LimbData,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        h.0.state(timeout_ms, out)
+    })
+}
+
+/// Lends the latest state in place, without a copy (waiting up to `timeout_ms` for a
+/// first one): `*out` points into shared memory and stays valid and unchanged until
+/// `limber_limb_release` (or disconnect). Meanwhile the calls that read states
+/// (state, borrow, wait_state, wait_outcome, liveness) fail with `LIMBER_CODE_BORROWED`;
+/// commands and requests work.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_borrow(
+    h: *mut LimberLimb,
+    timeout_ms: u64,
+    out: *mut *const LimbData,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        *out = h.0.borrow(timeout_ms)?;
+        Ok(())
+    })
+}
+
+/// Ends the loan of `limber_limb_borrow` (the pointer it gave is invalid from now on).
+/// Releasing with nothing borrowed is harmless.
+///
+/// # Safety
+/// `h` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_release(h: *mut LimberLimb) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the handle, checked for NULL here.
+        let h = unsafe { arg(h, "handle")? };
+        h.0.release();
+        Ok(())
+    })
+}
+
+/// Waits up to `timeout_ms` for a state newer than the latest one taken and copies it into
+/// `*out` (NULL: not copied).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_wait_state(
+    h: *mut LimberLimb,
+    timeout_ms: u64,
+    out: *mut LimbData,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, out.as_mut()) };
+        h.0.wait_state(timeout_ms, out)
+    })
+}
+
+/// Waits up to `timeout_ms` for the outcome of the command of `ticket`; `*status` is the
+/// driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `status` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_wait_outcome(
+    h: *mut LimberLimb,
+    ticket: LimberTicket,
+    timeout_ms: u64,
+    status: *mut u32,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, status) = unsafe { (arg(h, "handle")?, arg(status, "status")?) };
+        *status = h.0.wait_outcome(&ticket, timeout_ms)?;
+        Ok(())
+    })
+}
+
+/// Whether the driver publishes: `LIMBER_LIVENESS_ALIVE` if the latest state is younger
+/// than `max_age_ms`, `STALE` if older but the driver lives, `GONE`, or `NO_DATA`.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_liveness(
+    h: *mut LimberLimb,
+    max_age_ms: u64,
+    out: *mut LimberLiveness,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        *out = h.0.liveness(max_age_ms)?;
+        Ok(())
+    })
+}
+
+/// Whether the driver's process lives (costs tens of microseconds).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_driver_status(
+    h: *mut LimberLimb,
+    out: *mut LimberDriverStatus,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        *out = h.0.driver_status();
+        Ok(())
+    })
+}
+
+/// CMD HOME: moves the limb to its home pose. `*ticket` (NULL: not written) is for
+/// `limber_limb_wait_outcome`. Returns at once.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `ticket` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_home(
+    h: *mut LimberLimb,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, ticket) = unsafe { (arg(h, "handle")?, ticket.as_mut()) };
+        sent(h.0.client.home(), ticket)
+    })
+}
+
+/// CMD STOP: stops every joint now.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `ticket` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_stop(
+    h: *mut LimberLimb,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, ticket) = unsafe { (arg(h, "handle")?, ticket.as_mut()) };
+        sent(h.0.client.stop(), ticket)
+    })
+}
+
+/// CMD SETPOSE: the end effector to `position` (robot frame, m), its approach vector
+/// along `approach` and its orientation vector along `orientation`. A pose beyond reach
+/// is refused with the outcome `LIMBER_STATUS_OUT_OF_REACH` and the limb's state
+/// `LIMBER_LIMB_STATE_OOR`.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `ticket` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_set_pose(
+    h: *mut LimberLimb,
+    position: Vec3,
+    approach: Vec3,
+    orientation: Vec3,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, ticket) = unsafe { (arg(h, "handle")?, ticket.as_mut()) };
+        let r = h.0.client.set_pose(
+            position.to_array(),
+            approach.to_array(),
+            orientation.to_array(),
+        );
+        sent(r, ticket)
+    })
+}
+
+/// CMD SETPOSITION: the end effector to `position`, its orientation chosen by the driver.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `ticket` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_set_position(
+    h: *mut LimberLimb,
+    position: Vec3,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, ticket) = unsafe { (arg(h, "handle")?, ticket.as_mut()) };
+        sent(h.0.client.set_position(position.to_array()), ticket)
+    })
+}
+
+/// CMD VECMOVE: moves the end effector `length` m along `direction` in a straight line.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `ticket` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_vec_move(
+    h: *mut LimberLimb,
+    direction: Vec3,
+    length: f64,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, ticket) = unsafe { (arg(h, "handle")?, ticket.as_mut()) };
+        sent(h.0.client.vec_move(direction.to_array(), length), ticket)
+    })
+}
+
+/// REQ POWER: power on (`on` true) or off; waits up to `timeout_ms` for the reply.
+///
+/// # Safety
+/// `h` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_power(
+    h: *mut LimberLimb,
+    on: bool,
+    timeout_ms: u64,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the handle, checked for NULL here.
+        let h = unsafe { arg(h, "handle")? };
+        h.0.request(&LimbRequest::Power(on), timeout_ms).map(drop)
+    })
+}
+
+/// REQ BRAKES: brakes on or off; waits up to `timeout_ms` for the reply.
+///
+/// # Safety
+/// `h` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_brakes(
+    h: *mut LimberLimb,
+    on: bool,
+    timeout_ms: u64,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the handle, checked for NULL here.
+        let h = unsafe { arg(h, "handle")? };
+        h.0.request(&LimbRequest::Brakes(on), timeout_ms).map(drop)
+    })
+}
+
+/// REQ SPEED: the end effector's speed (m/s) for later moves.
+///
+/// # Safety
+/// `h` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_set_speed(
+    h: *mut LimberLimb,
+    speed: f64,
+    timeout_ms: u64,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the handle, checked for NULL here.
+        let h = unsafe { arg(h, "handle")? };
+        h.0.request(&LimbRequest::speed(speed)?, timeout_ms)
+            .map(drop)
+    })
+}
+
+/// REQ GEOM: copies the limb's geometry (its base position) into `*out`; waits up to
+/// `timeout_ms` for the reply.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_geometry(
+    h: *mut LimberLimb,
+    timeout_ms: u64,
+    out: *mut LimbGeom,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        match h.0.request(&LimbRequest::Geom, timeout_ms)? {
+            LimbReply::Geom(g) => {
+                *out = g;
+                Ok(())
+            }
+            LimbReply::Done => Err(Fail::new(
+                LimberCode::BadReply,
+                "the driver answered GEOM without a geometry",
+            )),
+        }
+    })
+}

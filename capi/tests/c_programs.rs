@@ -1,0 +1,658 @@
+//! C and C++ programs against liblimber, built the way a user builds them: cargo has built
+//! `liblimber.so` and `liblimber.a` for this test (in the directory of the test's own
+//! executable); `capi/install.sh` installs them with the headers and `limber.pc`; gcc and
+//! g++ compile the examples with their Makefiles (pkg-config), the README's clients with
+//! the README's own command lines, and the programs of `tests/c/` against the header and
+//! the library directly. Each runs against the Pioneer driver on the emulator (the code
+//! of `limber pioneer --emulated`, on a thread of this process), each test in a domain of
+//! its own; every run is bounded.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use limber_emulator::{Emulator, EmulatorConfig};
+use limber_interfaces::prelude::ActArrayData;
+use limber_pioneer::{PioneerConfig, PioneerDriver, RunOptions};
+use limber_services::prelude::*;
+use limber_services::{Domain, Role};
+
+/// How long one program may run before the test fails.
+const RUN_LIMIT: Duration = Duration::from_secs(120);
+const T: Duration = Duration::from_secs(5);
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("the workspace root")
+        .to_path_buf()
+}
+
+/// The Pioneer driver on the emulator, on a thread of this process, until dropped.
+struct Pioneer {
+    domain: Domain,
+    stop: Arc<AtomicBool>,
+    thread: Option<JoinHandle<()>>,
+    _emulator: Emulator,
+}
+
+impl Pioneer {
+    /// Starts the emulator and the driver and sets the fastest joint speeds (so that the
+    /// programs' motions take fractions of a second).
+    fn start() -> Pioneer {
+        let domain = Domain::unique_for_test();
+        let emulator = Emulator::start_pty(EmulatorConfig::default()).expect("the emulator");
+        let target = emulator.link_target();
+        let stop = Arc::new(AtomicBool::new(false));
+        let (ready_tx, ready_rx) = mpsc::channel();
+        let (d, s) = (domain.clone(), stop.clone());
+        let thread = std::thread::spawn(move || {
+            let ctx = Context::new(&d, Role::Driver, "pioneer").expect("the driver's context");
+            let mut driver = PioneerDriver::start(&ctx, PioneerConfig::default(), target)
+                .expect("the driver starts");
+            ready_tx.send(()).expect("the test waits");
+            let r = driver.run_until(RunOptions::default(), || s.load(Ordering::Relaxed));
+            driver.shutdown();
+            r.expect("the driver runs");
+        });
+        ready_rx
+            .recv_timeout(Duration::from_secs(30))
+            .expect("the driver is ready");
+        let ctx = Context::new(&domain, Role::Client, "capi-test").unwrap();
+        let mut arm = ActArrayClient::connect_timeout(&ctx, "pioneer/actarray/0", T).unwrap();
+        for j in 0..6 {
+            arm.set_speed_config(j, 20.0).unwrap();
+        }
+        Pioneer {
+            domain,
+            stop,
+            thread: Some(thread),
+            _emulator: emulator,
+        }
+    }
+
+    fn name(&self) -> &str {
+        self.domain.name()
+    }
+}
+
+impl Drop for Pioneer {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(t) = self.thread.take()
+            && t.join().is_err()
+            && !std::thread::panicking()
+        {
+            panic!("the driver thread failed");
+        }
+    }
+}
+
+/// Where cargo put `liblimber.so` and `liblimber.a` for this test: beside its executable.
+fn lib_dir() -> PathBuf {
+    let exe = std::env::current_exe().expect("the test's executable");
+    let dir = exe.parent().expect("its directory").to_path_buf();
+    assert!(
+        dir.join("liblimber.so").is_file() && dir.join("liblimber.a").is_file(),
+        "liblimber.so and liblimber.a are not in {}",
+        dir.display()
+    );
+    dir
+}
+
+/// A fresh scratch directory for one test, removed when dropped (it holds copies of the
+/// library: hundreds of MB in a debug build).
+struct Scratch(PathBuf);
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        if let Err(e) = std::fs::remove_dir_all(&self.0) {
+            eprintln!("cannot remove {}: {e}", self.0.display());
+        }
+    }
+}
+
+fn scratch(name: &str) -> Scratch {
+    let d =
+        Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("capi-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("a scratch directory");
+    Scratch(d)
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+/// Runs `cmd` to completion within [`RUN_LIMIT`]; fails the test unless it succeeds.
+fn run_ok(cmd: Command, what: &str) -> Output {
+    let o = limber_bounded_run::output_within(cmd, RUN_LIMIT);
+    assert!(
+        o.status.success(),
+        "{what} failed ({}):\nstdout:\n{}\nstderr:\n{}",
+        o.status,
+        text(&o.stdout),
+        text(&o.stderr)
+    );
+    o
+}
+
+/// Runs `exe args` in the driver's domain within [`RUN_LIMIT`]. Without cargo's
+/// `LD_LIBRARY_PATH` (which names target/debug, where an older liblimber.so may lie): the
+/// library is found by the run path linked into the program, as on a user's machine.
+fn run_in(p: &Pioneer, exe: &Path, args: &[&str]) -> Output {
+    let mut cmd = Command::new(exe);
+    cmd.args(args)
+        .env("LIMBER_DOMAIN", p.name())
+        .env_remove("LD_LIBRARY_PATH");
+    limber_bounded_run::output_within(cmd, RUN_LIMIT)
+}
+
+/// `capi/install.sh PREFIX BUILD_DIR` with the library of this test; returns PREFIX.
+fn install(dir: &Path) -> PathBuf {
+    let prefix = dir.join("prefix");
+    let mut cmd = Command::new("sh");
+    cmd.arg(root().join("capi/install.sh"))
+        .arg(&prefix)
+        .arg(lib_dir());
+    let o = run_ok(cmd, "capi/install.sh");
+    assert!(text(&o.stdout).contains("installed liblimber"));
+    for f in [
+        "lib/liblimber.so",
+        "lib/liblimber.a",
+        "lib/pkgconfig/limber.pc",
+        "include/limber/limber.h",
+        "include/limber/limber_client.h",
+        "include/limber/limber.hpp",
+    ] {
+        assert!(prefix.join(f).is_file(), "{f} not installed");
+    }
+    prefix
+}
+
+/// Compiles one C (`.c`) or C++ (`.cpp`) source of `tests/c/` against the headers of the
+/// source tree and this test's library.
+fn compile(src: &str, exe: &Path, extra: &[&str]) {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/c")
+        .join(src);
+    let cpp = src.extension().is_some_and(|e| e == "cpp");
+    let lib = lib_dir();
+    let mut cmd = Command::new(if cpp { "g++" } else { "gcc" });
+    cmd.arg(if cpp { "-std=c++17" } else { "-std=c11" })
+        .args(["-Wall", "-Wextra", "-Werror", "-O1"])
+        .arg("-I")
+        .arg(root().join("capi/include"))
+        .arg("-I")
+        .arg(root().join("interfaces/include"))
+        .arg(&src)
+        .arg("-o")
+        .arg(exe)
+        .args(extra);
+    if !extra.iter().any(|a| a.ends_with("liblimber.a")) {
+        cmd.arg("-L")
+            .arg(&lib)
+            .arg("-llimber")
+            .arg(format!("-Wl,-rpath,{}", lib.display()));
+    }
+    cmd.arg("-lm");
+    run_ok(cmd, &format!("compiling {}", src.display()));
+}
+
+/// The `(x, y, z)` of a line `<step>: limb at (x, y, z)` of the C example.
+fn position_at(out: &str, step: &str) -> [f64; 3] {
+    let prefix = format!("{step}: limb at (");
+    let line = out
+        .lines()
+        .find(|l| l.starts_with(&prefix))
+        .unwrap_or_else(|| panic!("no line {prefix:?} in:\n{out}"));
+    let v: Vec<f64> = line[prefix.len()..line.len() - 1]
+        .split(", ")
+        .map(|x| x.parse().expect("a number"))
+        .collect();
+    [v[0], v[1], v[2]]
+}
+
+fn near(a: [f64; 3], b: [f64; 3], tol: f64) -> bool {
+    a.iter().zip(b).all(|(x, y)| (x - y).abs() < tol)
+}
+
+/// Runs the build lines of the `sh` block of an example's README as written, from the
+/// workspace root, in a shell: `capi/install.sh "$HOME/..."`, `export PKG_CONFIG_PATH=...`,
+/// `make -C examples/...`. HOME is the scratch directory `dir`, the library that
+/// install.sh takes from `$CARGO_TARGET_DIR/release` is this test's, and `OUT` (which the
+/// Makefiles honour) puts the binary in `dir`. Not run: the `cargo build` line (cargo built
+/// the library for this test), `limber pioneer --emulated &` (the driver runs on a thread
+/// here), and the program itself (run by the test with its domain).
+fn run_readme_build_lines(readme: &str, dir: &Path) {
+    let readme = std::fs::read_to_string(root().join(readme)).unwrap();
+    let sh = fenced(&readme, "sh");
+    let script: Vec<&str> = sh
+        .lines()
+        .filter(|l| {
+            l.starts_with("capi/install.sh") || l.starts_with("export ") || l.starts_with("make ")
+        })
+        .collect();
+    assert_eq!(script.len(), 3, "{sh}");
+    assert!(
+        sh.starts_with("cargo build --release -p limber-c\n"),
+        "{sh}"
+    );
+    let target = dir.join("target");
+    std::fs::create_dir_all(&target).unwrap();
+    std::os::unix::fs::symlink(lib_dir(), target.join("release")).unwrap();
+    let mut cmd = Command::new("sh");
+    cmd.arg("-ec")
+        .arg(script.join("\n"))
+        .current_dir(root())
+        .env("HOME", dir)
+        .env("CARGO_TARGET_DIR", &target)
+        .env("OUT", dir)
+        .env_remove("PKG_CONFIG_PATH");
+    run_ok(cmd, &script.join("; "));
+    assert!(dir.join(".local/limber/lib/pkgconfig/limber.pc").is_file());
+}
+
+#[test]
+fn the_examples_build_as_their_readmes_say_and_pick_a_block_in_c_and_cpp() {
+    let dir = scratch("examples");
+    run_readme_build_lines("examples/c/README.md", &dir.join("c"));
+    run_readme_build_lines("examples/cpp/README.md", &dir.join("cpp"));
+    run_readme_build_lines("capi/README.md", &dir.join("capi"));
+    assert!(dir.join("capi/pick_block").is_file());
+    let (c, cpp) = (dir.join("c/pick_block"), dir.join("cpp/pick_block_cpp"));
+    let p = Pioneer::start();
+
+    // C: every step, the block gripped, put down where asked.
+    let o = run_in(&p, &c, &[]);
+    let out = text(&o.stdout);
+    assert!(o.status.success(), "{out}\n{}", text(&o.stderr));
+    assert!(out.contains("grip: gripper closed"), "{out}");
+    assert!(out.contains("release: gripper open"), "{out}");
+    assert!(
+        out.ends_with("done: block picked up and put down\n"),
+        "{out}"
+    );
+    assert!(
+        near(position_at(&out, "descend"), [0.38, 0.10, 0.17], 0.01),
+        "{out}"
+    );
+    assert!(
+        near(position_at(&out, "put down"), [0.38, -0.10, 0.17], 0.01),
+        "{out}"
+    );
+    let home = position_at(&out, "home");
+    assert!(
+        !near(home, position_at(&out, "descend"), 0.05),
+        "the arm moved: {out}"
+    );
+
+    // C++ (the paper's Listing 2): the same, in the paper's words.
+    let o = run_in(&p, &cpp, &[]);
+    let out = text(&o.stdout);
+    assert!(o.status.success(), "{out}\n{}", text(&o.stderr));
+    assert_eq!(out.matches("gripper closed").count(), 1, "{out}");
+    assert!(
+        out.ends_with("done: block picked up and put down\n"),
+        "{out}"
+    );
+
+    // A block beyond reach: both say so, go home and exit 2.
+    for exe in [&c, &cpp] {
+        let o = run_in(&p, exe, &["2.0", "0.0"]);
+        let out = text(&o.stdout);
+        let exe = exe.display();
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{exe}: {out}\n{}",
+            text(&o.stderr)
+        );
+        assert!(
+            out.contains("Target out of reach, terminating"),
+            "{exe}: {out}"
+        );
+        assert!(!out.contains("gripper closed"), "{exe}: {out}");
+    }
+}
+
+/// The first fenced block of `lang` in `text`.
+fn fenced(text: &str, lang: &str) -> String {
+    let fence = format!("```{lang}\n");
+    let start = text.find(&fence).expect("the block") + fence.len();
+    let len = text[start..].find("```").expect("its end");
+    text[start..start + len].to_string()
+}
+
+/// The fenced block of `lang` in README.md's "C and C++" section.
+fn readme_block(readme: &str, lang: &str) -> String {
+    fenced(
+        &readme[readme.find("## C and C++").expect("the section")..],
+        lang,
+    )
+}
+
+#[test]
+fn the_readme_clients_compile_and_run_as_written() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let dir = scratch("readme");
+    let prefix = install(&dir);
+    std::fs::write(dir.join("client.c"), readme_block(&readme, "c")).unwrap();
+    std::fs::write(dir.join("client.cpp"), readme_block(&readme, "cpp")).unwrap();
+    // The README's own compile lines (the build and install lines before them are what
+    // cargo and `install` above did, with this test's library and prefix).
+    let sh = readme_block(&readme, "sh");
+    let lines: Vec<&str> = sh
+        .lines()
+        .filter(|l| l.starts_with("cc ") || l.starts_with("c++ "))
+        .collect();
+    assert_eq!(lines.len(), 2, "{sh}");
+    assert!(sh.contains("cargo build --release -p limber-c"));
+    assert!(sh.contains("capi/install.sh"));
+    for line in lines {
+        let mut cmd = Command::new("sh");
+        cmd.arg("-c")
+            .arg(line)
+            .current_dir(&*dir)
+            .env("PKG_CONFIG_PATH", prefix.join("lib/pkgconfig"));
+        run_ok(cmd, line);
+    }
+    let p = Pioneer::start();
+    for (exe, target) in [("client", "0.3"), ("client_cpp", "-0.3")] {
+        let o = run_in(&p, &dir.join(exe), &[]);
+        let out = text(&o.stdout);
+        assert!(o.status.success(), "{exe}: {out}\n{}", text(&o.stderr));
+        assert!(out.starts_with("joint 0 at "), "{exe}: {out}");
+        assert!(out.contains("move: ok"), "{exe}: {out}");
+        // The arm took the command: joint 0 heads for the target.
+        let ctx = Context::new(&p.domain, Role::Client, "capi-test").unwrap();
+        let mut arm = ActArrayClient::connect_timeout(&ctx, "pioneer/actarray/0", T).unwrap();
+        let target: f64 = target.parse().unwrap();
+        let deadline = Instant::now() + Duration::from_secs(20);
+        while (arm.current(T).unwrap().actuators[0].position - target).abs() > 0.02 {
+            assert!(
+                Instant::now() < deadline,
+                "{exe}: joint 0 never reached {target}"
+            );
+            arm.wait_state(T).unwrap();
+        }
+    }
+}
+
+#[test]
+fn a_client_written_from_the_header_reads_the_joints_and_moves_one() {
+    let dir = scratch("joints");
+    let shared = dir.join("joints");
+    let stat = dir.join("joints_static");
+    compile("joints.c", &shared, &[]);
+    // The same program linked with the static library.
+    let a = lib_dir().join("liblimber.a");
+    compile(
+        "joints.c",
+        &stat,
+        &[
+            a.to_str().unwrap(),
+            "-lgcc_s",
+            "-lutil",
+            "-lrt",
+            "-lpthread",
+            "-ldl",
+        ],
+    );
+    let p = Pioneer::start();
+    for exe in [&shared, &stat] {
+        let o = run_in(&p, exe, &[]);
+        let out = text(&o.stdout);
+        assert!(o.status.success(), "{out}\n{}", text(&o.stderr));
+        assert!(out.starts_with("6 joints:"), "{out}");
+        assert!(out.contains("moved joint 1 from"), "{out}");
+        assert!(out.contains("driver alive"), "{out}");
+    }
+}
+
+#[test]
+fn every_error_path_returns_its_code_and_message() {
+    let dir = scratch("errors");
+    let exe = dir.join("errors");
+    compile("errors.c", &exe, &[]);
+    let p = Pioneer::start();
+    let o = run_in(&p, &exe, &[]);
+    let out = text(&o.stdout);
+    assert!(o.status.success(), "{out}\n{}", text(&o.stderr));
+    assert!(out.contains("all error paths ok"), "{out}");
+    // The code's message and the detail, as a user sees them.
+    assert!(
+        out.contains(&format!(
+            "ok: unknown device: no driver offers the device: no driver offers pioneer/actarray/7 in domain {}",
+            p.name()
+        )),
+        "{out}"
+    );
+}
+
+#[test]
+fn handles_work_from_threads_of_their_own() {
+    let dir = scratch("threads");
+    let exe = dir.join("threads");
+    compile("threads.c", &exe, &["-pthread"]);
+    let p = Pioneer::start();
+    let o = run_in(&p, &exe, &[]);
+    let out = text(&o.stdout);
+    assert!(o.status.success(), "{out}\n{}", text(&o.stderr));
+    assert_eq!(out, "threads ok\n");
+}
+
+/// A running program whose stdout lines arrive on a channel (disconnected at its end).
+struct Running {
+    child: Child,
+    lines: mpsc::Receiver<String>,
+}
+
+impl Running {
+    fn spawn(p: &Pioneer, exe: &Path) -> Running {
+        let mut child = Command::new(exe)
+            .env("LIMBER_DOMAIN", p.name())
+            .env_remove("LD_LIBRARY_PATH")
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .spawn()
+            .expect("spawn");
+        let out = child.stdout.take().expect("its stdout");
+        let (tx, lines) = mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(out).lines().map_while(Result::ok) {
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        Running { child, lines }
+    }
+
+    /// Every line until the program closed its stdout, within `limit`.
+    fn rest(&mut self, limit: Duration) -> String {
+        let deadline = Instant::now() + limit;
+        let mut s = String::new();
+        loop {
+            match self
+                .lines
+                .recv_timeout(deadline.saturating_duration_since(Instant::now()))
+            {
+                Ok(l) => {
+                    s.push_str(&l);
+                    s.push('\n');
+                }
+                Err(mpsc::RecvTimeoutError::Disconnected) => return s,
+                Err(mpsc::RecvTimeoutError::Timeout) => panic!("still running; so far:\n{s}"),
+            }
+        }
+    }
+}
+
+impl Drop for Running {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+#[test]
+fn rust_c_and_cpp_clients_work_on_one_driver_at_once() {
+    // C commands the limb and the gripper (pick a block); C++ watches the gripper and asks
+    // for the arm's geometry meanwhile; Rust (here) reads the limb and the gripper. Each
+    // sees the gripper close, and the limb move.
+    let dir = scratch("together");
+    let prefix = install(&dir);
+    let mut make = Command::new("make");
+    make.arg("-C")
+        .arg(root().join("examples/c"))
+        .arg(format!("OUT={}", dir.display()))
+        .env("PKG_CONFIG_PATH", prefix.join("lib/pkgconfig"));
+    run_ok(make, "make -C examples/c");
+    compile("watch.cpp", &dir.join("watch"), &[]);
+    let p = Pioneer::start();
+    let ctx = Context::new(&p.domain, Role::Client, "capi-test").unwrap();
+    let mut limb = LimbClient::connect_timeout(&ctx, "pioneer/limb/0", T).unwrap();
+    let mut gripper = GripperClient::connect_timeout(&ctx, "pioneer/gripper/1", T).unwrap();
+
+    let mut watch = Running::spawn(&p, &dir.join("watch"));
+    let first = watch
+        .lines
+        .recv_timeout(RUN_LIMIT)
+        .expect("the watcher starts");
+    assert!(first.starts_with("watching"), "{first}");
+    let mut pick = Running::spawn(&p, &dir.join("pick_block"));
+    let (mut saw_closed, mut z_min, mut z_max) = (false, f64::MAX, f64::MIN);
+    let deadline = Instant::now() + RUN_LIMIT;
+    let picked = loop {
+        if let Ok(g) = gripper.current(T) {
+            saw_closed |= g.gripper_state() == Ok(GripperState::Closed);
+        }
+        let z = limb.wait_state(T).expect("limb states").position.z;
+        (z_min, z_max) = (z_min.min(z), z_max.max(z));
+        if let Some(status) = pick.child.try_wait().unwrap() {
+            break status;
+        }
+        assert!(Instant::now() < deadline, "pick_block did not finish");
+    };
+    let picked_out = pick.rest(T);
+    assert!(picked.success(), "{picked_out}");
+    assert!(
+        picked_out.contains("done: block picked up and put down"),
+        "{picked_out}"
+    );
+    let watched = watch.rest(RUN_LIMIT);
+    assert!(
+        watched.contains("saw the gripper close and open; the arm has 6 actuators"),
+        "{watched}"
+    );
+    assert!(watch.child.wait().unwrap().success(), "{watched}");
+    assert!(saw_closed, "Rust never saw the gripper closed");
+    assert!(
+        z_max - z_min > 0.04,
+        "the limb did not move: z {z_min}..{z_max}"
+    );
+}
+
+#[test]
+fn a_handle_sees_its_driver_go() {
+    // Through the library's Rust face (the same functions C calls): alive while the
+    // driver runs, then gone, and waiting for a state says so instead of timing out.
+    use limber::*;
+    let p = Pioneer::start();
+    let domain = std::ffi::CString::new(p.name()).unwrap();
+    let mut h: *mut LimberActArray = std::ptr::null_mut();
+    let mut live = LimberLiveness::NoData;
+    let mut data = ActArrayData::default();
+    // SAFETY: valid strings, and pointers to locals that outlive the calls.
+    unsafe {
+        let c = limber_actarray_connect(
+            c"pioneer/actarray/0".as_ptr(),
+            domain.as_ptr(),
+            5000,
+            &mut h,
+        );
+        assert_eq!(c, LimberCode::Ok);
+        assert_eq!(limber_actarray_state(h, 5000, &mut data), LimberCode::Ok);
+        assert_eq!(limber_actarray_liveness(h, 5000, &mut live), LimberCode::Ok);
+    }
+    assert_eq!(live, LimberLiveness::Alive);
+    drop(p);
+    // SAFETY: as above; the handle is live until disconnected.
+    unsafe {
+        // The states published as it stopped, then the news that it is gone.
+        let mut c = LimberCode::Ok;
+        for _ in 0..100 {
+            c = limber_actarray_wait_state(h, 10_000, &mut data);
+            if c != LimberCode::Ok {
+                break;
+            }
+        }
+        assert_eq!(c, LimberCode::DriverGone);
+        assert_eq!(limber_actarray_liveness(h, 0, &mut live), LimberCode::Ok);
+        let mut status = LimberDriverStatus::Alive;
+        assert_eq!(
+            limber_actarray_driver_status(h, &mut status),
+            LimberCode::Ok
+        );
+        assert_ne!(status, LimberDriverStatus::Alive);
+        limber_actarray_disconnect(h);
+    }
+    assert_eq!(live, LimberLiveness::Gone);
+}
+
+/// What the Pioneer driver answers to each call of `tests/c/commands.c`: carried out, or
+/// the cause it names for what the Pioneer cannot do (no current control, no brakes, no
+/// acceleration setting, no store/retrieve on the arm gripper).
+const PIONEER_VERDICTS: &str = "\
+actarray move_to: ok
+actarray move_to_multi: ok
+actarray move_at_speed: ok
+actarray move_at_speed_multi: ok
+actarray set_current: unsupported by this device
+actarray set_current_multi: unsupported by this device
+actarray home: ok
+actarray power: ok
+actarray brakes: refused: unsupported by this device
+actarray set_speed_config: ok
+actarray set_accel_config: refused: unsupported by this device
+actarray geometry: ok
+limb set_pose: ok
+limb set_position: ok
+limb vec_move: ok
+limb stop: ok
+limb home: ok
+limb power: ok
+limb brakes: refused: unsupported by this device
+limb set_speed: ok
+limb geometry: ok
+gripper open: ok
+gripper close: ok
+gripper stop: ok
+gripper store: unsupported by this device
+gripper retrieve: unsupported by this device
+gripper geometry: ok
+";
+
+#[test]
+fn every_command_and_request_reaches_the_driver_as_itself() {
+    let dir = scratch("commands");
+    let exe = dir.join("commands");
+    compile("commands.c", &exe, &[]);
+    let p = Pioneer::start();
+    let o = run_in(&p, &exe, &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(text(&o.stdout), PIONEER_VERDICTS);
+}
