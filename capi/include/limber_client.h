@@ -883,6 +883,24 @@ limber_code limber_limb_set_speed(struct limber_limb *h, double speed, uint64_t 
  */
 limber_code limber_limb_geometry(struct limber_limb *h, uint64_t timeout_ms, limber_limb_geom *out);
 
+/*
+ REQ REACH: where the end effector would end for this pose (as
+ [`limber_limb_set_pose`] takes it), without moving: copies the answer into `*out`
+ (the pose it would reach, how far its position and approach would be off, and by how
+ much the orientation would be adjusted); waits up to `timeout_ms` for the reply. A pose
+ it cannot reach is refused with `LIMBER_CODE_REFUSED` and its cause
+ (`limber_last_refusal`).
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_limb_can_reach(struct limber_limb *h,
+                                  limber_vec3 position,
+                                  limber_vec3 approach,
+                                  limber_vec3 orientation,
+                                  uint64_t timeout_ms,
+                                  limber_limb_reach *out);
+
 #ifdef __cplusplus
 }  // extern "C"
 #endif  // __cplusplus

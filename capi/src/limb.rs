@@ -354,9 +354,44 @@ pub unsafe extern "C" fn limber_limb_geometry(
                 *out = g;
                 Ok(())
             }
-            LimbReply::Done => Err(Fail::new(
+            LimbReply::Done | LimbReply::Reach(_) => Err(Fail::new(
                 LimberCode::BadReply,
                 "the driver answered GEOM without a geometry",
+            )),
+        }
+    })
+}
+
+/// REQ REACH: where the end effector would end for this pose (as
+/// [`limber_limb_set_pose`] takes it), without moving: copies the answer into `*out`
+/// (the pose it would reach, how far its position and approach would be off, and by how
+/// much the orientation would be adjusted); waits up to `timeout_ms` for the reply. A pose
+/// it cannot reach is refused with `LIMBER_CODE_REFUSED` and its cause
+/// (`limber_last_refusal`).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_can_reach(
+    h: *mut LimberLimb,
+    position: Vec3,
+    approach: Vec3,
+    orientation: Vec3,
+    timeout_ms: u64,
+    out: *mut LimbReach,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        let req = LimbRequest::reach(position, approach, orientation)?;
+        match h.0.request(&req, timeout_ms)? {
+            LimbReply::Reach(r) => {
+                *out = r;
+                Ok(())
+            }
+            LimbReply::Done | LimbReply::Geom(_) => Err(Fail::new(
+                LimberCode::BadReply,
+                "the driver answered REACH without a pose",
             )),
         }
     })

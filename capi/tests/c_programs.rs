@@ -638,6 +638,9 @@ limb power: ok
 limb brakes: refused: unsupported by this device
 limb set_speed: ok
 limb geometry: ok
+limb can_reach: ok
+limb can_reach adjusted: yes
+limb can_reach far: refused: out of reach
 gripper open: ok
 gripper close: ok
 gripper stop: ok

@@ -72,6 +72,12 @@ int main(void) {
     request("limb set_speed", limber_limb_set_speed(l, 0.1, WAIT_MS));
     limber_limb_geom lg;
     request("limb geometry", limber_limb_geometry(l, WAIT_MS, &lg));
+    /* The README's pose: reachable with its orientation adjusted; 5 m away: out of reach. */
+    limber_limb_reach lr;
+    limber_vec3 rp = {0.38, 0.1, 0.22}, ra = {0, 0, -1}, ro = {0.94, 0.34, 0}, far = {5, 0, 0};
+    request("limb can_reach", limber_limb_can_reach(l, rp, ra, ro, WAIT_MS, &lr));
+    printf("limb can_reach adjusted: %s\n", lr.adjusted && lr.orientation_adjustment > 0 ? "yes" : "no");
+    request("limb can_reach far", limber_limb_can_reach(l, far, ra, ro, WAIT_MS, &lr));
 
     outcome("gripper open", limber_gripper_open(g, &t), wait_grip, g);
     outcome("gripper close", limber_gripper_close(g, &t), wait_grip, g);
