@@ -110,6 +110,11 @@ pub struct PioneerConfig {
     /// itself, so a driver killed with SIGKILL does not leave it moving. Sent at every
     /// connection; 0 disables the watchdog. Must exceed the keep-alive interval.
     pub autopark_s: u16,
+    /// Event mode: how long, µs, the loop keeps polling its clients after a command or
+    /// request before it sleeps again, so that a client's next command in a tight loop
+    /// needs no wake-up (`event_loop::linger`; at most 1 ms of CPU per burst). 0: sleep at
+    /// once. Chosen by measurement (`limber bench --only command`, the `event-*` rows).
+    pub linger_us: u32,
 }
 
 /// `armpac_layout` as its name in TOML.
@@ -167,6 +172,7 @@ impl Default for PioneerConfig {
             body_gripper: true,
             // The link timeout (1 s) and a reconnection or two, with room to spare.
             autopark_s: 10,
+            linger_us: limber_services::qos::DRIVER_LINGER.as_micros() as u32,
         }
     }
 }
@@ -199,6 +205,11 @@ impl PioneerConfig {
                 .replacen(
                     "setpose_position_tolerance =",
                     "# SETPOSE: position (m) and approach (degrees) within these; the orientation is the\n# nearest one the five joints can hold (outcome ADJUSTED, the limb state says by how much)\nsetpose_position_tolerance =",
+                    1,
+                )
+                .replacen(
+                    "linger_us =",
+                    "# linger_us: after a command, keep polling the clients this long (µs) before sleeping; 0: sleep at once\nlinger_us =",
                     1,
                 )
                 .replacen(
@@ -254,6 +265,9 @@ impl PioneerConfig {
                 "autopark_s must be 0 (disabled) or longer than pulse_interval_ms, or a live driver's arm parks",
             );
         }
+        if self.linger_us > 10_000 {
+            return bad("linger_us must be 0..=10000 (µs of polling after activity)");
+        }
         if self.link_timeout_ms < 200 {
             return bad("link_timeout_ms must be >= 200 (a robot sends a SIP every 100 ms)");
         }
@@ -277,6 +291,21 @@ impl PioneerConfig {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn linger_defaults_to_the_measured_budget_and_is_bounded() {
+        let c = PioneerConfig::default();
+        assert_eq!(
+            u128::from(c.linger_us),
+            limber_services::qos::DRIVER_LINGER.as_micros()
+        );
+        assert!(c.to_toml().contains("# linger_us:"));
+        assert_eq!(
+            PioneerConfig::from_toml("linger_us = 0").unwrap().linger_us,
+            0
+        );
+        assert!(PioneerConfig::from_toml("linger_us = 20000").is_err());
+    }
 
     #[test]
     fn autopark_defaults_to_ten_seconds_and_is_printed_with_its_meaning() {

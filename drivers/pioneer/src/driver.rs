@@ -792,15 +792,20 @@ impl PioneerDriver {
 
     /// Handles the pending commands and requests of every device. Spinning: commands on
     /// every call, requests on every 16th ([`DeviceSet::process_spin`]).
-    fn process_clients(&mut self, spin: bool) {
+    /// Handles what the clients sent; returns whether there was any.
+    fn process_clients(&mut self, spin: bool) -> bool {
         let mut handler = Serve(&mut self.robot);
         let r = if spin {
             self.hosts.process_spin(&mut handler)
         } else {
             self.hosts.process(&mut handler)
         };
-        if let Err(e) = r {
-            self.failures.note(Failure::Process, &e);
+        match r {
+            Ok(a) => a.commands + a.requests > 0,
+            Err(e) => {
+                self.failures.note(Failure::Process, &e);
+                false
+            }
         }
     }
 
@@ -1045,7 +1050,14 @@ impl PioneerDriver {
                             self.link_failed("read failed");
                         }
                     }
-                    Wake::Clients => self.process_clients(false),
+                    Wake::Clients => {
+                        if self.process_clients(false) {
+                            // A client in a tight loop sends its next command within the
+                            // linger: picked up without a wake-up.
+                            let linger = Duration::from_micros(self.robot.cfg.linger_us.into());
+                            event_loop::linger(linger, || self.process_clients(true));
+                        }
+                    }
                     Wake::Tick(n) => {
                         self.robot.stats.tick(now, nominal, n);
                         // A packet may be sitting in the decoder after a send.

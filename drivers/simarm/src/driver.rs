@@ -7,7 +7,7 @@ use std::time::Instant;
 use limber_interfaces::common::device_flag;
 use limber_services::event_loop::{self, LoopError, LoopExit, Wake};
 use limber_services::prelude::*;
-use limber_services::{DeviceError, HostError, ProcessError, PublishError};
+use limber_services::{DeviceError, HostError, ProcessError, PublishError, qos};
 
 use limber_kinematics::chain::Chain;
 
@@ -249,7 +249,23 @@ impl SimArm {
         self.last = Instant::now();
         let exit = event_loop::run(&listeners, tick, None, |wake| {
             match self.process() {
-                Ok(_) => process_failing = false,
+                Ok(n) => {
+                    process_failing = false;
+                    if n > 0 && matches!(wake, Wake::Clients) {
+                        // A client in a tight loop sends its next command within the
+                        // linger: picked up without a wake-up. A failure ends the linger;
+                        // the next wake-up meets it again and counts it.
+                        event_loop::linger(qos::DRIVER_LINGER, || {
+                            match self.hosts.process_spin(&mut Serve(&mut self.model)) {
+                                Ok(a) => a.total() > 0,
+                                Err(e) => {
+                                    tracing::debug!(error = %e, "processing while lingering");
+                                    false
+                                }
+                            }
+                        });
+                    }
+                }
                 Err(e) => {
                     self.failures.process += 1;
                     let n = self.failures.process;
