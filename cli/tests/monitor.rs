@@ -2,9 +2,7 @@
 //! ratatui's TestBackend), key commands read back from the device, a Pioneer driver
 //! (emulated) with its statistics and its death, and the binary's `--once`.
 
-use std::io::{BufRead, BufReader};
-use std::process::{Child, Command, Stdio};
-use std::sync::mpsc;
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use crossterm::event::KeyCode;
@@ -270,38 +268,9 @@ fn devices_appearing_and_dying_are_picked_up() {
     assert!(s.text.contains("no driver"), "{s:?}");
 }
 
-struct Pioneer(Child);
-
-impl Drop for Pioneer {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
 /// `limber pioneer --emulated` in `domain`, once it says it is ready.
-fn pioneer(domain: &Domain) -> Pioneer {
-    let mut child = Command::new(LIMBER)
-        .args(["pioneer", "--emulated"])
-        .env("LIMBER_DOMAIN", domain.name())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let out = child.stdout.take().unwrap();
-    let (tx, rx) = mpsc::channel();
-    std::thread::spawn(move || {
-        for line in BufReader::new(out).lines() {
-            let Ok(line) = line else { break };
-            if line.ends_with("ready") {
-                let _ = tx.send(());
-            }
-        }
-    });
-    let p = Pioneer(child);
-    rx.recv_timeout(Duration::from_secs(15))
-        .expect("the Pioneer driver is ready");
-    p
+fn pioneer(domain: &Domain) -> common::Bg {
+    common::pioneer_emulated(domain.name())
 }
 
 #[test]

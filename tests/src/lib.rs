@@ -22,6 +22,17 @@ pub struct Proc {
 }
 
 impl Proc {
+    /// Spawns `exe` with `args` in domain `domain` and waits (bounded) until it prints
+    /// `ready`, as every driver of the tests does once it serves.
+    pub fn spawn_ready(exe: &str, domain: &str, args: &[&str]) -> Proc {
+        let mut d = Proc::spawn(exe, domain, args);
+        assert!(
+            d.read_until(|l| l == "ready").is_some(),
+            "{exe} did not start"
+        );
+        d
+    }
+
     /// Spawns `exe` with `args` in domain `domain`, stdin and stdout piped.
     pub fn spawn(exe: &str, domain: &str, args: &[&str]) -> Proc {
         let mut child = Command::new(exe)

@@ -23,12 +23,7 @@ const T: Duration = Duration::from_secs(5);
 const LIMIT: Duration = Duration::from_secs(30);
 
 fn start_driver(domain: &Domain, extra: &[&str]) -> Proc {
-    let mut d = Proc::spawn(DRIVER, domain.name(), extra);
-    assert!(
-        d.read_until(|l| l == "ready").is_some(),
-        "driver did not start"
-    );
-    d
+    Proc::spawn_ready(DRIVER, domain.name(), extra)
 }
 
 fn ctx(domain: &Domain) -> Context {

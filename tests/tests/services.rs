@@ -11,12 +11,7 @@ const CLIENT: &str = env!("CARGO_BIN_EXE_limber-test-client");
 const T: Duration = Duration::from_secs(5);
 
 fn start_driver(domain: &Domain, extra: &[&str]) -> Proc {
-    let mut d = Proc::spawn(DRIVER, domain.name(), extra);
-    assert!(
-        d.read_until(|l| l == "ready").is_some(),
-        "driver did not start"
-    );
-    d
+    Proc::spawn_ready(DRIVER, domain.name(), extra)
 }
 
 fn client_ctx(domain: &Domain) -> Context {

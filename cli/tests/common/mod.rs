@@ -133,39 +133,10 @@ impl Drop for Bg {
     }
 }
 
-/// `limber pioneer --emulated` in `domain`, killed when dropped.
-pub struct Pioneer(std::process::Child);
-
-impl Drop for Pioneer {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-/// Starts `limber pioneer --emulated` in `domain` and waits (bounded) for its "ready".
-pub fn pioneer_emulated(domain: &str) -> Pioneer {
-    use std::io::{BufRead, BufReader};
-    use std::process::Stdio;
-    let mut child = Command::new(LIMBER)
-        .args(["pioneer", "--emulated"])
-        .env("LIMBER_DOMAIN", domain)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let out = child.stdout.take().unwrap();
-    let (tx, rx) = mpsc::channel();
-    std::thread::spawn(move || {
-        for line in BufReader::new(out).lines() {
-            let Ok(line) = line else { break };
-            if line.ends_with("ready") && tx.send(()).is_err() {
-                break;
-            }
-        }
-    });
-    let p = Pioneer(child);
-    rx.recv_timeout(Duration::from_secs(15))
-        .expect("the Pioneer driver is ready");
+/// Starts `limber pioneer --emulated` in `domain` and waits (bounded) for its "ready";
+/// killed when dropped.
+pub fn pioneer_emulated(domain: &str) -> Bg {
+    let mut p = Bg::spawn(domain, &["pioneer", "--emulated"]);
+    p.line(|l| l.ends_with("ready"));
     p
 }
