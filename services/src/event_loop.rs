@@ -242,7 +242,8 @@ pub fn linger(budget: Duration, mut poll: impl FnMut() -> bool) -> u64 {
         } else if idle_since.elapsed() >= budget {
             return found;
         } else {
-            core::hint::spin_loop();
+            // Yield rather than spin: a client sharing this core runs now.
+            std::thread::yield_now();
         }
         if start.elapsed() >= cap {
             return found;

@@ -221,7 +221,9 @@ impl<I: Interface> Client<I> {
                 // Right after a send: busy-poll for the answer of a driver that is awake.
                 if let Some(spin_end) = self.spin_until {
                     if Instant::now() < spin_end.min(until) {
-                        core::hint::spin_loop();
+                        // Yield rather than spin: when the driver shares this core (2 cores
+                        // and other load), it runs now instead of after the budget.
+                        std::thread::yield_now();
                         return Ok(());
                     }
                     self.spin_until = None;
