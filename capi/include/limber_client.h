@@ -40,6 +40,11 @@
 #include "limber.h"
 
 /*
+ The longest name of a lease holder, in bytes (`limber_*_acquire`).
+ */
+#define LIMBER_LEASE_NAME_MAX 31
+
+/*
  Longest device name kept in `limber_device_info.name`, with its NUL.
  */
 #define LIMBER_DEVICE_NAME_CAPACITY 96
@@ -121,6 +126,11 @@ enum limber_code
    An internal error in limber (a panic was caught at the boundary); please report it.
    */
   LIMBER_CODE_INTERNAL = 14,
+  /*
+   The control lease of this handle ended (its heartbeat was missed, or the driver
+   restarted): the driver stopped the device; acquire it again to go on.
+   */
+  LIMBER_CODE_LEASE_LOST = 15,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -249,6 +259,25 @@ typedef struct limber_ticket {
    */
   uint64_t receivers;
 } limber_ticket;
+
+/*
+ Who holds a device's control lease (`limber_*_holder`).
+ */
+typedef struct limber_lease_holder {
+  /*
+   The holder's client id (as `limber_*_client_id` gives it); 0: nobody holds the
+   device (then the other fields are zero).
+   */
+  uint64_t client_id;
+  /*
+   The holder's heartbeat: it renews at least this often (ms).
+   */
+  uint64_t heartbeat_ms;
+  /*
+   The holder's name, NUL-terminated (at most `LIMBER_LEASE_NAME_MAX` bytes).
+   */
+  char name[32];
+} limber_lease_holder;
 
 /*
  One device found by `limber_list_devices`.
@@ -537,6 +566,87 @@ limber_code limber_actarray_geometry(struct limber_actarray *h,
                                      limber_actarray_geom *out);
 
 /*
+ This handle's client id: how the driver, outcomes (`limber_actarray_preempted`) and
+ `limber_actarray_holder` name it.
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_actarray_client_id(struct limber_actarray *h, uint64_t *out);
+
+/*
+ Takes the device's control lease as `name` (NULL: this program's name; 1 to 31 bytes,
+ else `LIMBER_CODE_INVALID_VALUE`). Until `limber_actarray_release_lease` (or disconnect),
+ other clients' commands, and their requests that change the device, are refused as
+ `LIMBER_STATUS_LEASED` naming `name`; readers are unaffected. Renew it at least every
+ `heartbeat_ms` (`limber_actarray_renew`, or `limber_actarray_keep_lease` in a loop): when the
+ heartbeat is missed, or this process dies, the driver stops the device and frees it.
+ Acquiring again sets a new heartbeat. Held by another client: `LIMBER_CODE_REFUSED`,
+ `limber_last_refusal()` is `LIMBER_STATUS_LEASED` and `limber_last_error()` names the
+ holder. Waits for the driver's answer up to 2 s.
+
+ # Safety
+ `h` is NULL or a live handle; `name` is NULL or a NUL-terminated string.
+ */
+limber_code limber_actarray_acquire(struct limber_actarray *h,
+                                    const char *name,
+                                    uint64_t heartbeat_ms);
+
+/*
+ The lease's heartbeat: tells the driver this holder lives. A lease that ended
+ meanwhile: `LIMBER_CODE_LEASE_LOST` (nobody holds it now) or `LIMBER_CODE_REFUSED` with
+ `LIMBER_STATUS_LEASED` (another client took it).
+
+ # Safety
+ `h` is NULL or a live handle.
+ */
+limber_code limber_actarray_renew(struct limber_actarray *h);
+
+/*
+ For a control loop: renews the lease when a third of its heartbeat has passed since the
+ last renewal (`*renewed`, if not NULL, says whether it did); does nothing when no lease
+ is held. Fails as `limber_actarray_renew`.
+
+ # Safety
+ `h` is NULL or a live handle; `renewed` is NULL or writable.
+ */
+limber_code limber_actarray_keep_lease(struct limber_actarray *h, bool *renewed);
+
+/*
+ Gives the control lease back (the motion in progress goes on). Without a lease it does
+ nothing. (`limber_actarray_release` ends the loan of a borrowed state.)
+
+ # Safety
+ `h` is NULL or a live handle.
+ */
+limber_code limber_actarray_release_lease(struct limber_actarray *h);
+
+/*
+ Who holds the device's control lease: `out->client_id` is 0 when nobody does. Asks the
+ driver (waits for its answer up to 2 s).
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_actarray_holder(struct limber_actarray *h, struct limber_lease_holder *out);
+
+/*
+ Whether another client's command cut short the motion that the command of `ticket`
+ started (the driver's second outcome, `LIMBER_STATUS_PREEMPTED`): `*preempted`, and
+ `*by_client` (NULL: not written; 0 if not preempted) the preempting client's id. Looks
+ at the outcomes that arrived, without waiting; remembers this handle's last 256
+ commands.
+
+ # Safety
+ `h` is NULL or a live handle; `preempted` is NULL or writable; `by_client` is NULL or
+ writable.
+ */
+limber_code limber_actarray_preempted(struct limber_actarray *h,
+                                      struct limber_ticket ticket,
+                                      bool *preempted,
+                                      uint64_t *by_client);
+
+/*
  Lists the devices of `domain` (NULL: `LIMBER_DOMAIN`, or "limber"), sorted by name:
  writes the first `capacity` into `out[]` and the number found into `*count` (which
  may exceed `capacity`: call again with a larger array). `out` may be NULL when
@@ -701,6 +811,87 @@ limber_code limber_gripper_retrieve(struct limber_gripper *h, struct limber_tick
 limber_code limber_gripper_geometry(struct limber_gripper *h,
                                     uint64_t timeout_ms,
                                     limber_gripper_geom *out);
+
+/*
+ This handle's client id: how the driver, outcomes (`limber_gripper_preempted`) and
+ `limber_gripper_holder` name it.
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_gripper_client_id(struct limber_gripper *h, uint64_t *out);
+
+/*
+ Takes the device's control lease as `name` (NULL: this program's name; 1 to 31 bytes,
+ else `LIMBER_CODE_INVALID_VALUE`). Until `limber_gripper_release_lease` (or disconnect),
+ other clients' commands, and their requests that change the device, are refused as
+ `LIMBER_STATUS_LEASED` naming `name`; readers are unaffected. Renew it at least every
+ `heartbeat_ms` (`limber_gripper_renew`, or `limber_gripper_keep_lease` in a loop): when the
+ heartbeat is missed, or this process dies, the driver stops the device and frees it.
+ Acquiring again sets a new heartbeat. Held by another client: `LIMBER_CODE_REFUSED`,
+ `limber_last_refusal()` is `LIMBER_STATUS_LEASED` and `limber_last_error()` names the
+ holder. Waits for the driver's answer up to 2 s.
+
+ # Safety
+ `h` is NULL or a live handle; `name` is NULL or a NUL-terminated string.
+ */
+limber_code limber_gripper_acquire(struct limber_gripper *h,
+                                   const char *name,
+                                   uint64_t heartbeat_ms);
+
+/*
+ The lease's heartbeat: tells the driver this holder lives. A lease that ended
+ meanwhile: `LIMBER_CODE_LEASE_LOST` (nobody holds it now) or `LIMBER_CODE_REFUSED` with
+ `LIMBER_STATUS_LEASED` (another client took it).
+
+ # Safety
+ `h` is NULL or a live handle.
+ */
+limber_code limber_gripper_renew(struct limber_gripper *h);
+
+/*
+ For a control loop: renews the lease when a third of its heartbeat has passed since the
+ last renewal (`*renewed`, if not NULL, says whether it did); does nothing when no lease
+ is held. Fails as `limber_gripper_renew`.
+
+ # Safety
+ `h` is NULL or a live handle; `renewed` is NULL or writable.
+ */
+limber_code limber_gripper_keep_lease(struct limber_gripper *h, bool *renewed);
+
+/*
+ Gives the control lease back (the motion in progress goes on). Without a lease it does
+ nothing. (`limber_gripper_release` ends the loan of a borrowed state.)
+
+ # Safety
+ `h` is NULL or a live handle.
+ */
+limber_code limber_gripper_release_lease(struct limber_gripper *h);
+
+/*
+ Who holds the device's control lease: `out->client_id` is 0 when nobody does. Asks the
+ driver (waits for its answer up to 2 s).
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_gripper_holder(struct limber_gripper *h, struct limber_lease_holder *out);
+
+/*
+ Whether another client's command cut short the motion that the command of `ticket`
+ started (the driver's second outcome, `LIMBER_STATUS_PREEMPTED`): `*preempted`, and
+ `*by_client` (NULL: not written; 0 if not preempted) the preempting client's id. Looks
+ at the outcomes that arrived, without waiting; remembers this handle's last 256
+ commands.
+
+ # Safety
+ `h` is NULL or a live handle; `preempted` is NULL or writable; `by_client` is NULL or
+ writable.
+ */
+limber_code limber_gripper_preempted(struct limber_gripper *h,
+                                     struct limber_ticket ticket,
+                                     bool *preempted,
+                                     uint64_t *by_client);
 
 /*
  Connects to the limb `device` ("robot/limb/index") in `domain` (NULL:
@@ -900,6 +1091,85 @@ limber_code limber_limb_can_reach(struct limber_limb *h,
                                   limber_vec3 orientation,
                                   uint64_t timeout_ms,
                                   limber_limb_reach *out);
+
+/*
+ This handle's client id: how the driver, outcomes (`limber_limb_preempted`) and
+ `limber_limb_holder` name it.
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_limb_client_id(struct limber_limb *h, uint64_t *out);
+
+/*
+ Takes the device's control lease as `name` (NULL: this program's name; 1 to 31 bytes,
+ else `LIMBER_CODE_INVALID_VALUE`). Until `limber_limb_release_lease` (or disconnect),
+ other clients' commands, and their requests that change the device, are refused as
+ `LIMBER_STATUS_LEASED` naming `name`; readers are unaffected. Renew it at least every
+ `heartbeat_ms` (`limber_limb_renew`, or `limber_limb_keep_lease` in a loop): when the
+ heartbeat is missed, or this process dies, the driver stops the device and frees it.
+ Acquiring again sets a new heartbeat. Held by another client: `LIMBER_CODE_REFUSED`,
+ `limber_last_refusal()` is `LIMBER_STATUS_LEASED` and `limber_last_error()` names the
+ holder. Waits for the driver's answer up to 2 s.
+
+ # Safety
+ `h` is NULL or a live handle; `name` is NULL or a NUL-terminated string.
+ */
+limber_code limber_limb_acquire(struct limber_limb *h, const char *name, uint64_t heartbeat_ms);
+
+/*
+ The lease's heartbeat: tells the driver this holder lives. A lease that ended
+ meanwhile: `LIMBER_CODE_LEASE_LOST` (nobody holds it now) or `LIMBER_CODE_REFUSED` with
+ `LIMBER_STATUS_LEASED` (another client took it).
+
+ # Safety
+ `h` is NULL or a live handle.
+ */
+limber_code limber_limb_renew(struct limber_limb *h);
+
+/*
+ For a control loop: renews the lease when a third of its heartbeat has passed since the
+ last renewal (`*renewed`, if not NULL, says whether it did); does nothing when no lease
+ is held. Fails as `limber_limb_renew`.
+
+ # Safety
+ `h` is NULL or a live handle; `renewed` is NULL or writable.
+ */
+limber_code limber_limb_keep_lease(struct limber_limb *h, bool *renewed);
+
+/*
+ Gives the control lease back (the motion in progress goes on). Without a lease it does
+ nothing. (`limber_limb_release` ends the loan of a borrowed state.)
+
+ # Safety
+ `h` is NULL or a live handle.
+ */
+limber_code limber_limb_release_lease(struct limber_limb *h);
+
+/*
+ Who holds the device's control lease: `out->client_id` is 0 when nobody does. Asks the
+ driver (waits for its answer up to 2 s).
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_limb_holder(struct limber_limb *h, struct limber_lease_holder *out);
+
+/*
+ Whether another client's command cut short the motion that the command of `ticket`
+ started (the driver's second outcome, `LIMBER_STATUS_PREEMPTED`): `*preempted`, and
+ `*by_client` (NULL: not written; 0 if not preempted) the preempting client's id. Looks
+ at the outcomes that arrived, without waiting; remembers this handle's last 256
+ commands.
+
+ # Safety
+ `h` is NULL or a live handle; `preempted` is NULL or writable; `by_client` is NULL or
+ writable.
+ */
+limber_code limber_limb_preempted(struct limber_limb *h,
+                                  struct limber_ticket ticket,
+                                  bool *preempted,
+                                  uint64_t *by_client);
 
 #ifdef __cplusplus
 }  // extern "C"
