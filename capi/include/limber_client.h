@@ -21,6 +21,16 @@
  * LIMBER_STATUS_* of limber.h says why not). Requests wait for the driver's answer; a
  * refusal returns LIMBER_CODE_REFUSED and limber_last_refusal() gives its LIMBER_STATUS_*.
  *
+ * Control: any client may command any device (the last writer wins) unless one holds
+ * the device's lease: limber_*_acquire(handle, name, heartbeat_ms), renewed with
+ * limber_*_renew or limber_*_keep_lease, given back with limber_*_release_lease. Other
+ * clients' commands then have the outcome LIMBER_STATUS_LEASED, and their acquire and
+ * device-changing requests return LIMBER_CODE_REFUSED with limber_last_refusal()
+ * LIMBER_STATUS_LEASED; limber_last_error() names the holder. A holder that misses its
+ * heartbeat or dies loses the lease and the driver stops the device (the deadman).
+ * limber_*_holder says who holds a device; limber_*_preempted whether another client's
+ * command cut short the motion of one of yours.
+ *
  * Thread-safety: every handle owns its own iceoryx2 node and ports and shares nothing
  * with other handles, so different handles may be used by different threads at the same
  * time, and a handle may be passed from one thread to another between calls. One handle
@@ -409,7 +419,10 @@ limber_code limber_actarray_wait_state(struct limber_actarray *h,
 
 /*
  Waits up to `timeout_ms` for the outcome of the command of `ticket`; `*status` is the
- driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out).
+ driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out). A status other than OK is
+ also kept for `limber_last_refusal()` and `limber_last_error()`, which for
+ `LIMBER_STATUS_LEASED` names the client holding the device ("refused: held by another
+ client (alice, client 123)"); the call still returns `LIMBER_CODE_OK`.
 
  # Safety
  `h` is NULL or a live handle; `status` is NULL or writable.
@@ -731,7 +744,10 @@ limber_code limber_gripper_wait_state(struct limber_gripper *h,
 
 /*
  Waits up to `timeout_ms` for the outcome of the command of `ticket`; `*status` is the
- driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out).
+ driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out). A status other than OK is
+ also kept for `limber_last_refusal()` and `limber_last_error()`, which for
+ `LIMBER_STATUS_LEASED` names the client holding the device ("refused: held by another
+ client (alice, client 123)"); the call still returns `LIMBER_CODE_OK`.
 
  # Safety
  `h` is NULL or a live handle; `status` is NULL or writable.
@@ -961,7 +977,10 @@ limber_code limber_limb_wait_state(struct limber_limb *h,
 
 /*
  Waits up to `timeout_ms` for the outcome of the command of `ticket`; `*status` is the
- driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out).
+ driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out). A status other than OK is
+ also kept for `limber_last_refusal()` and `limber_last_error()`, which for
+ `LIMBER_STATUS_LEASED` names the client holding the device ("refused: held by another
+ client (alice, client 123)"); the call still returns `LIMBER_CODE_OK`.
 
  # Safety
  `h` is NULL or a live handle; `status` is NULL or writable.

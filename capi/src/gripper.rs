@@ -133,7 +133,10 @@ pub unsafe extern "C" fn limber_gripper_wait_state(
 }
 
 /// Waits up to `timeout_ms` for the outcome of the command of `ticket`; `*status` is the
-/// driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out).
+/// driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out). A status other than OK is
+/// also kept for `limber_last_refusal()` and `limber_last_error()`, which for
+/// `LIMBER_STATUS_LEASED` names the client holding the device ("refused: held by another
+/// client (alice, client 123)"); the call still returns `LIMBER_CODE_OK`.
 ///
 /// # Safety
 /// `h` is NULL or a live handle; `status` is NULL or writable.
@@ -303,7 +306,7 @@ pub unsafe extern "C" fn limber_gripper_client_id(
     out: *mut u64,
 ) -> LimberCode {
     guard(|| {
-        // SAFELimberGripper: the caller's promise on the pointers, checked for NULL here.
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
         let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
         *out = h.0.client.client_id();
         Ok(())
@@ -329,7 +332,7 @@ pub unsafe extern "C" fn limber_gripper_acquire(
     heartbeat_ms: u64,
 ) -> LimberCode {
     guard(|| {
-        // SAFELimberGripper: the caller's promise on the pointers, checked for NULL here.
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
         let (h, name) = unsafe { (arg(h, "handle")?, opt_str(name, "name")?) };
         h.0.acquire(name, heartbeat_ms)
     })
@@ -344,7 +347,7 @@ pub unsafe extern "C" fn limber_gripper_acquire(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn limber_gripper_renew(h: *mut LimberGripper) -> LimberCode {
     guard(|| {
-        // SAFELimberGripper: the caller's promise on the pointer, checked for NULL here.
+        // SAFETY: the caller's promise on the pointer, checked for NULL here.
         unsafe { arg(h, "handle")? }.0.renew()
     })
 }
@@ -361,7 +364,7 @@ pub unsafe extern "C" fn limber_gripper_keep_lease(
     renewed: *mut bool,
 ) -> LimberCode {
     guard(|| {
-        // SAFELimberGripper: the caller's promise on the pointers, checked for NULL here.
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
         let (h, renewed) = unsafe { (arg(h, "handle")?, renewed.as_mut()) };
         let r = h.0.keep_lease()?;
         if let Some(out) = renewed {
@@ -379,7 +382,7 @@ pub unsafe extern "C" fn limber_gripper_keep_lease(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn limber_gripper_release_lease(h: *mut LimberGripper) -> LimberCode {
     guard(|| {
-        // SAFELimberGripper: the caller's promise on the pointer, checked for NULL here.
+        // SAFETY: the caller's promise on the pointer, checked for NULL here.
         unsafe { arg(h, "handle")? }.0.release_lease()
     })
 }
@@ -395,7 +398,7 @@ pub unsafe extern "C" fn limber_gripper_holder(
     out: *mut LimberLeaseHolder,
 ) -> LimberCode {
     guard(|| {
-        // SAFELimberGripper: the caller's promise on the pointers, checked for NULL here.
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
         let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
         *out = h.0.holder()?;
         Ok(())
@@ -419,7 +422,7 @@ pub unsafe extern "C" fn limber_gripper_preempted(
     by_client: *mut u64,
 ) -> LimberCode {
     guard(|| {
-        // SAFELimberGripper: the caller's promise on the pointers, checked for NULL here.
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
         let (h, preempted, by_client) = unsafe {
             (
                 arg(h, "handle")?,

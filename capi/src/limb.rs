@@ -133,7 +133,10 @@ pub unsafe extern "C" fn limber_limb_wait_state(
 }
 
 /// Waits up to `timeout_ms` for the outcome of the command of `ticket`; `*status` is the
-/// driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out).
+/// driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out). A status other than OK is
+/// also kept for `limber_last_refusal()` and `limber_last_error()`, which for
+/// `LIMBER_STATUS_LEASED` names the client holding the device ("refused: held by another
+/// client (alice, client 123)"); the call still returns `LIMBER_CODE_OK`.
 ///
 /// # Safety
 /// `h` is NULL or a live handle; `status` is NULL or writable.
@@ -407,7 +410,7 @@ pub unsafe extern "C" fn limber_limb_can_reach(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn limber_limb_client_id(h: *mut LimberLimb, out: *mut u64) -> LimberCode {
     guard(|| {
-        // SAFELimberLimb: the caller's promise on the pointers, checked for NULL here.
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
         let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
         *out = h.0.client.client_id();
         Ok(())
@@ -433,7 +436,7 @@ pub unsafe extern "C" fn limber_limb_acquire(
     heartbeat_ms: u64,
 ) -> LimberCode {
     guard(|| {
-        // SAFELimberLimb: the caller's promise on the pointers, checked for NULL here.
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
         let (h, name) = unsafe { (arg(h, "handle")?, opt_str(name, "name")?) };
         h.0.acquire(name, heartbeat_ms)
     })
@@ -448,7 +451,7 @@ pub unsafe extern "C" fn limber_limb_acquire(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn limber_limb_renew(h: *mut LimberLimb) -> LimberCode {
     guard(|| {
-        // SAFELimberLimb: the caller's promise on the pointer, checked for NULL here.
+        // SAFETY: the caller's promise on the pointer, checked for NULL here.
         unsafe { arg(h, "handle")? }.0.renew()
     })
 }
@@ -465,7 +468,7 @@ pub unsafe extern "C" fn limber_limb_keep_lease(
     renewed: *mut bool,
 ) -> LimberCode {
     guard(|| {
-        // SAFELimberLimb: the caller's promise on the pointers, checked for NULL here.
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
         let (h, renewed) = unsafe { (arg(h, "handle")?, renewed.as_mut()) };
         let r = h.0.keep_lease()?;
         if let Some(out) = renewed {
@@ -483,7 +486,7 @@ pub unsafe extern "C" fn limber_limb_keep_lease(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn limber_limb_release_lease(h: *mut LimberLimb) -> LimberCode {
     guard(|| {
-        // SAFELimberLimb: the caller's promise on the pointer, checked for NULL here.
+        // SAFETY: the caller's promise on the pointer, checked for NULL here.
         unsafe { arg(h, "handle")? }.0.release_lease()
     })
 }
@@ -499,7 +502,7 @@ pub unsafe extern "C" fn limber_limb_holder(
     out: *mut LimberLeaseHolder,
 ) -> LimberCode {
     guard(|| {
-        // SAFELimberLimb: the caller's promise on the pointers, checked for NULL here.
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
         let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
         *out = h.0.holder()?;
         Ok(())
@@ -523,7 +526,7 @@ pub unsafe extern "C" fn limber_limb_preempted(
     by_client: *mut u64,
 ) -> LimberCode {
     guard(|| {
-        // SAFELimberLimb: the caller's promise on the pointers, checked for NULL here.
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
         let (h, preempted, by_client) = unsafe {
             (
                 arg(h, "handle")?,

@@ -677,6 +677,7 @@ fn a_lease_refuses_the_other_client_by_name_and_preemption_and_the_deadman_are_t
         "bob's acquire: the driver refused the request: held by another client (alice)",
         "bob's move after release: ok",
         "limb holder: lease",
+        "gripper lease ok",
         "alice's slow move preempted by bob",
         "alice's renew after the deadman: the lease was lost (heartbeat missed)",
         "all lease steps ok",

@@ -117,6 +117,29 @@ int main(void) {
     printf("limb holder: %s\n", limb_holder.name);
     if ((c = limber_limb_release_lease(limb)) != LIMBER_CODE_OK) return fail("limb release", c);
 
+    /* The gripper's lease. */
+    limber_gripper *grip = NULL;
+    if ((c = limber_gripper_connect("pioneer/gripper/1", NULL, WAIT_MS, &grip)) != LIMBER_CODE_OK)
+        return fail("connect gripper", c);
+    if ((c = limber_gripper_acquire(grip, "grip", 2000)) != LIMBER_CODE_OK) return fail("gripper acquire", c);
+    limber_lease_holder grip_holder;
+    if ((c = limber_gripper_holder(grip, &grip_holder)) != LIMBER_CODE_OK || strcmp(grip_holder.name, "grip") != 0)
+        return fail("gripper holder", c);
+    if ((c = limber_gripper_renew(grip)) != LIMBER_CODE_OK) return fail("gripper renew", c);
+    if ((c = limber_gripper_release_lease(grip)) != LIMBER_CODE_OK) return fail("gripper release", c);
+    if ((c = limber_gripper_holder(grip, &grip_holder)) != LIMBER_CODE_OK || grip_holder.client_id != 0)
+        return fail("gripper holder after release", c);
+    limber_gripper_disconnect(grip);
+    printf("gripper lease ok\n");
+
+    /* NULL where a pointer is required. */
+    limber_ticket none = {0, 0};
+    if ((c = limber_actarray_acquire(NULL, "alice", 1000)) != LIMBER_CODE_NULL_ARGUMENT) return fail("NULL handle", c);
+    if ((c = limber_actarray_holder(bob, NULL)) != LIMBER_CODE_NULL_ARGUMENT) return fail("NULL holder", c);
+    if ((c = limber_limb_preempted(limb, none, NULL, NULL)) != LIMBER_CODE_NULL_ARGUMENT)
+        return fail("NULL preempted", c);
+    if ((c = limber_actarray_client_id(bob, NULL)) != LIMBER_CODE_NULL_ARGUMENT) return fail("NULL id", c);
+
     /* Preemption: Alice turns joint 0 slowly; Bob stops it. */
     limber_ticket slow;
     if ((c = limber_actarray_move_at_speed(alice, 0, 0.2, &slow)) != LIMBER_CODE_OK) return fail("slow move", c);
