@@ -389,9 +389,9 @@ private:
 };
 
 /// A proxy's control lease for the lifetime of this object: acquired in the constructor
-/// (throws as Acquire()), released in the destructor (a failure there is not thrown: the
-/// driver frees the lease when its heartbeat runs out). Keep it with KeepLease() in the
-/// control loop.
+/// (throws as Acquire()), released in the destructor, which cannot throw: a failure there
+/// is left to the driver, which frees the lease when its heartbeat runs out; call
+/// Release() to see it. Keep the lease with KeepLease() in the control loop.
 ///
 ///     limber::Lease lease(arm, "picker", std::chrono::milliseconds(500));
 template <class T>
@@ -409,6 +409,10 @@ public:
     }
     /// Renews the lease when a third of its heartbeat has passed; whether it did.
     bool KeepLease() { return proxy_->KeepLease(); }
+    /// Gives the lease back now, throwing on failure (the destructor then does nothing).
+    void Release() {
+        if (proxy_ != nullptr) std::exchange(proxy_, nullptr)->Release();
+    }
 
 private:
     BasicProxy<T>* proxy_;

@@ -36,6 +36,11 @@ int main() try {
         lease.KeepLease();
     }
     if (other.Holder()) return bad("the lease outlived its guard");
+    {
+        limber::Lease lease(mine, "cpp-holder", 2s);
+        lease.Release();
+        if (other.Holder()) return bad("the lease outlived its Release()");
+    }
     // Under the program's name; Release() gives it back.
     other.Acquire(1s);
     std::printf("holder: %s\n", other.Holder()->name);
