@@ -387,7 +387,7 @@ limber_code limber_actarray_state(struct limber_actarray *h,
  Lends the latest state in place, without a copy (waiting up to `timeout_ms` for a
  first one): `*out` points into shared memory and stays valid and unchanged until
  `limber_actarray_release` (or disconnect). Meanwhile the calls that read states
- (state, borrow, wait_state, wait_outcome, liveness) fail with `LIMBER_CODE_BORROWED`;
+ (state, borrow, wait_state, wait_outcome, preempted, liveness) fail with `LIMBER_CODE_BORROWED`;
  commands and requests work.
 
  # Safety
@@ -712,7 +712,7 @@ limber_code limber_gripper_state(struct limber_gripper *h,
  Lends the latest state in place, without a copy (waiting up to `timeout_ms` for a
  first one): `*out` points into shared memory and stays valid and unchanged until
  `limber_gripper_release` (or disconnect). Meanwhile the calls that read states
- (state, borrow, wait_state, wait_outcome, liveness) fail with `LIMBER_CODE_BORROWED`;
+ (state, borrow, wait_state, wait_outcome, preempted, liveness) fail with `LIMBER_CODE_BORROWED`;
  commands and requests work.
 
  # Safety
@@ -945,7 +945,7 @@ limber_code limber_limb_state(struct limber_limb *h, uint64_t timeout_ms, limber
  Lends the latest state in place, without a copy (waiting up to `timeout_ms` for a
  first one): `*out` points into shared memory and stays valid and unchanged until
  `limber_limb_release` (or disconnect). Meanwhile the calls that read states
- (state, borrow, wait_state, wait_outcome, liveness) fail with `LIMBER_CODE_BORROWED`;
+ (state, borrow, wait_state, wait_outcome, preempted, liveness) fail with `LIMBER_CODE_BORROWED`;
  commands and requests work.
 
  # Safety

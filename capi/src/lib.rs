@@ -438,7 +438,7 @@ pub(crate) fn ms(timeout_ms: u64) -> Duration {
 ///
 /// A lent sample is the client's latest one, which only [`Client::refresh`] replaces (and
 /// with it releases the old one to the driver, who may overwrite it). Every call that
-/// refreshes (state, current, wait_state, wait_outcome, freshness) is refused while a
+/// refreshes (state, current, wait_state, wait_outcome, preempted, freshness) is refused while a
 /// sample is lent; commands, requests and `driver_status` do not refresh and stay allowed.
 pub(crate) struct Handle<I: Interface> {
     pub(crate) client: Client<I>,

@@ -80,7 +80,7 @@ pub unsafe extern "C" fn limber_limb_state(
 /// Lends the latest state in place, without a copy (waiting up to `timeout_ms` for a
 /// first one): `*out` points into shared memory and stays valid and unchanged until
 /// `limber_limb_release` (or disconnect). Meanwhile the calls that read states
-/// (state, borrow, wait_state, wait_outcome, liveness) fail with `LIMBER_CODE_BORROWED`;
+/// (state, borrow, wait_state, wait_outcome, preempted, liveness) fail with `LIMBER_CODE_BORROWED`;
 /// commands and requests work.
 ///
 /// # Safety

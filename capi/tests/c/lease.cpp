@@ -18,7 +18,7 @@ int main() try {
     limber::ActArrayProxy mine("pioneer/actarray/0");
     limber::ActArrayProxy other("pioneer/actarray/0");
     {
-        limber::Lease lease(mine, "cpp-holder", 2s);
+        limber::Lease lease(mine, "cpp-holder", 5s);
         auto who = other.Holder();
         if (!who || who->client_id != mine.ClientId() || std::string(who->name) != "cpp-holder")
             return bad("the holder is not cpp-holder");
@@ -37,12 +37,12 @@ int main() try {
     }
     if (other.Holder()) return bad("the lease outlived its guard");
     {
-        limber::Lease lease(mine, "cpp-holder", 2s);
+        limber::Lease lease(mine, "cpp-holder", 5s);
         lease.Release();
         if (other.Holder()) return bad("the lease outlived its Release()");
     }
     // Under the program's name; Release() gives it back.
-    other.Acquire(1s);
+    other.Acquire(5s);
     std::printf("holder: %s\n", other.Holder()->name);
     other.Release();
 
