@@ -195,15 +195,18 @@ pub extern "C" fn limber_strerror(code: i32) -> *const c_char {
 }
 
 /// Returns the detail of the last failure of a limber call on this thread (e.g. "no driver
-/// offers pioneer/limb/7 in domain limber (is the driver running? ...)"), or "" if none
-/// failed yet. Valid until the next limber call on this thread. Never NULL.
+/// offers pioneer/limb/7 in domain limber (is the driver running? ...)"), or of the last
+/// outcome other than `LIMBER_STATUS_OK` that `limber_*_wait_outcome` returned (e.g.
+/// "refused: held by another client (alice, client 123)"), or "" if none failed yet. Valid
+/// until the next limber call on this thread. Never NULL.
 #[unsafe(no_mangle)]
 pub extern "C" fn limber_last_error() -> *const c_char {
     LAST_ERROR.with(|e| e.borrow().as_ptr())
 }
 
 /// Returns the driver's reason (a `LIMBER_STATUS_*` of limber.h) of the last
-/// `LIMBER_CODE_REFUSED` on this thread, or `LIMBER_STATUS_OK` if there was none.
+/// `LIMBER_CODE_REFUSED` on this thread, or of the last outcome other than OK that
+/// `limber_*_wait_outcome` returned; `LIMBER_STATUS_OK` if there was none.
 #[unsafe(no_mangle)]
 pub extern "C" fn limber_last_refusal() -> u32 {
     LAST_REFUSAL.with(Cell::get)
