@@ -10,6 +10,11 @@
  * Commands return a limber_ticket at once; WaitOutcome(ticket, timeout) returns the
  * driver's verdict, a LIMBER_STATUS_* (limber::StatusText() describes it).
  *
+ * Control: Acquire(name, heartbeat) takes the device's lease (other clients are refused
+ * as LIMBER_STATUS_LEASED), Renew()/KeepLease() keep it, Release() gives it back;
+ * limber::Lease does both in its constructor and destructor. Holder() says who holds a
+ * device, Preempted(ticket) whether another client cut a command's motion short.
+ *
  * Thread-safety: as the C API's. A proxy is used by one thread at a time (it may be moved
  * to another thread between calls); different proxies work in different threads at once.
  */
@@ -18,6 +23,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -86,6 +92,13 @@ inline void Check(limber_code code) {
         static constexpr auto liveness = limber_##prefix##_liveness;                          \
         static constexpr auto driver_status = limber_##prefix##_driver_status;                \
         static constexpr auto geometry = limber_##prefix##_geometry;                          \
+        static constexpr auto client_id = limber_##prefix##_client_id;                        \
+        static constexpr auto acquire = limber_##prefix##_acquire;                            \
+        static constexpr auto renew = limber_##prefix##_renew;                                \
+        static constexpr auto keep_lease = limber_##prefix##_keep_lease;                      \
+        static constexpr auto release_lease = limber_##prefix##_release_lease;                \
+        static constexpr auto holder = limber_##prefix##_holder;                              \
+        static constexpr auto preempted = limber_##prefix##_preempted;                        \
     }
 LIMBER_HPP_TRAITS(ActArrayTraits, actarray, limber_actarray_data, limber_actarray_geom);
 LIMBER_HPP_TRAITS(LimbTraits, limb, limber_limb_data, limber_limb_geom);
@@ -180,6 +193,51 @@ public:
     const Geom& RequestGeometry(Duration timeout = kRequestTimeout) {
         detail::Check(T::geometry(h_, detail::Millis(timeout), &geom_));
         return geom_;
+    }
+    /// This proxy's client id (as Holder() and Preempted() name clients).
+    uint64_t ClientId() {
+        uint64_t id = 0;
+        detail::Check(T::client_id(h_, &id));
+        return id;
+    }
+    /// Takes the device's control lease as `name` (1 to LIMBER_LEASE_NAME_MAX bytes):
+    /// other clients' commands and device-changing requests are refused as
+    /// LIMBER_STATUS_LEASED until Release(). Renew it at least every `heartbeat` (Renew(),
+    /// or KeepLease() in a loop), or the driver stops the device and frees it. Held by
+    /// another client: throws LIMBER_CODE_REFUSED with refusal() LIMBER_STATUS_LEASED and
+    /// the holder's name in what().
+    void Acquire(const std::string& name, Duration heartbeat) {
+        detail::Check(T::acquire(h_, name.c_str(), detail::Millis(heartbeat)));
+    }
+    /// Takes the lease under this program's name.
+    void Acquire(Duration heartbeat) {
+        detail::Check(T::acquire(h_, nullptr, detail::Millis(heartbeat)));
+    }
+    /// The lease's heartbeat (throws LIMBER_CODE_LEASE_LOST when the lease ended).
+    void Renew() { detail::Check(T::renew(h_)); }
+    /// Renews the lease when a third of its heartbeat has passed; whether it did.
+    bool KeepLease() {
+        bool renewed = false;
+        detail::Check(T::keep_lease(h_, &renewed));
+        return renewed;
+    }
+    /// Gives the lease back (nothing happens without one).
+    void Release() { detail::Check(T::release_lease(h_)); }
+    /// Who holds the device's lease, if anybody.
+    std::optional<limber_lease_holder> Holder() {
+        limber_lease_holder h{};
+        detail::Check(T::holder(h_, &h));
+        if (h.client_id == 0) return std::nullopt;
+        return h;
+    }
+    /// The client whose command cut short the motion of `ticket`'s command, if one did
+    /// (as far as the outcomes that arrived tell; it does not wait).
+    std::optional<uint64_t> Preempted(limber_ticket ticket) {
+        bool preempted = false;
+        uint64_t by = 0;
+        detail::Check(T::preempted(h_, ticket, &preempted, &by));
+        if (!preempted) return std::nullopt;
+        return by;
     }
     /// The geometry of the last RequestGeometry() (zeros before).
     const Geom& GetGeom() const noexcept { return geom_; }
@@ -328,6 +386,36 @@ private:
         detail::Check(cmd(h_, &t));
         return t;
     }
+};
+
+/// A proxy's control lease for the lifetime of this object: acquired in the constructor
+/// (throws as Acquire()), released in the destructor, which cannot throw: a failure there
+/// is left to the driver, which frees the lease when its heartbeat runs out; call
+/// Release() to see it. Keep the lease with KeepLease() in the control loop.
+///
+///     limber::Lease lease(arm, "picker", std::chrono::milliseconds(500));
+template <class T>
+class Lease {
+public:
+    Lease(BasicProxy<T>& proxy, const std::string& name, Duration heartbeat) : proxy_(&proxy) {
+        proxy.Acquire(name, heartbeat);
+    }
+    Lease(const Lease&) = delete;
+    Lease& operator=(const Lease&) = delete;
+    Lease(Lease&& o) noexcept : proxy_(std::exchange(o.proxy_, nullptr)) {}
+    Lease& operator=(Lease&&) = delete;
+    ~Lease() {
+        if (proxy_ != nullptr) T::release_lease(proxy_->get());
+    }
+    /// Renews the lease when a third of its heartbeat has passed; whether it did.
+    bool KeepLease() { return proxy_->KeepLease(); }
+    /// Gives the lease back now, throwing on failure (the destructor then does nothing).
+    void Release() {
+        if (proxy_ != nullptr) std::exchange(proxy_, nullptr)->Release();
+    }
+
+private:
+    BasicProxy<T>* proxy_;
 };
 
 }  // namespace limber

@@ -21,6 +21,16 @@
  * LIMBER_STATUS_* of limber.h says why not). Requests wait for the driver's answer; a
  * refusal returns LIMBER_CODE_REFUSED and limber_last_refusal() gives its LIMBER_STATUS_*.
  *
+ * Control: any client may command any device (the last writer wins) unless one holds
+ * the device's lease: limber_*_acquire(handle, name, heartbeat_ms), renewed with
+ * limber_*_renew or limber_*_keep_lease, given back with limber_*_release_lease. Other
+ * clients' commands then have the outcome LIMBER_STATUS_LEASED, and their acquire and
+ * device-changing requests return LIMBER_CODE_REFUSED with limber_last_refusal()
+ * LIMBER_STATUS_LEASED; limber_last_error() names the holder. A holder that misses its
+ * heartbeat or dies loses the lease and the driver stops the device (the deadman).
+ * limber_*_holder says who holds a device; limber_*_preempted whether another client's
+ * command cut short the motion of one of yours.
+ *
  * Thread-safety: every handle owns its own iceoryx2 node and ports and shares nothing
  * with other handles, so different handles may be used by different threads at the same
  * time, and a handle may be passed from one thread to another between calls. One handle
@@ -38,6 +48,11 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "limber.h"
+
+/*
+ The longest name of a lease holder, in bytes (`limber_*_acquire`).
+ */
+#define LIMBER_LEASE_NAME_MAX 31
 
 /*
  Longest device name kept in `limber_device_info.name`, with its NUL.
@@ -121,6 +136,11 @@ enum limber_code
    An internal error in limber (a panic was caught at the boundary); please report it.
    */
   LIMBER_CODE_INTERNAL = 14,
+  /*
+   The control lease of this handle ended (its heartbeat was missed, or the driver
+   restarted): the driver stopped the device; acquire it again to go on.
+   */
+  LIMBER_CODE_LEASE_LOST = 15,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -251,6 +271,25 @@ typedef struct limber_ticket {
 } limber_ticket;
 
 /*
+ Who holds a device's control lease (`limber_*_holder`).
+ */
+typedef struct limber_lease_holder {
+  /*
+   The holder's client id (as `limber_*_client_id` gives it); 0: nobody holds the
+   device (then the other fields are zero).
+   */
+  uint64_t client_id;
+  /*
+   The holder's heartbeat: it renews at least this often (ms).
+   */
+  uint64_t heartbeat_ms;
+  /*
+   The holder's name, NUL-terminated (at most `LIMBER_LEASE_NAME_MAX` bytes).
+   */
+  char name[32];
+} limber_lease_holder;
+
+/*
  One device found by `limber_list_devices`.
  */
 typedef struct limber_device_info {
@@ -288,14 +327,17 @@ const char *limber_strerror(int32_t code);
 
 /*
  Returns the detail of the last failure of a limber call on this thread (e.g. "no driver
- offers pioneer/limb/7 in domain limber (is the driver running? ...)"), or "" if none
- failed yet. Valid until the next limber call on this thread. Never NULL.
+ offers pioneer/limb/7 in domain limber (is the driver running? ...)"), or of the last
+ outcome other than `LIMBER_STATUS_OK` that `limber_*_wait_outcome` returned (e.g.
+ "refused: held by another client (alice, client 123)"), or "" if none failed yet. Valid
+ until the next limber call on this thread. Never NULL.
  */
 const char *limber_last_error(void);
 
 /*
  Returns the driver's reason (a `LIMBER_STATUS_*` of limber.h) of the last
- `LIMBER_CODE_REFUSED` on this thread, or `LIMBER_STATUS_OK` if there was none.
+ `LIMBER_CODE_REFUSED` on this thread, or of the last outcome other than OK that
+ `limber_*_wait_outcome` returned; `LIMBER_STATUS_OK` if there was none.
  */
 uint32_t limber_last_refusal(void);
 
@@ -348,7 +390,7 @@ limber_code limber_actarray_state(struct limber_actarray *h,
  Lends the latest state in place, without a copy (waiting up to `timeout_ms` for a
  first one): `*out` points into shared memory and stays valid and unchanged until
  `limber_actarray_release` (or disconnect). Meanwhile the calls that read states
- (state, borrow, wait_state, wait_outcome, liveness) fail with `LIMBER_CODE_BORROWED`;
+ (state, borrow, wait_state, wait_outcome, preempted, liveness) fail with `LIMBER_CODE_BORROWED`;
  commands and requests work.
 
  # Safety
@@ -380,7 +422,10 @@ limber_code limber_actarray_wait_state(struct limber_actarray *h,
 
 /*
  Waits up to `timeout_ms` for the outcome of the command of `ticket`; `*status` is the
- driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out).
+ driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out). A status other than OK is
+ also kept for `limber_last_refusal()` and `limber_last_error()`, which for
+ `LIMBER_STATUS_LEASED` names the client holding the device ("refused: held by another
+ client (alice, client 123)"); the call still returns `LIMBER_CODE_OK`.
 
  # Safety
  `h` is NULL or a live handle; `status` is NULL or writable.
@@ -537,6 +582,87 @@ limber_code limber_actarray_geometry(struct limber_actarray *h,
                                      limber_actarray_geom *out);
 
 /*
+ This handle's client id: how the driver, outcomes (`limber_actarray_preempted`) and
+ `limber_actarray_holder` name it.
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_actarray_client_id(struct limber_actarray *h, uint64_t *out);
+
+/*
+ Takes the device's control lease as `name` (NULL: this program's name; 1 to 31 bytes,
+ else `LIMBER_CODE_INVALID_VALUE`). Until `limber_actarray_release_lease` (or disconnect),
+ other clients' commands, and their requests that change the device, are refused as
+ `LIMBER_STATUS_LEASED` naming `name`; readers are unaffected. Renew it at least every
+ `heartbeat_ms` (`limber_actarray_renew`, or `limber_actarray_keep_lease` in a loop): when the
+ heartbeat is missed, or this process dies, the driver stops the device and frees it.
+ Acquiring again sets a new heartbeat. Held by another client: `LIMBER_CODE_REFUSED`,
+ `limber_last_refusal()` is `LIMBER_STATUS_LEASED` and `limber_last_error()` names the
+ holder. Waits for the driver's answer up to 2 s.
+
+ # Safety
+ `h` is NULL or a live handle; `name` is NULL or a NUL-terminated string.
+ */
+limber_code limber_actarray_acquire(struct limber_actarray *h,
+                                    const char *name,
+                                    uint64_t heartbeat_ms);
+
+/*
+ The lease's heartbeat: tells the driver this holder lives. A lease that ended
+ meanwhile: `LIMBER_CODE_LEASE_LOST` (nobody holds it now) or `LIMBER_CODE_REFUSED` with
+ `LIMBER_STATUS_LEASED` (another client took it).
+
+ # Safety
+ `h` is NULL or a live handle.
+ */
+limber_code limber_actarray_renew(struct limber_actarray *h);
+
+/*
+ For a control loop: renews the lease when a third of its heartbeat has passed since the
+ last renewal (`*renewed`, if not NULL, says whether it did); does nothing when no lease
+ is held. Fails as `limber_actarray_renew`.
+
+ # Safety
+ `h` is NULL or a live handle; `renewed` is NULL or writable.
+ */
+limber_code limber_actarray_keep_lease(struct limber_actarray *h, bool *renewed);
+
+/*
+ Gives the control lease back (the motion in progress goes on). Without a lease it does
+ nothing. (`limber_actarray_release` ends the loan of a borrowed state.)
+
+ # Safety
+ `h` is NULL or a live handle.
+ */
+limber_code limber_actarray_release_lease(struct limber_actarray *h);
+
+/*
+ Who holds the device's control lease: `out->client_id` is 0 when nobody does. Asks the
+ driver (waits for its answer up to 2 s).
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_actarray_holder(struct limber_actarray *h, struct limber_lease_holder *out);
+
+/*
+ Whether another client's command cut short the motion that the command of `ticket`
+ started (the driver's second outcome, `LIMBER_STATUS_PREEMPTED`): `*preempted`, and
+ `*by_client` (NULL: not written; 0 if not preempted) the preempting client's id. Looks
+ at the outcomes that arrived, without waiting; remembers this handle's last 256
+ commands.
+
+ # Safety
+ `h` is NULL or a live handle; `preempted` is NULL or writable; `by_client` is NULL or
+ writable.
+ */
+limber_code limber_actarray_preempted(struct limber_actarray *h,
+                                      struct limber_ticket ticket,
+                                      bool *preempted,
+                                      uint64_t *by_client);
+
+/*
  Lists the devices of `domain` (NULL: `LIMBER_DOMAIN`, or "limber"), sorted by name:
  writes the first `capacity` into `out[]` and the number found into `*count` (which
  may exceed `capacity`: call again with a larger array). `out` may be NULL when
@@ -589,7 +715,7 @@ limber_code limber_gripper_state(struct limber_gripper *h,
  Lends the latest state in place, without a copy (waiting up to `timeout_ms` for a
  first one): `*out` points into shared memory and stays valid and unchanged until
  `limber_gripper_release` (or disconnect). Meanwhile the calls that read states
- (state, borrow, wait_state, wait_outcome, liveness) fail with `LIMBER_CODE_BORROWED`;
+ (state, borrow, wait_state, wait_outcome, preempted, liveness) fail with `LIMBER_CODE_BORROWED`;
  commands and requests work.
 
  # Safety
@@ -621,7 +747,10 @@ limber_code limber_gripper_wait_state(struct limber_gripper *h,
 
 /*
  Waits up to `timeout_ms` for the outcome of the command of `ticket`; `*status` is the
- driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out).
+ driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out). A status other than OK is
+ also kept for `limber_last_refusal()` and `limber_last_error()`, which for
+ `LIMBER_STATUS_LEASED` names the client holding the device ("refused: held by another
+ client (alice, client 123)"); the call still returns `LIMBER_CODE_OK`.
 
  # Safety
  `h` is NULL or a live handle; `status` is NULL or writable.
@@ -703,6 +832,87 @@ limber_code limber_gripper_geometry(struct limber_gripper *h,
                                     limber_gripper_geom *out);
 
 /*
+ This handle's client id: how the driver, outcomes (`limber_gripper_preempted`) and
+ `limber_gripper_holder` name it.
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_gripper_client_id(struct limber_gripper *h, uint64_t *out);
+
+/*
+ Takes the device's control lease as `name` (NULL: this program's name; 1 to 31 bytes,
+ else `LIMBER_CODE_INVALID_VALUE`). Until `limber_gripper_release_lease` (or disconnect),
+ other clients' commands, and their requests that change the device, are refused as
+ `LIMBER_STATUS_LEASED` naming `name`; readers are unaffected. Renew it at least every
+ `heartbeat_ms` (`limber_gripper_renew`, or `limber_gripper_keep_lease` in a loop): when the
+ heartbeat is missed, or this process dies, the driver stops the device and frees it.
+ Acquiring again sets a new heartbeat. Held by another client: `LIMBER_CODE_REFUSED`,
+ `limber_last_refusal()` is `LIMBER_STATUS_LEASED` and `limber_last_error()` names the
+ holder. Waits for the driver's answer up to 2 s.
+
+ # Safety
+ `h` is NULL or a live handle; `name` is NULL or a NUL-terminated string.
+ */
+limber_code limber_gripper_acquire(struct limber_gripper *h,
+                                   const char *name,
+                                   uint64_t heartbeat_ms);
+
+/*
+ The lease's heartbeat: tells the driver this holder lives. A lease that ended
+ meanwhile: `LIMBER_CODE_LEASE_LOST` (nobody holds it now) or `LIMBER_CODE_REFUSED` with
+ `LIMBER_STATUS_LEASED` (another client took it).
+
+ # Safety
+ `h` is NULL or a live handle.
+ */
+limber_code limber_gripper_renew(struct limber_gripper *h);
+
+/*
+ For a control loop: renews the lease when a third of its heartbeat has passed since the
+ last renewal (`*renewed`, if not NULL, says whether it did); does nothing when no lease
+ is held. Fails as `limber_gripper_renew`.
+
+ # Safety
+ `h` is NULL or a live handle; `renewed` is NULL or writable.
+ */
+limber_code limber_gripper_keep_lease(struct limber_gripper *h, bool *renewed);
+
+/*
+ Gives the control lease back (the motion in progress goes on). Without a lease it does
+ nothing. (`limber_gripper_release` ends the loan of a borrowed state.)
+
+ # Safety
+ `h` is NULL or a live handle.
+ */
+limber_code limber_gripper_release_lease(struct limber_gripper *h);
+
+/*
+ Who holds the device's control lease: `out->client_id` is 0 when nobody does. Asks the
+ driver (waits for its answer up to 2 s).
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_gripper_holder(struct limber_gripper *h, struct limber_lease_holder *out);
+
+/*
+ Whether another client's command cut short the motion that the command of `ticket`
+ started (the driver's second outcome, `LIMBER_STATUS_PREEMPTED`): `*preempted`, and
+ `*by_client` (NULL: not written; 0 if not preempted) the preempting client's id. Looks
+ at the outcomes that arrived, without waiting; remembers this handle's last 256
+ commands.
+
+ # Safety
+ `h` is NULL or a live handle; `preempted` is NULL or writable; `by_client` is NULL or
+ writable.
+ */
+limber_code limber_gripper_preempted(struct limber_gripper *h,
+                                     struct limber_ticket ticket,
+                                     bool *preempted,
+                                     uint64_t *by_client);
+
+/*
  Connects to the limb `device` ("robot/limb/index") in `domain` (NULL:
  the `LIMBER_DOMAIN` environment variable, or "limber"), waiting up to `timeout_ms` for a
  driver to offer it. On success `*out` is the new handle; free it with
@@ -738,7 +948,7 @@ limber_code limber_limb_state(struct limber_limb *h, uint64_t timeout_ms, limber
  Lends the latest state in place, without a copy (waiting up to `timeout_ms` for a
  first one): `*out` points into shared memory and stays valid and unchanged until
  `limber_limb_release` (or disconnect). Meanwhile the calls that read states
- (state, borrow, wait_state, wait_outcome, liveness) fail with `LIMBER_CODE_BORROWED`;
+ (state, borrow, wait_state, wait_outcome, preempted, liveness) fail with `LIMBER_CODE_BORROWED`;
  commands and requests work.
 
  # Safety
@@ -770,7 +980,10 @@ limber_code limber_limb_wait_state(struct limber_limb *h,
 
 /*
  Waits up to `timeout_ms` for the outcome of the command of `ticket`; `*status` is the
- driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out).
+ driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out). A status other than OK is
+ also kept for `limber_last_refusal()` and `limber_last_error()`, which for
+ `LIMBER_STATUS_LEASED` names the client holding the device ("refused: held by another
+ client (alice, client 123)"); the call still returns `LIMBER_CODE_OK`.
 
  # Safety
  `h` is NULL or a live handle; `status` is NULL or writable.
@@ -900,6 +1113,85 @@ limber_code limber_limb_can_reach(struct limber_limb *h,
                                   limber_vec3 orientation,
                                   uint64_t timeout_ms,
                                   limber_limb_reach *out);
+
+/*
+ This handle's client id: how the driver, outcomes (`limber_limb_preempted`) and
+ `limber_limb_holder` name it.
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_limb_client_id(struct limber_limb *h, uint64_t *out);
+
+/*
+ Takes the device's control lease as `name` (NULL: this program's name; 1 to 31 bytes,
+ else `LIMBER_CODE_INVALID_VALUE`). Until `limber_limb_release_lease` (or disconnect),
+ other clients' commands, and their requests that change the device, are refused as
+ `LIMBER_STATUS_LEASED` naming `name`; readers are unaffected. Renew it at least every
+ `heartbeat_ms` (`limber_limb_renew`, or `limber_limb_keep_lease` in a loop): when the
+ heartbeat is missed, or this process dies, the driver stops the device and frees it.
+ Acquiring again sets a new heartbeat. Held by another client: `LIMBER_CODE_REFUSED`,
+ `limber_last_refusal()` is `LIMBER_STATUS_LEASED` and `limber_last_error()` names the
+ holder. Waits for the driver's answer up to 2 s.
+
+ # Safety
+ `h` is NULL or a live handle; `name` is NULL or a NUL-terminated string.
+ */
+limber_code limber_limb_acquire(struct limber_limb *h, const char *name, uint64_t heartbeat_ms);
+
+/*
+ The lease's heartbeat: tells the driver this holder lives. A lease that ended
+ meanwhile: `LIMBER_CODE_LEASE_LOST` (nobody holds it now) or `LIMBER_CODE_REFUSED` with
+ `LIMBER_STATUS_LEASED` (another client took it).
+
+ # Safety
+ `h` is NULL or a live handle.
+ */
+limber_code limber_limb_renew(struct limber_limb *h);
+
+/*
+ For a control loop: renews the lease when a third of its heartbeat has passed since the
+ last renewal (`*renewed`, if not NULL, says whether it did); does nothing when no lease
+ is held. Fails as `limber_limb_renew`.
+
+ # Safety
+ `h` is NULL or a live handle; `renewed` is NULL or writable.
+ */
+limber_code limber_limb_keep_lease(struct limber_limb *h, bool *renewed);
+
+/*
+ Gives the control lease back (the motion in progress goes on). Without a lease it does
+ nothing. (`limber_limb_release` ends the loan of a borrowed state.)
+
+ # Safety
+ `h` is NULL or a live handle.
+ */
+limber_code limber_limb_release_lease(struct limber_limb *h);
+
+/*
+ Who holds the device's control lease: `out->client_id` is 0 when nobody does. Asks the
+ driver (waits for its answer up to 2 s).
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_limb_holder(struct limber_limb *h, struct limber_lease_holder *out);
+
+/*
+ Whether another client's command cut short the motion that the command of `ticket`
+ started (the driver's second outcome, `LIMBER_STATUS_PREEMPTED`): `*preempted`, and
+ `*by_client` (NULL: not written; 0 if not preempted) the preempting client's id. Looks
+ at the outcomes that arrived, without waiting; remembers this handle's last 256
+ commands.
+
+ # Safety
+ `h` is NULL or a live handle; `preempted` is NULL or writable; `by_client` is NULL or
+ writable.
+ */
+limber_code limber_limb_preempted(struct limber_limb *h,
+                                  struct limber_ticket ticket,
+                                  bool *preempted,
+                                  uint64_t *by_client);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -29,7 +29,8 @@ use std::sync::OnceLock;
 
 use limber_interfaces::prelude::*;
 use limber_services::client::{
-    Client, CommandError, ConnectError, DriverStatus, Freshness, RequestError, Ticket, WaitError,
+    Client, CommandError, ConnectError, DriverStatus, Freshness, LeaseError, Outcome, RequestError,
+    Ticket, WaitError,
 };
 use limber_services::{Context, Domain, ListError, NameError, Role};
 
@@ -81,10 +82,13 @@ pub enum LimberCode {
     Transport = 13,
     /// An internal error in limber (a panic was caught at the boundary); please report it.
     Internal = 14,
+    /// The control lease of this handle ended (its heartbeat was missed, or the driver
+    /// restarted): the driver stopped the device; acquire it again to go on.
+    LeaseLost = 15,
 }
 
 /// Every code, in order.
-const ALL_CODES: [LimberCode; 15] = [
+const ALL_CODES: [LimberCode; 16] = [
     LimberCode::Ok,
     LimberCode::NullArgument,
     LimberCode::BadUtf8,
@@ -100,6 +104,7 @@ const ALL_CODES: [LimberCode; 15] = [
     LimberCode::BadReply,
     LimberCode::Transport,
     LimberCode::Internal,
+    LimberCode::LeaseLost,
 ];
 
 impl LimberCode {
@@ -121,6 +126,7 @@ impl LimberCode {
             LimberCode::BadReply => c"the reply could not be decoded",
             LimberCode::Transport => c"shared-memory transport failed (iceoryx2)",
             LimberCode::Internal => c"internal error in limber (please report it)",
+            LimberCode::LeaseLost => c"the lease was lost (heartbeat missed)",
         }
     }
 }
@@ -134,6 +140,23 @@ pub struct LimberTicket {
     /// How many driver processes received it (normally 1).
     pub receivers: u64,
 }
+
+/// Who holds a device's control lease (`limber_*_holder`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct LimberLeaseHolder {
+    /// The holder's client id (as `limber_*_client_id` gives it); 0: nobody holds the
+    /// device (then the other fields are zero).
+    pub client_id: u64,
+    /// The holder's heartbeat: it renews at least this often (ms).
+    pub heartbeat_ms: u64,
+    /// The holder's name, NUL-terminated (at most `LIMBER_LEASE_NAME_MAX` bytes).
+    pub name: [c_char; 32],
+}
+
+/// The longest name of a lease holder, in bytes (`limber_*_acquire`).
+pub const LIMBER_LEASE_NAME_MAX: usize = 31;
+const _: () = assert!(LIMBER_LEASE_NAME_MAX + 1 == 32);
 
 /// How fresh a handle's latest state is (`limber_*_liveness`).
 #[repr(i32)]
@@ -172,15 +195,18 @@ pub extern "C" fn limber_strerror(code: i32) -> *const c_char {
 }
 
 /// Returns the detail of the last failure of a limber call on this thread (e.g. "no driver
-/// offers pioneer/limb/7 in domain limber (is the driver running? ...)"), or "" if none
-/// failed yet. Valid until the next limber call on this thread. Never NULL.
+/// offers pioneer/limb/7 in domain limber (is the driver running? ...)"), or of the last
+/// outcome other than `LIMBER_STATUS_OK` that `limber_*_wait_outcome` returned (e.g.
+/// "refused: held by another client (alice, client 123)"), or "" if none failed yet. Valid
+/// until the next limber call on this thread. Never NULL.
 #[unsafe(no_mangle)]
 pub extern "C" fn limber_last_error() -> *const c_char {
     LAST_ERROR.with(|e| e.borrow().as_ptr())
 }
 
 /// Returns the driver's reason (a `LIMBER_STATUS_*` of limber.h) of the last
-/// `LIMBER_CODE_REFUSED` on this thread, or `LIMBER_STATUS_OK` if there was none.
+/// `LIMBER_CODE_REFUSED` on this thread, or of the last outcome other than OK that
+/// `limber_*_wait_outcome` returned; `LIMBER_STATUS_OK` if there was none.
 #[unsafe(no_mangle)]
 pub extern "C" fn limber_last_refusal() -> u32 {
     LAST_REFUSAL.with(Cell::get)
@@ -310,6 +336,24 @@ impl From<WaitError> for Fail {
     }
 }
 
+impl From<LeaseError> for Fail {
+    fn from(e: LeaseError) -> Self {
+        let (code, refusal) = match &e {
+            LeaseError::Held { .. } => (LimberCode::Refused, Status::Leased),
+            LeaseError::Refused(s) => (LimberCode::Refused, *s),
+            LeaseError::Lost => (LimberCode::LeaseLost, Status::Ok),
+            LeaseError::Timeout(_) => (LimberCode::Timeout, Status::Ok),
+            LeaseError::NoDriver => (LimberCode::NoDriver, Status::Ok),
+            LeaseError::DriverGone => (LimberCode::DriverGone, Status::Ok),
+            LeaseError::Decode(_) => (LimberCode::BadReply, Status::Ok),
+            LeaseError::Transport(_) => (LimberCode::Transport, Status::Ok),
+        };
+        let mut f = Fail::from_error(code, &e);
+        f.refusal = refusal as u32;
+        f
+    }
+}
+
 impl From<ValueError> for Fail {
     fn from(e: ValueError) -> Self {
         Fail::from_error(LimberCode::InvalidValue, &e)
@@ -397,7 +441,7 @@ pub(crate) fn ms(timeout_ms: u64) -> Duration {
 ///
 /// A lent sample is the client's latest one, which only [`Client::refresh`] replaces (and
 /// with it releases the old one to the driver, who may overwrite it). Every call that
-/// refreshes (state, current, wait_state, wait_outcome, freshness) is refused while a
+/// refreshes (state, current, wait_state, wait_outcome, preempted, freshness) is refused while a
 /// sample is lent; commands, requests and `driver_status` do not refresh and stay allowed.
 pub(crate) struct Handle<I: Interface> {
     pub(crate) client: Client<I>,
@@ -483,18 +527,90 @@ impl<I: Interface> Handle<I> {
         Ok(())
     }
 
-    /// Waits up to `timeout_ms` for the outcome of `ticket` (a `LIMBER_STATUS_*`).
+    /// Waits up to `timeout_ms` for the outcome of `ticket` (a `LIMBER_STATUS_*`). An
+    /// outcome other than `LIMBER_STATUS_OK` is kept for `limber_last_error` and
+    /// `limber_last_refusal` too (for `LIMBER_STATUS_LEASED`, with the holder's name).
     pub(crate) fn wait_outcome(
         &mut self,
         ticket: &LimberTicket,
         timeout_ms: u64,
     ) -> Result<u32, Fail> {
         self.not_borrowed()?;
-        let t = Ticket {
-            seq: ticket.seq,
-            receivers: usize::try_from(ticket.receivers).unwrap_or(usize::MAX),
+        let o = self
+            .client
+            .wait_outcome_detail(ticket_of(ticket), ms(timeout_ms))?;
+        if o.status != Status::Ok {
+            let mut f = Fail::new(LimberCode::Refused, outcome_text(&o));
+            f.refusal = o.status as u32;
+            f.record();
+        }
+        Ok(o.status as u32)
+    }
+
+    /// Takes the device's control lease as `name` (`None`: this process's name),
+    /// renewed at least every `heartbeat_ms`.
+    pub(crate) fn acquire(&mut self, name: Option<&str>, heartbeat_ms: u64) -> Result<(), Fail> {
+        let name = match name {
+            Some(n) => n.to_string(),
+            None => {
+                let mut n = process_name();
+                n.truncate(LIMBER_LEASE_NAME_MAX);
+                n
+            }
         };
-        Ok(self.client.wait_outcome(t, ms(timeout_ms))? as u32)
+        if name.is_empty() || name.len() > LIMBER_LEASE_NAME_MAX {
+            return Err(Fail::new(
+                LimberCode::InvalidValue,
+                format!(
+                    "a lease name has 1 to {LIMBER_LEASE_NAME_MAX} bytes, not {} ({name:?})",
+                    name.len()
+                ),
+            ));
+        }
+        self.client.acquire(&name, ms(heartbeat_ms))?;
+        Ok(())
+    }
+
+    /// The heartbeat of the lease.
+    pub(crate) fn renew(&mut self) -> Result<(), Fail> {
+        Ok(self.client.renew()?)
+    }
+
+    /// Renews the lease when a third of its heartbeat has passed; whether it did.
+    pub(crate) fn keep_lease(&mut self) -> Result<bool, Fail> {
+        Ok(self.client.keep_lease()?)
+    }
+
+    /// Gives the lease back (nothing to do when none is held).
+    pub(crate) fn release_lease(&mut self) -> Result<(), Fail> {
+        Ok(self.client.release()?)
+    }
+
+    /// Who holds the device (client id 0: nobody).
+    pub(crate) fn holder(&mut self) -> Result<LimberLeaseHolder, Fail> {
+        let mut out = LimberLeaseHolder::default();
+        if let Some(h) = self.client.holder()? {
+            out.client_id = h.client_id;
+            out.heartbeat_ms = u64::try_from(h.timeout.as_millis()).unwrap_or(u64::MAX);
+            let mut n = h.name.len().min(LIMBER_LEASE_NAME_MAX);
+            while !h.name.is_char_boundary(n) {
+                n -= 1;
+            }
+            for (d, b) in out.name.iter_mut().zip(&h.name.as_bytes()[..n]) {
+                *d = *b as c_char;
+            }
+        }
+        Ok(out)
+    }
+
+    /// Whether another client's command cut short the motion of `ticket`'s command (as
+    /// far as the outcomes that arrived tell): the preempting client's id if so.
+    pub(crate) fn preempted(&mut self, ticket: &LimberTicket) -> Result<Option<u64>, Fail> {
+        self.not_borrowed()?;
+        Ok(self
+            .client
+            .preempted(ticket_of(ticket))?
+            .map(|o| o.other_client))
     }
 
     /// Alive (a state younger than `max_age_ms`), stale, gone, or no data yet.
@@ -521,6 +637,32 @@ impl<I: Interface> Handle<I> {
     pub(crate) fn request(&mut self, req: &I::Request, timeout_ms: u64) -> Result<I::Reply, Fail> {
         Ok(self.client.request_with_timeout(req, ms(timeout_ms))?)
     }
+}
+
+fn ticket_of(t: &LimberTicket) -> Ticket {
+    Ticket {
+        seq: t.seq,
+        receivers: usize::try_from(t.receivers).unwrap_or(usize::MAX),
+    }
+}
+
+/// The detail of an outcome that is not OK: its status, and the other client involved.
+fn outcome_text(o: &Outcome) -> String {
+    let mut t = format!("refused: {}", o.status.describe());
+    if o.status == Status::Leased {
+        let name = if o.other_name().is_empty() {
+            "unnamed"
+        } else {
+            o.other_name()
+        };
+        t = format!(
+            "refused: held by another client ({name}, client {})",
+            o.other_client
+        );
+    } else if o.other_client != 0 {
+        t.push_str(&format!(" (by client {})", o.other_client));
+    }
+    t
 }
 
 /// Writes a sent command's ticket (if `out` is given).

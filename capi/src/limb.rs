@@ -5,8 +5,8 @@ use core::ffi::c_char;
 use limber_interfaces::prelude::*;
 
 use crate::{
-    Fail, Handle, LimberCode, LimberDriverStatus, LimberLiveness, LimberTicket, arg, guard,
-    opt_str, req_str, sent,
+    Fail, Handle, LimberCode, LimberDriverStatus, LimberLeaseHolder, LimberLiveness, LimberTicket,
+    arg, guard, opt_str, req_str, sent,
 };
 
 /// A connection to a limb (opaque). Use it from one thread at a time.
@@ -80,7 +80,7 @@ pub unsafe extern "C" fn limber_limb_state(
 /// Lends the latest state in place, without a copy (waiting up to `timeout_ms` for a
 /// first one): `*out` points into shared memory and stays valid and unchanged until
 /// `limber_limb_release` (or disconnect). Meanwhile the calls that read states
-/// (state, borrow, wait_state, wait_outcome, liveness) fail with `LIMBER_CODE_BORROWED`;
+/// (state, borrow, wait_state, wait_outcome, preempted, liveness) fail with `LIMBER_CODE_BORROWED`;
 /// commands and requests work.
 ///
 /// # Safety
@@ -133,7 +133,10 @@ pub unsafe extern "C" fn limber_limb_wait_state(
 }
 
 /// Waits up to `timeout_ms` for the outcome of the command of `ticket`; `*status` is the
-/// driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out).
+/// driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out). A status other than OK is
+/// also kept for `limber_last_refusal()` and `limber_last_error()`, which for
+/// `LIMBER_STATUS_LEASED` names the client holding the device ("refused: held by another
+/// client (alice, client 123)"); the call still returns `LIMBER_CODE_OK`.
 ///
 /// # Safety
 /// `h` is NULL or a live handle; `status` is NULL or writable.
@@ -394,5 +397,148 @@ pub unsafe extern "C" fn limber_limb_can_reach(
                 "the driver answered REACH without a pose",
             )),
         }
+    })
+}
+
+// ----- control: who commands the device ------------------------------------------------
+
+/// This handle's client id: how the driver, outcomes (`limber_limb_preempted`) and
+/// `limber_limb_holder` name it.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_client_id(h: *mut LimberLimb, out: *mut u64) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        *out = h.0.client.client_id();
+        Ok(())
+    })
+}
+
+/// Takes the device's control lease as `name` (NULL: this program's name; 1 to 31 bytes,
+/// else `LIMBER_CODE_INVALID_VALUE`). Until `limber_limb_release_lease` (or disconnect),
+/// other clients' commands, and their requests that change the device, are refused as
+/// `LIMBER_STATUS_LEASED` naming `name`; readers are unaffected. Renew it at least every
+/// `heartbeat_ms` (`limber_limb_renew`, or `limber_limb_keep_lease` in a loop): when the
+/// heartbeat is missed, or this process dies, the driver stops the device and frees it.
+/// Acquiring again sets a new heartbeat. Held by another client: `LIMBER_CODE_REFUSED`,
+/// `limber_last_refusal()` is `LIMBER_STATUS_LEASED` and `limber_last_error()` names the
+/// holder. Waits for the driver's answer up to 2 s.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `name` is NULL or a NUL-terminated string.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_acquire(
+    h: *mut LimberLimb,
+    name: *const c_char,
+    heartbeat_ms: u64,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, name) = unsafe { (arg(h, "handle")?, opt_str(name, "name")?) };
+        h.0.acquire(name, heartbeat_ms)
+    })
+}
+
+/// The lease's heartbeat: tells the driver this holder lives. A lease that ended
+/// meanwhile: `LIMBER_CODE_LEASE_LOST` (nobody holds it now) or `LIMBER_CODE_REFUSED` with
+/// `LIMBER_STATUS_LEASED` (another client took it).
+///
+/// # Safety
+/// `h` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_renew(h: *mut LimberLimb) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointer, checked for NULL here.
+        unsafe { arg(h, "handle")? }.0.renew()
+    })
+}
+
+/// For a control loop: renews the lease when a third of its heartbeat has passed since the
+/// last renewal (`*renewed`, if not NULL, says whether it did); does nothing when no lease
+/// is held. Fails as `limber_limb_renew`.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `renewed` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_keep_lease(
+    h: *mut LimberLimb,
+    renewed: *mut bool,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, renewed) = unsafe { (arg(h, "handle")?, renewed.as_mut()) };
+        let r = h.0.keep_lease()?;
+        if let Some(out) = renewed {
+            *out = r;
+        }
+        Ok(())
+    })
+}
+
+/// Gives the control lease back (the motion in progress goes on). Without a lease it does
+/// nothing. (`limber_limb_release` ends the loan of a borrowed state.)
+///
+/// # Safety
+/// `h` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_release_lease(h: *mut LimberLimb) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointer, checked for NULL here.
+        unsafe { arg(h, "handle")? }.0.release_lease()
+    })
+}
+
+/// Who holds the device's control lease: `out->client_id` is 0 when nobody does. Asks the
+/// driver (waits for its answer up to 2 s).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_holder(
+    h: *mut LimberLimb,
+    out: *mut LimberLeaseHolder,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        *out = h.0.holder()?;
+        Ok(())
+    })
+}
+
+/// Whether another client's command cut short the motion that the command of `ticket`
+/// started (the driver's second outcome, `LIMBER_STATUS_PREEMPTED`): `*preempted`, and
+/// `*by_client` (NULL: not written; 0 if not preempted) the preempting client's id. Looks
+/// at the outcomes that arrived, without waiting; remembers this handle's last 256
+/// commands.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `preempted` is NULL or writable; `by_client` is NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_preempted(
+    h: *mut LimberLimb,
+    ticket: LimberTicket,
+    preempted: *mut bool,
+    by_client: *mut u64,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, preempted, by_client) = unsafe {
+            (
+                arg(h, "handle")?,
+                arg(preempted, "preempted")?,
+                by_client.as_mut(),
+            )
+        };
+        let p = h.0.preempted(&ticket)?;
+        *preempted = p.is_some();
+        if let Some(out) = by_client {
+            *out = p.unwrap_or(0);
+        }
+        Ok(())
     })
 }

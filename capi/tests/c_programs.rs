@@ -659,3 +659,40 @@ fn every_command_and_request_reaches_the_driver_as_itself() {
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert_eq!(text(&o.stdout), PIONEER_VERDICTS);
 }
+
+#[test]
+fn a_lease_refuses_the_other_client_by_name_and_preemption_and_the_deadman_are_told() {
+    let dir = scratch("lease");
+    let (c, cpp) = (dir.join("lease"), dir.join("lease_cpp"));
+    compile("lease.c", &c, &[]);
+    compile("lease.cpp", &cpp, &[]);
+    let p = Pioneer::start();
+    let o = run_in(&p, &c, &[]);
+    let out = text(&o.stdout);
+    assert!(o.status.success(), "{out}\n{}", text(&o.stderr));
+    for line in [
+        "empty name: invalid value; nothing was sent: a lease name has 1 to 31 bytes, not 0",
+        "holder: alice",
+        "bob's move: held by another client: refused: held by another client (alice, client ",
+        "bob's acquire: the driver refused the request: held by another client (alice)",
+        "bob's move after release: ok",
+        "limb holder: lease",
+        "gripper lease ok",
+        "alice's slow move preempted by bob",
+        "alice's renew after the deadman: the lease was lost (heartbeat missed)",
+        "all lease steps ok",
+    ] {
+        assert!(out.contains(line), "{line:?} not in:\n{out}");
+    }
+    let o = run_in(&p, &cpp, &[]);
+    let out = text(&o.stdout);
+    assert!(o.status.success(), "{out}\n{}", text(&o.stderr));
+    assert!(
+        out.contains(
+            "refused: the driver refused the request: held by another client (cpp-holder)"
+        ),
+        "{out}"
+    );
+    assert!(out.contains("holder: lease_cpp"), "{out}");
+    assert!(out.contains("all C++ lease steps ok"), "{out}");
+}
