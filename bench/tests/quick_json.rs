@@ -69,6 +69,7 @@ fn quick_run_writes_a_well_formed_report() {
         "ik.pioneer.pose",
         "ik.chain6.pose",
         "loop.to_robot",
+        "loop.driver",
         "loop.to_client",
         "loop.total",
     ] {

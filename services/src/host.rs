@@ -32,6 +32,9 @@ pub struct Origin {
     pub seq: u64,
     /// When the client sent it (`CLOCK_MONOTONIC` ns).
     pub sent_ns: u64,
+    /// When the driver took it from the channel (`CLOCK_MONOTONIC` ns; 0 for the driver's
+    /// own commands): what the driver does from here on is its own cost.
+    pub received_ns: u64,
 }
 
 /// What a driver implements for each interface it serves: `DeviceHandler<ActArray>`,
@@ -739,6 +742,7 @@ impl<I: Interface> DeviceHost<I> {
                 client_id: meta.client_id,
                 seq: meta.seq,
                 sent_ns: meta.stamp_ns,
+                received_ns: monotonic_ns(),
             };
             self.stats.overflows += self.clients.record(meta.client_id, meta.seq);
             let holder = self.lease.filter(|l| l.client_id != meta.client_id);
@@ -1032,6 +1036,7 @@ impl<I: Interface> DeviceHost<I> {
                 client_id: meta.client_id,
                 seq: meta.seq,
                 sent_ns: meta.stamp_ns,
+                received_ns: monotonic_ns(),
             };
             let holder = self.lease.filter(|l| l.client_id != meta.client_id);
             let reply = match I::Request::read(raw) {

@@ -9,12 +9,12 @@
 //! * `command → robot reply read by the driver`: the client's send stamp to the state's
 //!   acquisition stamp (`StateHeader::stamp_ns` = when the driver read the ARMpac):
 //!   client → driver, validation, the serial write, the emulator, the ARMpac back;
+//! * `command arrival → bytes on the pty`: inside that, the driver's own cost, from taking
+//!   the command off its channel to the P2OS bytes written (validation, encoding, the
+//!   write), measured by the driver (`LoopStats::arrival_to_wire`; the last 512 commands);
 //! * `reply read → client sees the state`: acquisition stamp to the client's receipt
 //!   (driver publish, notify, client wake-up);
 //! * the total, client send → client receipt.
-//!
-//! The driver's own command-to-wire latency is in its statistics (`limber echo
-//! pioneer/driver`).
 
 use std::time::{Duration, Instant};
 
@@ -25,7 +25,7 @@ use limber_services::{Role, monotonic_ns};
 use super::request::{DEVICE, START_TIMEOUT};
 use super::{RunCtx, Scenario};
 use crate::BenchError;
-use crate::child::{ChildProc, ChildSpec};
+use crate::child::{ChildProc, ChildSpec, read_histogram};
 use crate::progress::Progress;
 use crate::stats::{Measurement, Metric, Strategy, new_histogram};
 
@@ -55,9 +55,11 @@ impl Scenario for Loop {
         }
         let domain = ctx.domain();
         let (warm, n) = (ctx.count(50, 20), ctx.count(1_000, 200));
+        let out = ctx.tmp_file("loop-driver.hdr");
         let mut child = ChildProc::spawn(&ChildSpec {
             role: "pioneer-driver".into(),
             domain: Some(domain.name().to_string()),
+            out: Some(out.clone()),
             cpu: ctx.child_cpu(),
             deadline: ctx.deadline_for(warm + n, Duration::from_millis(20)),
             ..Default::default()
@@ -102,6 +104,7 @@ impl Scenario for Loop {
             tracing::warn!("cannot tell the client child to quit: {e}");
         }
         child.finish(Duration::from_secs(10))?;
+        let driver = read_histogram(&out)?;
         let bytes = Some((
             core::mem::size_of::<ActArrayCmdMsg>(),
             core::mem::size_of::<ActArrayData>(),
@@ -112,6 +115,12 @@ impl Scenario for Loop {
                 "command → robot reply read by the driver (emulator fast mode)",
                 Metric::OneWay,
                 to_robot,
+            ),
+            (
+                "loop.driver",
+                "command arrival → bytes on the pty (the driver's own cost)",
+                Metric::OneWay,
+                driver,
             ),
             (
                 "loop.to_client",

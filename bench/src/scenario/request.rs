@@ -134,10 +134,25 @@ pub fn driver_role(args: &BenchArgs) -> Result<(), BenchError> {
             }
         },
     );
+    // The driver's own cost per command (arrival → bytes on the pty), for `loop`.
+    let written = match &args.out {
+        Some(_) => {
+            let mut h = new_histogram()?;
+            for ns in driver.loop_stats().arrival_to_wire.samples() {
+                h.saturating_record(*ns);
+            }
+            Some(h)
+        }
+        None => None,
+    };
     drop(driver);
     if let Err(e) = emu.stop() {
         tracing::warn!("stopping the emulator: {e}");
     }
     r.map(|_| ())
-        .map_err(|e| err("pioneer driver loop", e.to_string()))
+        .map_err(|e| err("pioneer driver loop", e.to_string()))?;
+    match written {
+        Some(h) => roles::write_histogram(args, &h),
+        None => Ok(()),
+    }
 }

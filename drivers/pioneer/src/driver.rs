@@ -134,6 +134,7 @@ fn origin_internal() -> Origin {
         client_id: 0,
         seq: 0,
         sent_ns: 0,
+        received_ns: 0,
     }
 }
 
@@ -675,6 +676,11 @@ impl PioneerDriver {
     /// see `tests/tests/alloc.rs`), and statistics samples.
     pub fn samples_published(&self) -> u64 {
         self.stats.header.seq + self.hosts.stats().published
+    }
+
+    /// The loop's timing: periods, jitter, command-to-wire latencies.
+    pub fn loop_stats(&self) -> &crate::stats::LoopStats {
+        &self.robot.stats
     }
 
     /// True while the link is up.

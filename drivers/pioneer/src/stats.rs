@@ -34,6 +34,11 @@ impl Ring {
         self.max = self.max.max(ns);
     }
 
+    /// The samples in the ring (the latest, at most 512), in no particular order.
+    pub fn samples(&self) -> &[u64] {
+        &self.samples[..self.len]
+    }
+
     /// (p50, p99, max since start) of the samples in the ring; zeros when empty.
     pub fn summary(&self) -> (u64, u64, u64) {
         if self.len == 0 {
@@ -61,6 +66,9 @@ pub struct LoopStats {
     pub jitter: Ring,
     /// Client send → bytes on the wire.
     pub cmd_to_wire: Ring,
+    /// Command taken from the channel → bytes on the wire: the driver's own cost
+    /// (validation, IK, encoding, the write), without the way from the client.
+    pub arrival_to_wire: Ring,
     last_tick: Option<Instant>,
     /// SIPs counted in the current second.
     pub sips_this_second: u64,

@@ -362,10 +362,16 @@ impl RobotModel {
                 if let Command::ArmPower(on) = *cmd {
                     self.arm.power_commanded(on);
                 }
+                let now = monotonic_ns();
                 if from.sent_ns != 0 {
                     self.stats
                         .cmd_to_wire
-                        .push(monotonic_ns().saturating_sub(from.sent_ns));
+                        .push(now.saturating_sub(from.sent_ns));
+                }
+                if from.received_ns != 0 {
+                    self.stats
+                        .arrival_to_wire
+                        .push(now.saturating_sub(from.received_ns));
                 }
                 Ok(())
             }

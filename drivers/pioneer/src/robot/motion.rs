@@ -14,6 +14,7 @@ const DEADMAN: Origin = Origin {
     client_id: 0,
     seq: 0,
     sent_ns: 0,
+    received_ns: 0,
 };
 
 /// Bits of the five arm joints (the limb's), without the gripper (joint 5).
