@@ -105,6 +105,10 @@ impl Chain {
             pe <= options.position_tolerance && oe <= options.orientation_tolerance
         };
 
+        // Four times the cost of a residual exactly at both tolerances: above it, the
+        // tolerances cannot both be met whatever the round-off in either measure.
+        let near_cost = 4.0
+            * (options.position_tolerance.powi(2) + (w * options.orientation_tolerance).powi(2));
         let mut rng = DeterministicRng::new(options.seed);
         let mut q = JointVec::from_slice(seed).ok_or(ChainIkError::WrongJointCount {
             expected: n,
@@ -140,15 +144,19 @@ impl Chain {
                     best_cost = cost;
                     best_q = q;
                 }
-                let errs = errors(&pose);
-                if converged(errs) {
-                    return Ok(ChainSolution {
-                        q,
-                        position_error: errs.0,
-                        orientation_error: errs.1,
-                        iterations,
-                        restarts: attempt,
-                    });
+                // The residual bounds both errors (‖e‖² = pe² + (w·oe)²), so the exact
+                // errors are worth computing only once it is small.
+                if cost <= near_cost {
+                    let errs = errors(&pose);
+                    if converged(errs) {
+                        return Ok(ChainSolution {
+                            q,
+                            position_error: errs.0,
+                            orientation_error: errs.1,
+                            iterations,
+                            restarts: attempt,
+                        });
+                    }
                 }
                 if it == options.max_iterations {
                     break;
