@@ -167,16 +167,22 @@ impl Chain {
                     continue;
                 };
                 // Freeze joints that sit on a limit and would be pushed beyond it.
-                let mut frozen = false;
-                let mut jf = jac;
-                for (i, j) in self.joints.iter().enumerate() {
-                    let out = (q[i] <= j.min && dq[i] < 0.0) || (q[i] >= j.max && dq[i] > 0.0);
-                    if out {
-                        jf.column_mut(i).fill(0.0);
-                        frozen = true;
+                let pushed_out = |i: usize, j: &JointSpec| {
+                    (q[i] <= j.min && dq[i] < 0.0) || (q[i] >= j.max && dq[i] > 0.0)
+                };
+                if self
+                    .joints
+                    .iter()
+                    .enumerate()
+                    .any(|(i, j)| pushed_out(i, j))
+                {
+                    // Only then copy the Jacobian (6 × MAX_JOINTS) to zero columns.
+                    let mut jf = jac;
+                    for (i, j) in self.joints.iter().enumerate() {
+                        if pushed_out(i, j) {
+                            jf.column_mut(i).fill(0.0);
+                        }
                     }
-                }
-                if frozen {
                     match dls_step(&jf, &e, lambda, n) {
                         Some(d) => dq = d,
                         None => {
