@@ -242,6 +242,7 @@ impl PioneerGeometry {
             WristGoal::Frame(target),
             current,
             options.position_tolerance,
+            false,
         )
     }
 
@@ -301,6 +302,7 @@ impl PioneerGeometry {
             WristGoal::Approach(&a),
             current,
             options.position_tolerance,
+            false,
         )
     }
 
@@ -318,12 +320,17 @@ impl PioneerGeometry {
     }
 
     /// Closed-form candidates. `tol` widens the reachable annulus of the wrist centre.
+    /// With `in_limits_only`, candidates with an angle outside its limit are dropped as
+    /// soon as that angle is known (before the FK check that scores them): the
+    /// SETPOSITION search uses it once it knows that exact solutions exist, when only
+    /// the in-limit candidates can change its answer.
     pub(super) fn candidates(
         &self,
         p: &Vector3<f64>,
         goal: WristGoal<'_>,
         current: &Theta,
         tol: f64,
+        in_limits_only: bool,
     ) -> Result<IkCandidates, PioneerIkError> {
         let a = match goal {
             WristGoal::Frame(pose) => pose.approach(),
@@ -339,6 +346,10 @@ impl PioneerGeometry {
         let (dmin, dmax) = self.wrist_reach();
         let mut out = IkCandidates::new();
         let mut front_distance = f64::NAN;
+        let in_limit = |i: usize, v: f64| {
+            let l = self.limits[i];
+            fit_angle_to_limits(v, l.min, l.max, current[i], LIMIT_TOLERANCE).is_some()
+        };
         for (shoulder, t1) in [(Shoulder::Front, yaw), (Shoulder::Back, wrap_pi(yaw + PI))] {
             let (s1, c1) = t1.sin_cos();
             let r = c1 * w.x + s1 * w.y - self.l1;
@@ -348,6 +359,9 @@ impl PioneerGeometry {
                 front_distance = d;
             }
             if d > dmax + tol || d < dmin - tol {
+                continue;
+            }
+            if in_limits_only && !in_limit(0, t1) {
                 continue;
             }
             // |θ3| by the half-angle formula, tan²(θ3/2) = (1 − c3)/(1 + c3) with
@@ -423,6 +437,9 @@ impl PioneerGeometry {
                     s23,
                     c23,
                 } = *arm;
+                if in_limits_only && !(in_limit(1, t2) && in_limit(2, t3)) {
+                    continue;
+                }
                 // Columns of R0 = Rz(θ1)·Ry(−θ23).
                 let fx = Vector3::new(c1 * c23, s1 * c23, s23);
                 let fy = Vector3::new(-s1, c1, 0.0);
@@ -445,6 +462,9 @@ impl PioneerGeometry {
                                 Some(v) => theta[i] = v,
                                 None => within = false,
                             }
+                        }
+                        if in_limits_only && !within {
+                            return;
                         }
                         let fk = self.fk_trig(&Trig {
                             s1,

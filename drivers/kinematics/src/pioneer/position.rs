@@ -94,6 +94,10 @@ impl PioneerGeometry {
             orientation_tolerance: EXACT_ORIENTATION,
             ..*options
         };
+        // An approach is taken only for an in-limit candidate; the others matter only
+        // to tell "outside the limits" from "out of reach" at the end, so once an
+        // exact solution outside the limits has been seen they are no longer scored
+        // (the answer is the same, and each attempt costs a fraction).
         let mut attempt_with = |a: &Vector3<f64>, opts: &PioneerIkOptions| {
             let cands = self
                 .candidates(
@@ -101,6 +105,7 @@ impl PioneerGeometry {
                     WristGoal::Approach(a),
                     current,
                     opts.position_tolerance,
+                    any_exact,
                 )
                 .ok()?;
             match cands.select(current, opts) {
@@ -164,31 +169,64 @@ impl PioneerGeometry {
                 .is_some()
         };
         if !yaw_ok(yaw) || !yaw_ok(yaw + PI) {
-            let mut best: Option<(f64, IkCandidate)> = None;
-            for t1 in [yaw_limit.min, yaw_limit.max] {
+            let circles = [yaw_limit.min, yaw_limit.max].map(|t1| {
                 let (s1, c1) = t1.sin_cos();
                 let normal = Vector3::new(-s1, c1, 0.0);
                 let off = position.dot(&normal);
-                if off.abs() >= self.l5 {
-                    continue;
-                }
-                let r = (self.l5 * self.l5 - off * off).sqrt();
-                let centre = position - normal * off;
-                let e1 = Vector3::new(c1, s1, 0.0);
-                for j in 0..steps * 2 {
+                (off.abs() < self.l5).then(|| {
+                    let r = (self.l5 * self.l5 - off * off).sqrt();
+                    (position - normal * off, Vector3::new(c1, s1, 0.0), r)
+                })
+            });
+            let approach_at = |circle: usize, j: usize| {
+                circles[circle].map(|(centre, e1, r)| {
                     let psi = j as f64 * step;
                     let w = centre + (e1 * psi.cos() + Vector3::z() * psi.sin()) * r;
-                    let a = (position - w) / self.l5;
-                    if let Some(c) = attempt(&a) {
-                        let score = -a.dot(&preferred);
-                        if best.is_none_or(|(bs, _)| score < bs) {
-                            best = Some((score, c));
+                    (position - w) / self.l5
+                })
+            };
+            let per_circle = steps * 2;
+            if 2 * per_circle <= CIRCLE_SCAN_CAPACITY {
+                // Every approach on both circles, scored, then tried best first: the
+                // first feasible one is the one a full scan keeps (smallest score, ties
+                // to the earlier circle and angle), after a fraction of the attempts.
+                let mut order = [(0.0f64, 0u16); CIRCLE_SCAN_CAPACITY];
+                let mut len = 0;
+                for circle in 0..2 {
+                    for j in 0..per_circle {
+                        if let Some(a) = approach_at(circle, j) {
+                            order[len] = (-a.dot(&preferred), (circle * per_circle + j) as u16);
+                            len += 1;
                         }
                     }
                 }
-            }
-            if let Some((_, c)) = best {
-                return Ok(c);
+                let order = &mut order[..len];
+                order.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+                for &(_, index) in order.iter() {
+                    let index = usize::from(index);
+                    let a = approach_at(index / per_circle, index % per_circle);
+                    if let Some(c) = a.and_then(|a| attempt(&a)) {
+                        return Ok(c);
+                    }
+                }
+            } else {
+                let mut best: Option<(f64, IkCandidate)> = None;
+                for circle in 0..2 {
+                    for j in 0..per_circle {
+                        let Some(a) = approach_at(circle, j) else {
+                            break;
+                        };
+                        if let Some(c) = attempt(&a) {
+                            let score = -a.dot(&preferred);
+                            if best.is_none_or(|(bs, _)| score < bs) {
+                                best = Some((score, c));
+                            }
+                        }
+                    }
+                }
+                if let Some((_, c)) = best {
+                    return Ok(c);
+                }
             }
         }
         // 4. Out of the plane: cones around the preferred approach.
@@ -237,6 +275,11 @@ impl PioneerGeometry {
         }
     }
 }
+
+/// Most approaches the yaw-limit scan of [`PioneerGeometry::solve_position`] orders
+/// before trying them (both circles; 720 at the default 1° step). A finer step scans
+/// in angle order instead, keeping the best.
+const CIRCLE_SCAN_CAPACITY: usize = 1024;
 
 /// Two unit vectors that complete `a` (a unit vector) to an orthonormal basis.
 fn perpendicular_basis(a: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
