@@ -83,8 +83,8 @@ DEFAULT_REQUEST_TIMEOUT = 2.0
 #: How often a waiting client checks that the driver is still alive, seconds.
 LIVENESS_PERIOD = 0.020
 
-MAX_DOMAIN_LEN = 48
-MAX_ROBOT_LEN = 64
+MAX_DOMAIN_LEN = L.NAME_MAX_DOMAIN_LEN
+MAX_ROBOT_LEN = L.NAME_MAX_ROBOT_LEN
 MAX_ACTUATORS = L.LIMITS_MAX_ACTUATORS
 #: Direction vectors shorter than this count as zero (Rust: ``limb::MIN_VECTOR_NORM``).
 MIN_VECTOR_NORM = 1e-9
@@ -92,11 +92,11 @@ MIN_VECTOR_NORM = 1e-9
 _DRIVER_NODE_PREFIX = "limber-driver:"
 _CLIENT_NODE_PREFIX = "limber-client:"
 _LAYOUT_ATTR = "limber.layout"
-_EVENT_COMMAND = 1  # on `wake`
-_EVENT_REQUEST = 2  # on `wake`
+_EVENT_COMMAND = L.WAKE_COMMAND
+_EVENT_REQUEST = L.WAKE_REQUEST
 _OUTCOME_SLOTS = 16
 # Outcomes buffered on the `outcome` channel per client (Rust `qos::OUTCOME_BUFFER`).
-_OUTCOME_BUFFER = 256
+_OUTCOME_BUFFER = L.QOS_OUTCOME_BUFFER
 _IDENT = re.compile(r"^[A-Za-z0-9_-]+$")
 
 
@@ -152,28 +152,7 @@ class Status(enum.IntEnum):
 
     def describe(self) -> str:
         """The short human-readable reason (the same text as Rust's ``Status::describe``)."""
-        return _STATUS_TEXT[self]
-
-
-_STATUS_TEXT = {
-    Status.OK: "ok",
-    Status.UNSUPPORTED: "unsupported by this device",
-    Status.UNKNOWN_JOINT: "unknown joint",
-    Status.NOT_FINITE: "value not finite",
-    Status.BEYOND_LIMITS: "beyond the joint limits",
-    Status.OUT_OF_REACH: "out of reach",
-    Status.NOT_CALIBRATED: "not calibrated yet",
-    Status.LINK_DOWN: "link to the hardware is down",
-    Status.BUSY: "device busy",
-    Status.TIMEOUT: "hardware timeout",
-    Status.INVALID_ARGUMENT: "invalid argument",
-    Status.POWERED_OFF: "powered off",
-    Status.UNREACHABLE_ORIENTATION: "orientation not attainable by this limb's joints",
-    Status.CLAMPED: "ok, clamped to the limit",
-    Status.PREEMPTED: "preempted by another client",
-    Status.LEASED: "held by another client",
-    Status.ADJUSTED: "ok, orientation adjusted",
-}
+        return L.DESCRIBE_STATUS[int(self)]
 
 
 class DriverStatus(enum.Enum):
@@ -363,7 +342,7 @@ class Domain:
         if name is None:
             name = os.environ.get(DOMAIN_ENV) or DEFAULT_DOMAIN
         if not isinstance(name, str) or len(name) > MAX_DOMAIN_LEN or not _IDENT.match(name):
-            raise ValueError(f"invalid domain {name!r}: use 1 to 48 characters of [A-Za-z0-9_-]")
+            raise ValueError(f"invalid domain {name!r}: use 1 to {MAX_DOMAIN_LEN} characters of [A-Za-z0-9_-]")
         self._name = name
         self._prefix = None
 
@@ -446,7 +425,7 @@ class DeviceName:
             raise bad
         if len(robot) > MAX_ROBOT_LEN or not _IDENT.match(robot):
             raise ValueError(
-                f"invalid robot name {robot!r}: use 1 to 64 characters of [A-Za-z0-9_-]"
+                f"invalid robot name {robot!r}: use 1 to {MAX_ROBOT_LEN} characters of [A-Za-z0-9_-]"
             )
         return cls(robot, iface, n)
 
