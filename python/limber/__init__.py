@@ -15,6 +15,8 @@ from ._layout import *  # noqa: F401,F403
 from ._layout import LAYOUT_VERSION, STRUCTS  # noqa: F401
 from .client import (  # noqa: F401
     DEFAULT_DOMAIN,
+    SPIN_BUDGET,
+    SPIN_BUDGET_ENV,
     DEFAULT_REQUEST_TIMEOUT,
     DOMAIN_ENV,
     ActArrayClient,
@@ -35,6 +37,8 @@ from .client import (  # noqa: F401
     Status,
     Ticket,
     TransportError,
+    WaitMode,
+    default_spin_budget,
     UnexpectedReplyError,
     WaitTimeout,
 )

@@ -57,6 +57,10 @@ __all__ = [
     "Status",
     "DriverStatus",
     "Freshness",
+    "WaitMode",
+    "SPIN_BUDGET",
+    "SPIN_BUDGET_ENV",
+    "default_spin_budget",
     "Ticket",
     "LimberError",
     "NoDriverError",
@@ -110,6 +114,51 @@ def _iox2():
 def monotonic_ns() -> int:
     """``CLOCK_MONOTONIC`` in ns: the time base of every stamp (as in Rust)."""
     return time.clock_gettime_ns(time.CLOCK_MONOTONIC)
+
+
+# ----- waiting -------------------------------------------------------------------------
+
+#: The spin budget of a client in event mode when nothing else is configured, seconds, on a
+#: machine with two or more cores (Rust ``qos::SPIN_BUDGET``).
+SPIN_BUDGET = 30e-6
+#: The environment variable that sets the clients' spin budget in µs (``0``: block at once).
+SPIN_BUDGET_ENV = "LIMBER_SPIN_US"
+
+
+def _spin_budget_from(env: Optional[str], cores: int) -> float:
+    """The spin budget for ``LIMBER_SPIN_US`` = ``env`` (None: unset) on ``cores`` cores."""
+    if env is not None:
+        try:
+            us = int(env.strip())
+        except ValueError:
+            us = -1
+        if us >= 0:
+            return min(us, 1_000_000) / 1e6
+        import warnings
+
+        warnings.warn(
+            f"{SPIN_BUDGET_ENV}={env!r} is not a number of microseconds: using the default",
+            stacklevel=3,
+        )
+    return SPIN_BUDGET if cores >= 2 else 0.0
+
+
+def default_spin_budget() -> float:
+    """The default spin budget of a client in event mode, seconds (Rust
+    ``qos::default_spin_budget``): ``LIMBER_SPIN_US`` if set (µs, at most 1 s), else
+    :data:`SPIN_BUDGET` on a machine with two or more cores and zero on one core (where a
+    spinning client would only delay the driver it waits for)."""
+    return _spin_budget_from(os.environ.get(SPIN_BUDGET_ENV), os.cpu_count() or 1)
+
+
+class WaitMode(enum.Enum):
+    """How a client waits for states, outcomes and replies (Rust ``WaitMode``)."""
+
+    #: Block on the driver's notification (default; costs a wake-up, frees the CPU), after
+    #: polling for the spin budget right after a command or request.
+    EVENT = "event"
+    #: Busy-poll shared memory (lowest latency; takes a whole core).
+    SPIN = "spin"
 
 
 # ----- status codes and small types ------------------------------------------------------
@@ -610,6 +659,9 @@ class _Client:
         self._latest = None
         self.request_timeout = DEFAULT_REQUEST_TIMEOUT
         self.wake_driver = True
+        self._wait_mode = WaitMode.EVENT
+        self._spin_budget = default_spin_budget()
+        self._spin_until: Optional[float] = None
         iox2.set_log_level_from_env_or(iox2.LogLevel.Error)
         node_name = (_CLIENT_NODE_PREFIX + proc_name)[: iox2.NodeName.max_len()]
         try:
@@ -887,8 +939,49 @@ class _Client:
                     raise DriverGoneError("the driver is gone")
             self._pause(min(deadline, next_check))
 
+    @property
+    def wait_mode(self) -> WaitMode:
+        """How this client waits (default :attr:`WaitMode.EVENT`)."""
+        return self._wait_mode
+
+    def set_wait_mode(self, mode: WaitMode) -> None:
+        """Sets how this client waits for states, outcomes and replies."""
+        if not isinstance(mode, WaitMode):
+            raise ValueError(f"wait mode must be a WaitMode, not {mode!r}")
+        self._wait_mode = mode
+
+    @property
+    def spin_budget(self) -> float:
+        """The spin budget in seconds (see :meth:`set_spin_budget`)."""
+        return self._spin_budget
+
+    def set_spin_budget(self, seconds: float) -> None:
+        """In :attr:`WaitMode.EVENT`, how long a wait that follows a command or request polls
+        (yielding the CPU) before it blocks (default :func:`default_spin_budget`; zero: block
+        at once). The answer of a driver that is awake then arrives without a wake-up of this
+        process, at the price of up to this much CPU time per exchange."""
+        s = float(seconds)
+        if not math.isfinite(s) or s < 0:
+            raise ValueError(f"spin budget must be a finite number of seconds >= 0, not {seconds!r}")
+        self._spin_budget = s
+        self._spin_until = None  # a window opened under the old budget ends now
+
+    def _sent(self) -> None:
+        """Starts the busy-poll window of a send."""
+        self._spin_until = time.monotonic() + self._spin_budget if self._spin_budget > 0 else None
+
     def _pause(self, until: float) -> None:
-        """Blocks until ``until`` (time.monotonic) or the driver's next notification."""
+        """Blocks (event mode) or polls once (spin mode) until ``until`` (time.monotonic) or
+        the driver's next notification."""
+        if self._wait_mode is WaitMode.SPIN:
+            return
+        if self._spin_until is not None:
+            # Right after a send: poll for the answer of a driver that is awake, yielding
+            # the CPU so that a driver sharing this core runs at once.
+            if time.monotonic() < min(self._spin_until, until):
+                os.sched_yield()
+                return
+            self._spin_until = None
         iox2 = _iox2()
         if self._notify is None:
             try:
@@ -972,6 +1065,7 @@ class _Client:
                 pass
         if receivers == 0:
             raise NoDriverError("no driver receives commands")
+        self._sent()
         return Ticket(self._cmd_seq, receivers)
 
     # ----- requests ---------------------------------------------------------------------
@@ -1009,6 +1103,7 @@ class _Client:
                     self._wake.notify_with_custom_event_id(iox2.EventId.new(_EVENT_REQUEST))
                 except Exception:
                     pass
+            self._sent()
             deadline = time.monotonic() + timeout
             next_check = time.monotonic() + LIVENESS_PERIOD
             while True:
