@@ -21,6 +21,7 @@ from .client import (  # noqa: F401
     DOMAIN_ENV,
     ActArrayClient,
     DecodeError,
+    DeviceInfo,
     DeviceName,
     Domain,
     DriverGoneError,
@@ -39,6 +40,7 @@ from .client import (  # noqa: F401
     TransportError,
     WaitMode,
     default_spin_budget,
+    list_devices,
     UnexpectedReplyError,
     WaitTimeout,
 )

@@ -54,6 +54,8 @@ __all__ = [
     "LIVENESS_PERIOD",
     "Domain",
     "DeviceName",
+    "DeviceInfo",
+    "list_devices",
     "Status",
     "DriverStatus",
     "Freshness",
@@ -484,6 +486,88 @@ class DeviceName:
 
     def __str__(self) -> str:
         return f"{self.robot}/{self.interface}/{self.index}"
+
+
+# ----- discovery -------------------------------------------------------------------------
+
+_DRIVER_ATTR = "limber.driver"
+
+
+@dataclass(frozen=True)
+class DeviceInfo:
+    """One device found in a domain (Rust ``discovery::DeviceInfo``)."""
+
+    #: Its name (``robot/interface/index``).
+    name: DeviceName
+    #: The driver that offers it (its ``limber.driver`` attribute).
+    driver: str
+    #: The layout version it speaks.
+    layout: str
+    #: True while the driver's process lives.
+    alive: bool
+    #: Processes attached to its state channel (driver and clients).
+    nodes: int
+
+    @property
+    def interface(self) -> str:
+        """The interface: ``actarray``, ``limb`` or ``gripper``."""
+        return self.name.interface
+
+
+def list_devices(domain: "Optional[Domain | str]" = None) -> "list[DeviceInfo]":
+    """Every device of ``domain`` (default: from ``LIMBER_DOMAIN``), sorted by name, as
+    ``limber list`` shows them. A device whose driver died is listed as not alive until its
+    services are cleaned up. Raises :class:`TransportError` when the domain cannot be read."""
+    iox2 = _iox2()
+    dom = domain if isinstance(domain, Domain) else Domain(domain)
+    iox2.set_log_level_from_env_or(iox2.LogLevel.Error)
+    try:
+        _secure_shm(dom.prefix)
+        services = iox2.Service.list(dom.iceoryx2_config(), iox2.ServiceType.Ipc)
+    except LimberError:
+        raise
+    except Exception as e:
+        raise TransportError(f"cannot list the services of domain {dom}: {e!r}") from None
+    out = []
+    for details in services:
+        try:
+            if details.messaging_pattern() != iox2.MessagingPattern.PublishSubscribe:
+                continue
+            parts = details.name().to_string().split("/")
+            if len(parts) != 5 or parts[0] != "limber" or parts[4] != "data":
+                continue
+            try:
+                name = DeviceName.parse("/".join(parts[1:4]))
+            except ValueError:
+                continue
+            attrs = {
+                a.key.to_string(): a.value.to_string() for a in details.attributes().values
+            }
+            nodes = details.nodes()
+        except Exception as e:
+            raise TransportError(f"cannot read the services of domain {dom}: {e!r}") from None
+        alive = False
+        for n in nodes:
+            if isinstance(n, iox2.NodeState.Alive):
+                try:
+                    node_details = n[0].details
+                    is_driver = node_details is not None and node_details.name.as_str().startswith(
+                        _DRIVER_NODE_PREFIX
+                    )
+                except Exception:
+                    is_driver = False
+                alive = alive or is_driver
+        out.append(
+            DeviceInfo(
+                name=name,
+                driver=attrs.get(_DRIVER_ATTR, ""),
+                layout=attrs.get(_LAYOUT_ATTR, ""),
+                alive=alive,
+                nodes=len(nodes),
+            )
+        )
+    out.sort(key=lambda d: (d.name.robot, _INTERFACES.index(d.name.interface), d.name.index))
+    return out
 
 
 # ----- validation (the Rust constructors' rules) -----------------------------------------
