@@ -25,6 +25,7 @@ from .client import (  # noqa: F401
     DeviceName,
     Domain,
     DriverGoneError,
+    DriverStatsReader,
     DriverStatus,
     Freshness,
     GripperClient,
@@ -41,6 +42,7 @@ from .client import (  # noqa: F401
     WaitMode,
     default_spin_budget,
     list_devices,
+    stats_text,
     UnexpectedReplyError,
     WaitTimeout,
 )

@@ -56,6 +56,8 @@ __all__ = [
     "DeviceName",
     "DeviceInfo",
     "list_devices",
+    "DriverStatsReader",
+    "stats_text",
     "Status",
     "DriverStatus",
     "Freshness",
@@ -1470,6 +1472,132 @@ class GripperClient(_Client):
                            o.height, i.width, i.length, i.height):
             raise DecodeError("undecodable reply: gripper geometry is not finite")
         return g
+
+
+# ----- driver statistics -----------------------------------------------------------------
+
+
+def stats_text(field: "ctypes.Array[ctypes.c_uint8]") -> str:
+    """A text field of :class:`DriverStats` (NUL-padded UTF-8) as a string; raises
+    :class:`DecodeError` when it is not UTF-8 (Rust ``diagnostics::get_text``)."""
+    raw = bytes(field)
+    end = raw.find(b"\0")
+    try:
+        return (raw if end < 0 else raw[:end]).decode("utf-8")
+    except UnicodeDecodeError:
+        raise DecodeError("undecodable text field in the driver statistics") from None
+
+
+class DriverStatsReader:
+    """Reads the statistics a driver publishes on ``<robot>/driver/0`` (its loop, link and
+    hardware: :class:`DriverStats`), as ``limber echo pioneer/driver`` does (Rust
+    ``diagnostics::StatsReader``). Open with :meth:`open`; close with :meth:`close` or
+    ``with``."""
+
+    def __init__(self) -> None:  # use open()
+        self._closed = True
+        self._sub = None
+        self._node = None
+        self._latest: "Optional[L.DriverStats]" = None
+
+    @classmethod
+    def open(
+        cls, robot: str = "pioneer", domain: "Optional[Domain | str]" = None
+    ) -> "DriverStatsReader":
+        """Opens the statistics of ``robot``'s driver in ``domain`` (default: from
+        ``LIMBER_DOMAIN``). Raises :class:`NoDriverError` when no driver publishes them,
+        :class:`ValueError` for a bad robot name, :class:`TransportError` otherwise."""
+        if not isinstance(robot, str) or len(robot) > MAX_ROBOT_LEN or not _IDENT.match(robot):
+            raise ValueError(
+                f"invalid robot name {robot!r}: use 1 to {MAX_ROBOT_LEN} characters of [A-Za-z0-9_-]"
+            )
+        dom = domain if isinstance(domain, Domain) else Domain(domain)
+        iox2 = _iox2()
+        iox2.set_log_level_from_env_or(iox2.LogLevel.Error)
+        self = cls()
+        node_name = (_CLIENT_NODE_PREFIX + _default_process_name())[: iox2.NodeName.max_len()]
+        try:
+            self._node = (
+                iox2.NodeBuilder.new()
+                .name(iox2.NodeName.new(node_name))
+                .config(dom.iceoryx2_config())
+                .signal_handling_mode(iox2.SignalHandlingMode.Disabled)
+                .create(iox2.ServiceType.Ipc)
+            )
+        except Exception as e:
+            raise TransportError(f"cannot join domain {dom}: {e!r}") from None
+        _secure_shm(dom.prefix)
+        self._closed = False
+        _open_clients.add(self)  # type: ignore[arg-type]
+        try:
+            svc = (
+                self._node.service_builder(iox2.ServiceName.new(f"limber/{robot}/driver/0/data"))
+                .publish_subscribe(L.DriverStats)
+                .open()
+            )
+            self._sub = svc.subscriber_builder().create()
+            del svc
+        except Exception as e:
+            self.close()
+            if "DoesNotExist" in repr(e):
+                raise NoDriverError(
+                    f"no driver of robot {robot} publishes statistics in domain {dom}"
+                ) from None
+            raise TransportError(f"cannot open the statistics of {robot}: {e!r}") from None
+        return self
+
+    def refresh(self) -> bool:
+        """Takes what arrived; true if there was something new."""
+        if self._closed:
+            raise LimberError("the statistics reader is closed")
+        got = False
+        while True:
+            try:
+                sample = self._sub.receive()
+            except Exception as e:
+                raise TransportError(f"cannot receive statistics: {e!r}") from None
+            if sample is None:
+                return got
+            try:
+                self._latest = _copy(L.DriverStats, sample.payload_ptr)
+            finally:
+                sample.delete()
+            got = True
+
+    def latest(self) -> "Optional[L.DriverStats]":
+        """The latest statistics taken (a copy), or None."""
+        return self._latest
+
+    def wait(self, timeout: float) -> "L.DriverStats":
+        """Waits up to ``timeout`` s (polling every 5 ms, as Rust) for new statistics and
+        returns them (a copy). Raises :class:`WaitTimeout`."""
+        deadline = time.monotonic() + timeout
+        while True:
+            if self.refresh():
+                assert self._latest is not None
+                return self._latest
+            if time.monotonic() >= deadline:
+                raise WaitTimeout(f"no driver statistics within {timeout} s")
+            time.sleep(0.005)
+
+    def close(self) -> None:
+        """Releases the subscriber and the node (idempotent)."""
+        if self._sub is not None:
+            try:
+                self._sub.delete()
+            except Exception:
+                pass
+        self._sub = None
+        self._node = None
+        if not self._closed:
+            self._closed = True
+            _open_clients.discard(self)  # type: ignore[arg-type]
+
+    def __enter__(self) -> "DriverStatsReader":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
 
 @atexit.register
