@@ -43,7 +43,7 @@ import sys
 import time
 import weakref
 from dataclasses import dataclass
-from typing import ClassVar, Iterable, Optional, Sequence
+from typing import Any, ClassVar, Generic, Iterable, Optional, Sequence, Type, TypeVar
 
 from . import _layout as L
 
@@ -261,7 +261,7 @@ class TransportError(LimberError):
 class NackError(LimberError):
     """The driver refused a request (NACK) and said why: :attr:`status`."""
 
-    def __init__(self, status: Status):
+    def __init__(self, status: Status) -> None:
         self.status = status
         super().__init__(f"refused: {status.describe()} ({status.name})")
 
@@ -282,7 +282,7 @@ class OutcomeMissed(LimberError):
     """The outcome of this command was overwritten before it was read (a later command of
     this client has been applied since). :attr:`newer_seq` is that command's number."""
 
-    def __init__(self, newer_seq: int):
+    def __init__(self, newer_seq: int) -> None:
         self.newer_seq = newer_seq
         super().__init__(f"outcome missed; a later command (seq {newer_seq}) was applied since")
 
@@ -391,7 +391,7 @@ class Domain:
 
     __slots__ = ("_name", "_prefix")
 
-    def __init__(self, name: Optional[str] = None):
+    def __init__(self, name: Optional[str] = None) -> None:
         if name is None:
             name = os.environ.get(DOMAIN_ENV) or DEFAULT_DOMAIN
         if not isinstance(name, str) or len(name) > MAX_DOMAIN_LEN or not _IDENT.match(name):
@@ -428,7 +428,7 @@ class Domain:
             self._prefix = prefix
         return self._prefix
 
-    def iceoryx2_config(self):
+    def iceoryx2_config(self) -> Any:
         """A fresh iceoryx2 config for this domain (defaults plus its root path and prefix)."""
         iox2 = _iox2()
         cfg = iox2.config.default()
@@ -658,7 +658,12 @@ def _default_process_name() -> str:
     return name[:64]
 
 
-class _Client:
+#: The state type of a client (``ActArrayData``, ``LimbData``, ``GripperData``).
+_D = TypeVar("_D", bound=ctypes.Structure)
+_C = TypeVar("_C", bound="_Client[Any]")
+
+
+class _Client(Generic[_D]):
     """A connection to one device. Use :class:`ActArrayClient`, :class:`LimbClient` or
     :class:`GripperClient`."""
 
@@ -668,7 +673,7 @@ class _Client:
     REQ_MSG: ClassVar[type]
     REPLY_MSG: ClassVar[type]
 
-    def __init__(self):  # use connect()
+    def __init__(self) -> None:  # use connect()
         self._closed = True
         self._node = None
         self._data_svc = None
@@ -684,7 +689,7 @@ class _Client:
 
     @classmethod
     def connect(
-        cls,
+        cls: Type[_C],
         device: str,
         domain: "Domain | str | None" = None,
         timeout: float = 0.0,
@@ -692,7 +697,7 @@ class _Client:
         name: Optional[str] = None,
         request_timeout: float = DEFAULT_REQUEST_TIMEOUT,
         wake_driver: bool = True,
-    ):
+    ) -> _C:
         """Connects to ``device`` (``robot/interface/index``) in ``domain`` (a :class:`Domain`,
         a domain name, or ``None`` for ``LIMBER_DOMAIN``/``limber``).
 
@@ -865,10 +870,10 @@ class _Client:
     def closed(self) -> bool:
         return self._closed
 
-    def __enter__(self):
+    def __enter__(self: _C) -> _C:
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.close()
 
     def __del__(self):
@@ -949,14 +954,14 @@ class _Client:
             finally:
                 s.delete()
 
-    def state(self):
+    def state(self) -> Optional[_D]:
         """The latest state, after taking what arrived: a *copy* of the ``*Data`` ctypes
         struct (``ActArrayData``, ``LimbData``, ``GripperData``; same fields as in Rust), or
         ``None`` if no sample arrived yet."""
         self.refresh()
         return self._latest
 
-    def last_state(self):
+    def last_state(self) -> Optional[_D]:
         """The latest state already taken, without looking for a newer one."""
         return self._latest
 
@@ -976,7 +981,7 @@ class _Client:
             return Freshness.FRESH
         return Freshness.STALE if self.driver_status() is DriverStatus.ALIVE else Freshness.GONE
 
-    def wait_state(self, timeout: float):
+    def wait_state(self, timeout: float) -> _D:
         """Waits up to ``timeout`` s for a state sample newer than the latest one taken and
         returns it (a copy). Raises :class:`WaitTimeout` or :class:`DriverGoneError`."""
         self._check_open()
@@ -1245,7 +1250,7 @@ class _Client:
 # ----- actarray --------------------------------------------------------------------------
 
 
-class ActArrayClient(_Client):
+class ActArrayClient(_Client[L.ActArrayData]):
     """A client of an actuator array (Player's ``ActArrayProxy``; Rust ``ActArrayClient``).
 
     Commands return a :class:`Ticket`. Joint indices outside the array capacity (0..31),
@@ -1347,7 +1352,7 @@ class ActArrayClient(_Client):
 # ----- limb ------------------------------------------------------------------------------
 
 
-class LimbClient(_Client):
+class LimbClient(_Client[L.LimbData]):
     """A client of a limb (Player's ``LimbProxy``; Rust ``LimbClient``). Vectors are any
     3-sequences (robot frame, m); direction vectors must not be zero."""
 
@@ -1428,7 +1433,7 @@ class LimbClient(_Client):
 # ----- gripper ---------------------------------------------------------------------------
 
 
-class GripperClient(_Client):
+class GripperClient(_Client[L.GripperData]):
     """A client of a gripper (Player's ``GripperProxy``; Rust ``GripperClient``)."""
 
     INTERFACE = "gripper"
