@@ -66,6 +66,10 @@ __all__ = [
     "SPIN_BUDGET_ENV",
     "default_spin_budget",
     "Ticket",
+    "Outcome",
+    "LeaseHolder",
+    "LeaseHeldError",
+    "LeaseLostError",
     "LimberError",
     "NoDriverError",
     "IncompatibleError",
@@ -208,6 +212,40 @@ class Status(enum.IntEnum):
         return L.DESCRIBE_STATUS[int(self)]
 
 
+@dataclass(frozen=True)
+class Outcome:
+    """The outcome of one of this client's commands (Rust ``Outcome``)."""
+
+    #: The command's sequence number (its :attr:`Ticket.seq`).
+    seq: int
+    #: What became of it.
+    status: Status
+    #: The other client involved: the one whose command preempted it (``PREEMPTED``) or
+    #: the one holding the device (``LEASED``); 0 if none.
+    other_client: int
+    #: The other client's name, when it holds the device's lease (empty otherwise).
+    other_name: str
+
+
+@dataclass(frozen=True)
+class LeaseHolder:
+    """Who holds a device (:meth:`holder`; Rust ``LeaseHolder``)."""
+
+    #: The holder's client id.
+    client_id: int
+    #: The holder's name.
+    name: str
+    #: Its heartbeat timeout, seconds.
+    timeout: float
+
+
+def _name_of(field: "ctypes.Array[ctypes.c_uint8]") -> str:
+    """A 32-byte NUL-padded name field (undecodable bytes replaced)."""
+    raw = bytes(field)
+    end = raw.find(b"\0")
+    return (raw if end < 0 else raw[:end]).decode("utf-8", "replace")
+
+
 class DriverStatus(enum.Enum):
     """Whether the driver of a device is running (Rust ``DriverStatus``)."""
 
@@ -264,6 +302,19 @@ class NackError(LimberError):
     def __init__(self, status: Status) -> None:
         self.status = status
         super().__init__(f"refused: {status.describe()} ({status.name})")
+
+
+class LeaseHeldError(LimberError):
+    """Another client holds the device's lease: :attr:`client_id` and :attr:`name`."""
+
+    def __init__(self, client_id: int, name: str) -> None:
+        self.client_id = client_id
+        self.name = name
+        super().__init__(f"the device is held by {name or '?'} (client {client_id:#x})")
+
+
+class LeaseLostError(LimberError):
+    """The lease this client held was ended by the driver (a missed heartbeat)."""
 
 
 class RequestTimeout(LimberError, TimeoutError):
@@ -675,6 +726,8 @@ class _Client(Generic[_D]):
 
     def __init__(self) -> None:  # use connect()
         self._closed = True
+        self._lease_port = None
+        self._lease_held = None
         self._node = None
         self._data_svc = None
         self._states = None
@@ -747,6 +800,10 @@ class _Client(Generic[_D]):
         self._cmd_seq = 0
         self._req_seq = 0
         self._outcomes = [(0, 0)] * _OUTCOME_SLOTS
+        self._preemptions = [Outcome(0, Status.OK, 0, "")] * _OUTCOME_SLOTS
+        self._lease_port: Any = None
+        self._lease_seq = 0
+        self._lease_held: "Optional[tuple[float, float]]" = None  # heartbeat, last renewal
         self._latest = None
         self.request_timeout = DEFAULT_REQUEST_TIMEOUT
         self.wake_driver = True
@@ -851,8 +908,16 @@ class _Client(Generic[_D]):
     # ----- lifetime ---------------------------------------------------------------------
 
     def close(self) -> None:
-        """Releases every port and the node (idempotent). The client is unusable afterwards."""
-        for attr in ("_notify", "_wake", "_requests", "_commands", "_outcome_sub", "_states"):
+        """Releases the lease if held, then every port and the node (idempotent). The client
+        is unusable afterwards."""
+        if self.__dict__.get("_lease_held") is not None and not self.__dict__.get("_closed", True):
+            try:
+                self.release()
+            except LimberError as e:
+                import warnings
+
+                warnings.warn(f"{self._device}: cannot release the lease: {e}", stacklevel=2)
+        for attr in ("_lease_port", "_notify", "_wake", "_requests", "_commands", "_outcome_sub", "_states"):
             port = self.__dict__.get(attr)
             if port is not None:
                 try:
@@ -951,6 +1016,10 @@ class _Client(Generic[_D]):
                 if o.client_id == self._client_id and o.status != L.STATUS_PREEMPTED:
                     seq = o.cmd_seq
                     self._outcomes[seq % _OUTCOME_SLOTS] = (seq, o.status)
+                elif o.client_id == self._client_id:
+                    self._preemptions[o.cmd_seq % _OUTCOME_SLOTS] = Outcome(
+                        o.cmd_seq, Status.PREEMPTED, o.other_client, _name_of(o.other_name)
+                    )
             finally:
                 s.delete()
 
@@ -1087,6 +1156,163 @@ class _Client(Generic[_D]):
             self._notify.timed_wait(iox2.Duration.from_secs_f64(left))
         except Exception as e:
             raise TransportError(f"waiting failed: {e!r}") from None
+
+    # ----- ownership --------------------------------------------------------------------
+
+    def preempted(self, ticket: Ticket) -> Optional[Outcome]:
+        """Whether the motion that the command of ``ticket`` started was cut short by another
+        client's command: its :class:`Outcome` (with the other client, and its name if it
+        held the device), or None. Looks at what arrived; remembers the last 16 commands."""
+        self.refresh()
+        p = self._preemptions[ticket.seq % _OUTCOME_SLOTS]
+        return p if p.seq == ticket.seq else None
+
+    def acquire(self, name: str, heartbeat: float) -> None:
+        """Takes the device: until :meth:`release` (or :meth:`close`), other clients'
+        commands, and their requests that change the device, are refused with ``LEASED``
+        naming ``name``; readers are unaffected. The lease lives as long as this client
+        renews it (:meth:`renew`, :meth:`keep_lease`) at least every ``heartbeat`` seconds,
+        and as long as its process lives: otherwise the driver stops the device and frees it.
+        Raises :class:`LeaseHeldError` when another client holds it."""
+        hb = float(heartbeat)
+        if not math.isfinite(hb) or hb <= 0:
+            raise ValueError(f"heartbeat must be a finite number of seconds > 0, not {heartbeat!r}")
+        if not isinstance(name, str) or len(name.encode("utf-8")) > 31:
+            raise ValueError(f"lease name must be a string of at most 31 bytes, not {name!r}")
+        reply = self._lease_call(L.LEASE_OP_ACQUIRE, min(int(hb * 1e9), 2**64 - 1), name)
+        if reply.status == L.STATUS_OK and reply.holder_client == self._client_id:
+            self._lease_held = (hb, time.monotonic())
+            return
+        raise self._lease_refusal(reply)
+
+    def renew(self) -> None:
+        """The heartbeat: tells the driver this holder is alive. Raises
+        :class:`LeaseLostError` when the driver ended the lease."""
+        reply = self._lease_call(L.LEASE_OP_RENEW, 0, "")
+        if reply.status == L.STATUS_OK and reply.holder_client == self._client_id:
+            if self._lease_held is not None:
+                self._lease_held = (self._lease_held[0], time.monotonic())
+            return
+        if reply.status == L.STATUS_OK:
+            self._lease_held = None
+            raise LeaseLostError("the lease was ended by the driver (a missed heartbeat?)")
+        if reply.status == L.STATUS_LEASED:
+            self._lease_held = None
+        raise self._lease_refusal(reply)
+
+    def keep_lease(self) -> bool:
+        """For a control loop: renews the lease when a third of its heartbeat has passed
+        since the last renewal (returns whether it did); does nothing when none is held."""
+        if self._lease_held is None:
+            return False
+        hb, last = self._lease_held
+        if time.monotonic() - last < hb / 3:
+            return False
+        self.renew()
+        return True
+
+    def release(self) -> None:
+        """Gives the device back (the motion in progress goes on). Releasing a lease not
+        held is no error."""
+        if self._lease_held is None:
+            return
+        try:
+            reply = self._lease_call(L.LEASE_OP_RELEASE, 0, "")
+        finally:
+            self._lease_held = None
+        if reply.status != L.STATUS_OK:
+            raise self._lease_refusal(reply)
+
+    @property
+    def holds_lease(self) -> bool:
+        """Whether this client holds the device (as far as it knows: :meth:`renew` finds
+        out whether the driver ended the lease)."""
+        return self._lease_held is not None
+
+    def holder(self) -> Optional[LeaseHolder]:
+        """Who holds the device, if anybody (a request to the driver)."""
+        reply = self._lease_call(L.LEASE_OP_QUERY, 0, "")
+        if reply.holder_client == 0:
+            return None
+        return LeaseHolder(reply.holder_client, _name_of(reply.holder_name), reply.timeout_ns / 1e9)
+
+    @staticmethod
+    def _lease_refusal(reply: "L.LeaseReply") -> LimberError:
+        if reply.status == L.STATUS_LEASED:
+            return LeaseHeldError(reply.holder_client, _name_of(reply.holder_name))
+        try:
+            return NackError(Status(reply.status))
+        except ValueError:
+            return DecodeError(f"undecodable lease reply: status {reply.status}")
+
+    def _lease_call(self, op: int, timeout_ns: int, name: str) -> "L.LeaseReply":
+        """One lease request and its reply, within the request timeout."""
+        self._check_open()
+        iox2 = _iox2()
+        if self._lease_port is None:
+            layout = iox2.AttributeVerifier.new().require(
+                iox2.AttributeKey.new(_LAYOUT_ATTR), iox2.AttributeValue.new(str(L.LAYOUT_VERSION))
+            )
+            try:
+                svc = (
+                    self._node.service_builder(iox2.ServiceName.new(self._device.service_name("lease")))
+                    .request_response(L.LeaseReq, L.LeaseReply)
+                    .enable_fire_and_forget_requests(False)
+                    .open_with_attributes(layout)
+                )
+                self._lease_port = svc.client_builder().create()
+                del svc
+            except Exception as e:
+                if "DoesNotExist" in repr(e):
+                    raise NoDriverError(f"no driver offers leases of {self._device}") from None
+                raise TransportError(f"{self._device}: cannot open the lease channel: {e!r}") from None
+        self._lease_seq += 1
+        req = L.LeaseReq()
+        req.client_id = self._client_id
+        req.seq = self._lease_seq
+        req.timeout_ns = timeout_ns
+        req.op = op
+        node_id = self._node.id.value
+        req.node_lo = node_id & (2**64 - 1)
+        req.node_hi = (node_id >> 64) & (2**64 - 1)
+        raw = name.encode("utf-8")[:31]
+        ctypes.memmove(ctypes.addressof(req.name), raw, len(raw))
+        try:
+            pending = self._lease_port.loan_uninit().write_payload(req).send()
+        except Exception as e:
+            raise TransportError(f"lease request failed: {e!r}") from None
+        try:
+            if pending.number_of_server_connections == 0:
+                raise NoDriverError("no driver serves lease requests")
+            if self.wake_driver:
+                try:
+                    self._wake.notify_with_custom_event_id(iox2.EventId.new(_EVENT_REQUEST))
+                except Exception:
+                    pass
+            self._sent()
+            timeout = self.request_timeout
+            deadline = time.monotonic() + timeout
+            next_check = time.monotonic() + LIVENESS_PERIOD
+            while True:
+                try:
+                    r = pending.receive()
+                except Exception as e:
+                    raise TransportError(f"lease request failed: {e!r}") from None
+                if r is not None:
+                    try:
+                        return _copy(L.LeaseReply, r.payload_ptr)
+                    finally:
+                        r.delete()
+                now = time.monotonic()
+                if now >= deadline:
+                    raise RequestTimeout(f"no lease reply within {timeout} s")
+                if now >= next_check:
+                    next_check = now + LIVENESS_PERIOD
+                    if self.driver_status() is not DriverStatus.ALIVE:
+                        raise DriverGoneError("the driver is gone")
+                self._pause(min(deadline, next_check))
+        finally:
+            pending.delete()
 
     # ----- liveness ---------------------------------------------------------------------
 
