@@ -129,6 +129,22 @@ extern "C" {
 #define LIMBER_LEASE_OP_RELEASE 3 /* give the device back */
 #define LIMBER_LEASE_OP_QUERY 4 /* who holds the device */
 
+/* Name limits (domain and robot names are [A-Za-z0-9_-]+) */
+#define LIMBER_NAME_MAX_DOMAIN_LEN 48 /* longest domain name */
+#define LIMBER_NAME_MAX_ROBOT_LEN 64 /* longest robot name */
+
+/* Event ids on a device's wake channel (client to driver) */
+#define LIMBER_WAKE_COMMAND 1 /* a command was sent */
+#define LIMBER_WAKE_REQUEST 2 /* a request was sent */
+#define LIMBER_WAKE_HELLO 3 /* a client connected */
+
+/* Event ids on a device's notify channel (driver to clients) */
+#define LIMBER_NOTIFY_STATE 1 /* a state sample was published */
+#define LIMBER_NOTIFY_REPLY 2 /* a reply was sent */
+
+/* Buffer sizes a client opens its ports with */
+#define LIMBER_QOS_OUTCOME_BUFFER 256 /* outcomes buffered per client on the outcome channel */
+
 /* limber.v2.Vec3 (size 24, align 8) */
 typedef struct limber_vec3 {
     double x;

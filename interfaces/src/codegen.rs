@@ -147,6 +147,24 @@ pub fn c_header(m: &Manifest) -> String {
     s
 }
 
+/// A Python string literal of `text` (double-quoted; backslash, quote and non-printable
+/// characters escaped).
+fn py_str(text: &str) -> String {
+    let mut out = String::from("\"");
+    for ch in text.chars() {
+        match ch {
+            '\\' => out.push_str("\\\\"),
+            '"' => out.push_str("\\\""),
+            ' '..='~' => out.push(ch),
+            _ => {
+                write!(out, "\\U{:08x}", ch as u32).expect("writing to a String cannot fail");
+            }
+        }
+    }
+    out.push('"');
+    out
+}
+
 /// The Python module of ctypes classes.
 pub fn python_module(m: &Manifest) -> String {
     let mut s = String::new();
@@ -166,6 +184,15 @@ pub fn python_module(m: &Manifest) -> String {
         }
         s.push('\n');
     }
+    out!(
+        s,
+        "# The text of every status code (Rust's Status::describe)"
+    );
+    out!(s, "DESCRIBE_STATUS = {{");
+    for t in &m.status_texts {
+        out!(s, "    {}: {},", t.code, py_str(t.text));
+    }
+    out!(s, "}}\n");
     let mut names = Vec::new();
     for st in &m.structs {
         names.push(st.name);

@@ -46,6 +46,7 @@ pub mod interface;
 pub mod limb;
 pub mod manifest;
 pub mod message;
+pub mod protocol;
 pub mod wire;
 
 pub use common::{
@@ -165,9 +166,23 @@ pub fn manifest() -> Manifest {
     constants.extend_from_slice(gripper::GROUPS);
     constants.extend_from_slice(diagnostics::GROUPS);
     constants.push(control::LEASE_OP_GROUP);
+    constants.extend_from_slice(&[
+        protocol::NAME_GROUP,
+        protocol::WAKE_GROUP,
+        protocol::NOTIFY_GROUP,
+        protocol::QOS_GROUP,
+    ]);
+    let status_texts = Status::ALL
+        .iter()
+        .map(|s| manifest::StatusText {
+            code: s.code(),
+            text: s.describe(),
+        })
+        .collect();
     Manifest {
         layout_version: LAYOUT_VERSION,
         structs,
         constants,
+        status_texts,
     }
 }

@@ -68,6 +68,17 @@ pub struct Manifest {
     pub structs: Vec<StructLayout>,
     /// Every constant group.
     pub constants: Vec<ConstantGroup>,
+    /// The text of every status code (`Status::describe`), in code order.
+    pub status_texts: Vec<StatusText>,
+}
+
+/// The human-readable text of one status code.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct StatusText {
+    /// The wire code.
+    pub code: u32,
+    /// What `Status::describe` says.
+    pub text: &'static str,
 }
 
 impl Manifest {

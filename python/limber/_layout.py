@@ -118,6 +118,43 @@ LEASE_OP_RENEW = 2  # heartbeat of the holder
 LEASE_OP_RELEASE = 3  # give the device back
 LEASE_OP_QUERY = 4  # who holds the device
 
+# Name limits (domain and robot names are [A-Za-z0-9_-]+)
+NAME_MAX_DOMAIN_LEN = 48  # longest domain name
+NAME_MAX_ROBOT_LEN = 64  # longest robot name
+
+# Event ids on a device's wake channel (client to driver)
+WAKE_COMMAND = 1  # a command was sent
+WAKE_REQUEST = 2  # a request was sent
+WAKE_HELLO = 3  # a client connected
+
+# Event ids on a device's notify channel (driver to clients)
+NOTIFY_STATE = 1  # a state sample was published
+NOTIFY_REPLY = 2  # a reply was sent
+
+# Buffer sizes a client opens its ports with
+QOS_OUTCOME_BUFFER = 256  # outcomes buffered per client on the outcome channel
+
+# The text of every status code (Rust's Status::describe)
+DESCRIBE_STATUS = {
+    0: "ok",
+    1: "unsupported by this device",
+    2: "unknown joint",
+    3: "value not finite",
+    4: "beyond the joint limits",
+    5: "out of reach",
+    6: "not calibrated yet",
+    7: "link to the hardware is down",
+    8: "device busy",
+    9: "hardware timeout",
+    10: "invalid argument",
+    11: "powered off",
+    12: "orientation not attainable by this limb's joints",
+    13: "ok, clamped to the limit",
+    14: "preempted by another client",
+    15: "held by another client",
+    16: "ok, orientation adjusted",
+}
+
 
 class Vec3(ctypes.Structure):
     """limber.v2.Vec3 (size 24, align 8)."""

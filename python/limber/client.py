@@ -43,7 +43,7 @@ import sys
 import time
 import weakref
 from dataclasses import dataclass
-from typing import ClassVar, Iterable, Optional, Sequence
+from typing import Any, ClassVar, Generic, Iterable, Optional, Sequence, Type, TypeVar
 
 from . import _layout as L
 
@@ -54,10 +54,22 @@ __all__ = [
     "LIVENESS_PERIOD",
     "Domain",
     "DeviceName",
+    "DeviceInfo",
+    "list_devices",
+    "DriverStatsReader",
+    "stats_text",
     "Status",
     "DriverStatus",
     "Freshness",
+    "WaitMode",
+    "SPIN_BUDGET",
+    "SPIN_BUDGET_ENV",
+    "default_spin_budget",
     "Ticket",
+    "Outcome",
+    "LeaseHolder",
+    "LeaseHeldError",
+    "LeaseLostError",
     "LimberError",
     "NoDriverError",
     "IncompatibleError",
@@ -83,8 +95,8 @@ DEFAULT_REQUEST_TIMEOUT = 2.0
 #: How often a waiting client checks that the driver is still alive, seconds.
 LIVENESS_PERIOD = 0.020
 
-MAX_DOMAIN_LEN = 48
-MAX_ROBOT_LEN = 64
+MAX_DOMAIN_LEN = L.NAME_MAX_DOMAIN_LEN
+MAX_ROBOT_LEN = L.NAME_MAX_ROBOT_LEN
 MAX_ACTUATORS = L.LIMITS_MAX_ACTUATORS
 #: Direction vectors shorter than this count as zero (Rust: ``limb::MIN_VECTOR_NORM``).
 MIN_VECTOR_NORM = 1e-9
@@ -92,11 +104,11 @@ MIN_VECTOR_NORM = 1e-9
 _DRIVER_NODE_PREFIX = "limber-driver:"
 _CLIENT_NODE_PREFIX = "limber-client:"
 _LAYOUT_ATTR = "limber.layout"
-_EVENT_COMMAND = 1  # on `wake`
-_EVENT_REQUEST = 2  # on `wake`
+_EVENT_COMMAND = L.WAKE_COMMAND
+_EVENT_REQUEST = L.WAKE_REQUEST
 _OUTCOME_SLOTS = 16
 # Outcomes buffered on the `outcome` channel per client (Rust `qos::OUTCOME_BUFFER`).
-_OUTCOME_BUFFER = 256
+_OUTCOME_BUFFER = L.QOS_OUTCOME_BUFFER
 _IDENT = re.compile(r"^[A-Za-z0-9_-]+$")
 
 
@@ -110,6 +122,51 @@ def _iox2():
 def monotonic_ns() -> int:
     """``CLOCK_MONOTONIC`` in ns: the time base of every stamp (as in Rust)."""
     return time.clock_gettime_ns(time.CLOCK_MONOTONIC)
+
+
+# ----- waiting -------------------------------------------------------------------------
+
+#: The spin budget of a client in event mode when nothing else is configured, seconds, on a
+#: machine with two or more cores (Rust ``qos::SPIN_BUDGET``).
+SPIN_BUDGET = 30e-6
+#: The environment variable that sets the clients' spin budget in µs (``0``: block at once).
+SPIN_BUDGET_ENV = "LIMBER_SPIN_US"
+
+
+def _spin_budget_from(env: Optional[str], cores: int) -> float:
+    """The spin budget for ``LIMBER_SPIN_US`` = ``env`` (None: unset) on ``cores`` cores."""
+    if env is not None:
+        try:
+            us = int(env.strip())
+        except ValueError:
+            us = -1
+        if us >= 0:
+            return min(us, 1_000_000) / 1e6
+        import warnings
+
+        warnings.warn(
+            f"{SPIN_BUDGET_ENV}={env!r} is not a number of microseconds: using the default",
+            stacklevel=3,
+        )
+    return SPIN_BUDGET if cores >= 2 else 0.0
+
+
+def default_spin_budget() -> float:
+    """The default spin budget of a client in event mode, seconds (Rust
+    ``qos::default_spin_budget``): ``LIMBER_SPIN_US`` if set (µs, at most 1 s), else
+    :data:`SPIN_BUDGET` on a machine with two or more cores and zero on one core (where a
+    spinning client would only delay the driver it waits for)."""
+    return _spin_budget_from(os.environ.get(SPIN_BUDGET_ENV), os.cpu_count() or 1)
+
+
+class WaitMode(enum.Enum):
+    """How a client waits for states, outcomes and replies (Rust ``WaitMode``)."""
+
+    #: Block on the driver's notification (default; costs a wake-up, frees the CPU), after
+    #: polling for the spin budget right after a command or request.
+    EVENT = "event"
+    #: Busy-poll shared memory (lowest latency; takes a whole core).
+    SPIN = "spin"
 
 
 # ----- status codes and small types ------------------------------------------------------
@@ -152,28 +209,41 @@ class Status(enum.IntEnum):
 
     def describe(self) -> str:
         """The short human-readable reason (the same text as Rust's ``Status::describe``)."""
-        return _STATUS_TEXT[self]
+        return L.DESCRIBE_STATUS[int(self)]
 
 
-_STATUS_TEXT = {
-    Status.OK: "ok",
-    Status.UNSUPPORTED: "unsupported by this device",
-    Status.UNKNOWN_JOINT: "unknown joint",
-    Status.NOT_FINITE: "value not finite",
-    Status.BEYOND_LIMITS: "beyond the joint limits",
-    Status.OUT_OF_REACH: "out of reach",
-    Status.NOT_CALIBRATED: "not calibrated yet",
-    Status.LINK_DOWN: "link to the hardware is down",
-    Status.BUSY: "device busy",
-    Status.TIMEOUT: "hardware timeout",
-    Status.INVALID_ARGUMENT: "invalid argument",
-    Status.POWERED_OFF: "powered off",
-    Status.UNREACHABLE_ORIENTATION: "orientation not attainable by this limb's joints",
-    Status.CLAMPED: "ok, clamped to the limit",
-    Status.PREEMPTED: "preempted by another client",
-    Status.LEASED: "held by another client",
-    Status.ADJUSTED: "ok, orientation adjusted",
-}
+@dataclass(frozen=True)
+class Outcome:
+    """The outcome of one of this client's commands (Rust ``Outcome``)."""
+
+    #: The command's sequence number (its :attr:`Ticket.seq`).
+    seq: int
+    #: What became of it.
+    status: Status
+    #: The other client involved: the one whose command preempted it (``PREEMPTED``) or
+    #: the one holding the device (``LEASED``); 0 if none.
+    other_client: int
+    #: The other client's name, when it holds the device's lease (empty otherwise).
+    other_name: str
+
+
+@dataclass(frozen=True)
+class LeaseHolder:
+    """Who holds a device (:meth:`holder`; Rust ``LeaseHolder``)."""
+
+    #: The holder's client id.
+    client_id: int
+    #: The holder's name.
+    name: str
+    #: Its heartbeat timeout, seconds.
+    timeout: float
+
+
+def _name_of(field: "ctypes.Array[ctypes.c_uint8]") -> str:
+    """A 32-byte NUL-padded name field (undecodable bytes replaced)."""
+    raw = bytes(field)
+    end = raw.find(b"\0")
+    return (raw if end < 0 else raw[:end]).decode("utf-8", "replace")
 
 
 class DriverStatus(enum.Enum):
@@ -229,9 +299,22 @@ class TransportError(LimberError):
 class NackError(LimberError):
     """The driver refused a request (NACK) and said why: :attr:`status`."""
 
-    def __init__(self, status: Status):
+    def __init__(self, status: Status) -> None:
         self.status = status
         super().__init__(f"refused: {status.describe()} ({status.name})")
+
+
+class LeaseHeldError(LimberError):
+    """Another client holds the device's lease: :attr:`client_id` and :attr:`name`."""
+
+    def __init__(self, client_id: int, name: str) -> None:
+        self.client_id = client_id
+        self.name = name
+        super().__init__(f"the device is held by {name or '?'} (client {client_id:#x})")
+
+
+class LeaseLostError(LimberError):
+    """The lease this client held was ended by the driver (a missed heartbeat)."""
 
 
 class RequestTimeout(LimberError, TimeoutError):
@@ -250,7 +333,7 @@ class OutcomeMissed(LimberError):
     """The outcome of this command was overwritten before it was read (a later command of
     this client has been applied since). :attr:`newer_seq` is that command's number."""
 
-    def __init__(self, newer_seq: int):
+    def __init__(self, newer_seq: int) -> None:
         self.newer_seq = newer_seq
         super().__init__(f"outcome missed; a later command (seq {newer_seq}) was applied since")
 
@@ -359,11 +442,11 @@ class Domain:
 
     __slots__ = ("_name", "_prefix")
 
-    def __init__(self, name: Optional[str] = None):
+    def __init__(self, name: Optional[str] = None) -> None:
         if name is None:
             name = os.environ.get(DOMAIN_ENV) or DEFAULT_DOMAIN
         if not isinstance(name, str) or len(name) > MAX_DOMAIN_LEN or not _IDENT.match(name):
-            raise ValueError(f"invalid domain {name!r}: use 1 to 48 characters of [A-Za-z0-9_-]")
+            raise ValueError(f"invalid domain {name!r}: use 1 to {MAX_DOMAIN_LEN} characters of [A-Za-z0-9_-]")
         self._name = name
         self._prefix = None
 
@@ -396,7 +479,7 @@ class Domain:
             self._prefix = prefix
         return self._prefix
 
-    def iceoryx2_config(self):
+    def iceoryx2_config(self) -> Any:
         """A fresh iceoryx2 config for this domain (defaults plus its root path and prefix)."""
         iox2 = _iox2()
         cfg = iox2.config.default()
@@ -446,7 +529,7 @@ class DeviceName:
             raise bad
         if len(robot) > MAX_ROBOT_LEN or not _IDENT.match(robot):
             raise ValueError(
-                f"invalid robot name {robot!r}: use 1 to 64 characters of [A-Za-z0-9_-]"
+                f"invalid robot name {robot!r}: use 1 to {MAX_ROBOT_LEN} characters of [A-Za-z0-9_-]"
             )
         return cls(robot, iface, n)
 
@@ -456,6 +539,88 @@ class DeviceName:
 
     def __str__(self) -> str:
         return f"{self.robot}/{self.interface}/{self.index}"
+
+
+# ----- discovery -------------------------------------------------------------------------
+
+_DRIVER_ATTR = "limber.driver"
+
+
+@dataclass(frozen=True)
+class DeviceInfo:
+    """One device found in a domain (Rust ``discovery::DeviceInfo``)."""
+
+    #: Its name (``robot/interface/index``).
+    name: DeviceName
+    #: The driver that offers it (its ``limber.driver`` attribute).
+    driver: str
+    #: The layout version it speaks.
+    layout: str
+    #: True while the driver's process lives.
+    alive: bool
+    #: Processes attached to its state channel (driver and clients).
+    nodes: int
+
+    @property
+    def interface(self) -> str:
+        """The interface: ``actarray``, ``limb`` or ``gripper``."""
+        return self.name.interface
+
+
+def list_devices(domain: "Optional[Domain | str]" = None) -> "list[DeviceInfo]":
+    """Every device of ``domain`` (default: from ``LIMBER_DOMAIN``), sorted by name, as
+    ``limber list`` shows them. A device whose driver died is listed as not alive until its
+    services are cleaned up. Raises :class:`TransportError` when the domain cannot be read."""
+    iox2 = _iox2()
+    dom = domain if isinstance(domain, Domain) else Domain(domain)
+    iox2.set_log_level_from_env_or(iox2.LogLevel.Error)
+    try:
+        _secure_shm(dom.prefix)
+        services = iox2.Service.list(dom.iceoryx2_config(), iox2.ServiceType.Ipc)
+    except LimberError:
+        raise
+    except Exception as e:
+        raise TransportError(f"cannot list the services of domain {dom}: {e!r}") from None
+    out = []
+    for details in services:
+        try:
+            if details.messaging_pattern() != iox2.MessagingPattern.PublishSubscribe:
+                continue
+            parts = details.name().to_string().split("/")
+            if len(parts) != 5 or parts[0] != "limber" or parts[4] != "data":
+                continue
+            try:
+                name = DeviceName.parse("/".join(parts[1:4]))
+            except ValueError:
+                continue
+            attrs = {
+                a.key.to_string(): a.value.to_string() for a in details.attributes().values
+            }
+            nodes = details.nodes()
+        except Exception as e:
+            raise TransportError(f"cannot read the services of domain {dom}: {e!r}") from None
+        alive = False
+        for n in nodes:
+            if isinstance(n, iox2.NodeState.Alive):
+                try:
+                    node_details = n[0].details
+                    is_driver = node_details is not None and node_details.name.as_str().startswith(
+                        _DRIVER_NODE_PREFIX
+                    )
+                except Exception:
+                    is_driver = False
+                alive = alive or is_driver
+        out.append(
+            DeviceInfo(
+                name=name,
+                driver=attrs.get(_DRIVER_ATTR, ""),
+                layout=attrs.get(_LAYOUT_ATTR, ""),
+                alive=alive,
+                nodes=len(nodes),
+            )
+        )
+    out.sort(key=lambda d: (d.name.robot, _INTERFACES.index(d.name.interface), d.name.index))
+    return out
 
 
 # ----- validation (the Rust constructors' rules) -----------------------------------------
@@ -544,7 +709,12 @@ def _default_process_name() -> str:
     return name[:64]
 
 
-class _Client:
+#: The state type of a client (``ActArrayData``, ``LimbData``, ``GripperData``).
+_D = TypeVar("_D", bound=ctypes.Structure)
+_C = TypeVar("_C", bound="_Client[Any]")
+
+
+class _Client(Generic[_D]):
     """A connection to one device. Use :class:`ActArrayClient`, :class:`LimbClient` or
     :class:`GripperClient`."""
 
@@ -554,8 +724,10 @@ class _Client:
     REQ_MSG: ClassVar[type]
     REPLY_MSG: ClassVar[type]
 
-    def __init__(self):  # use connect()
+    def __init__(self) -> None:  # use connect()
         self._closed = True
+        self._lease_port = None
+        self._lease_held = None
         self._node = None
         self._data_svc = None
         self._states = None
@@ -570,7 +742,7 @@ class _Client:
 
     @classmethod
     def connect(
-        cls,
+        cls: Type[_C],
         device: str,
         domain: "Domain | str | None" = None,
         timeout: float = 0.0,
@@ -578,7 +750,7 @@ class _Client:
         name: Optional[str] = None,
         request_timeout: float = DEFAULT_REQUEST_TIMEOUT,
         wake_driver: bool = True,
-    ):
+    ) -> _C:
         """Connects to ``device`` (``robot/interface/index``) in ``domain`` (a :class:`Domain`,
         a domain name, or ``None`` for ``LIMBER_DOMAIN``/``limber``).
 
@@ -628,9 +800,16 @@ class _Client:
         self._cmd_seq = 0
         self._req_seq = 0
         self._outcomes = [(0, 0)] * _OUTCOME_SLOTS
+        self._preemptions = [Outcome(0, Status.OK, 0, "")] * _OUTCOME_SLOTS
+        self._lease_port: Any = None
+        self._lease_seq = 0
+        self._lease_held: "Optional[tuple[float, float]]" = None  # heartbeat, last renewal
         self._latest = None
         self.request_timeout = DEFAULT_REQUEST_TIMEOUT
         self.wake_driver = True
+        self._wait_mode = WaitMode.EVENT
+        self._spin_budget = default_spin_budget()
+        self._spin_until: Optional[float] = None
         iox2.set_log_level_from_env_or(iox2.LogLevel.Error)
         node_name = (_CLIENT_NODE_PREFIX + proc_name)[: iox2.NodeName.max_len()]
         try:
@@ -729,8 +908,16 @@ class _Client:
     # ----- lifetime ---------------------------------------------------------------------
 
     def close(self) -> None:
-        """Releases every port and the node (idempotent). The client is unusable afterwards."""
-        for attr in ("_notify", "_wake", "_requests", "_commands", "_outcome_sub", "_states"):
+        """Releases the lease if held, then every port and the node (idempotent). The client
+        is unusable afterwards."""
+        if self.__dict__.get("_lease_held") is not None and not self.__dict__.get("_closed", True):
+            try:
+                self.release()
+            except LimberError as e:
+                import warnings
+
+                warnings.warn(f"{self._device}: cannot release the lease: {e}", stacklevel=2)
+        for attr in ("_lease_port", "_notify", "_wake", "_requests", "_commands", "_outcome_sub", "_states"):
             port = self.__dict__.get(attr)
             if port is not None:
                 try:
@@ -748,10 +935,10 @@ class _Client:
     def closed(self) -> bool:
         return self._closed
 
-    def __enter__(self):
+    def __enter__(self: _C) -> _C:
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.close()
 
     def __del__(self):
@@ -829,17 +1016,21 @@ class _Client:
                 if o.client_id == self._client_id and o.status != L.STATUS_PREEMPTED:
                     seq = o.cmd_seq
                     self._outcomes[seq % _OUTCOME_SLOTS] = (seq, o.status)
+                elif o.client_id == self._client_id:
+                    self._preemptions[o.cmd_seq % _OUTCOME_SLOTS] = Outcome(
+                        o.cmd_seq, Status.PREEMPTED, o.other_client, _name_of(o.other_name)
+                    )
             finally:
                 s.delete()
 
-    def state(self):
+    def state(self) -> Optional[_D]:
         """The latest state, after taking what arrived: a *copy* of the ``*Data`` ctypes
         struct (``ActArrayData``, ``LimbData``, ``GripperData``; same fields as in Rust), or
         ``None`` if no sample arrived yet."""
         self.refresh()
         return self._latest
 
-    def last_state(self):
+    def last_state(self) -> Optional[_D]:
         """The latest state already taken, without looking for a newer one."""
         return self._latest
 
@@ -859,7 +1050,7 @@ class _Client:
             return Freshness.FRESH
         return Freshness.STALE if self.driver_status() is DriverStatus.ALIVE else Freshness.GONE
 
-    def wait_state(self, timeout: float):
+    def wait_state(self, timeout: float) -> _D:
         """Waits up to ``timeout`` s for a state sample newer than the latest one taken and
         returns it (a copy). Raises :class:`WaitTimeout` or :class:`DriverGoneError`."""
         self._check_open()
@@ -908,8 +1099,49 @@ class _Client:
                     raise DriverGoneError("the driver is gone")
             self._pause(min(deadline, next_check))
 
+    @property
+    def wait_mode(self) -> WaitMode:
+        """How this client waits (default :attr:`WaitMode.EVENT`)."""
+        return self._wait_mode
+
+    def set_wait_mode(self, mode: WaitMode) -> None:
+        """Sets how this client waits for states, outcomes and replies."""
+        if not isinstance(mode, WaitMode):
+            raise ValueError(f"wait mode must be a WaitMode, not {mode!r}")
+        self._wait_mode = mode
+
+    @property
+    def spin_budget(self) -> float:
+        """The spin budget in seconds (see :meth:`set_spin_budget`)."""
+        return self._spin_budget
+
+    def set_spin_budget(self, seconds: float) -> None:
+        """In :attr:`WaitMode.EVENT`, how long a wait that follows a command or request polls
+        (yielding the CPU) before it blocks (default :func:`default_spin_budget`; zero: block
+        at once). The answer of a driver that is awake then arrives without a wake-up of this
+        process, at the price of up to this much CPU time per exchange."""
+        s = float(seconds)
+        if not math.isfinite(s) or s < 0:
+            raise ValueError(f"spin budget must be a finite number of seconds >= 0, not {seconds!r}")
+        self._spin_budget = s
+        self._spin_until = None  # a window opened under the old budget ends now
+
+    def _sent(self) -> None:
+        """Starts the busy-poll window of a send."""
+        self._spin_until = time.monotonic() + self._spin_budget if self._spin_budget > 0 else None
+
     def _pause(self, until: float) -> None:
-        """Blocks until ``until`` (time.monotonic) or the driver's next notification."""
+        """Blocks (event mode) or polls once (spin mode) until ``until`` (time.monotonic) or
+        the driver's next notification."""
+        if self._wait_mode is WaitMode.SPIN:
+            return
+        if self._spin_until is not None:
+            # Right after a send: poll for the answer of a driver that is awake, yielding
+            # the CPU so that a driver sharing this core runs at once.
+            if time.monotonic() < min(self._spin_until, until):
+                os.sched_yield()
+                return
+            self._spin_until = None
         iox2 = _iox2()
         if self._notify is None:
             try:
@@ -924,6 +1156,163 @@ class _Client:
             self._notify.timed_wait(iox2.Duration.from_secs_f64(left))
         except Exception as e:
             raise TransportError(f"waiting failed: {e!r}") from None
+
+    # ----- ownership --------------------------------------------------------------------
+
+    def preempted(self, ticket: Ticket) -> Optional[Outcome]:
+        """Whether the motion that the command of ``ticket`` started was cut short by another
+        client's command: its :class:`Outcome` (with the other client, and its name if it
+        held the device), or None. Looks at what arrived; remembers the last 16 commands."""
+        self.refresh()
+        p = self._preemptions[ticket.seq % _OUTCOME_SLOTS]
+        return p if p.seq == ticket.seq else None
+
+    def acquire(self, name: str, heartbeat: float) -> None:
+        """Takes the device: until :meth:`release` (or :meth:`close`), other clients'
+        commands, and their requests that change the device, are refused with ``LEASED``
+        naming ``name``; readers are unaffected. The lease lives as long as this client
+        renews it (:meth:`renew`, :meth:`keep_lease`) at least every ``heartbeat`` seconds,
+        and as long as its process lives: otherwise the driver stops the device and frees it.
+        Raises :class:`LeaseHeldError` when another client holds it."""
+        hb = float(heartbeat)
+        if not math.isfinite(hb) or hb <= 0:
+            raise ValueError(f"heartbeat must be a finite number of seconds > 0, not {heartbeat!r}")
+        if not isinstance(name, str) or len(name.encode("utf-8")) > 31:
+            raise ValueError(f"lease name must be a string of at most 31 bytes, not {name!r}")
+        reply = self._lease_call(L.LEASE_OP_ACQUIRE, min(int(hb * 1e9), 2**64 - 1), name)
+        if reply.status == L.STATUS_OK and reply.holder_client == self._client_id:
+            self._lease_held = (hb, time.monotonic())
+            return
+        raise self._lease_refusal(reply)
+
+    def renew(self) -> None:
+        """The heartbeat: tells the driver this holder is alive. Raises
+        :class:`LeaseLostError` when the driver ended the lease."""
+        reply = self._lease_call(L.LEASE_OP_RENEW, 0, "")
+        if reply.status == L.STATUS_OK and reply.holder_client == self._client_id:
+            if self._lease_held is not None:
+                self._lease_held = (self._lease_held[0], time.monotonic())
+            return
+        if reply.status == L.STATUS_OK:
+            self._lease_held = None
+            raise LeaseLostError("the lease was ended by the driver (a missed heartbeat?)")
+        if reply.status == L.STATUS_LEASED:
+            self._lease_held = None
+        raise self._lease_refusal(reply)
+
+    def keep_lease(self) -> bool:
+        """For a control loop: renews the lease when a third of its heartbeat has passed
+        since the last renewal (returns whether it did); does nothing when none is held."""
+        if self._lease_held is None:
+            return False
+        hb, last = self._lease_held
+        if time.monotonic() - last < hb / 3:
+            return False
+        self.renew()
+        return True
+
+    def release(self) -> None:
+        """Gives the device back (the motion in progress goes on). Releasing a lease not
+        held is no error."""
+        if self._lease_held is None:
+            return
+        try:
+            reply = self._lease_call(L.LEASE_OP_RELEASE, 0, "")
+        finally:
+            self._lease_held = None
+        if reply.status != L.STATUS_OK:
+            raise self._lease_refusal(reply)
+
+    @property
+    def holds_lease(self) -> bool:
+        """Whether this client holds the device (as far as it knows: :meth:`renew` finds
+        out whether the driver ended the lease)."""
+        return self._lease_held is not None
+
+    def holder(self) -> Optional[LeaseHolder]:
+        """Who holds the device, if anybody (a request to the driver)."""
+        reply = self._lease_call(L.LEASE_OP_QUERY, 0, "")
+        if reply.holder_client == 0:
+            return None
+        return LeaseHolder(reply.holder_client, _name_of(reply.holder_name), reply.timeout_ns / 1e9)
+
+    @staticmethod
+    def _lease_refusal(reply: "L.LeaseReply") -> LimberError:
+        if reply.status == L.STATUS_LEASED:
+            return LeaseHeldError(reply.holder_client, _name_of(reply.holder_name))
+        try:
+            return NackError(Status(reply.status))
+        except ValueError:
+            return DecodeError(f"undecodable lease reply: status {reply.status}")
+
+    def _lease_call(self, op: int, timeout_ns: int, name: str) -> "L.LeaseReply":
+        """One lease request and its reply, within the request timeout."""
+        self._check_open()
+        iox2 = _iox2()
+        if self._lease_port is None:
+            layout = iox2.AttributeVerifier.new().require(
+                iox2.AttributeKey.new(_LAYOUT_ATTR), iox2.AttributeValue.new(str(L.LAYOUT_VERSION))
+            )
+            try:
+                svc = (
+                    self._node.service_builder(iox2.ServiceName.new(self._device.service_name("lease")))
+                    .request_response(L.LeaseReq, L.LeaseReply)
+                    .enable_fire_and_forget_requests(False)
+                    .open_with_attributes(layout)
+                )
+                self._lease_port = svc.client_builder().create()
+                del svc
+            except Exception as e:
+                if "DoesNotExist" in repr(e):
+                    raise NoDriverError(f"no driver offers leases of {self._device}") from None
+                raise TransportError(f"{self._device}: cannot open the lease channel: {e!r}") from None
+        self._lease_seq += 1
+        req = L.LeaseReq()
+        req.client_id = self._client_id
+        req.seq = self._lease_seq
+        req.timeout_ns = timeout_ns
+        req.op = op
+        node_id = self._node.id.value
+        req.node_lo = node_id & (2**64 - 1)
+        req.node_hi = (node_id >> 64) & (2**64 - 1)
+        raw = name.encode("utf-8")[:31]
+        ctypes.memmove(ctypes.addressof(req.name), raw, len(raw))
+        try:
+            pending = self._lease_port.loan_uninit().write_payload(req).send()
+        except Exception as e:
+            raise TransportError(f"lease request failed: {e!r}") from None
+        try:
+            if pending.number_of_server_connections == 0:
+                raise NoDriverError("no driver serves lease requests")
+            if self.wake_driver:
+                try:
+                    self._wake.notify_with_custom_event_id(iox2.EventId.new(_EVENT_REQUEST))
+                except Exception:
+                    pass
+            self._sent()
+            timeout = self.request_timeout
+            deadline = time.monotonic() + timeout
+            next_check = time.monotonic() + LIVENESS_PERIOD
+            while True:
+                try:
+                    r = pending.receive()
+                except Exception as e:
+                    raise TransportError(f"lease request failed: {e!r}") from None
+                if r is not None:
+                    try:
+                        return _copy(L.LeaseReply, r.payload_ptr)
+                    finally:
+                        r.delete()
+                now = time.monotonic()
+                if now >= deadline:
+                    raise RequestTimeout(f"no lease reply within {timeout} s")
+                if now >= next_check:
+                    next_check = now + LIVENESS_PERIOD
+                    if self.driver_status() is not DriverStatus.ALIVE:
+                        raise DriverGoneError("the driver is gone")
+                self._pause(min(deadline, next_check))
+        finally:
+            pending.delete()
 
     # ----- liveness ---------------------------------------------------------------------
 
@@ -993,6 +1382,7 @@ class _Client:
                 pass
         if receivers == 0:
             raise NoDriverError("no driver receives commands")
+        self._sent()
         return Ticket(self._cmd_seq, receivers)
 
     # ----- requests ---------------------------------------------------------------------
@@ -1030,6 +1420,7 @@ class _Client:
                     self._wake.notify_with_custom_event_id(iox2.EventId.new(_EVENT_REQUEST))
                 except Exception:
                     pass
+            self._sent()
             deadline = time.monotonic() + timeout
             next_check = time.monotonic() + LIVENESS_PERIOD
             while True:
@@ -1085,7 +1476,7 @@ class _Client:
 # ----- actarray --------------------------------------------------------------------------
 
 
-class ActArrayClient(_Client):
+class ActArrayClient(_Client[L.ActArrayData]):
     """A client of an actuator array (Player's ``ActArrayProxy``; Rust ``ActArrayClient``).
 
     Commands return a :class:`Ticket`. Joint indices outside the array capacity (0..31),
@@ -1187,7 +1578,7 @@ class ActArrayClient(_Client):
 # ----- limb ------------------------------------------------------------------------------
 
 
-class LimbClient(_Client):
+class LimbClient(_Client[L.LimbData]):
     """A client of a limb (Player's ``LimbProxy``; Rust ``LimbClient``). Vectors are any
     3-sequences (robot frame, m); direction vectors must not be zero."""
 
@@ -1268,7 +1659,7 @@ class LimbClient(_Client):
 # ----- gripper ---------------------------------------------------------------------------
 
 
-class GripperClient(_Client):
+class GripperClient(_Client[L.GripperData]):
     """A client of a gripper (Player's ``GripperProxy``; Rust ``GripperClient``)."""
 
     INTERFACE = "gripper"
@@ -1312,6 +1703,132 @@ class GripperClient(_Client):
                            o.height, i.width, i.length, i.height):
             raise DecodeError("undecodable reply: gripper geometry is not finite")
         return g
+
+
+# ----- driver statistics -----------------------------------------------------------------
+
+
+def stats_text(field: "ctypes.Array[ctypes.c_uint8]") -> str:
+    """A text field of :class:`DriverStats` (NUL-padded UTF-8) as a string; raises
+    :class:`DecodeError` when it is not UTF-8 (Rust ``diagnostics::get_text``)."""
+    raw = bytes(field)
+    end = raw.find(b"\0")
+    try:
+        return (raw if end < 0 else raw[:end]).decode("utf-8")
+    except UnicodeDecodeError:
+        raise DecodeError("undecodable text field in the driver statistics") from None
+
+
+class DriverStatsReader:
+    """Reads the statistics a driver publishes on ``<robot>/driver/0`` (its loop, link and
+    hardware: :class:`DriverStats`), as ``limber echo pioneer/driver`` does (Rust
+    ``diagnostics::StatsReader``). Open with :meth:`open`; close with :meth:`close` or
+    ``with``."""
+
+    def __init__(self) -> None:  # use open()
+        self._closed = True
+        self._sub = None
+        self._node = None
+        self._latest: "Optional[L.DriverStats]" = None
+
+    @classmethod
+    def open(
+        cls, robot: str = "pioneer", domain: "Optional[Domain | str]" = None
+    ) -> "DriverStatsReader":
+        """Opens the statistics of ``robot``'s driver in ``domain`` (default: from
+        ``LIMBER_DOMAIN``). Raises :class:`NoDriverError` when no driver publishes them,
+        :class:`ValueError` for a bad robot name, :class:`TransportError` otherwise."""
+        if not isinstance(robot, str) or len(robot) > MAX_ROBOT_LEN or not _IDENT.match(robot):
+            raise ValueError(
+                f"invalid robot name {robot!r}: use 1 to {MAX_ROBOT_LEN} characters of [A-Za-z0-9_-]"
+            )
+        dom = domain if isinstance(domain, Domain) else Domain(domain)
+        iox2 = _iox2()
+        iox2.set_log_level_from_env_or(iox2.LogLevel.Error)
+        self = cls()
+        node_name = (_CLIENT_NODE_PREFIX + _default_process_name())[: iox2.NodeName.max_len()]
+        try:
+            self._node = (
+                iox2.NodeBuilder.new()
+                .name(iox2.NodeName.new(node_name))
+                .config(dom.iceoryx2_config())
+                .signal_handling_mode(iox2.SignalHandlingMode.Disabled)
+                .create(iox2.ServiceType.Ipc)
+            )
+        except Exception as e:
+            raise TransportError(f"cannot join domain {dom}: {e!r}") from None
+        _secure_shm(dom.prefix)
+        self._closed = False
+        _open_clients.add(self)  # type: ignore[arg-type]
+        try:
+            svc = (
+                self._node.service_builder(iox2.ServiceName.new(f"limber/{robot}/driver/0/data"))
+                .publish_subscribe(L.DriverStats)
+                .open()
+            )
+            self._sub = svc.subscriber_builder().create()
+            del svc
+        except Exception as e:
+            self.close()
+            if "DoesNotExist" in repr(e):
+                raise NoDriverError(
+                    f"no driver of robot {robot} publishes statistics in domain {dom}"
+                ) from None
+            raise TransportError(f"cannot open the statistics of {robot}: {e!r}") from None
+        return self
+
+    def refresh(self) -> bool:
+        """Takes what arrived; true if there was something new."""
+        if self._closed:
+            raise LimberError("the statistics reader is closed")
+        got = False
+        while True:
+            try:
+                sample = self._sub.receive()
+            except Exception as e:
+                raise TransportError(f"cannot receive statistics: {e!r}") from None
+            if sample is None:
+                return got
+            try:
+                self._latest = _copy(L.DriverStats, sample.payload_ptr)
+            finally:
+                sample.delete()
+            got = True
+
+    def latest(self) -> "Optional[L.DriverStats]":
+        """The latest statistics taken (a copy), or None."""
+        return self._latest
+
+    def wait(self, timeout: float) -> "L.DriverStats":
+        """Waits up to ``timeout`` s (polling every 5 ms, as Rust) for new statistics and
+        returns them (a copy). Raises :class:`WaitTimeout`."""
+        deadline = time.monotonic() + timeout
+        while True:
+            if self.refresh():
+                assert self._latest is not None
+                return self._latest
+            if time.monotonic() >= deadline:
+                raise WaitTimeout(f"no driver statistics within {timeout} s")
+            time.sleep(0.005)
+
+    def close(self) -> None:
+        """Releases the subscriber and the node (idempotent)."""
+        if self._sub is not None:
+            try:
+                self._sub.delete()
+            except Exception:
+                pass
+        self._sub = None
+        self._node = None
+        if not self._closed:
+            self._closed = True
+            _open_clients.discard(self)  # type: ignore[arg-type]
+
+    def __enter__(self) -> "DriverStatsReader":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
 
 @atexit.register

@@ -96,3 +96,29 @@ def test_bytes_written_by_python_decode_as_expected():
     assert int.from_bytes(raw[0:8], "little") == 7
     assert int.from_bytes(raw[24:28], "little") == 1
     assert int.from_bytes(raw[32:36], "little", signed=True) == 2
+
+
+def test_status_texts_are_rusts(manifest):
+    """Every status code has an enum member whose text is Rust's ``Status::describe``."""
+    texts = {t["code"]: t["text"] for t in manifest["status_texts"]}
+    assert texts == _layout.DESCRIBE_STATUS
+    assert sorted(int(s) for s in limber.Status) == sorted(texts)
+    for s in limber.Status:
+        assert s.describe() == texts[int(s)]
+    assert limber.Status.LEASED.describe() == "held by another client"
+
+
+def test_client_protocol_numbers_come_from_the_manifest(manifest):
+    from limber import client
+
+    assert client.MAX_DOMAIN_LEN == _layout.NAME_MAX_DOMAIN_LEN
+    assert client.MAX_ROBOT_LEN == _layout.NAME_MAX_ROBOT_LEN
+    assert client._EVENT_COMMAND == _layout.WAKE_COMMAND
+    assert client._EVENT_REQUEST == _layout.WAKE_REQUEST
+    assert client._OUTCOME_BUFFER == _layout.QOS_OUTCOME_BUFFER
+    limber.Domain("d" * _layout.NAME_MAX_DOMAIN_LEN)
+    with pytest.raises(ValueError):
+        limber.Domain("d" * (_layout.NAME_MAX_DOMAIN_LEN + 1))
+    limber.DeviceName.parse("r" * _layout.NAME_MAX_ROBOT_LEN + "/limb/0")
+    with pytest.raises(ValueError):
+        limber.DeviceName.parse("r" * (_layout.NAME_MAX_ROBOT_LEN + 1) + "/limb/0")

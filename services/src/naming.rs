@@ -25,9 +25,9 @@ pub const DOMAIN_ENV: &str = "LIMBER_DOMAIN";
 /// The domain used when [`DOMAIN_ENV`] is not set.
 pub const DEFAULT_DOMAIN: &str = "limber";
 /// Longest domain name.
-pub const MAX_DOMAIN_LEN: usize = 48;
+pub const MAX_DOMAIN_LEN: usize = limber_interfaces::protocol::MAX_DOMAIN_LEN;
 /// Longest robot name.
-pub const MAX_ROBOT_LEN: usize = 64;
+pub const MAX_ROBOT_LEN: usize = limber_interfaces::protocol::MAX_ROBOT_LEN;
 
 /// A name could not be parsed or is not allowed.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]

@@ -23,7 +23,7 @@ pub const CMD_BUFFER: usize = 256;
 /// Outcomes buffered per client (every client sees every outcome of the device and keeps
 /// its own): this many commands of all clients may be decided between two looks of a
 /// waiting client before its outcome is overwritten (safe overflow).
-pub const OUTCOME_BUFFER: usize = 256;
+pub const OUTCOME_BUFFER: usize = limber_interfaces::protocol::OUTCOME_BUFFER;
 /// Subscribers of `cmd`: the driver, a dead driver not yet cleaned up, and observers.
 pub const CMD_SUBSCRIBERS: usize = 4;
 /// Servers of `req`: the driver plus one dead driver not yet cleaned up.
@@ -36,15 +36,15 @@ pub const WAKE_LISTENERS: usize = 4;
 pub const NOTIFY_NOTIFIERS: usize = 4;
 
 /// Event id on `wake`: a command was sent.
-pub const EVENT_COMMAND: usize = 1;
+pub const EVENT_COMMAND: usize = limber_interfaces::protocol::WAKE_COMMAND;
 /// Event id on `wake`: a request was sent.
-pub const EVENT_REQUEST: usize = 2;
+pub const EVENT_REQUEST: usize = limber_interfaces::protocol::WAKE_REQUEST;
 /// Event id on `wake`: a client connected (the driver hands it the latest state).
-pub const EVENT_HELLO: usize = 3;
+pub const EVENT_HELLO: usize = limber_interfaces::protocol::WAKE_HELLO;
 /// Event id on `notify`: a state sample was published.
-pub const EVENT_STATE: usize = 1;
+pub const EVENT_STATE: usize = limber_interfaces::protocol::NOTIFY_STATE;
 /// Event id on `notify`: a reply was sent.
-pub const EVENT_REPLY: usize = 2;
+pub const EVENT_REPLY: usize = limber_interfaces::protocol::NOTIFY_REPLY;
 
 /// The spin budget of a client in event mode when nothing else is configured, on a machine
 /// with at least two cores (see [`default_spin_budget`]). Chosen by measurement
