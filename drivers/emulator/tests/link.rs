@@ -714,7 +714,10 @@ fn a_tcp_endpoint_serves_one_client_at_a_time() {
             break;
         }
     }
-    assert!(fresh, "no SIP sent after the refusal reached the first client");
+    assert!(
+        fresh,
+        "no SIP sent after the refusal reached the first client"
+    );
     first.close().unwrap();
     // Gone: the next client is served.
     emu_wait(&emu, "the first client gone", |s| !s.connected);
