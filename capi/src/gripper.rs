@@ -48,15 +48,9 @@ pub unsafe extern "C" fn limber_gripper_connect(
 /// `h` is NULL or a handle of `limber_gripper_connect` not yet disconnected.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn limber_gripper_disconnect(h: *mut LimberGripper) {
-    if !h.is_null() {
-        // SAFETY: the handle came from Box::into_raw in limber_gripper_connect and is
-        // freed once.
-        let h = unsafe { Box::from_raw(h) };
-        let _ = guard(move || {
-            drop(h);
-            Ok(())
-        });
-    }
+    // SAFETY: the caller's promise (see above): NULL or a handle of the connect call,
+    // freed once.
+    unsafe { crate::free_handle(h) }
 }
 
 /// Copies the latest state into `*out`, waiting up to `timeout_ms` for a first one

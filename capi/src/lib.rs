@@ -382,6 +382,27 @@ pub(crate) fn guard(body: impl FnOnce() -> Result<(), Fail>) -> LimberCode {
     }
 }
 
+/// Frees a handle made by `Box::into_raw` in a `*_connect` (NULL is ignored). Dropping it
+/// closes the client's ports; a panic there is caught, recorded as the thread's last error
+/// (a `void` function has no code to return) and logged.
+///
+/// # Safety
+/// `h` is NULL or came from `Box::into_raw` of a `*_connect` and is freed once.
+pub(crate) unsafe fn free_handle<T>(h: *mut T) {
+    if h.is_null() {
+        return;
+    }
+    // SAFETY: the caller's promise: a handle of `*_connect`, freed once.
+    let h = unsafe { Box::from_raw(h) };
+    let code = guard(move || {
+        drop(h);
+        Ok(())
+    });
+    if code != LimberCode::Ok {
+        tracing::warn!(?code, "closing a handle failed");
+    }
+}
+
 // ----- pointers from C ------------------------------------------------------------------
 
 /// `p` as a reference, or `LIMBER_CODE_NULL_ARGUMENT` naming `what`.

@@ -65,10 +65,10 @@ fn header_human(h: &StateHeader) -> String {
         match Status::try_from(h.last_cmd.status) {
             // "ok, clamped to the limit", "ok, orientation adjusted": carried out.
             Ok(st) if st.is_carried_out() => {
-                let _ = write!(s, " [last command: {st}]");
+                s.push_str(&format!(" [last command: {st}]"));
             }
             Ok(st) => {
-                let _ = write!(s, " [last command refused: {st}]");
+                s.push_str(&format!(" [last command refused: {st}]"));
             }
             Err(_) => s.push_str(" [last command refused: ?]"),
         }

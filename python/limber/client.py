@@ -418,6 +418,24 @@ def _global_mgmt_files(prefix: str):
     ]
 
 
+def _join_domain(domain: "Domain", node_name: str) -> Any:
+    """A node named `node_name` in `domain` (iceoryx2's signal handling off: the program's
+    own handlers stay in charge), with the domain's node counter narrowed to the owner."""
+    iox2 = _iox2()
+    try:
+        node = (
+            iox2.NodeBuilder.new()
+            .name(iox2.NodeName.new(node_name))
+            .config(domain.iceoryx2_config())
+            .signal_handling_mode(iox2.SignalHandlingMode.Disabled)
+            .create(iox2.ServiceType.Ipc)
+        )
+    except Exception as e:
+        raise TransportError(f"cannot join domain {domain}: {e!r}") from None
+    _secure_shm(domain.prefix)
+    return node
+
+
 def _secure_shm(prefix: str) -> None:
     """Refuses a node counter of the domain owned by someone else; narrows ours to 0600
     (iceoryx2 makes it 0666)."""
@@ -812,17 +830,7 @@ class _Client(Generic[_D]):
         self._spin_until: Optional[float] = None
         iox2.set_log_level_from_env_or(iox2.LogLevel.Error)
         node_name = (_CLIENT_NODE_PREFIX + proc_name)[: iox2.NodeName.max_len()]
-        try:
-            self._node = (
-                iox2.NodeBuilder.new()
-                .name(iox2.NodeName.new(node_name))
-                .config(domain.iceoryx2_config())
-                .signal_handling_mode(iox2.SignalHandlingMode.Disabled)
-                .create(iox2.ServiceType.Ipc)
-            )
-        except Exception as e:
-            raise TransportError(f"cannot join domain {domain}: {e!r}") from None
-        _secure_shm(domain.prefix)
+        self._node = _join_domain(domain, node_name)
         self._closed = False
         _open_clients.add(self)
 
@@ -1747,17 +1755,7 @@ class DriverStatsReader:
         iox2.set_log_level_from_env_or(iox2.LogLevel.Error)
         self = cls()
         node_name = (_CLIENT_NODE_PREFIX + _default_process_name())[: iox2.NodeName.max_len()]
-        try:
-            self._node = (
-                iox2.NodeBuilder.new()
-                .name(iox2.NodeName.new(node_name))
-                .config(dom.iceoryx2_config())
-                .signal_handling_mode(iox2.SignalHandlingMode.Disabled)
-                .create(iox2.ServiceType.Ipc)
-            )
-        except Exception as e:
-            raise TransportError(f"cannot join domain {dom}: {e!r}") from None
-        _secure_shm(dom.prefix)
+        self._node = _join_domain(dom, node_name)
         self._closed = False
         _open_clients.add(self)  # type: ignore[arg-type]
         try:

@@ -229,7 +229,9 @@ fn token(dir: &Path, domain: &str) -> Result<String, DomainError> {
         drop(f);
         // link(2) does not replace: the first process to make the token wins.
         let linked = fs::hard_link(&tmp, &path);
-        let _ = fs::remove_file(&tmp);
+        if let Err(e) = fs::remove_file(&tmp) {
+            tracing::debug!(path = %tmp.display(), error = %e, "cannot remove the temporary token file");
+        }
         match linked {
             Ok(()) => {}
             Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {}
