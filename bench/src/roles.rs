@@ -9,13 +9,15 @@
 //! | `state-pub` | state | a `DeviceHost` publishing the arm state at 1 kHz after `go` |
 //! | `state-sub` | state | an `ActArrayClient` blocking in `wait_state`, recording one-way latency |
 //! | `cmd-driver-spin` / `cmd-driver-event` | command | a `DeviceHost` driver, busy-polling or in `event_loop::run` |
-//! | `pioneer-driver` | request | the emulator on a pty and the Pioneer driver on it |
+//! | `pioneer-driver` | request, loop | the emulator on a pty and the Pioneer driver on it |
+//! | `pioneer-driver-spin` | loop | the same, the driver busy-polling |
 //! | `{uds,tcp}-echo-{spin,blocking}` | peers | a socket echo with the same bytes |
 
 use std::io::Write;
 use std::time::{Duration, Instant};
 
 use iceoryx2::prelude::*;
+use limber_pioneer::LoopMode;
 use limber_services::Domain;
 
 use crate::scenario::{command, floor, peers, physical, state};
@@ -36,7 +38,8 @@ pub fn run_role(role: &str, args: &BenchArgs) -> Result<(), BenchError> {
         "waitset-echo" => floor::echo_role(args, floor::Echo::WaitSet),
         "state-pub" => state::publisher_role(args),
         "state-sub" => state::subscriber_role(args),
-        "pioneer-driver" => crate::scenario::request::driver_role(args),
+        "pioneer-driver" => crate::scenario::request::driver_role(args, LoopMode::Event),
+        "pioneer-driver-spin" => crate::scenario::request::driver_role(args, LoopMode::Spin),
         "cmd-driver-spin" => command::driver_role(args, true),
         "cmd-driver-event" => command::driver_role(args, false),
         "uds-echo-spin" => peers::echo_role(args, peers::Transport::Uds, true),

@@ -15,6 +15,11 @@
 //! * `reply read → client sees the state`: acquisition stamp to the client's receipt
 //!   (driver publish, notify, client wake-up);
 //! * the total, client send → client receipt.
+//!
+//! Run twice when both strategies are enabled: with the event-driven driver (ids
+//! `loop.*`), and with the busy-polling driver (`limber pioneer --spin`; ids `loop.spin.*`,
+//! labels ending `[driver spinning]`), whose `driver` stage is the driver's own cost when
+//! it is awake. The client waits on events in both, so the emulator thread keeps a core.
 
 use std::time::{Duration, Instant};
 
@@ -48,103 +53,144 @@ impl Scenario for Loop {
         "full loop through the emulator over a pty, fast mode (command → P2OS → emulator → ARMpac → state), split by stage"
     }
     fn run(&self, ctx: &mut RunCtx) -> Result<(), BenchError> {
-        if !ctx.blocking_enabled() {
-            ctx.notes
-                .push("loop runs the event-driven driver only; skipped by --strategy spin".into());
-            return Ok(());
+        if ctx.blocking_enabled() {
+            run_variant(ctx, Variant::Event)?;
         }
-        let domain = ctx.domain();
-        let (warm, n) = (ctx.count(50, 20), ctx.count(1_000, 200));
-        let out = ctx.tmp_file("loop-driver.hdr");
-        let mut child = ChildProc::spawn(&ChildSpec {
-            role: "pioneer-driver".into(),
-            domain: Some(domain.name().to_string()),
-            out: Some(out.clone()),
-            cpu: ctx.child_cpu(),
-            deadline: ctx.deadline_for(warm + n, Duration::from_millis(20)),
-            ..Default::default()
-        })?;
-        child.expect("ready", START_TIMEOUT)?;
-        let cctx = Context::new(&domain, Role::Client, "bench-loop")
-            .map_err(|e| err("client context", e.to_string()))?;
-        let mut arm = ActArrayClient::connect_timeout(&cctx, DEVICE, START_TIMEOUT)
-            .map_err(|e| err("connect", e.to_string()))?;
-        arm.set_request_timeout(super::SAMPLE_TIMEOUT);
-        arm.power(true).map_err(|e| err("power", e.to_string()))?;
-        let (mut to_robot, mut to_client, mut total) =
-            (new_histogram()?, new_histogram()?, new_histogram()?);
-        let progress = Progress::new(ctx.progress, "loop through the emulator", warm + n);
-        for i in 1..=warm + n {
-            let target = if i % 2 == 0 { 0.15 } else { -0.15 };
-            let t0 = monotonic_ns();
-            arm.move_to(0, target)
-                .map_err(|e| err("command", e.to_string()))?;
-            // The first state acquired after the command was sent: the emulator's prompt
-            // ARMpac, read by the driver.
-            let deadline = Instant::now() + super::SAMPLE_TIMEOUT;
-            let (stamp, seen) = loop {
-                let s = arm
-                    .wait_state(deadline.saturating_duration_since(Instant::now()))
-                    .map_err(|e| err("state", e.to_string()))?;
-                let stamp = s.header.stamp_ns;
-                if stamp > t0 {
-                    break (stamp, monotonic_ns());
-                }
-            };
-            if i > warm {
-                to_robot.saturating_record(stamp.saturating_sub(t0));
-                to_client.saturating_record(seen.saturating_sub(stamp));
-                total.saturating_record(seen.saturating_sub(t0));
-            }
-            progress.tick(i);
-        }
-        progress.finish();
-        drop(arm);
-        if let Err(e) = child.send_line("quit") {
-            tracing::warn!("cannot tell the client child to quit: {e}");
-        }
-        child.finish(Duration::from_secs(10))?;
-        let driver = read_histogram(&out)?;
-        let bytes = Some((
-            core::mem::size_of::<ActArrayCmdMsg>(),
-            core::mem::size_of::<ActArrayData>(),
-        ));
-        for (id, label, metric, hist) in [
-            (
-                "loop.to_robot",
-                "command → robot reply read by the driver (emulator fast mode)",
-                Metric::OneWay,
-                to_robot,
-            ),
-            (
-                "loop.driver",
-                "command arrival → bytes on the pty (the driver's own cost)",
-                Metric::OneWay,
-                driver,
-            ),
-            (
-                "loop.to_client",
-                "reply read → client sees the state",
-                Metric::OneWay,
-                to_client,
-            ),
-            (
-                "loop.total",
-                "command → state, through the emulator (fast mode)",
-                Metric::RoundTrip,
-                total,
-            ),
-        ] {
-            ctx.push(Measurement {
-                scenario: "loop",
-                id: id.into(),
-                label: label.into(),
-                strategy: Strategy::Blocking,
-                metric,
-                bytes,
-                hist,
-            });
+        if ctx.spin_enabled() {
+            run_variant(ctx, Variant::DriverSpin)?;
         }
         Ok(())
     }
+}
+
+/// How the driver child waits; the client always waits on events (its spin budget
+/// included), so the emulator thread keeps a core when the driver spins on the other.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Variant {
+    /// The event-driven driver (the default).
+    Event,
+    /// The busy-polling driver (`limber pioneer --spin`).
+    DriverSpin,
+}
+
+impl Variant {
+    /// The child role, the id prefix, the label suffix and the driver stage's strategy.
+    fn parts(self) -> (&'static str, &'static str, &'static str, Strategy) {
+        match self {
+            Variant::Event => ("pioneer-driver", "loop", "", Strategy::Blocking),
+            Variant::DriverSpin => (
+                "pioneer-driver-spin",
+                "loop.spin",
+                " [driver spinning]",
+                Strategy::Spin,
+            ),
+        }
+    }
+}
+
+/// One run of the loop with the driver child of `variant`.
+fn run_variant(ctx: &mut RunCtx, variant: Variant) -> Result<(), BenchError> {
+    let (role, prefix, suffix, driver_strategy) = variant.parts();
+    let domain = ctx.domain();
+    let (warm, n) = (ctx.count(50, 20), ctx.count(1_000, 200));
+    let out = ctx.tmp_file(&format!("{prefix}-driver.hdr"));
+    let mut child = ChildProc::spawn(&ChildSpec {
+        role: role.into(),
+        domain: Some(domain.name().to_string()),
+        out: Some(out.clone()),
+        cpu: ctx.child_cpu(),
+        deadline: ctx.deadline_for(warm + n, Duration::from_millis(20)),
+        ..Default::default()
+    })?;
+    child.expect("ready", START_TIMEOUT)?;
+    let cctx = Context::new(&domain, Role::Client, "bench-loop")
+        .map_err(|e| err("client context", e.to_string()))?;
+    let mut arm = ActArrayClient::connect_timeout(&cctx, DEVICE, START_TIMEOUT)
+        .map_err(|e| err("connect", e.to_string()))?;
+    arm.set_request_timeout(super::SAMPLE_TIMEOUT);
+    arm.power(true).map_err(|e| err("power", e.to_string()))?;
+    let (mut to_robot, mut to_client, mut total) =
+        (new_histogram()?, new_histogram()?, new_histogram()?);
+    let progress = Progress::new(
+        ctx.progress,
+        &format!("loop through the emulator{suffix}"),
+        warm + n,
+    );
+    for i in 1..=warm + n {
+        let target = if i % 2 == 0 { 0.15 } else { -0.15 };
+        let t0 = monotonic_ns();
+        arm.move_to(0, target)
+            .map_err(|e| err("command", e.to_string()))?;
+        // The first state acquired after the command was sent: the emulator's prompt
+        // ARMpac, read by the driver.
+        let deadline = Instant::now() + super::SAMPLE_TIMEOUT;
+        let (stamp, seen) = loop {
+            let s = arm
+                .wait_state(deadline.saturating_duration_since(Instant::now()))
+                .map_err(|e| err("state", e.to_string()))?;
+            let stamp = s.header.stamp_ns;
+            if stamp > t0 {
+                break (stamp, monotonic_ns());
+            }
+        };
+        if i > warm {
+            to_robot.saturating_record(stamp.saturating_sub(t0));
+            to_client.saturating_record(seen.saturating_sub(stamp));
+            total.saturating_record(seen.saturating_sub(t0));
+        }
+        progress.tick(i);
+    }
+    progress.finish();
+    drop(arm);
+    if let Err(e) = child.send_line("quit") {
+        tracing::warn!("cannot tell the client child to quit: {e}");
+    }
+    child.finish(Duration::from_secs(10))?;
+    let driver = read_histogram(&out)?;
+    let bytes = Some((
+        core::mem::size_of::<ActArrayCmdMsg>(),
+        core::mem::size_of::<ActArrayData>(),
+    ));
+    for (stage, label, strategy, metric, hist) in [
+        (
+            "to_robot",
+            "command → robot reply read by the driver (emulator fast mode)",
+            Strategy::Blocking,
+            Metric::OneWay,
+            to_robot,
+        ),
+        (
+            "driver",
+            "command arrival → bytes on the pty (the driver's own cost)",
+            driver_strategy,
+            Metric::OneWay,
+            driver,
+        ),
+        (
+            "to_client",
+            "reply read → client sees the state",
+            Strategy::Blocking,
+            Metric::OneWay,
+            to_client,
+        ),
+        (
+            "total",
+            "command → state, through the emulator (fast mode)",
+            Strategy::Blocking,
+            Metric::RoundTrip,
+            total,
+        ),
+    ] {
+        let label = format!("{label}{suffix}");
+        ctx.push(Measurement {
+            scenario: "loop",
+            id: format!("{prefix}.{stage}"),
+            label,
+            strategy,
+            metric,
+            bytes,
+            hist,
+        });
+    }
+    Ok(())
 }

@@ -102,7 +102,7 @@ impl Scenario for Request {
 
 /// The Pioneer driver child (`pioneer-driver`): the emulator on a pty and the driver on
 /// it, until `quit` on stdin or the deadline.
-pub fn driver_role(args: &BenchArgs) -> Result<(), BenchError> {
+pub fn driver_role(args: &BenchArgs, mode: LoopMode) -> Result<(), BenchError> {
     let domain = roles::child_domain(args)?;
     let deadline = roles::child_deadline(args);
     let ctx = Context::new(&domain, Role::Driver, "bench-pioneer")
@@ -121,19 +121,14 @@ pub fn driver_role(args: &BenchArgs) -> Result<(), BenchError> {
     }
     let lines = roles::stdin_lines();
     roles::announce("ready");
-    let r = driver.run_until(
-        RunOptions {
-            mode: LoopMode::Event,
-        },
-        move || {
-            use std::sync::mpsc::TryRecvError;
-            match lines.try_recv() {
-                Ok(l) if l.trim() == "quit" => true,
-                Err(TryRecvError::Disconnected) => true,
-                _ => Instant::now() > deadline,
-            }
-        },
-    );
+    let r = driver.run_until(RunOptions { mode }, move || {
+        use std::sync::mpsc::TryRecvError;
+        match lines.try_recv() {
+            Ok(l) if l.trim() == "quit" => true,
+            Err(TryRecvError::Disconnected) => true,
+            _ => Instant::now() > deadline,
+        }
+    });
     // The driver's own cost per command (arrival → bytes on the pty), for `loop`.
     let written = match &args.out {
         Some(_) => {
