@@ -661,3 +661,23 @@ fn a_second_driver_with_the_same_robot_name_is_refused_before_it_opens_the_link(
     let t = arm.move_to(0, 0.3).unwrap();
     assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
 }
+
+/// The soak found a device whose clients' wake-ups stopped reaching the event-driven loop
+/// (its commands and requests then waited for ever). A client that never wakes the driver
+/// stands in for it: its commands and requests are still served, at the driver's ticks.
+#[test]
+fn commands_without_a_wake_up_are_still_served_at_the_next_tick() {
+    let domain = Domain::unique_for_test();
+    let emu = Emulator::start_pty(EmulatorConfig::default()).unwrap();
+    let _driver = start(&domain, &emu, "nowake");
+    let c = ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
+    arm.power(true).unwrap();
+    arm.set_wake_driver(false);
+    arm.set_spin_budget(Duration::ZERO);
+    for target in [0.2, -0.2, 0.1] {
+        let t = arm.move_to(0, target).unwrap();
+        assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
+    }
+    assert_eq!(arm.geometry().unwrap().actuators_count, 6);
+}

@@ -169,6 +169,11 @@ pub struct PioneerDriver {
     last_cleanup: Instant,
     mode: LoopMode,
     wakeups: u64,
+    tick_found_work: u64,
+    /// A clients' wake-up came since the last tick.
+    woken_since_tick: bool,
+    /// Ticks in a row that found work without any wake-up in between.
+    deaf_ticks: u32,
     failures: Failures,
     arm_probe: Option<ArmProbe>,
     arm_info_arrived: bool,
@@ -179,6 +184,10 @@ pub struct PioneerDriver {
 
 /// Longest wait between two ARM_INFO retries of the loop.
 const ARM_PROBE_MAX: Duration = Duration::from_secs(30);
+
+/// Ticks in a row that find clients' work without a wake-up before the driver warns that
+/// wake-ups are lost.
+const DEAF_TICKS: u32 = 20;
 
 /// ARM_INFO retries of the loop, while the link is up but no ARMINFOpac answered the
 /// handshake's: sent from the timer (never waited for), the reply is read by
@@ -505,6 +514,9 @@ impl PioneerDriver {
             last_cleanup: Instant::now(),
             mode: LoopMode::Event,
             wakeups: 0,
+            tick_found_work: 0,
+            woken_since_tick: false,
+            deaf_ticks: 0,
             failures: Failures::default(),
             arm_probe: None,
             arm_info_arrived: false,
@@ -1031,6 +1043,35 @@ impl PioneerDriver {
         self.wakeups
     }
 
+    /// Ticks of the event-driven loop that found commands or requests waiting (which a
+    /// client's wake-up had not brought in first): the safety net under lost wake-ups.
+    pub fn tick_found_work(&self) -> u64 {
+        self.tick_found_work
+    }
+
+    /// Counts a tick that found clients' work, and warns (once per episode) when ticks
+    /// keep finding work while no wake-up comes: the clients' wake-ups are lost.
+    fn note_tick_work(&mut self, found: bool) {
+        let woken = std::mem::take(&mut self.woken_since_tick);
+        if found {
+            self.tick_found_work += 1;
+        }
+        if found && !woken {
+            self.deaf_ticks = self.deaf_ticks.saturating_add(1);
+            if self.deaf_ticks == DEAF_TICKS {
+                tracing::warn!(
+                    "clients' commands arrive but their wake-ups do not ({DEAF_TICKS} ticks in a \
+                     row): serving them at every tick until wake-ups come again"
+                );
+            }
+        } else {
+            if self.deaf_ticks >= DEAF_TICKS {
+                tracing::info!("clients' wake-ups arrive again");
+            }
+            self.deaf_ticks = 0;
+        }
+    }
+
     fn run_event(&mut self, stop: &mut dyn FnMut() -> bool) -> Result<LoopExit, DriverError> {
         let mut listeners = self.hosts.take_wake_listeners();
         let tick = self.robot.cfg.tick();
@@ -1057,6 +1098,7 @@ impl PioneerDriver {
                         }
                     }
                     Wake::Clients => {
+                        self.woken_since_tick = true;
                         if self.process_clients(false) {
                             // A client in a tight loop sends its next command within the
                             // linger: picked up without a wake-up.
@@ -1071,6 +1113,12 @@ impl PioneerDriver {
                             self.link_failed("read failed");
                         }
                         self.tick(now);
+                        // The safety net under the clients' wake-ups: a wake-up that never
+                        // comes (seen in the soak: a device's listener stopped waking the
+                        // loop, and its commands and requests waited for ever) delays a
+                        // command by one tick at most instead of freezing that device.
+                        let found = self.process_clients(false);
+                        self.note_tick_work(found);
                     }
                 }
                 if std::mem::take(&mut self.arm_info_arrived) {
