@@ -208,6 +208,9 @@ pub struct RobotState {
     pub autoparks: u64,
     /// CONFIG (18) commands answered with a CONFIGpac.
     pub config_requests: u64,
+    /// GRIPPER (33) and GRIPPERVAL (36) commands received after OPEN, with or without a
+    /// gripper.
+    pub gripper_commands: u64,
     /// GRIPPER (33) commands received by a robot without a gripper (ignored).
     pub unsupported_gripper_commands: u64,
     /// GRIPPERVAL (36) commands received by a robot without a gripper (ignored).
@@ -248,6 +251,7 @@ pub struct Robot {
     cycle: Duration,
     watchdog: Option<Duration>,
     config_requests: u64,
+    gripper_commands: u64,
     unsupported_gripper: u64,
     unsupported_gripperval: u64,
 }
@@ -302,6 +306,7 @@ impl Robot {
             cycle: Duration::from_millis(100),
             watchdog: None,
             config_requests: 0,
+            gripper_commands: 0,
             unsupported_gripper: 0,
             unsupported_gripperval: 0,
         }
@@ -475,6 +480,9 @@ impl Robot {
         self.last_contact = now;
         let arg = cmd.int();
         let open = self.stage == SyncStage::Open;
+        if open && matches!(cmd.number, num::GRIPPER | num::GRIPPERVAL) {
+            self.gripper_commands += 1;
+        }
         match cmd.number {
             num::SYNC0 if !open => {
                 self.stage = SyncStage::AfterSync0;
@@ -887,6 +895,7 @@ impl Robot {
             autopark_s: self.autopark_s,
             autoparks: self.autoparks,
             config_requests: self.config_requests,
+            gripper_commands: self.gripper_commands,
             unsupported_gripper_commands: self.unsupported_gripper,
             unsupported_gripperval_commands: self.unsupported_gripperval,
         }

@@ -51,9 +51,10 @@ pub struct ConnectOptions {
 }
 
 /// What the CONFIG probe of the handshake found ([`ConnectOptions::config`]).
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub enum ConfigProbe {
     /// CONFIG was not sent.
+    #[default]
     NotAsked,
     /// The robot answered with this CONFIGpac.
     Answered(Box<ConfigPacket>),

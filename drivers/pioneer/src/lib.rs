@@ -22,7 +22,7 @@ mod realtime;
 mod robot;
 mod stats;
 
-pub use config::{ConfigError, GripperGeometry, PioneerConfig};
-pub use driver::{DriverError, Hardware, LoopMode, PioneerDriver, RunOptions};
+pub use config::{BodyGripper, ConfigError, GripperGeometry, PioneerConfig};
+pub use driver::{DriverError, Hardware, LoopMode, PioneerDriver, RunOptions, gripper_decision};
 pub use realtime::{RealtimeWarning, apply_realtime};
 pub use stats::{LoopStats, Ring};
