@@ -41,7 +41,7 @@ pub struct EmulatorArgs {
     pub no_arm: bool,
     /// Emulate a robot without a body gripper and lift: its CONFIGpac says so (GRIPPER 0),
     /// and GRIPPER (33) and GRIPPERVAL (36) commands are logged as unsupported, counted
-    /// and ignored, like a gripperless controller (the count is printed at exit).
+    /// and ignored, like a gripperless controller (their count is printed on stdout at exit).
     #[arg(long)]
     pub no_gripper: bool,
     /// Never answer CONFIG (18), like a controller that does not implement it.
@@ -201,11 +201,14 @@ fn serve(args: EmulatorArgs) -> Result<(), EmulatorError> {
     }
     let st = emu.state().robot;
     if st.unsupported_gripper_commands + st.unsupported_gripperval_commands > 0 {
-        eprintln!(
-            "limber emulator: unsupported commands received (the robot has no gripper): \
-             GRIPPER (33) x{}, GRIPPERVAL (36) x{}",
+        let mut out = std::io::stdout().lock();
+        writeln!(
+            out,
+            "unsupported commands received (the robot has no gripper): GRIPPER (33) x{}, \
+             GRIPPERVAL (36) x{}",
             st.unsupported_gripper_commands, st.unsupported_gripperval_commands
-        );
+        )?;
+        out.flush()?;
     }
     emu.stop()
 }
