@@ -197,9 +197,10 @@ impl Connection {
 
     /// Runs the handshake on an open link: sync (trying the baud rates in
     /// order on a serial link, never over TCP), read the robot's identity,
-    /// OPEN, PULSE, wait for the first SIP, set the sonar, and, if asked,
-    /// start the ARMpac stream and read the ARMINFOpac (no answer within the
-    /// timeout = no arm).
+    /// OPEN, PULSE, wait for the first SIP, set the sonar, if asked read the
+    /// CONFIGpac ([`ConnectOptions::config`], [`Connection::config`]), and, if
+    /// asked, start the ARMpac stream and read the ARMINFOpac (no answer within
+    /// the timeout = no arm).
     pub fn establish(mut link: Link, opts: &ConnectOptions) -> Result<Connection, ConnectError> {
         let (identity, baud) = Self::sync(&mut link, opts)?;
         link.send(&Command::Open)?;
