@@ -39,9 +39,14 @@ pub struct EmulatorArgs {
     /// Emulate a robot without an arm (arm commands are ignored).
     #[arg(long)]
     pub no_arm: bool,
-    /// Emulate a robot without a body gripper and lift.
+    /// Emulate a robot without a body gripper and lift: its CONFIGpac says so (GRIPPER 0),
+    /// and GRIPPER (33) and GRIPPERVAL (36) commands are logged as unsupported, counted
+    /// and ignored, like a gripperless controller (their count is printed on stdout at exit).
     #[arg(long)]
     pub no_gripper: bool,
+    /// Never answer CONFIG (18), like a controller that does not implement it.
+    #[arg(long)]
+    pub no_config: bool,
     /// pty: answer only when the line is set to this baud rate.
     #[arg(long)]
     pub baud: Option<u32>,
@@ -120,6 +125,7 @@ impl EmulatorArgs {
                 silent: false,
                 slow_wire_baud: self.slow_wire,
                 drop_arm_info_replies: self.drop_arm_info,
+                no_config: self.no_config,
             },
             watchdog: self.watchdog_ms.map(Duration::from_millis),
             timing: if self.fast {
@@ -192,6 +198,17 @@ fn serve(args: EmulatorArgs) -> Result<(), EmulatorError> {
             break;
         }
         std::thread::sleep(Duration::from_millis(50));
+    }
+    let st = emu.state().robot;
+    if st.unsupported_gripper_commands + st.unsupported_gripperval_commands > 0 {
+        let mut out = std::io::stdout().lock();
+        writeln!(
+            out,
+            "unsupported commands received (the robot has no gripper): GRIPPER (33) x{}, \
+             GRIPPERVAL (36) x{}",
+            st.unsupported_gripper_commands, st.unsupported_gripperval_commands
+        )?;
+        out.flush()?;
     }
     emu.stop()
 }

@@ -139,9 +139,8 @@ fn serve(args: PioneerArgs, domain: &limber_services::Domain) -> Result<(), Pion
             "no arm: the robot did not answer ARM_INFO; not serving {r}/actarray/0, {r}/limb/0, {r}/gripper/1 (asking again: served if it answers)"
         );
     }
-    if hw.gripper {
-        noteln!("serving {r}/gripper/0 (body gripper), {r}/actarray/1 (lift)");
-    }
+    // Served or not, and why (the robot's CONFIGpac, or `body_gripper`).
+    noteln!("{}", hw.gripper_note);
     noteln!("serving {r}/driver/0 (statistics); ready");
     let mode = if args.spin {
         LoopMode::Spin

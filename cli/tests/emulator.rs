@@ -71,3 +71,22 @@ fn drop_arm_info_flag() {
     assert_eq!(c.args.config().unwrap().faults.drop_arm_info_replies, 2);
     assert!(Cli::try_parse_from(["emulator", "--drop-arm-info", "-1"]).is_err());
 }
+
+/// Issue 13 item 4: `--no-gripper` is a robot without the body gripper (its CONFIGpac says
+/// so), `--no-config` a controller that never answers CONFIG; by default it has the
+/// gripper and answers.
+#[test]
+fn gripper_and_config_flags() {
+    let cfg = Cli::try_parse_from(["emulator"])
+        .unwrap()
+        .args
+        .config()
+        .unwrap();
+    assert!(cfg.model.gripper && !cfg.faults.no_config);
+    let cfg = Cli::try_parse_from(["emulator", "--pty", "--no-gripper", "--no-config"])
+        .unwrap()
+        .args
+        .config()
+        .unwrap();
+    assert!(!cfg.model.gripper && cfg.faults.no_config);
+}

@@ -307,3 +307,57 @@ fn an_arm_that_answers_late_appears_in_list() {
     assert_eq!(drv.term(), Some(0));
     assert_eq!(emu.term(), Some(0));
 }
+
+/// Issue 13 item 4 with the commands a user types: `limber emulator --pty --no-gripper` is
+/// a robot whose CONFIGpac says "no gripper"; `limber pioneer` (`body_gripper` "auto")
+/// serves neither the gripper nor the lift and says so in `limber list` and the verbs'
+/// exit 3; forced with `body_gripper = true` it serves them, and the emulator, which
+/// ignores such commands, reports at exit the one it received: none came before.
+#[test]
+fn a_gripperless_emulator_gets_no_gripper_command_unless_forced() {
+    let d = Domain::unique_for_test();
+    let (mut emu, port) = emulator(&d, false, &["--no-gripper"]);
+    let cfg = config("gripperless");
+    let mut drv = pioneer(&d, &port, cfg.to_str().unwrap(), &[]);
+    let o = limber(d.name(), &["list"]);
+    assert!(
+        stdout(&o).contains("robot pioneer has no gripper, no lift (driver pioneer)"),
+        "{}",
+        stdout(&o)
+    );
+    let o = limber(
+        d.name(),
+        &["gripper", "pioneer/gripper/0", "open", "--timeout", "0.5"],
+    );
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("robot pioneer has no gripper"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(drv.term(), Some(0));
+
+    let forced = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("link-gripper-forced.toml");
+    std::fs::write(
+        &forced,
+        "link_timeout_ms = 400\nreconnect_interval_ms = 100\narm_info_timeout_ms = 500\n\
+         body_gripper = true\n",
+    )
+    .unwrap();
+    let mut drv = pioneer(&d, &port, forced.to_str().unwrap(), &[]);
+    let o = limber(d.name(), &["gripper", "pioneer/gripper/0", "open"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // A barrier: a later arm command the emulator carried out (the link keeps order).
+    let o = limber(
+        d.name(),
+        &["actarray", "pioneer/actarray/0", "pos", "0", "0.2"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(drv.term(), Some(0));
+    assert_eq!(emu.term(), Some(0));
+    let report = emu.line(|l| l.starts_with("unsupported commands received"));
+    assert!(
+        report.ends_with("GRIPPER (33) x1, GRIPPERVAL (36) x0"),
+        "{report}"
+    );
+}

@@ -84,9 +84,11 @@ pub mod hardware {
     /// The driver looked for an arm and the robot has none (ARM_INFO unanswered): its
     /// devices are not served (the driver keeps asking, and serves them if it answers).
     pub const NO_ARM: u32 = 0x100;
-    /// The robot has no body gripper (or the configuration says so): not served.
+    /// The robot has no body gripper: its CONFIGpac says none, it did not answer CONFIG,
+    /// or the configuration says so (`body_gripper`). Not served.
     pub const NO_GRIPPER: u32 = 0x200;
-    /// The robot has no gripper lift (or the configuration says so): not served.
+    /// The robot has no gripper lift (it comes with the body gripper: see [`NO_GRIPPER`]).
+    /// Not served.
     pub const NO_LIFT: u32 = 0x400;
 
     /// The hardware a device stands for in the Pioneer driver's naming (`actarray/0`,

@@ -75,9 +75,9 @@ fn the_driver_reads_the_configured_layout_and_warns_of_the_other() {
     }
 }
 
-/// Issue 13 item 4 (the part that does not need the CONFIGpac): `body_gripper = false`
-/// serves neither the body gripper nor the lift, so no gripper or lift command can reach a
-/// robot without them.
+/// Issue 13 item 4: `body_gripper = false` serves neither the body gripper nor the lift,
+/// whatever the robot's CONFIGpac says (here: a gripper), so no gripper or lift command
+/// can reach the robot (`what_the_robot_has.rs` has the CONFIGpac's own cases).
 #[test]
 fn body_gripper_false_serves_neither_gripper_nor_lift() {
     let emu = Emulator::start_pty(EmulatorConfig::default()).unwrap();
@@ -87,6 +87,16 @@ fn body_gripper_false_serves_neither_gripper_nor_lift() {
     let mut driver = PioneerDriver::start(&ctx, cfg, emu.link_target()).unwrap();
     assert!(!driver.hardware().gripper);
     assert!(driver.hardware().arm);
+    assert!(
+        matches!(&driver.hardware().config, limber_p2os::ConfigProbe::Answered(c) if c.has_gripper()),
+        "{:?}",
+        driver.hardware().config
+    );
+    assert!(
+        driver.hardware().gripper_note.contains("although"),
+        "{}",
+        driver.hardware().gripper_note
+    );
     let mut names: Vec<String> = limber_services::list_devices(&domain)
         .unwrap()
         .iter()

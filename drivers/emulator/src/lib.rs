@@ -11,7 +11,10 @@
 //! powers, homes, parks and stops the arm (HOME takes 1..6 or any value
 //! above 6 for all joints, STOP 1..6 or 255, as the manuals say), opens and
 //! closes the paddles with breakbeams driven by a simulated object, and
-//! raises/lowers the lift (3.5 s per stroke).
+//! raises/lowers the lift (3.5 s per stroke). It answers CONFIG (18) with a CONFIGpac
+//! built from its model ([`Robot::config_packet`]: GRIPPER says whether the body gripper
+//! is fitted); a robot without the gripper ([`ModelConfig::gripper`] false) logs and counts
+//! GRIPPER (33) and GRIPPERVAL (36) as unsupported, like a real gripperless controller.
 //!
 //! Timing ([`EmulatorConfig::timing`]): by default like the controller,
 //! whose packets go out once per cycle: SYNC replies, ARMINFOpac and a
@@ -96,6 +99,9 @@ pub struct Faults {
     /// connections; see [`EmulatorStats::arm_info_dropped`]): a deterministic "lost
     /// ARM_INFO reply". Raising it later drops that many in all.
     pub drop_arm_info_replies: u32,
+    /// Never answer CONFIG (18), like a controller or simulator that does not implement
+    /// it: the CONFIGpacs are dropped ([`EmulatorStats::config_dropped`]).
+    pub no_config: bool,
 }
 
 /// Configuration of an emulator.
@@ -181,6 +187,8 @@ pub struct EmulatorStats {
     pub arm_info_dropped: u64,
     /// ARMINFOpac replies written (not dropped).
     pub arm_info_out: u64,
+    /// CONFIGpac replies dropped by [`Faults::no_config`].
+    pub config_dropped: u64,
 }
 
 /// A snapshot of the emulator.
@@ -247,6 +255,7 @@ impl Emulator {
         let tcp_addr = ep.tcp_addr();
         let mut robot = Robot::new(config.model.clone(), Instant::now());
         robot.set_timing(config.timing);
+        robot.set_controller(config.cycle, config.watchdog);
         let shared = Arc::new(Shared {
             stop: AtomicBool::new(false),
             control: Mutex::new(Control {

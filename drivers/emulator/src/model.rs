@@ -3,9 +3,9 @@
 
 use limber_p2os::vendor_conventions as vc;
 use limber_p2os::{
-    ArmInfo, ArmPacket, ArmStatus, ArmpacLayout, Frame, GripperCommand, GripperPacket,
-    GripperSwitchFacts, GripperSwitches, JointCalibration, ReceivedCommand, RobotIdentity, Sip,
-    SonarReading, num,
+    ArmInfo, ArmPacket, ArmStatus, ArmpacLayout, ConfigPacket, ConfigWorking, Frame,
+    GripperCommand, GripperPacket, GripperSwitchFacts, GripperSwitches, JointCalibration,
+    ReceivedCommand, RobotIdentity, Sip, SonarReading, num,
 };
 use std::time::{Duration, Instant};
 
@@ -84,7 +84,11 @@ pub struct ModelConfig {
     /// The arm and its calibration; `None` = no arm (arm commands are
     /// ignored silently, like a simulator without an arm).
     pub arm: Option<ArmInfo>,
-    /// A body gripper with lift is fitted.
+    /// A body gripper with lift is fitted: said in the CONFIGpac (GRIPPER) and the
+    /// GRIPPERpac (type 1, the Pioneer 2/3 gripper). Without one, GRIPPER (33) and
+    /// GRIPPERVAL (36) commands are logged and counted as unsupported
+    /// ([`RobotState::unsupported_gripper_commands`]) and ignored, as a controller
+    /// without a gripper does.
     pub gripper: bool,
     /// Time of a full lift stroke (the reference: 3.5 s).
     pub lift_stroke: Duration,
@@ -202,6 +206,15 @@ pub struct RobotState {
     pub autopark_s: u16,
     /// Times the autopark watchdog parked the arm (homed it and powered it off).
     pub autoparks: u64,
+    /// CONFIG (18) commands answered with a CONFIGpac.
+    pub config_requests: u64,
+    /// GRIPPER (33) and GRIPPERVAL (36) commands received after OPEN, with or without a
+    /// gripper.
+    pub gripper_commands: u64,
+    /// GRIPPER (33) commands received by a robot without a gripper (ignored).
+    pub unsupported_gripper_commands: u64,
+    /// GRIPPERVAL (36) commands received by a robot without a gripper (ignored).
+    pub unsupported_gripperval_commands: u64,
 }
 
 /// The emulated controller.
@@ -235,6 +248,12 @@ pub struct Robot {
     last_contact: Instant,
     autopark_s: u16,
     autoparks: u64,
+    cycle: Duration,
+    watchdog: Option<Duration>,
+    config_requests: u64,
+    gripper_commands: u64,
+    unsupported_gripper: u64,
+    unsupported_gripperval: u64,
 }
 
 impl Robot {
@@ -284,7 +303,85 @@ impl Robot {
             deferred: Vec::new(),
             arm_pac_once: false,
             gripper_pac_once: false,
+            cycle: Duration::from_millis(100),
+            watchdog: None,
+            config_requests: 0,
+            gripper_commands: 0,
+            unsupported_gripper: 0,
+            unsupported_gripperval: 0,
         }
+    }
+
+    /// The controller's cycle and command watchdog, as the CONFIGpac reports them
+    /// (SIPCYCLE, WATCHDOG); 100 ms and none until set.
+    pub fn set_controller(&mut self, cycle: Duration, watchdog: Option<Duration>) {
+        self.cycle = cycle;
+        self.watchdog = watchdog;
+    }
+
+    /// The CONFIGpac this robot answers CONFIG with: the identity's class, subclass and
+    /// name, the cycle and watchdog, GRIPPER 1 with the body gripper (0 without), the
+    /// front sonar ring; the drive's limits are those of a Pioneer 3-DX, illustrative
+    /// (the emulator has no drive).
+    pub fn config_packet(&self) -> ConfigPacket {
+        let id = &self.cfg.identity;
+        let ms = |d: Duration| u16::try_from(d.as_millis()).unwrap_or(u16::MAX);
+        ConfigPacket {
+            robot_type: id.class.clone(),
+            subtype: id.subclass.clone(),
+            serial_number: "EMU-0001".into(),
+            four_mots: 0,
+            rot_vel_top: 360,
+            trans_vel_top: 2200,
+            rot_acc_top: 300,
+            trans_acc_top: 2000,
+            pwm_max: 400,
+            name: id.name.clone(),
+            sip_cycle_ms: u8::try_from(self.cycle.as_millis()).unwrap_or(u8::MAX),
+            host_baud: 0,
+            aux1_baud: 0,
+            gripper: u16::from(self.cfg.gripper),
+            front_sonar: 1,
+            rear_sonar: 0,
+            low_battery: 115,
+            rev_count: 16570,
+            watchdog_ms: self.watchdog.map_or(0, ms),
+            p2mpacs: 0,
+            stall_val: 450,
+            stall_count: 100,
+            joy_vel: 300,
+            joy_rot_vel: 60,
+            working: ConfigWorking {
+                rot_vel_max: 300,
+                trans_vel_max: 1500,
+                rot_acc: 100,
+                rot_decel: 100,
+                rot_kp: 40,
+                rot_kv: 20,
+                rot_ki: 0,
+                trans_acc: 300,
+                trans_decel: 300,
+                trans_kp: 40,
+                trans_kv: 30,
+                trans_ki: 0,
+            },
+            bumpers: Some((5, 5)),
+            charger: Some(0),
+            aros18: Some((40, 2, 0)),
+            extra_len: 0,
+        }
+    }
+
+    /// A command a controller without the hardware ignores: logged and counted.
+    fn unsupported(&mut self, number: u8) {
+        let (count, what) = match number {
+            num::GRIPPER => (&mut self.unsupported_gripper, "GRIPPER"),
+            _ => (&mut self.unsupported_gripperval, "GRIPPERVAL"),
+        };
+        *count += 1;
+        tracing::warn!(
+            "received unsupported command {number} ({what}: this robot has no gripper); ignored              ({count} so far)"
+        );
     }
 
     /// Sets when packets go out (controller timing by default).
@@ -383,6 +480,9 @@ impl Robot {
         self.last_contact = now;
         let arg = cmd.int();
         let open = self.stage == SyncStage::Open;
+        if open && matches!(cmd.number, num::GRIPPER | num::GRIPPERVAL) {
+            self.gripper_commands += 1;
+        }
         match cmd.number {
             num::SYNC0 if !open => {
                 self.stage = SyncStage::AfterSync0;
@@ -406,19 +506,26 @@ impl Robot {
             num::CLOSE => self.reset_connection(),
             _ if !open => {}
             num::SONAR => self.sonar = arg.unwrap_or(0) != 0,
-            num::GRIPPER if self.cfg.gripper => {
+            num::CONFIG => {
+                self.config_requests += 1;
+                let f = self.config_packet().encode();
+                self.reply(f, out);
+            }
+            num::GRIPPER | num::GRIPPERVAL if !self.cfg.gripper => self.unsupported(cmd.number),
+            num::GRIPPER => {
                 if let Some(g) = arg.and_then(|a| u8::try_from(a & 0xFF).ok()) {
                     self.gripper_command(g, now);
                 }
             }
-            num::GRIPPERVAL if self.cfg.gripper && self.pending_carry => {
+            num::GRIPPERVAL if self.pending_carry => {
                 self.pending_carry = false;
                 let v = f64::from(arg.unwrap_or(0));
                 let travel = v * 0.020 / self.cfg.lift_stroke.as_secs_f64().max(1e-6);
                 let t = self.lift.pos + travel;
                 self.lift.set_target(t, now);
             }
-            num::GRIPPERPACREQUEST if self.cfg.gripper => {
+            // Answered with or without a gripper: HAS GRIPPER says which.
+            num::GRIPPERPACREQUEST => {
                 let a = arg.unwrap_or(0);
                 if a == 1 {
                     match self.timing {
@@ -751,7 +858,7 @@ impl Robot {
     /// The current 0xE0 gripper packet.
     pub fn gripper_packet(&self) -> GripperPacket {
         GripperPacket {
-            gripper_type: if self.cfg.gripper { 2 } else { 0 },
+            gripper_type: u8::from(self.cfg.gripper),
             switches: self.switches(),
             grasp_time: 10,
         }
@@ -787,6 +894,10 @@ impl Robot {
             commands: self.commands,
             autopark_s: self.autopark_s,
             autoparks: self.autoparks,
+            config_requests: self.config_requests,
+            gripper_commands: self.gripper_commands,
+            unsupported_gripper_commands: self.unsupported_gripper,
+            unsupported_gripperval_commands: self.unsupported_gripperval,
         }
     }
 }

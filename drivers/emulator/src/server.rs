@@ -238,6 +238,10 @@ impl Wire {
                 }
                 self.stats.arm_info_out += 1;
             }
+            Some(&ptype::CONFIG) if faults.no_config => {
+                self.stats.config_dropped += 1;
+                return Ok(());
+            }
             _ => {}
         }
         self.stats.packets_out += 1;

@@ -567,7 +567,7 @@ fn gripper_packet_stream_and_body_gripper_store_deploy() {
     c.send(&Command::GripperPacketRequest(2)).unwrap();
     let r = c.wait_until(
         WAIT,
-        |p| matches!(p, RobotPacket::Gripper(g) if g.gripper_type == 2),
+        |p| matches!(p, RobotPacket::Gripper(g) if g.gripper_type == 1),
     );
     assert!(r.is_ok());
     c.send(&Command::Gripper(GripperCommand::Deploy)).unwrap();
@@ -724,4 +724,51 @@ fn a_tcp_endpoint_serves_one_client_at_a_time() {
     let second = connect(&emu);
     assert_eq!(emu.state().stats.connections, 2);
     second.close().unwrap();
+}
+
+/// The handshake's CONFIG probe, in the controller's timing: a robot with the body gripper
+/// says so, one without says so, and one that never answers CONFIG is `Unanswered` after
+/// the attempts, with the connection still usable.
+#[test]
+fn the_handshake_reads_what_the_robot_has_from_its_configpac() {
+    let probe = ConnectOptions {
+        config: true,
+        config_timeout: Duration::from_millis(400),
+        config_attempts: 2,
+        ..opts()
+    };
+    for gripper in [true, false] {
+        let mut cfg = EmulatorConfig {
+            cycle: Duration::from_millis(20),
+            ..EmulatorConfig::default()
+        };
+        cfg.model.gripper = gripper;
+        let emu = start(Wire::Pty, cfg);
+        let c = Connection::open(&emu.link_target(), &probe).unwrap();
+        match c.config() {
+            ConfigProbe::Answered(p) => {
+                assert_eq!(p.has_gripper(), gripper);
+                assert_eq!(p.sip_cycle_ms, 20);
+                assert_eq!(p.robot_type, "Pioneer");
+            }
+            other => panic!("gripper {gripper}: {other:?}"),
+        }
+        assert!(c.arm_calibration().is_some());
+        assert_eq!(emu.state().robot.config_requests, 1);
+    }
+    let mut cfg = EmulatorConfig {
+        cycle: Duration::from_millis(20),
+        ..EmulatorConfig::default()
+    };
+    cfg.faults.no_config = true;
+    let emu = start(Wire::Tcp, cfg);
+    let mut c = Connection::open(&emu.link_target(), &probe).unwrap();
+    assert_eq!(c.config(), &ConfigProbe::Unanswered { attempts: 2 });
+    assert_eq!(emu.state().stats.config_dropped, 2);
+    assert!(c.arm_calibration().is_some());
+    wait_sip(&mut c, "after the unanswered probe", |_| true);
+    // Not asked unless the options say so.
+    drop(c);
+    let c = Connection::open(&emu.link_target(), &opts()).unwrap();
+    assert_eq!(c.config(), &ConfigProbe::NotAsked);
 }

@@ -316,10 +316,66 @@ fn a_robot_without_arm_or_gripper_ignores_their_commands() {
     assert!(s.cmd(0, Command::ArmInfo).is_empty());
     assert!(s.cmd(0, Command::ArmStatus(ArmStatusMode::Once)).is_empty());
     s.cmd(0, Command::Gripper(GripperCommand::LiftUp));
+    s.cmd(0, Command::Gripper(GripperCommand::LiftCarry));
+    s.cmd(0, Command::GripperValue(-10));
     s.advance(5000);
     assert_eq!(s.robot.state().lift, 0.0);
     assert_eq!(s.cycle(5000).len(), 1);
     assert!(!s.robot.state().has_arm);
+    // Logged and counted as unsupported, like a controller without a gripper.
+    let st = s.robot.state();
+    assert_eq!(st.unsupported_gripper_commands, 2);
+    assert_eq!(st.unsupported_gripperval_commands, 1);
+    // GRIPREQUEST is answered: HAS GRIPPER 0.
+    let r = s.cmd(5000, Command::GripperPacketRequest(1));
+    assert!(
+        matches!(RobotPacket::parse(&r[0]), Ok(RobotPacket::Gripper(g)) if g.gripper_type == 0),
+        "{r:?}"
+    );
+}
+
+/// CONFIG (18) is answered with a CONFIGpac built from the model: GRIPPER says whether
+/// the body gripper is fitted; like every reply, at the next cycle in controller timing.
+#[test]
+fn config_is_answered_with_what_the_robot_has() {
+    for gripper in [true, false] {
+        let cfg = ModelConfig {
+            gripper,
+            ..ModelConfig::default()
+        };
+        let mut s = Sim::new(cfg.clone());
+        s.open();
+        let r = s.cmd(0, Command::Config);
+        assert_eq!(r.len(), 1, "{r:?}");
+        let c = ConfigPacket::parse(&r[0]).unwrap();
+        assert_eq!(c.has_gripper(), gripper);
+        assert_eq!(c.robot_type, cfg.identity.class);
+        assert_eq!(c.subtype, cfg.identity.subclass);
+        assert_eq!(c.name, cfg.identity.name);
+        assert_eq!(c.sip_cycle_ms, 100);
+        assert_eq!(s.robot.state().config_requests, 1);
+        if gripper {
+            s.cmd(0, Command::Gripper(GripperCommand::Open));
+            assert_eq!(s.robot.state().unsupported_gripper_commands, 0);
+        }
+
+        let mut s = Sim::with_timing(cfg, Timing::Controller);
+        s.cmd(0, Command::Sync0);
+        s.cycle(100);
+        s.cmd(100, Command::Sync1);
+        s.cycle(200);
+        s.cmd(200, Command::Sync2);
+        s.cycle(300);
+        s.cmd(300, Command::Open);
+        assert!(s.cmd(310, Command::Config).is_empty(), "answered at once");
+        let c = s.cycle(400);
+        let configs: Vec<_> = c
+            .iter()
+            .filter_map(|p| ConfigPacket::parse(p).ok())
+            .collect();
+        assert_eq!(configs.len(), 1, "{c:?}");
+        assert_eq!(configs[0].has_gripper(), gripper);
+    }
 }
 
 #[test]
@@ -328,7 +384,7 @@ fn gripper_packet_on_request_and_sonar() {
     s.open();
     let r = s.cmd(0, Command::GripperPacketRequest(1));
     assert!(
-        matches!(RobotPacket::parse(&r[0]), Ok(RobotPacket::Gripper(g)) if g.gripper_type == 2)
+        matches!(RobotPacket::parse(&r[0]), Ok(RobotPacket::Gripper(g)) if g.gripper_type == 1)
     );
     s.cmd(0, Command::Sonar(true));
     let c = s.cycle(100);

@@ -4,7 +4,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use limber_p2os::{Decoder, ReceivedCommand, RobotPacket};
+use limber_p2os::{ConfigPacket, Decoder, ReceivedCommand, RobotPacket};
 
 fuzz_target!(|data: &[u8]| {
     let Some((&chunk, stream)) = data.split_first() else {
@@ -17,6 +17,7 @@ fuzz_target!(|data: &[u8]| {
         d.decode(part, |p| {
             assert!(!p.is_empty());
             let _ = RobotPacket::parse(p);
+            let _ = ConfigPacket::parse(p);
             let _ = ReceivedCommand::parse(p);
             delivered += 1;
         });

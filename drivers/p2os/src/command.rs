@@ -20,6 +20,8 @@ pub mod num {
     pub const CLOSE: u8 = 2;
     /// ENABLE: base motors on/off.
     pub const ENABLE: u8 = 4;
+    /// CONFIG (no argument): the controller sends one CONFIGpac (0x20).
+    pub const CONFIG: u8 = 18;
     /// SONAR: sonar on/off.
     pub const SONAR: u8 = 28;
     /// STOP: stop the base.
@@ -200,6 +202,8 @@ pub enum Command {
     Enable(bool),
     /// Sonar on/off.
     Sonar(bool),
+    /// Ask for one CONFIGpac ([`crate::ConfigPacket`]).
+    Config,
     /// Stop the base.
     Stop,
     /// A body-gripper or lift sub-command.
@@ -262,6 +266,7 @@ impl Command {
             Sync2 | Close => num::SYNC2,
             Enable(_) => num::ENABLE,
             Sonar(_) => num::SONAR,
+            Config => num::CONFIG,
             Stop => num::STOP,
             Gripper(_) => num::GRIPPER,
             GripperValue(_) => num::GRIPPERVAL,
@@ -287,8 +292,8 @@ impl Command {
         use Command::*;
         let lsb_msb = |lsb: u8, msb: u8| i32::from(u16::from_le_bytes([lsb, msb]));
         match *self {
-            Sync0 | Sync1 | Sync2 | Pulse | Open | Close | Stop | ArmInfo | ArmInit | ArmCheck
-            | ArmPark => None,
+            Sync0 | Sync1 | Sync2 | Pulse | Open | Close | Config | Stop | ArmInfo | ArmInit
+            | ArmCheck | ArmPark => None,
             Enable(b) | Sonar(b) | ArmPower(b) => Some(i32::from(b)),
             Gripper(g) => Some(g as i32),
             GripperValue(v) => {

@@ -1,9 +1,10 @@
 //! The connection state machine: sync, OPEN, keep-alive, arm set-up, CLOSE.
 
 use super::command::{ArmStatusMode, Command};
+use super::configpac::{ConfigPacket, ConfigPacketError};
 use super::convert::ArmCalibration;
 use super::link::{Link, LinkError, LinkTarget, OpenError};
-use super::packet::{ArmPacket, GripperPacket, RobotIdentity, RobotPacket, Sip};
+use super::packet::{ArmPacket, GripperPacket, RobotIdentity, RobotPacket, Sip, ptype};
 use std::os::fd::{AsRawFd, RawFd};
 use std::time::{Duration, Instant};
 use thiserror::Error;
@@ -39,6 +40,32 @@ pub struct ConnectOptions {
     pub arm_info_attempts: u32,
     /// Send PULSE when nothing was sent for this long ([`Connection::keep_alive`]).
     pub pulse_interval: Duration,
+    /// Ask CONFIG (18) after OPEN and read the CONFIGpac: what the robot has
+    /// ([`Connection::config`]). Off by default.
+    pub config: bool,
+    /// How long to wait for the CONFIGpac after each CONFIG.
+    pub config_timeout: Duration,
+    /// CONFIG attempts before the robot counts as not answering it (one lost reply must
+    /// not decide what the robot has).
+    pub config_attempts: u32,
+}
+
+/// What the CONFIG probe of the handshake found ([`ConnectOptions::config`]).
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub enum ConfigProbe {
+    /// CONFIG was not sent.
+    #[default]
+    NotAsked,
+    /// The robot answered with this CONFIGpac.
+    Answered(Box<ConfigPacket>),
+    /// No CONFIGpac within the timeout, after every attempt.
+    Unanswered {
+        /// CONFIG commands sent.
+        attempts: u32,
+    },
+    /// The robot answered with a packet of type 0x20 that is not a CONFIGpac limber can
+    /// read (after every attempt).
+    Malformed(ConfigPacketError),
 }
 
 impl Default for ConnectOptions {
@@ -55,6 +82,9 @@ impl Default for ConnectOptions {
             arm_info_timeout: Duration::from_secs(1),
             arm_info_attempts: 3,
             pulse_interval: Duration::from_secs(1),
+            config: false,
+            config_timeout: Duration::from_secs(1),
+            config_attempts: 3,
         }
     }
 }
@@ -118,6 +148,7 @@ pub struct Connection {
     last_arm: Option<ArmPacket>,
     last_gripper: Option<GripperPacket>,
     pulse_interval: Duration,
+    config: ConfigProbe,
 }
 
 enum SyncWait {
@@ -166,9 +197,10 @@ impl Connection {
 
     /// Runs the handshake on an open link: sync (trying the baud rates in
     /// order on a serial link, never over TCP), read the robot's identity,
-    /// OPEN, PULSE, wait for the first SIP, set the sonar, and, if asked,
-    /// start the ARMpac stream and read the ARMINFOpac (no answer within the
-    /// timeout = no arm).
+    /// OPEN, PULSE, wait for the first SIP, set the sonar, if asked read the
+    /// CONFIGpac ([`ConnectOptions::config`], [`Connection::config`]), and, if
+    /// asked, start the ARMpac stream and read the ARMINFOpac (no answer within
+    /// the timeout = no arm).
     pub fn establish(mut link: Link, opts: &ConnectOptions) -> Result<Connection, ConnectError> {
         let (identity, baud) = Self::sync(&mut link, opts)?;
         link.send(&Command::Open)?;
@@ -182,6 +214,7 @@ impl Connection {
             last_arm: None,
             last_gripper: None,
             pulse_interval: opts.pulse_interval,
+            config: ConfigProbe::NotAsked,
         };
         let got_sip = conn.wait_until(opts.first_sip_timeout, |p| matches!(p, RobotPacket::Sip(_)));
         match got_sip {
@@ -191,6 +224,9 @@ impl Connection {
         }
         if let Some(on) = opts.sonar {
             conn.send(&Command::Sonar(on))?;
+        }
+        if opts.config {
+            conn.config = conn.probe_config(opts.config_timeout, opts.config_attempts)?;
         }
         if opts.arm {
             conn.send(&Command::ArmStatus(opts.arm_status))?;
@@ -276,6 +312,50 @@ impl Connection {
                 Vec::new()
             },
         })
+    }
+
+    /// Sends CONFIG and waits up to `timeout` for the CONFIGpac (other packets are
+    /// recorded meanwhile), up to `attempts` times while nothing readable arrives.
+    pub fn probe_config(
+        &mut self,
+        timeout: Duration,
+        attempts: u32,
+    ) -> Result<ConfigProbe, LinkError> {
+        let attempts = attempts.max(1);
+        let mut last = ConfigProbe::Unanswered { attempts };
+        for attempt in 1..=attempts {
+            self.send(&Command::Config)?;
+            let mut got = None;
+            let r = self.wait_until(timeout, |p| match p {
+                RobotPacket::Other {
+                    packet_type: ptype::CONFIG,
+                    payload,
+                } => {
+                    got = Some(ConfigPacket::parse(payload));
+                    true
+                }
+                _ => false,
+            });
+            match (r, got) {
+                (Ok(()), Some(Ok(c))) => return Ok(ConfigProbe::Answered(Box::new(c))),
+                (Ok(()), Some(Err(e))) => {
+                    tracing::warn!("unreadable CONFIGpac (attempt {attempt} of {attempts}): {e}");
+                    last = ConfigProbe::Malformed(e);
+                }
+                (Err(LinkError::Timeout(_)), _) | (Ok(()), None) => {
+                    tracing::debug!(
+                        "no CONFIGpac within {timeout:?} (attempt {attempt} of {attempts})"
+                    );
+                }
+                (Err(e), _) => return Err(e),
+            }
+        }
+        Ok(last)
+    }
+
+    /// What the handshake's CONFIG probe found ([`ConnectOptions::config`]).
+    pub fn config(&self) -> &ConfigProbe {
+        &self.config
     }
 
     /// Sends ARM_INFO and waits up to `timeout` for the ARMINFOpac (other

@@ -7,7 +7,8 @@
 //! * [`Command`]: typed client → robot commands (connection, arm, gripper,
 //!   lift), and [`ReceivedCommand`] for the robot side.
 //! * [`RobotPacket`]: typed robot → client packets (SIP, ARMpac, ARMINFOpac,
-//!   the 0xE0 gripper packet, sync replies).
+//!   the 0xE0 gripper packet, sync replies); [`ConfigPacket`]: the CONFIGpac
+//!   (0x20), what the robot has.
 //! * [`ArmCalibration`]: tick ↔ radian and speed conversions from ARMINFOpac.
 //! * [`Link`]: a serial device, pty or TCP connection with counters and a
 //!   raw fd for epoll; [`Connection`]: the handshake state machine.
@@ -27,6 +28,7 @@
 
 pub mod codec;
 mod command;
+mod configpac;
 mod connection;
 mod convert;
 mod link;
@@ -42,7 +44,10 @@ pub use command::{
     Argument, ArmJoint, ArmStatusMode, BadJoint, Command, GripperCommand, JointSelection,
     ReceivedCommand, num,
 };
-pub use connection::{BAUD_RATES, CloseError, ConnectError, ConnectOptions, Connection};
+pub use configpac::{ConfigPacket, ConfigPacketError, ConfigWorking};
+pub use connection::{
+    BAUD_RATES, CloseError, ConfigProbe, ConnectError, ConnectOptions, Connection,
+};
 pub use convert::{ArmCalibration, ConversionError, TickTarget};
 pub use link::{DEFAULT_TCP_PORT, Link, LinkError, LinkStats, LinkTarget, OpenError};
 pub use packet::{

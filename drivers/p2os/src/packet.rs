@@ -676,10 +676,12 @@ impl ArmInfo {
     }
 }
 
-/// ARIA's gripper packet (0xE0).
+/// The GRIPPERpac (0xE0), sent once after GRIPREQUEST (37) with argument 1, every cycle
+/// with 2 (the Pioneer Gripper manual; ARIA's ArGripper reads it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct GripperPacket {
-    /// 0 none, 1 User-I/O, 2 General-I/O.
+    /// HAS GRIPPER, the gripper type (the Pioneer Gripper manual): 0 none, 1 the Pioneer
+    /// 2/3 gripper, 2 the PeopleBot's.
     pub gripper_type: u8,
     /// The switch byte.
     pub switches: GripperSwitches,

@@ -277,6 +277,7 @@ fn fuzz_random_and_mutated_frames() {
             d.decode(&rest[..n], |p| {
                 delivered += 1;
                 let _ = RobotPacket::parse(p);
+                let _ = limber_p2os::ConfigPacket::parse(p);
                 let _ = ReceivedCommand::parse(p);
             });
             fed += n as u64;

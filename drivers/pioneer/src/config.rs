@@ -75,7 +75,9 @@ pub struct PioneerConfig {
     /// How long each ARM_INFO may go unanswered, ms. The handshake asks 3 times before
     /// the robot counts as armless; the loop then keeps asking in the background, the wait
     /// doubling from this value up to 30 s (an arm found so late needs a driver restart to
-    /// be served; after a reconnect, the arm's ARMpac stream is restarted).
+    /// be served; after a reconnect, the arm's ARMpac stream is restarted). Also how long
+    /// each CONFIG (the body-gripper probe at start) may go unanswered: asked 3 times with
+    /// `body_gripper = "auto"`, once when it is true or false.
     pub arm_info_timeout_ms: u64,
     /// Send PULSE when nothing was sent for this long, ms.
     pub pulse_interval_ms: u64,
@@ -101,10 +103,13 @@ pub struct PioneerConfig {
     /// warns when the robot's packets only make sense in the other layout.
     #[serde(with = "layout_name")]
     pub armpac_layout: ArmpacLayout,
-    /// The robot has the body gripper and its lift: serve `<robot>/gripper/0` and
-    /// `<robot>/actarray/1`. Set false for a robot without them (e.g. a simulator), so no
-    /// gripper or lift command is ever sent to it.
-    pub body_gripper: bool,
+    /// Whether the robot has the body gripper and its lift (`<robot>/gripper/0` and
+    /// `<robot>/actarray/1`): `"auto"` (the default) asks the robot at connect (CONFIG;
+    /// served if its CONFIGpac says a gripper is fitted, not served if it says none or
+    /// does not answer); `true` or `false` decide for a controller that does not answer
+    /// CONFIG. Without them no gripper or lift command is ever sent to the robot.
+    #[serde(with = "body_gripper_value")]
+    pub body_gripper: BodyGripper,
     /// The arm's autopark watchdog (AUTOPARK, P2OS command 80), s: when no command
     /// (PULSE included) reaches the robot for this long, the arm homes and powers off by
     /// itself, so a driver killed with SIGKILL does not leave it moving. Sent at every
@@ -115,6 +120,64 @@ pub struct PioneerConfig {
     /// needs no wake-up (`event_loop::linger`; at most 1 ms of CPU per burst). 0: sleep at
     /// once. Chosen by measurement (`limber bench --only command`, the `event-*` rows).
     pub linger_us: u32,
+}
+
+/// `body_gripper`: whether the robot has the body gripper and its lift.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum BodyGripper {
+    /// `"auto"`: ask the robot at connect (CONFIG, 18) and trust its CONFIGpac; a robot
+    /// that does not answer gets neither device (a warning says how to force it).
+    #[default]
+    Auto,
+    /// `true`: fitted, served whatever the robot says (the robot is asked all the same, and
+    /// a CONFIGpac saying "no gripper" is warned of).
+    Fitted,
+    /// `false`: not fitted, never served.
+    Absent,
+}
+
+/// `body_gripper` in TOML: `"auto"`, `true` or `false`.
+mod body_gripper_value {
+    use super::BodyGripper;
+    use serde::de::{self, Visitor};
+    use serde::{Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &BodyGripper, s: S) -> Result<S::Ok, S::Error> {
+        match v {
+            BodyGripper::Auto => s.serialize_str("auto"),
+            BodyGripper::Fitted => s.serialize_bool(true),
+            BodyGripper::Absent => s.serialize_bool(false),
+        }
+    }
+
+    struct V;
+
+    impl Visitor<'_> for V {
+        type Value = BodyGripper;
+
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("true, false or \"auto\"")
+        }
+
+        fn visit_bool<E: de::Error>(self, b: bool) -> Result<BodyGripper, E> {
+            Ok(if b {
+                BodyGripper::Fitted
+            } else {
+                BodyGripper::Absent
+            })
+        }
+
+        fn visit_str<E: de::Error>(self, v: &str) -> Result<BodyGripper, E> {
+            match v {
+                "auto" => Ok(BodyGripper::Auto),
+                _ => Err(E::invalid_value(de::Unexpected::Str(v), &self)),
+            }
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<BodyGripper, D::Error> {
+        d.deserialize_any(V)
+    }
 }
 
 /// `armpac_layout` as its name in TOML.
@@ -169,7 +232,7 @@ impl Default for PioneerConfig {
             setpose_position_tolerance: 0.001,
             setpose_approach_tolerance_deg: 1.0,
             armpac_layout: ArmpacLayout::default(),
-            body_gripper: true,
+            body_gripper: BodyGripper::Auto,
             // The link timeout (1 s) and a reconnection or two, with room to spare.
             autopark_s: 10,
             linger_us: limber_services::qos::DRIVER_LINGER.as_micros() as u32,
@@ -210,6 +273,11 @@ impl PioneerConfig {
                 .replacen(
                     "linger_us =",
                     "# linger_us: after a command, keep polling the clients this long (µs) before sleeping; 0: sleep at once\nlinger_us =",
+                    1,
+                )
+                .replacen(
+                    "body_gripper =",
+                    "# body_gripper: \"auto\" asks the robot (CONFIG) at connect; true/false decide for a\n# controller that does not answer (false: gripper/0 and actarray/1 never served)\nbody_gripper =",
                     1,
                 )
                 .replacen(
@@ -305,6 +373,29 @@ mod tests {
             0
         );
         assert!(PioneerConfig::from_toml("linger_us = 20000").is_err());
+    }
+
+    #[test]
+    fn body_gripper_is_auto_by_default_true_false_or_auto_and_nothing_else() {
+        let c = PioneerConfig::default();
+        assert_eq!(c.body_gripper, BodyGripper::Auto);
+        let text = c.to_toml();
+        assert!(text.contains("body_gripper = \"auto\""), "{text}");
+        assert!(text.contains("# body_gripper:"), "{text}");
+        assert_eq!(PioneerConfig::from_toml(&text).unwrap(), c);
+        for (toml, want) in [
+            ("body_gripper = true", BodyGripper::Fitted),
+            ("body_gripper = false", BodyGripper::Absent),
+            ("body_gripper = \"auto\"", BodyGripper::Auto),
+        ] {
+            let c = PioneerConfig::from_toml(toml).unwrap();
+            assert_eq!(c.body_gripper, want, "{toml}");
+            assert_eq!(PioneerConfig::from_toml(&c.to_toml()).unwrap(), c, "{toml}");
+        }
+        for bad in ["body_gripper = \"yes\"", "body_gripper = 1"] {
+            let e = PioneerConfig::from_toml(bad).unwrap_err();
+            assert!(e.to_string().contains("auto"), "{bad}: {e}");
+        }
     }
 
     #[test]

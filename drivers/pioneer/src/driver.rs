@@ -15,11 +15,11 @@ use limber_services::{
 use thiserror::Error;
 
 use limber_p2os::{
-    ArmStatusMode, Command, ConnectError, ConnectOptions, Connection, LinkError, LinkTarget,
-    RobotIdentity, RobotPacket,
+    ArmStatusMode, Command, ConfigProbe, ConnectError, ConnectOptions, Connection, LinkError,
+    LinkTarget, RobotIdentity, RobotPacket,
 };
 
-use super::config::PioneerConfig;
+use super::config::{BodyGripper, PioneerConfig};
 use crate::robot::RobotModel;
 
 /// The driver could not start or failed.
@@ -99,8 +99,71 @@ pub struct Hardware {
     pub identity: RobotIdentity,
     /// ARM_INFO was answered.
     pub arm: bool,
-    /// The body gripper and lift are served (from the config's `body_gripper`).
+    /// The body gripper and lift are served: the robot's CONFIGpac said so, or the
+    /// configuration's `body_gripper = true` ([`gripper_decision`]).
     pub gripper: bool,
+    /// Why the body gripper and lift are (not) served, in a sentence for the log.
+    pub gripper_note: String,
+    /// What the CONFIG probe at start found.
+    pub config: ConfigProbe,
+}
+
+/// Whether to serve the body gripper and its lift, from the configuration's
+/// `body_gripper` and the CONFIG probe, with the sentence that says why (`robot`: the
+/// robot name in device names). Safe by default: `auto` serves them only when the robot's
+/// CONFIGpac says a gripper is fitted; `true` serves them whatever the robot says (the
+/// user knows the robot; a CONFIGpac saying "none" is warned of, and the commands then
+/// reach a controller that ignores them); `false` never does.
+pub fn gripper_decision(setting: BodyGripper, probe: &ConfigProbe, robot: &str) -> (bool, String) {
+    let devices = format!("{robot}/gripper/0 (body gripper) and {robot}/actarray/1 (lift)");
+    let says = match probe {
+        ConfigProbe::Answered(c) => Some(c.has_gripper()),
+        _ => None,
+    };
+    let unanswered = match probe {
+        ConfigProbe::Unanswered { attempts } => {
+            format!("the robot did not answer CONFIG (18) ({attempts} attempts)")
+        }
+        ConfigProbe::Malformed(e) => format!("the robot's CONFIGpac is unreadable ({e})"),
+        ConfigProbe::NotAsked => "CONFIG (18) was not asked".into(),
+        ConfigProbe::Answered(_) => String::new(),
+    };
+    match (setting, says) {
+        (BodyGripper::Auto, Some(true)) => (
+            true,
+            format!("the robot's CONFIGpac says a gripper is fitted: serving {devices}"),
+        ),
+        (BodyGripper::Auto, Some(false)) => (
+            false,
+            format!("the robot's CONFIGpac says no gripper is fitted: not serving {devices}"),
+        ),
+        (BodyGripper::Auto, None) => (
+            false,
+            format!(
+                "{unanswered}: not serving {devices}; if the robot has the body gripper, set \
+                 body_gripper = true in the configuration (false to silence this warning)"
+            ),
+        ),
+        (BodyGripper::Fitted, Some(false)) => (
+            true,
+            format!(
+                "body_gripper = true: serving {devices} although the robot's CONFIGpac says no \
+                 gripper is fitted; its commands are sent to the robot, which may ignore them"
+            ),
+        ),
+        (BodyGripper::Fitted, _) => (true, format!("body_gripper = true: serving {devices}")),
+        (BodyGripper::Absent, Some(true)) => (
+            false,
+            format!(
+                "body_gripper = false: not serving {devices} although the robot's CONFIGpac \
+                 says a gripper is fitted"
+            ),
+        ),
+        (BodyGripper::Absent, _) => (
+            false,
+            format!("body_gripper = false: not serving {devices}"),
+        ),
+    }
 }
 
 /// The driver's name in device attributes and statistics.
@@ -143,6 +206,14 @@ fn options(cfg: &PioneerConfig, target: &LinkTarget) -> ConnectOptions {
         arm_info_timeout: Duration::from_millis(cfg.arm_info_timeout_ms),
         pulse_interval: Duration::from_millis(cfg.pulse_interval_ms),
         arm_status: ArmStatusMode::Continuous,
+        // What the robot has: asked at start (the reconnections keep what was decided).
+        config: true,
+        config_timeout: Duration::from_millis(cfg.arm_info_timeout_ms),
+        config_attempts: if cfg.body_gripper == BodyGripper::Auto {
+            3
+        } else {
+            1
+        },
         ..ConnectOptions::default()
     };
     if let (Some(b), LinkTarget::Serial(_)) = (cfg.baud, target) {
@@ -153,7 +224,9 @@ fn options(cfg: &PioneerConfig, target: &LinkTarget) -> ConnectOptions {
 
 /// The Pioneer driver: serves `<robot>/actarray/0` (arm), `<robot>/limb/0`,
 /// `<robot>/gripper/0` (body gripper), `<robot>/gripper/1` (arm gripper) and
-/// `<robot>/actarray/1` (lift), and `<robot>/driver/0` (statistics).
+/// `<robot>/actarray/1` (lift), and `<robot>/driver/0` (statistics). The arm's devices only
+/// if the robot answers ARM_INFO; the body gripper's and the lift only if it has them
+/// ([`gripper_decision`]).
 pub struct PioneerDriver {
     ctx: Context,
     target: LinkTarget,
@@ -468,11 +541,26 @@ impl PioneerDriver {
             }
         })?;
         let mut model = RobotModel::new(cfg.clone());
+        let (gripper, gripper_note) = gripper_decision(cfg.body_gripper, conn.config(), &cfg.robot);
         let hardware = Hardware {
             identity: conn.identity().clone(),
             arm: conn.arm_calibration().is_some(),
-            gripper: cfg.body_gripper,
+            gripper,
+            gripper_note,
+            config: conn.config().clone(),
         };
+        let surprising = match (cfg.body_gripper, conn.config()) {
+            (BodyGripper::Auto, ConfigProbe::Answered(_)) => false,
+            (BodyGripper::Auto, _) => true,
+            (BodyGripper::Fitted, ConfigProbe::Answered(c)) => !c.has_gripper(),
+            (BodyGripper::Absent, ConfigProbe::Answered(c)) => c.has_gripper(),
+            _ => false,
+        };
+        if surprising {
+            tracing::warn!("{}", hardware.gripper_note);
+        } else {
+            tracing::info!("{}", hardware.gripper_note);
+        }
         if let Some(cal) = conn.arm_calibration() {
             model.set_calibration(*cal);
         }
@@ -918,6 +1006,8 @@ impl PioneerDriver {
         self.next_reconnect = now + Duration::from_millis(self.robot.cfg.reconnect_interval_ms);
         let mut opts = options(&self.robot.cfg, &self.target);
         opts.sync_attempts = 2;
+        // What the robot has was decided at start.
+        opts.config = false;
         opts.arm = self.hardware.arm;
         // One ARM_INFO in the handshake; if it goes unanswered, the loop asks again
         // without waiting (a bounded backoff), as after a start.
@@ -1232,6 +1322,46 @@ mod tests {
         ConnectError::NoSync {
             attempts: 2,
             bauds: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn the_gripper_is_served_when_the_robot_says_so_or_the_user_forces_it() {
+        let says = |g: u16| {
+            ConfigProbe::Answered(Box::new(limber_p2os::ConfigPacket {
+                gripper: g,
+                ..Default::default()
+            }))
+        };
+        let silent = ConfigProbe::Unanswered { attempts: 3 };
+        let bad = ConfigProbe::Malformed(limber_p2os::ConfigPacketError::Empty);
+        for (setting, probe, served, note) in [
+            (BodyGripper::Auto, says(1), true, "says a gripper is fitted"),
+            (BodyGripper::Auto, says(0), false, "says no gripper"),
+            (
+                BodyGripper::Auto,
+                silent.clone(),
+                false,
+                "set body_gripper = true",
+            ),
+            (BodyGripper::Auto, bad, false, "unreadable"),
+            (BodyGripper::Fitted, says(0), true, "although"),
+            (
+                BodyGripper::Fitted,
+                silent.clone(),
+                true,
+                "body_gripper = true",
+            ),
+            (BodyGripper::Absent, says(1), false, "although"),
+            (BodyGripper::Absent, silent, false, "body_gripper = false"),
+        ] {
+            let (s, n) = gripper_decision(setting, &probe, "kim");
+            assert_eq!(s, served, "{setting:?} {probe:?}: {n}");
+            assert!(n.contains(note), "{setting:?} {probe:?}: {n}");
+            assert!(
+                n.contains("kim/gripper/0") && n.contains("kim/actarray/1"),
+                "{n}"
+            );
         }
     }
 
