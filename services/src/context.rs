@@ -144,6 +144,12 @@ impl Context {
             crate::domain_dir::check_shm_space().map_err(domain_err)?;
         }
         let prefix = domain.prefix().map_err(domain_err)?;
+        let group = domain.group().map_err(domain_err)?;
+        if let Some(g) = group {
+            // Before iceoryx2 makes this process's files: they are opened to the group as
+            // they appear (crate::widen).
+            crate::widen::start(prefix, domain.root().map_err(domain_err)?, g);
+        }
         let node = NodeBuilder::new()
             .name(&node_name)
             .config(config)
@@ -168,7 +174,10 @@ impl Context {
                 }
             })?;
         // iceoryx2 makes the domain's node counter world-writable (0666).
-        crate::domain_dir::secure_shm(prefix).map_err(domain_err)?;
+        crate::domain_dir::secure_shm(prefix, group).map_err(domain_err)?;
+        if group.is_some() {
+            crate::widen::remove_orphans(prefix, domain.root().map_err(domain_err)?);
+        }
         Ok(Context {
             inner: Rc::new(Inner {
                 domain: domain.clone(),

@@ -57,7 +57,16 @@ fn valid_ident(s: &str, max: usize) -> bool {
 pub struct Domain {
     name: String,
     /// The iceoryx2 configuration, made on first use (it needs the domain's files).
-    config: Arc<OnceLock<(Config, String)>>,
+    config: Arc<OnceLock<Resolved>>,
+}
+
+/// A domain's iceoryx2 configuration, prefix and group, made once.
+#[derive(Debug)]
+struct Resolved {
+    config: Config,
+    prefix: String,
+    root: std::path::PathBuf,
+    group: Option<domain_dir::Group>,
 }
 
 impl Domain {
@@ -105,15 +114,26 @@ impl Domain {
     /// prefix of the domain's files, which are prepared (and checked) on the first call; see
     /// [`crate::domain_dir`].
     pub fn config(&self) -> Result<&Config, DomainError> {
-        Ok(&self.resolved()?.0)
+        Ok(&self.resolved()?.config)
     }
 
     /// The iceoryx2 prefix of this domain's files (`limber_<token>_`).
     pub fn prefix(&self) -> Result<&str, DomainError> {
-        Ok(&self.resolved()?.1)
+        Ok(&self.resolved()?.prefix)
     }
 
-    fn resolved(&self) -> Result<&(Config, String), DomainError> {
+    /// The iceoryx2 root path of this domain's files (`<runtime>/iceoryx2/`).
+    pub fn root(&self) -> Result<&std::path::Path, DomainError> {
+        Ok(&self.resolved()?.root)
+    }
+
+    /// The Unix group that shares this domain (group mode, `LIMBER_GROUP`), or None: the
+    /// domain is its user's alone.
+    pub fn group(&self) -> Result<Option<&domain_dir::Group>, DomainError> {
+        Ok(self.resolved()?.group.as_ref())
+    }
+
+    fn resolved(&self) -> Result<&Resolved, DomainError> {
         if let Some(c) = self.config.get() {
             return Ok(c);
         }
@@ -133,7 +153,12 @@ impl Domain {
         config.global.set_root_path(
             &IoxPath::new(root.as_bytes()).map_err(|_| bad("an invalid iceoryx2 root path"))?,
         );
-        Ok(self.config.get_or_init(|| (config, files.prefix)))
+        Ok(self.config.get_or_init(|| Resolved {
+            config,
+            prefix: files.prefix,
+            root: files.root,
+            group: files.group,
+        }))
     }
 }
 
