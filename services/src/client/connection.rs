@@ -4,6 +4,11 @@
 use core::time::Duration;
 use std::time::Instant;
 
+/// In group mode, how long [`Client::connect`] tries again a service whose files are not
+/// open to the group yet (they are widened within milliseconds of being made; iceoryx2
+/// itself waits up to its `creation_timeout`, 1 s, for segments).
+pub const GROUP_PERMISSION_WAIT: Duration = Duration::from_secs(2);
+
 use iceoryx2::node::NodeView;
 use iceoryx2::port::client::Client as IoxClient;
 use iceoryx2::port::listener::Listener;
@@ -92,7 +97,38 @@ pub type GripperClient = Client<Gripper>;
 impl<I: Interface> Client<I> {
     /// Connects to `device` ("robot/interface/index") in the context's domain. Fails with
     /// [`ConnectError::NoDriver`] at once if nobody offers it.
+    ///
+    /// In group mode (`LIMBER_GROUP`) a service whose files the member who made them has
+    /// not opened to the group yet (the instant after they were made) is tried again for up
+    /// to [`GROUP_PERMISSION_WAIT`] before [`ConnectError::Permission`].
     pub fn connect(ctx: &Context, device: &str) -> Result<Self, ConnectError> {
+        Self::connect_within(ctx, device, Instant::now() + GROUP_PERMISSION_WAIT)
+    }
+
+    fn connect_within(
+        ctx: &Context,
+        device: &str,
+        deadline: Instant,
+    ) -> Result<Self, ConnectError> {
+        let grouped = ctx.domain().group().ok().flatten().is_some();
+        let mut logged = false;
+        loop {
+            match Self::connect_once(ctx, device) {
+                Err(ConnectError::Permission { channel, .. })
+                    if grouped && Instant::now() < deadline =>
+                {
+                    if !logged {
+                        tracing::info!(device, channel, "group mode: the device's files are not open to the group yet; trying again");
+                        logged = true;
+                    }
+                    std::thread::sleep(Duration::from_millis(10));
+                }
+                other => return other,
+            }
+        }
+    }
+
+    fn connect_once(ctx: &Context, device: &str) -> Result<Self, ConnectError> {
         let device: DeviceName = device.parse()?;
         if device.interface() != I::KIND {
             return Err(ConnectError::Incompatible {
@@ -113,8 +149,9 @@ impl<I: Interface> Client<I> {
         timeout: Duration,
     ) -> Result<Self, ConnectError> {
         let deadline = Instant::now() + timeout;
+        let permission_deadline = deadline.max(Instant::now() + GROUP_PERMISSION_WAIT);
         loop {
-            match Self::connect(ctx, device) {
+            match Self::connect_within(ctx, device, permission_deadline) {
                 Err(ConnectError::NoDriver { .. }) if Instant::now() < deadline => {
                     std::thread::sleep(Duration::from_millis(20));
                 }
@@ -132,6 +169,20 @@ impl<I: Interface> Client<I> {
                     device: dev.clone(),
                     domain: domain.clone(),
                     elsewhere: crate::domain_dir::elsewhere_note(&domain),
+                }
+            } else if e.is_permission_denied() {
+                let hint = match ctx.domain().group().ok().flatten() {
+                    Some(g) => format!(
+                        "in group mode ({}) the member who started the driver must run a limber with group mode, with LIMBER_GROUP={} set (README, Security)",
+                        g.name, g.name
+                    ),
+                    None => "they belong to another user; a domain is its owner's alone (README, Security)".to_string(),
+                };
+                ConnectError::Permission {
+                    device: dev.clone(),
+                    channel,
+                    hint,
+                    source: e,
                 }
             } else if e.is_incompatible() {
                 ConnectError::Incompatible {
