@@ -625,7 +625,10 @@ mod tests {
         let md = fs::metadata(dir.join("d.token")).unwrap();
         assert_eq!(md.mode() & 0o777, 0o600);
         fs::write(dir.join("bad.token"), "nope").unwrap();
-        assert!(matches!(token(&dir, "bad", None), Err(DomainError::BadToken(_))));
+        assert!(matches!(
+            token(&dir, "bad", None),
+            Err(DomainError::BadToken(_))
+        ));
         fs::set_permissions(&dir, fs::Permissions::from_mode(0o755)).unwrap();
         private_dir(&dir, 0o711).unwrap();
         assert_eq!(

@@ -47,7 +47,10 @@ fn wanted_mode(md: &fs::Metadata, name: &str, in_shm: bool) -> Option<u32> {
             // Final shared memory (in /dev/shm; 0200 while being initialised), and the
             // node monitors' lock files in the root path.
             0o600 if in_shm => Some(0o660),
-            0o600 if name.ends_with(".node_monitor") || name.ends_with(".node_monitor_owner_lock") => {
+            0o600
+                if name.ends_with(".node_monitor")
+                    || name.ends_with(".node_monitor_owner_lock") =>
+            {
                 Some(0o660)
             }
             // The node counter, made world-writable by iceoryx2.
@@ -216,7 +219,10 @@ pub(crate) fn start(prefix: &str, root: &Path, group: &Group) {
     static STARTED: Mutex<Option<HashSet<String>>> = Mutex::new(None);
     {
         let mut started = STARTED.lock().unwrap_or_else(|p| p.into_inner());
-        if !started.get_or_insert_with(HashSet::new).insert(prefix.to_string()) {
+        if !started
+            .get_or_insert_with(HashSet::new)
+            .insert(prefix.to_string())
+        {
             return;
         }
     }
@@ -234,7 +240,11 @@ pub(crate) fn start(prefix: &str, root: &Path, group: &Group) {
     };
     if let Some(fd) = &fd {
         watch.add(fd, Path::new(SHM_DIR), true);
-        for d in [root.to_path_buf(), root.join("services"), root.join("nodes")] {
+        for d in [
+            root.to_path_buf(),
+            root.join("services"),
+            root.join("nodes"),
+        ] {
             watch.add(fd, &d, false);
         }
         if let Ok(rd) = fs::read_dir(root.join("nodes")) {
@@ -356,7 +366,10 @@ pub fn remove_orphans(prefix: &str, root: &Path) -> usize {
         }
     }
     if removed > 0 {
-        tracing::info!(removed, "group mode: removed this user's files of ports that are gone");
+        tracing::info!(
+            removed,
+            "group mode: removed this user's files of ports that are gone"
+        );
     }
     removed
 }
@@ -375,7 +388,10 @@ mod tests {
         );
         assert_eq!(port_ids(p, &format!("{p}{h}_5.data")), Some(vec!["5"]));
         assert_eq!(port_ids(p, &format!("{p}{h}_5.dynamic")), None);
-        assert_eq!(port_ids(p, &format!("{p}{h}_node.0_10_0.global_mgmt")), None);
+        assert_eq!(
+            port_ids(p, &format!("{p}{h}_node.0_10_0.global_mgmt")),
+            None
+        );
         assert_eq!(port_ids("limber_other_", &format!("{p}{h}_5.data")), None);
     }
 }

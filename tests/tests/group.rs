@@ -37,7 +37,11 @@ fn users() -> Option<u32> {
     }
     // Tests run in parallel processes: groupadd/useradd may meet another's lock or find the
     // group or user made meanwhile. Bounded retries.
-    let has_group = || run(Command::new("getent").args(["group", GROUP])).status.success();
+    let has_group = || {
+        run(Command::new("getent").args(["group", GROUP]))
+            .status
+            .success()
+    };
     let in_group = |u: &str| {
         let out = run(Command::new("id").args(["-nG", u]));
         out.status.success()
@@ -47,11 +51,8 @@ fn users() -> Option<u32> {
     };
     let exists = |u: &str| run(Command::new("id").args(["-u", u])).status.success();
     for _ in 0..50 {
-        let ready = has_group()
-            && in_group(A)
-            && in_group(B)
-            && exists(OUTSIDER)
-            && !in_group(OUTSIDER);
+        let ready =
+            has_group() && in_group(A) && in_group(B) && exists(OUTSIDER) && !in_group(OUTSIDER);
         if ready {
             let out = run(Command::new("getent").args(["group", GROUP]));
             let text = String::from_utf8_lossy(&out.stdout).into_owned();
@@ -62,7 +63,8 @@ fn users() -> Option<u32> {
         }
         for u in [A, B, OUTSIDER] {
             if !exists(u) {
-                let _ = run(Command::new("useradd").args(["-M", "-r", "-s", "/usr/sbin/nologin", u]));
+                let _ =
+                    run(Command::new("useradd").args(["-M", "-r", "-s", "/usr/sbin/nologin", u]));
             }
         }
         for u in [A, B] {
@@ -122,7 +124,17 @@ impl Scratch {
     /// `sh -c script` as `user`.
     fn sh(&self, user: &str, script: &str) -> Output {
         run(Command::new("setpriv")
-            .args(["--reuid", user, "--regid", user, "--init-groups", "--", "sh", "-c", script])
+            .args([
+                "--reuid",
+                user,
+                "--regid",
+                user,
+                "--init-groups",
+                "--",
+                "sh",
+                "-c",
+                script,
+            ])
             .current_dir(&self.dir))
     }
 }
@@ -153,12 +165,7 @@ fn spawn(c: Command) -> Proc {
 /// The position of joint `j` in a `limber echo --json` line.
 fn position(line: &str, j: usize) -> Option<f64> {
     let after = line.split("\"position\":").nth(j + 1)?;
-    after
-        .split(|c| c == ',' || c == '}')
-        .next()?
-        .trim()
-        .parse()
-        .ok()
+    after.split([',', '}']).next()?.trim().parse().ok()
 }
 
 /// The domain's files in /dev/shm.
@@ -230,15 +237,30 @@ fn two_members_share_the_arm_and_an_outsider_is_locked_out() {
     ));
     assert!(out.status.success(), "{}", text(&out));
     let before = position(&String::from_utf8_lossy(&out.stdout), 1).expect("joint 1's position");
-    let target = if before > 0.0 { before - 0.4 } else { before + 0.4 };
+    let target = if before > 0.0 {
+        before - 0.4
+    } else {
+        before + 0.4
+    };
     let out = run(&mut s.limber(
         B,
         &domain,
         true,
-        &["actarray", "pioneer/actarray/0", "pos", "1", &format!("{target:.3}")],
+        &[
+            "actarray",
+            "pioneer/actarray/0",
+            "pos",
+            "1",
+            &format!("{target:.3}"),
+        ],
     ));
     assert!(out.status.success(), "{}", text(&out));
-    assert_eq!(String::from_utf8_lossy(&out.stdout).trim(), "ok", "{}", text(&out));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout).trim(),
+        "ok",
+        "{}",
+        text(&out)
+    );
     let mut echo = spawn(s.limber(
         B,
         &domain,
@@ -295,7 +317,8 @@ fn two_members_share_the_arm_and_an_outsider_is_locked_out() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success(), "{}", text(&out));
     assert!(
-        err.contains(&format!("you (user {OUTSIDER}")) && err.contains(&format!("not in group {GROUP}")),
+        err.contains(&format!("you (user {OUTSIDER}"))
+            && err.contains(&format!("not in group {GROUP}")),
         "{err}"
     );
     let out = run(&mut s.limber(OUTSIDER, &domain, false, &["list"]));
@@ -329,9 +352,20 @@ fn two_members_share_the_arm_and_an_outsider_is_locked_out() {
         B,
         &domain,
         true,
-        &["actarray", "pioneer/actarray/0", "pos", "1", &format!("{before:.3}")],
+        &[
+            "actarray",
+            "pioneer/actarray/0",
+            "pos",
+            "1",
+            &format!("{before:.3}"),
+        ],
     ));
-    assert_eq!(String::from_utf8_lossy(&out.stdout).trim(), "ok", "{}", text(&out));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout).trim(),
+        "ok",
+        "{}",
+        text(&out)
+    );
 
     // The driver ends cleanly (as A, the signal through its process).
     driver.signal(libc::SIGTERM);
@@ -395,14 +429,24 @@ fn a_member_waits_a_bounded_time_for_files_not_yet_open_to_the_group() {
         B,
         &domain,
         true,
-        &["-v", "actarray", "pioneer/actarray/0", "pos", "1", "0.1", "--timeout", "20"],
+        &[
+            "-v",
+            "actarray",
+            "pioneer/actarray/0",
+            "pos",
+            "1",
+            "0.1",
+            "--timeout",
+            "20",
+        ],
     );
     c.env("NO_COLOR", "1");
     let mut cmd = spawn_with_stderr(c);
     cmd.read_until(|l| l.contains("not open to the group yet; trying again"))
         .expect("B waits");
     close(false);
-    cmd.read_until(|l| l == "ok").expect("B's command is carried out");
+    cmd.read_until(|l| l == "ok")
+        .expect("B's command is carried out");
     assert_eq!(cmd.wait_timeout(LIMIT), Some(0));
     let prefix = prefix(&s, &domain);
     drop(driver);
@@ -425,4 +469,41 @@ fn spawn_with_stderr(c: Command) -> Proc {
         };
     }
     spawn(sh)
+}
+
+#[test]
+fn a_runtime_directory_that_is_not_the_groups_is_refused_with_its_owner_named() {
+    let Some(_) = users() else { return };
+    let s = Scratch::new("planted");
+    let domain = Domain::unique_for_test();
+    // The outsider plants the runtime directory first, with the right mode but its own
+    // group.
+    let out = s.sh(OUTSIDER, "mkdir rt && chmod 2770 rt");
+    assert!(out.status.success(), "{}", text(&out));
+    let out = run(&mut s.limber(A, &domain, true, &["list"]));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{}", text(&out));
+    assert!(
+        err.contains(&format!("owner user {OUTSIDER}"))
+            && err.contains(&format!("is not {GROUP}"))
+            && err.contains("LIMBER_RUNTIME_DIR"),
+        "{err}"
+    );
+}
+
+#[test]
+fn an_unknown_group_is_refused_with_what_to_do() {
+    // No root needed: the group does not exist, whoever asks.
+    let out = run(Command::new(CLI)
+        .arg("list")
+        .env("LIMBER_DOMAIN", Domain::unique_for_test().name())
+        .env("LIMBER_GROUP", "limber-no-such-group"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{}", text(&out));
+    assert!(
+        err.contains("limber-no-such-group")
+            && err.contains("does not exist")
+            && err.contains("groupadd"),
+        "{err}"
+    );
 }

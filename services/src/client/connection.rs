@@ -118,7 +118,11 @@ impl<I: Interface> Client<I> {
                     if grouped && Instant::now() < deadline =>
                 {
                     if !logged {
-                        tracing::info!(device, channel, "group mode: the device's files are not open to the group yet; trying again");
+                        tracing::info!(
+                            device,
+                            channel,
+                            "group mode: the device's files are not open to the group yet; trying again"
+                        );
                         logged = true;
                     }
                     std::thread::sleep(Duration::from_millis(10));
