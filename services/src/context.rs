@@ -176,7 +176,9 @@ impl Context {
         // iceoryx2 makes the domain's node counter world-writable (0666).
         crate::domain_dir::secure_shm(prefix, group).map_err(domain_err)?;
         if group.is_some() {
-            crate::widen::remove_orphans(prefix, domain.root().map_err(domain_err)?);
+            let root = domain.root().map_err(domain_err)?;
+            crate::widen::cleanup_own_dead_nodes(config, root);
+            crate::widen::remove_orphans(prefix, root);
         }
         Ok(Context {
             inner: Rc::new(Inner {

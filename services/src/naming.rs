@@ -153,6 +153,12 @@ impl Domain {
         config.global.set_root_path(
             &IoxPath::new(root.as_bytes()).map_err(|_| bad("an invalid iceoryx2 root path"))?,
         );
+        if files.group.is_some() {
+            // Each member cleans up after its own dead processes only (crate::widen).
+            config.global.node.cleanup_dead_nodes_on_creation = false;
+            config.global.node.cleanup_dead_nodes_on_destruction = false;
+            config.global.service.cleanup_dead_nodes_on_open = false;
+        }
         Ok(self.config.get_or_init(|| Resolved {
             config,
             prefix: files.prefix,

@@ -27,6 +27,7 @@ use std::os::unix::fs::{FileTypeExt, MetadataExt, PermissionsExt};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
+use iceoryx2::node::NodeView;
 use rustix::fs::inotify;
 
 use crate::domain_dir::{DomainError, GROUP_DIR_MODE, Group, IoError, euid};
@@ -45,7 +46,8 @@ fn wanted_mode(md: &fs::Metadata, name: &str, in_shm: bool) -> Option<u32> {
     } else if ft.is_file() {
         match mode {
             // Final shared memory (in /dev/shm; 0200 while being initialised), and the
-            // node monitors' lock files in the root path.
+            // node monitors' lock files in the root path (iceoryx2 opens both for writing
+            // to tell whether a node is alive).
             0o600 if in_shm => Some(0o660),
             0o600
                 if name.ends_with(".node_monitor")
@@ -372,6 +374,67 @@ pub fn remove_orphans(prefix: &str, root: &Path) -> usize {
         );
     }
     removed
+}
+
+/// Whether the node directory of node `id` under `root` belongs to this process's user.
+fn node_is_mine(root: &Path, id: u128) -> bool {
+    fs::symlink_metadata(root.join("nodes").join(id.to_string())).is_ok_and(|md| md.uid() == euid())
+}
+
+/// Removes the resources of the dead processes attached to `svc`. In group mode only those
+/// of this user's processes: `/dev/shm` is sticky, so a member cleaning up another member's
+/// dead process removes its registrations but not its files, and leaves its services marked
+/// for destruction with files nobody but their owner (or root) can remove, which no driver
+/// can offer again. So iceoryx2's own cleanup of dead nodes is off in group mode
+/// ([`crate::naming::Domain::config`]) and each member's processes clean up after its own.
+pub(crate) fn cleanup_dead_nodes<P>(svc: &P, domain: &crate::naming::Domain)
+where
+    P: iceoryx2::service::port_factory::PortFactory<Service = iceoryx2::prelude::ipc::Service>,
+{
+    use iceoryx2::prelude::{CallbackProgression, NodeState};
+    if !matches!(domain.group(), Ok(Some(_))) {
+        svc.try_cleanup_dead_nodes();
+        return;
+    }
+    let Ok(root) = domain.root() else { return };
+    let mut dead = Vec::new();
+    if let Err(e) = svc.nodes(|n| {
+        if let NodeState::Dead(v) = n
+            && node_is_mine(root, v.id().value())
+        {
+            dead.push(v);
+        }
+        CallbackProgression::Continue
+    }) {
+        tracing::warn!(error = %e, "cannot list the nodes of a service");
+    }
+    for v in dead {
+        if let Err(e) = v.blocking_remove_stale_resources(std::time::Duration::ZERO) {
+            tracing::debug!(error = ?e, "cannot clean up after a dead process of ours");
+        }
+    }
+}
+
+/// Removes the resources of this user's dead processes in the domain (group mode: what
+/// iceoryx2 does for every dead process when a node is created, see [`cleanup_dead_nodes`]).
+pub(crate) fn cleanup_own_dead_nodes(config: &iceoryx2::config::Config, root: &Path) {
+    use iceoryx2::prelude::{CallbackProgression, Node, NodeState, ipc};
+    let mut dead = Vec::new();
+    if let Err(e) = Node::<ipc::Service>::list(config, |n| {
+        if let NodeState::Dead(v) = n
+            && node_is_mine(root, v.id().value())
+        {
+            dead.push(v);
+        }
+        CallbackProgression::Continue
+    }) {
+        tracing::warn!(error = ?e, "cannot list the nodes of the domain");
+    }
+    for v in dead {
+        if let Err(e) = v.blocking_remove_stale_resources(std::time::Duration::ZERO) {
+            tracing::debug!(error = ?e, "cannot clean up after a dead process of ours");
+        }
+    }
 }
 
 #[cfg(test)]

@@ -507,3 +507,70 @@ fn an_unknown_group_is_refused_with_what_to_do() {
         "{err}"
     );
 }
+
+#[test]
+fn a_members_crashed_driver_is_cleaned_up_by_its_user_then_another_member_restarts_it() {
+    let Some(_) = users() else { return };
+    let s = Scratch::new("crash");
+    let domain = Domain::unique_for_test();
+    let mut driver = start_driver(&s, &domain);
+    let out = run(&mut s.limber(
+        B,
+        &domain,
+        true,
+        &["actarray", "pioneer/actarray/0", "pos", "1", "0.2"],
+    ));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout).trim(),
+        "ok",
+        "{}",
+        text(&out)
+    );
+    driver.signal(libc::SIGKILL);
+    assert_eq!(driver.wait_timeout(LIMIT), None, "killed");
+
+    // B's tools see the driver dead and go on; B may not clean up after A's process (that
+    // would leave A's services marked for destruction with files only A can remove), so
+    // B's driver is refused, naming A and what to do.
+    let out = run(&mut s.limber(B, &domain, true, &["list"]));
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("dead"),
+        "{}",
+        text(&out)
+    );
+    let out = run(&mut s.limber(B, &domain, true, &["pioneer", "--emulated"]));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{}", text(&out));
+    assert!(
+        err.contains(&format!("a process of user {A}")) && err.contains("limber list"),
+        "{err}"
+    );
+
+    // A's next limber command cleans up; then B's driver serves and A commands it.
+    let out = run(&mut s.limber(A, &domain, true, &["list"]));
+    assert!(out.status.success(), "{}", text(&out));
+    let mut c = s.limber(B, &domain, true, &["pioneer", "--emulated"]);
+    c.env("LIMBER_GROUP", GROUP);
+    let mut driver = spawn(c);
+    assert!(
+        driver.read_until(|l| l.ends_with("ready")).is_some(),
+        "B's driver did not start"
+    );
+    let out = run(&mut s.limber(
+        A,
+        &domain,
+        true,
+        &["actarray", "pioneer/actarray/0", "pos", "1", "0.1"],
+    ));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout).trim(),
+        "ok",
+        "{}",
+        text(&out)
+    );
+    let prefix = prefix(&s, &domain);
+    driver.signal(libc::SIGTERM);
+    assert_eq!(driver.wait_timeout(LIMIT), Some(0), "B's driver's exit");
+    remove_leftovers(&prefix);
+}

@@ -349,12 +349,15 @@ impl<I: Interface> Client<I> {
     /// cleaned up on the way, so that a restarted driver is picked up by this client.
     /// Costs tens of microseconds: not for every control cycle.
     pub fn driver_status(&self) -> DriverStatus {
-        driver_status_of(&self.data_svc)
+        driver_status_of(&self.data_svc, self.ctx.domain())
     }
 }
 
 /// The status of the driver attached to a device's data service.
-pub(super) fn driver_status_of<P: PortFactory<Service = ipc::Service>>(svc: &P) -> DriverStatus {
+pub(super) fn driver_status_of<P: PortFactory<Service = ipc::Service>>(
+    svc: &P,
+    domain: &crate::naming::Domain,
+) -> DriverStatus {
     let mut alive = false;
     let mut dead = false;
     let is_driver = |d: &Option<iceoryx2::node::NodeDetails>| {
@@ -377,7 +380,7 @@ pub(super) fn driver_status_of<P: PortFactory<Service = ipc::Service>>(svc: &P) 
     if alive {
         DriverStatus::Alive
     } else if dead {
-        svc.try_cleanup_dead_nodes();
+        crate::widen::cleanup_dead_nodes(svc, domain);
         DriverStatus::Dead
     } else {
         DriverStatus::Absent
