@@ -91,6 +91,15 @@ pub(crate) struct Inner {
     pub(crate) name: String,
 }
 
+impl Drop for Inner {
+    fn drop(&mut self) {
+        // Group mode: the files this process's ports made since they were created (a
+        // connection) are opened to the group before the process may end, so that the
+        // members who still hold them never wait on them.
+        self.domain.widen_now();
+    }
+}
+
 /// A process's membership of a domain. Cheap to clone; not `Send` (iceoryx2 ports of
 /// the `ipc` service are bound to their thread).
 #[derive(Clone)]

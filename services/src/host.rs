@@ -557,6 +557,8 @@ impl<I: Interface> DeviceHost<I> {
             .create()
             .map_err(|e| transport("lease", e.into()))?;
 
+        // Group mode: this device's files open to the group at once.
+        ctx.domain().widen_now();
         Ok(DeviceHost {
             domain: ctx.domain().clone(),
             device: device.clone(),

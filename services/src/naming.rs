@@ -133,6 +133,17 @@ impl Domain {
         Ok(self.resolved()?.group.as_ref())
     }
 
+    /// In group mode, opens this user's files of the domain to the group now (the watch of
+    /// [`crate::widen`] does as they appear; this covers the files a port made before a
+    /// short-lived process ends). Nothing otherwise.
+    pub(crate) fn widen_now(&self) {
+        if let Some(r) = self.config.get()
+            && let Some(g) = &r.group
+        {
+            crate::widen::sweep(&r.prefix, &r.root, g);
+        }
+    }
+
     fn resolved(&self) -> Result<&Resolved, DomainError> {
         if let Some(c) = self.config.get() {
             return Ok(c);

@@ -259,6 +259,9 @@ impl<I: Interface> Client<I> {
             .event()
             .open_with_attributes(&layout)
             .map_err(|e| map("notify", e.into()))?;
+        // Group mode: open the files these ports made to the group at once (the watch of
+        // crate::widen would, a little later).
+        ctx.domain().widen_now();
         // Wake the driver so that it hands this new subscriber the latest state at once
         // (otherwise it does at its next publication: a delay, not a failure).
         if let Err(e) = wake.notify_with_custom_event_id(EventId::new(qos::EVENT_HELLO)) {
