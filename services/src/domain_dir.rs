@@ -503,15 +503,31 @@ fn global_mgmt_files(prefix: &str) -> Vec<PathBuf> {
 
 /// Refuses a `global_mgmt` file of the domain that belongs to another user (in group mode:
 /// that is neither ours nor the group's).
+///
+/// In group mode, a counter another member's process has just made (0666, of that member's
+/// own group) is given the instant that process needs to open it to the group (at most
+/// [`COUNTER_WAIT`]).
 fn check_shm(prefix: &str, group: Option<&Group>) -> Result<(), DomainError> {
     for path in global_mgmt_files(prefix) {
-        let md = fs::symlink_metadata(&path).map_err(io_err("inspect", &path))?;
-        if !trusted(&md, group) {
-            return Err(untrusted(&path, &md, group));
+        let deadline = std::time::Instant::now() + COUNTER_WAIT;
+        loop {
+            let md = fs::symlink_metadata(&path).map_err(io_err("inspect", &path))?;
+            if trusted(&md, group) {
+                break;
+            }
+            let fresh = group.is_some() && md.mode() & 0o777 == 0o666;
+            if !fresh || std::time::Instant::now() >= deadline {
+                return Err(untrusted(&path, &md, group));
+            }
+            std::thread::sleep(std::time::Duration::from_millis(5));
         }
     }
     Ok(())
 }
+
+/// How long, in group mode, a node counter just made by another member may take to be
+/// opened to the group ([`check_shm`]).
+const COUNTER_WAIT: std::time::Duration = std::time::Duration::from_secs(1);
 
 /// Narrows the mode of the domain's `global_mgmt` files of ours to 0600 (iceoryx2 makes
 /// them 0666); in group mode to 0660, of the group. Called after the node was created.
