@@ -4,11 +4,6 @@
 use core::time::Duration;
 use std::time::Instant;
 
-/// In group mode, how long [`Client::connect`] tries again a service whose files are not
-/// open to the group yet (they are widened within milliseconds of being made; iceoryx2
-/// itself waits up to its `creation_timeout`, 1 s, for segments).
-pub const GROUP_PERMISSION_WAIT: Duration = Duration::from_secs(2);
-
 use iceoryx2::node::NodeView;
 use iceoryx2::port::client::Client as IoxClient;
 use iceoryx2::port::listener::Listener;
@@ -28,6 +23,11 @@ use crate::context::Context;
 use crate::error::Iox2Error;
 use crate::naming::{Channel, DRIVER_NODE_PREFIX, DeviceName, attr};
 use crate::qos;
+
+/// In group mode, how long [`Client::connect`] tries again a service whose files are not
+/// open to the group yet (they are widened within milliseconds of being made; iceoryx2
+/// itself waits up to its `creation_timeout`, 1 s, for segments).
+pub const GROUP_PERMISSION_WAIT: Duration = Duration::from_secs(2);
 
 pub(super) const OUTCOME_SLOTS: usize = 16;
 
