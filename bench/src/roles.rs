@@ -126,7 +126,8 @@ pub fn raw_node(domain: &Domain) -> Result<Node<ipc::Service>, BenchError> {
         .create::<ipc::Service>()
         .map_err(|e| BenchError::transport("creating an iceoryx2 node", e))?;
     if let Ok(prefix) = domain.prefix() {
-        limber_services::domain_dir::secure_shm(prefix)
+        let group = domain.group().ok().flatten();
+        limber_services::domain_dir::secure_shm(prefix, group)
             .map_err(|e| BenchError::transport("securing the domain's node counter", e))?;
     }
     Ok(node)

@@ -288,7 +288,9 @@ impl From<ConnectError> for Fail {
             ConnectError::Context(_) => LimberCode::Transport,
             ConnectError::NoDriver { .. } => LimberCode::NoDriver,
             ConnectError::Incompatible { .. } => LimberCode::Incompatible,
-            ConnectError::Transport { .. } => LimberCode::Transport,
+            ConnectError::Transport { .. } | ConnectError::Permission { .. } => {
+                LimberCode::Transport
+            }
         };
         Fail::from_error(code, &e)
     }

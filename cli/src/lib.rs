@@ -29,8 +29,10 @@ pub mod simarm;
 #[command(name = "limber", version, about, long_about = None, propagate_version = true)]
 struct Cli {
     /// The domain to work in (default: $LIMBER_DOMAIN, or "limber"). Robots and tests in
-    /// different domains never see each other; a domain is its user's alone (its files are
-    /// in $LIMBER_RUNTIME_DIR, default /tmp/limber-<uid>: README, Security).
+    /// different domains never see each other; a domain is its user's alone, or with
+    /// $LIMBER_GROUP set the domain of a Unix group's members (its files are in
+    /// $LIMBER_RUNTIME_DIR, default /tmp/limber-<uid>, in group mode /tmp/limber-g-<gid>:
+    /// README, Security).
     #[arg(long, global = true, value_name = "NAME", env = limber_services::naming::DOMAIN_ENV,
           value_parser = parse_domain)]
     domain: Option<Domain>,

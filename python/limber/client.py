@@ -350,10 +350,21 @@ class UnexpectedReplyError(DecodeError):
 
 
 RUNTIME_DIR_ENV = "LIMBER_RUNTIME_DIR"
+GROUP_ENV = "LIMBER_GROUP"
 
 
 def _runtime_dir() -> str:
-    """``$LIMBER_RUNTIME_DIR``, else ``/tmp/limber-<uid>`` (as in Rust's ``domain_dir``)."""
+    """``$LIMBER_RUNTIME_DIR``, else ``/tmp/limber-<uid>`` (as in Rust's ``domain_dir``).
+
+    Group mode (``LIMBER_GROUP``) is refused: the Python client does not open the files
+    iceoryx2 makes to the group, so the other members could not use them."""
+    group = os.environ.get(GROUP_ENV)
+    if group:
+        raise TransportError(
+            f"LIMBER_GROUP={group} asks for group mode, which the Python client does not "
+            "support (it would not open its files to the group's other members): use the "
+            "limber command line, the Rust or the C API, or unset LIMBER_GROUP (README, Security)"
+        )
     return os.environ.get(RUNTIME_DIR_ENV) or f"/tmp/limber-{os.geteuid()}"
 
 

@@ -91,6 +91,15 @@ pub(crate) struct Inner {
     pub(crate) name: String,
 }
 
+impl Drop for Inner {
+    fn drop(&mut self) {
+        // Group mode: the files this process's ports made since they were created (a
+        // connection) are opened to the group before the process may end, so that the
+        // members who still hold them never wait on them.
+        self.domain.widen_now();
+    }
+}
+
 /// A process's membership of a domain. Cheap to clone; not `Send` (iceoryx2 ports of
 /// the `ipc` service are bound to their thread).
 #[derive(Clone)]
@@ -144,6 +153,12 @@ impl Context {
             crate::domain_dir::check_shm_space().map_err(domain_err)?;
         }
         let prefix = domain.prefix().map_err(domain_err)?;
+        let group = domain.group().map_err(domain_err)?;
+        if let Some(g) = group {
+            // Before iceoryx2 makes this process's files: they are opened to the group as
+            // they appear (crate::widen).
+            crate::widen::start(prefix, domain.root().map_err(domain_err)?, g);
+        }
         let node = NodeBuilder::new()
             .name(&node_name)
             .config(config)
@@ -168,7 +183,12 @@ impl Context {
                 }
             })?;
         // iceoryx2 makes the domain's node counter world-writable (0666).
-        crate::domain_dir::secure_shm(prefix).map_err(domain_err)?;
+        crate::domain_dir::secure_shm(prefix, group).map_err(domain_err)?;
+        if group.is_some() {
+            let root = domain.root().map_err(domain_err)?;
+            crate::widen::cleanup_own_dead_nodes(config, root);
+            crate::widen::remove_orphans(prefix, root);
+        }
         Ok(Context {
             inner: Rc::new(Inner {
                 domain: domain.clone(),

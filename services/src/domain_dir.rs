@@ -17,6 +17,15 @@
 //! `<runtime>/iceoryx2/`, which nobody else can enter. Before a process joins, a
 //! `global_mgmt` file of the domain owned by another user is refused; after it joined, the
 //! counter's mode is narrowed from 0666 to 0600.
+//!
+//! **Group mode** (`LIMBER_GROUP=<group>`): several accounts of one Unix group share the
+//! domains of a runtime directory of the group's (`$LIMBER_RUNTIME_DIR`, else
+//! `/tmp/limber-g-<gid>`), mode 2770 and owned by the group, refused when it has another
+//! group or mode, or when this user is not in the group. iceoryx2 0.10 creates every file
+//! owner-only (0600 segments, 0400 static configurations, 0750 directories), so each
+//! process of the group widens the domain's files *it owns* as soon as iceoryx2 has
+//! finished them ([`crate::widen`]): segments and sockets 0660, static files 0440,
+//! directories 2770, all of the group. Everyone outside the group stays locked out.
 
 use std::fs;
 use std::io::{self, Write};
@@ -25,8 +34,12 @@ use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
-/// The environment variable that names the runtime directory (default `/tmp/limber-<uid>`).
+/// The environment variable that names the runtime directory (default `/tmp/limber-<uid>`,
+/// in group mode `/tmp/limber-g-<gid>`).
 pub const RUNTIME_DIR_ENV: &str = "LIMBER_RUNTIME_DIR";
+/// The environment variable that turns group mode on: the name (or number) of the Unix
+/// group whose members share the domains (README, Security).
+pub const GROUP_ENV: &str = "LIMBER_GROUP";
 /// Where POSIX shared memory lives on Linux.
 const SHM_DIR: &str = "/dev/shm";
 /// The suffix iceoryx2 gives its per-domain node counter.
@@ -47,6 +60,42 @@ pub enum DomainError {
         owner: String,
         /// This process's user, `name (uid N)`.
         me: String,
+    },
+    /// `LIMBER_GROUP` names a group that does not exist.
+    #[error(
+        "LIMBER_GROUP names the group {0:?}, which does not exist: create it (groupadd {0}) and add its users (usermod -aG {0} USER), or unset LIMBER_GROUP"
+    )]
+    UnknownGroup(String),
+    /// This user is not a member of the group of `LIMBER_GROUP`.
+    #[error(
+        "you ({me}) are not in group {group} (gid {gid}, LIMBER_GROUP): only its members share its domains. Ask an administrator to run usermod -aG {group} <your user> and log in again, or unset LIMBER_GROUP"
+    )]
+    NotInGroup {
+        /// The group's name.
+        group: String,
+        /// The group's id.
+        gid: u32,
+        /// This process's user, `name (uid N)`.
+        me: String,
+    },
+    /// In group mode, a directory or file that is not the group's: another group, a mode
+    /// others can use, or a file neither ours nor the group's.
+    #[error(
+        "{path} (owner {owner}, group {file_group}, mode {mode:o}) is not {group}'s: in group mode limber only uses {what}. Remove it (as root or as its owner), or set LIMBER_RUNTIME_DIR to a directory of the group's"
+    )]
+    NotTheGroups {
+        /// The file or directory.
+        path: PathBuf,
+        /// Its owner, `name (uid N)`.
+        owner: String,
+        /// Its group, `name (gid N)`.
+        file_group: String,
+        /// Its mode.
+        mode: u32,
+        /// The group of `LIMBER_GROUP`, `name (gid N)`.
+        group: String,
+        /// What would have been accepted.
+        what: &'static str,
     },
     /// The runtime directory is not a directory (a symbolic link, a file).
     #[error("{0} is not a directory (a symbolic link or a file): limber will not follow it")]
@@ -131,11 +180,87 @@ pub fn describe_user(uid: u32) -> String {
     }
 }
 
-/// The runtime directory of this process: `$LIMBER_RUNTIME_DIR`, else `/tmp/limber-<uid>`.
+/// The Unix group of group mode (`LIMBER_GROUP`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Group {
+    /// Its name.
+    pub name: String,
+    /// Its id.
+    pub gid: u32,
+}
+
+/// `name (gid N)` for a group id (the name from /etc/group, when it is there).
+pub fn describe_group(gid: u32) -> String {
+    match group_entries().into_iter().find(|(_, id)| *id == gid) {
+        Some((n, _)) => format!("{n} (gid {gid})"),
+        None => format!("gid {gid}"),
+    }
+}
+
+/// The (name, gid) pairs of /etc/group.
+fn group_entries() -> Vec<(String, u32)> {
+    let Ok(text) = fs::read_to_string("/etc/group") else {
+        return Vec::new();
+    };
+    text.lines()
+        .filter_map(|l| {
+            let mut f = l.split(':');
+            let name = f.next()?;
+            let gid: u32 = f.nth(1)?.parse().ok()?;
+            Some((name.to_string(), gid))
+        })
+        .collect()
+}
+
+/// The group of group mode: `LIMBER_GROUP` (a name, or a number), None when unset. Refused
+/// when the group does not exist or this user is not a member (root may use any group).
+pub fn group_from_env() -> Result<Option<Group>, DomainError> {
+    let Some(v) = std::env::var_os(GROUP_ENV).filter(|v| !v.is_empty()) else {
+        return Ok(None);
+    };
+    let v = v.to_string_lossy().into_owned();
+    let entries = group_entries();
+    let found = entries
+        .iter()
+        .find(|(n, _)| *n == v)
+        .or_else(|| {
+            v.parse::<u32>()
+                .ok()
+                .and_then(|g| entries.iter().find(|(_, id)| *id == g))
+        })
+        .ok_or_else(|| DomainError::UnknownGroup(v.clone()))?;
+    let group = Group {
+        name: found.0.clone(),
+        gid: found.1,
+    };
+    let gid = rustix::process::Gid::from_raw(group.gid);
+    let member = euid() == 0
+        || rustix::process::getegid() == gid
+        || rustix::process::getgroups().is_ok_and(|gs| gs.contains(&gid));
+    if !member {
+        return Err(DomainError::NotInGroup {
+            group: group.name,
+            gid: group.gid,
+            me: describe_user(euid()),
+        });
+    }
+    Ok(Some(group))
+}
+
+/// The runtime directory of this process: `$LIMBER_RUNTIME_DIR`, else `/tmp/limber-<uid>`
+/// (in group mode, `/tmp/limber-g-<gid>`: see [`runtime_dir_for`]).
 pub fn runtime_dir() -> PathBuf {
+    runtime_dir_for(group_from_env().ok().flatten().as_ref())
+}
+
+/// The runtime directory for a group (None: this user's own).
+pub fn runtime_dir_for(group: Option<&Group>) -> PathBuf {
     match std::env::var_os(RUNTIME_DIR_ENV) {
         Some(v) if !v.is_empty() => PathBuf::from(v),
-        _ => PathBuf::from(format!("/tmp/limber-{}", euid())),
+        _ => match group {
+            Some(g) => PathBuf::from(format!("/tmp/limber-g-{}", g.gid)),
+            None => PathBuf::from(format!("/tmp/limber-{}", euid())),
+        },
     }
 }
 
@@ -165,6 +290,8 @@ pub struct DomainFiles {
     pub root: PathBuf,
     /// The iceoryx2 prefix (`limber_<token>_`).
     pub prefix: String,
+    /// The group sharing the domain (group mode), or None.
+    pub group: Option<Group>,
 }
 
 fn foreign(path: &Path, uid: u32) -> DomainError {
@@ -198,6 +325,70 @@ fn private_dir(dir: &Path, mode: u32) -> Result<(), DomainError> {
     Ok(())
 }
 
+/// The mode of a group's directories: rwx for owner and group, setgid (new files and
+/// directories in it get the group).
+pub const GROUP_DIR_MODE: u32 = 0o2770;
+
+fn not_the_groups(
+    path: &Path,
+    md: &fs::Metadata,
+    group: &Group,
+    what: &'static str,
+) -> DomainError {
+    DomainError::NotTheGroups {
+        path: path.to_path_buf(),
+        owner: describe_user(md.uid()),
+        file_group: describe_group(md.gid()),
+        mode: md.mode() & 0o7777,
+        group: describe_group(group.gid),
+        what,
+    }
+}
+
+/// Makes sure `dir` is a directory of `group`, mode 2770 (creating it if missing; fixing
+/// the group and mode when it is ours). One of another group, or that others can use, is
+/// refused: it could have been planted.
+fn group_dir(dir: &Path, group: &Group) -> Result<(), DomainError> {
+    const WHAT: &str = "directories of the group, mode 2770";
+    match fs::DirBuilder::new().mode(0o700).create(dir) {
+        Ok(()) => {}
+        Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {}
+        Err(e) => return Err(io_err("create", dir)(e)),
+    }
+    let md = fs::symlink_metadata(dir).map_err(io_err("inspect", dir))?;
+    if !md.file_type().is_dir() {
+        return Err(DomainError::NotADirectory(dir.to_path_buf()));
+    }
+    let right = md.gid() == group.gid && md.mode() & 0o7777 == GROUP_DIR_MODE;
+    if right {
+        return Ok(());
+    }
+    if md.uid() != euid() {
+        return Err(not_the_groups(dir, &md, group, WHAT));
+    }
+    if md.gid() != group.gid {
+        rustix::fs::chown(dir, None, Some(rustix::fs::Gid::from_raw(group.gid)))
+            .map_err(|e| io_err("change the group of", dir)(e.into()))?;
+    }
+    fs::set_permissions(dir, fs::Permissions::from_mode(GROUP_DIR_MODE))
+        .map_err(io_err("change the mode of", dir))?;
+    Ok(())
+}
+
+/// Whether a file found in a domain may be used: ours, or (group mode) the group's and not
+/// writable by others.
+fn trusted(md: &fs::Metadata, group: Option<&Group>) -> bool {
+    md.uid() == euid() || group.is_some_and(|g| md.gid() == g.gid && md.mode() & 0o002 == 0)
+}
+
+/// The error for a file that is not [`trusted`].
+fn untrusted(path: &Path, md: &fs::Metadata, group: Option<&Group>) -> DomainError {
+    match group {
+        Some(g) => not_the_groups(path, md, g, "files of its members"),
+        None => foreign(path, md.uid()),
+    }
+}
+
 fn new_token() -> Result<String, DomainError> {
     let mut bytes = [0u8; 8];
     let path = Path::new("/dev/urandom");
@@ -212,7 +403,7 @@ fn valid_token(t: &str) -> bool {
 
 /// The token of `domain` in `dir`, made on first use (several processes may race: one wins,
 /// all read its token).
-fn token(dir: &Path, domain: &str) -> Result<String, DomainError> {
+fn token(dir: &Path, domain: &str, group: Option<&Group>) -> Result<String, DomainError> {
     let path = dir.join(format!("{domain}.token"));
     if fs::symlink_metadata(&path).is_err() {
         let token = new_token()?;
@@ -226,6 +417,13 @@ fn token(dir: &Path, domain: &str) -> Result<String, DomainError> {
             .map_err(io_err("create", &tmp))?;
         f.write_all(format!("{token}\n").as_bytes())
             .map_err(io_err("write", &tmp))?;
+        if let Some(g) = group {
+            // The members read it; it has the group of the (setgid) directory already.
+            rustix::fs::fchown(&f, None, Some(rustix::fs::Gid::from_raw(g.gid)))
+                .map_err(|e| io_err("change the group of", &tmp)(e.into()))?;
+            f.set_permissions(fs::Permissions::from_mode(0o640))
+                .map_err(io_err("change the mode of", &tmp))?;
+        }
         drop(f);
         // link(2) does not replace: the first process to make the token wins.
         let linked = fs::hard_link(&tmp, &path);
@@ -242,8 +440,8 @@ fn token(dir: &Path, domain: &str) -> Result<String, DomainError> {
     if !md.file_type().is_file() {
         return Err(DomainError::BadToken(path));
     }
-    if md.uid() != euid() {
-        return Err(foreign(&path, md.uid()));
+    if !trusted(&md, group) {
+        return Err(untrusted(&path, &md, group));
     }
     let text = fs::read_to_string(&path).map_err(io_err("read", &path))?;
     let t = text.trim();
@@ -256,19 +454,35 @@ fn token(dir: &Path, domain: &str) -> Result<String, DomainError> {
 /// Prepares the files of `domain` for this process (see the module documentation):
 /// the private runtime directory, the domain's token, and a check that no file of the
 /// domain in `/dev/shm` belongs to someone else.
+///
+/// In group mode (`LIMBER_GROUP`) the runtime directory and the iceoryx2 root are the
+/// group's (2770); iceoryx2's `services` and `nodes` directories are made here, the group's
+/// too, so that every member can create its files there.
 pub fn prepare(domain: &str) -> Result<DomainFiles, DomainError> {
-    let dir = runtime_dir();
-    private_dir(&dir, 0o711)?;
-    let token = token(&dir, domain)?;
-    let prefix = format!("limber_{token}_");
-    check_shm(&prefix)?;
+    let group = group_from_env()?;
+    let dir = runtime_dir_for(group.as_ref());
     let iox = dir.join("iceoryx2");
-    private_dir(&iox, 0o700)?;
+    match &group {
+        None => private_dir(&dir, 0o711)?,
+        Some(g) => group_dir(&dir, g)?,
+    }
+    let token = token(&dir, domain, group.as_ref())?;
+    let prefix = format!("limber_{token}_");
+    check_shm(&prefix, group.as_ref())?;
+    match &group {
+        None => private_dir(&iox, 0o700)?,
+        Some(g) => {
+            group_dir(&iox, g)?;
+            group_dir(&iox.join("services"), g)?;
+            group_dir(&iox.join("nodes"), g)?;
+        }
+    }
     let mut root = iox.into_os_string();
     root.push("/");
     Ok(DomainFiles {
         root: PathBuf::from(root),
         prefix,
+        group,
     })
 }
 
@@ -287,27 +501,54 @@ fn global_mgmt_files(prefix: &str) -> Vec<PathBuf> {
         .collect()
 }
 
-/// Refuses a `global_mgmt` file of the domain that belongs to another user.
-fn check_shm(prefix: &str) -> Result<(), DomainError> {
+/// Refuses a `global_mgmt` file of the domain that belongs to another user (in group mode:
+/// that is neither ours nor the group's).
+///
+/// In group mode, a counter another member's process has just made (0666, of that member's
+/// own group) is given the instant that process needs to open it to the group (at most
+/// [`COUNTER_WAIT`]).
+fn check_shm(prefix: &str, group: Option<&Group>) -> Result<(), DomainError> {
     for path in global_mgmt_files(prefix) {
-        let md = fs::symlink_metadata(&path).map_err(io_err("inspect", &path))?;
-        if md.uid() != euid() {
-            return Err(foreign(&path, md.uid()));
+        let deadline = std::time::Instant::now() + COUNTER_WAIT;
+        loop {
+            let md = fs::symlink_metadata(&path).map_err(io_err("inspect", &path))?;
+            if trusted(&md, group) {
+                break;
+            }
+            let fresh = group.is_some() && md.mode() & 0o777 == 0o666;
+            if !fresh || std::time::Instant::now() >= deadline {
+                return Err(untrusted(&path, &md, group));
+            }
+            std::thread::sleep(std::time::Duration::from_millis(5));
         }
     }
     Ok(())
 }
 
+/// How long, in group mode, a node counter just made by another member may take to be
+/// opened to the group ([`check_shm`]).
+const COUNTER_WAIT: std::time::Duration = std::time::Duration::from_secs(1);
+
 /// Narrows the mode of the domain's `global_mgmt` files of ours to 0600 (iceoryx2 makes
-/// them 0666). Called after the node was created.
-pub fn secure_shm(prefix: &str) -> Result<(), DomainError> {
+/// them 0666); in group mode to 0660, of the group. Called after the node was created.
+pub fn secure_shm(prefix: &str, group: Option<&Group>) -> Result<(), DomainError> {
     for path in global_mgmt_files(prefix) {
         let md = fs::symlink_metadata(&path).map_err(io_err("inspect", &path))?;
         if md.uid() != euid() {
-            return Err(foreign(&path, md.uid()));
+            if trusted(&md, group) {
+                continue;
+            }
+            return Err(untrusted(&path, &md, group));
         }
-        if md.mode() & 0o077 != 0 {
-            fs::set_permissions(&path, fs::Permissions::from_mode(0o600))
+        let mode = if group.is_some() { 0o660 } else { 0o600 };
+        if let Some(g) = group
+            && md.gid() != g.gid
+        {
+            rustix::fs::chown(&path, None, Some(rustix::fs::Gid::from_raw(g.gid)))
+                .map_err(|e| io_err("change the group of", &path)(e.into()))?;
+        }
+        if md.mode() & 0o777 != mode {
+            fs::set_permissions(&path, fs::Permissions::from_mode(mode))
                 .map_err(io_err("change the mode of", &path))?;
         }
     }
@@ -373,7 +614,7 @@ mod tests {
         let tokens: Vec<String> = (0..8)
             .map(|_| {
                 let d = dir.clone();
-                std::thread::spawn(move || token(&d, "raced").unwrap())
+                std::thread::spawn(move || token(&d, "raced", None).unwrap())
             })
             .collect::<Vec<_>>()
             .into_iter()
@@ -393,14 +634,17 @@ mod tests {
             0o711,
             "a new runtime directory is private"
         );
-        let a = token(&dir, "d").unwrap();
-        let b = token(&dir, "d").unwrap();
+        let a = token(&dir, "d", None).unwrap();
+        let b = token(&dir, "d", None).unwrap();
         assert_eq!(a, b);
-        assert_ne!(a, token(&dir, "e").unwrap());
+        assert_ne!(a, token(&dir, "e", None).unwrap());
         let md = fs::metadata(dir.join("d.token")).unwrap();
         assert_eq!(md.mode() & 0o777, 0o600);
         fs::write(dir.join("bad.token"), "nope").unwrap();
-        assert!(matches!(token(&dir, "bad"), Err(DomainError::BadToken(_))));
+        assert!(matches!(
+            token(&dir, "bad", None),
+            Err(DomainError::BadToken(_))
+        ));
         fs::set_permissions(&dir, fs::Permissions::from_mode(0o755)).unwrap();
         private_dir(&dir, 0o711).unwrap();
         assert_eq!(

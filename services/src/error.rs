@@ -143,6 +143,30 @@ impl Iox2Error {
         )
     }
 
+    /// True when iceoryx2 could not open a service's files for lack of permission (in group
+    /// mode: a member's file not yet opened to the group; else another user's domain).
+    pub fn is_permission_denied(&self) -> bool {
+        matches!(
+            self,
+            Iox2Error::PubSubOpen(PublishSubscribeOpenError::InsufficientPermissions)
+                | Iox2Error::PubSubOpenOrCreate(
+                    PublishSubscribeOpenOrCreateError::PublishSubscribeOpenError(
+                        PublishSubscribeOpenError::InsufficientPermissions
+                    )
+                )
+                | Iox2Error::EventOpen(EventOpenError::InsufficientPermissions)
+                | Iox2Error::EventOpenOrCreate(EventOpenOrCreateError::EventOpenError(
+                    EventOpenError::InsufficientPermissions
+                ))
+                | Iox2Error::ReqRespOpen(RequestResponseOpenError::InsufficientPermissions)
+                | Iox2Error::ReqRespOpenOrCreate(
+                    RequestResponseOpenOrCreateError::RequestResponseOpenError(
+                        RequestResponseOpenError::InsufficientPermissions
+                    )
+                )
+        )
+    }
+
     /// True when the service exists with other attributes (another layout version or
     /// driver) or other payload types.
     pub fn is_incompatible_attributes_or_types(&self) -> bool {

@@ -157,6 +157,17 @@ pub enum HostError {
         /// The device.
         device: String,
     },
+    /// Group mode: the device's previous driver, a process of another member, died, and
+    /// only its user (or root) may clean up after it (README, Security).
+    #[error(
+        "{device}: its previous driver, a process of {owner}, died; in group mode only that user (or root) may clean up after it: run any limber command as that user (e.g. limber list), then start the driver again"
+    )]
+    DeadDriverOfAnotherMember {
+        /// The device.
+        device: String,
+        /// The dead driver's user, `user NAME (uid N)`.
+        owner: String,
+    },
     /// iceoryx2 failed to create a service or port.
     #[error("{device}: cannot create the {channel} channel: {source}")]
     Transport {
@@ -327,6 +338,8 @@ impl ClientTable {
 /// in place, commands and requests are read in place.
 pub struct DeviceHost<I: Interface> {
     device: DeviceName,
+    /// The domain (group mode decides whose dead processes this host may clean up).
+    domain: crate::naming::Domain,
     data_svc:
         iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, I::Data, ()>,
     publisher: Publisher<ipc::Service, I::Data, ()>,
@@ -437,8 +450,11 @@ impl<I: Interface> DeviceHost<I> {
             .map_err(|e| transport("data", e.into()))?;
         // A live driver already publishing this device: refuse to serve it twice.
         if data_svc.dynamic_config().number_of_publishers() > 0 {
-            data_svc.try_cleanup_dead_nodes();
+            crate::widen::cleanup_dead_nodes(&data_svc, ctx.domain());
             if data_svc.dynamic_config().number_of_publishers() > 0 {
+                if let Some(owner) = dead_node_of_another_user(&data_svc, ctx) {
+                    return Err(HostError::DeadDriverOfAnotherMember { device: dev, owner });
+                }
                 return Err(HostError::AlreadyServed { device: dev });
             }
         }
@@ -541,7 +557,10 @@ impl<I: Interface> DeviceHost<I> {
             .create()
             .map_err(|e| transport("lease", e.into()))?;
 
+        // Group mode: this device's files open to the group at once.
+        ctx.domain().widen_now();
         Ok(DeviceHost {
+            domain: ctx.domain().clone(),
             device: device.clone(),
             data_svc,
             publisher,
@@ -1084,12 +1103,38 @@ impl<I: Interface> DeviceHost<I> {
     }
 
     /// Removes the resources of dead processes (crashed clients) from this device's
-    /// services. Cheap enough for a 1 Hz housekeeping tick, not for every cycle.
+    /// services (in group mode, of this user's processes only: README, Security). Cheap
+    /// enough for a 1 Hz housekeeping tick, not for every cycle.
     pub fn cleanup_dead(&self) {
-        use iceoryx2::service::port_factory::PortFactory;
-        self.data_svc.try_cleanup_dead_nodes();
-        self.lease_svc.try_cleanup_dead_nodes();
+        crate::widen::cleanup_dead_nodes(&self.data_svc, &self.domain);
+        crate::widen::cleanup_dead_nodes(&self.lease_svc, &self.domain);
     }
+}
+
+/// In group mode, the user of a dead node of `svc` that belongs to another user (its node
+/// directory is theirs: only they may clean it up), as `user NAME (uid N)`.
+fn dead_node_of_another_user<
+    P: iceoryx2::service::port_factory::PortFactory<Service = ipc::Service>,
+>(
+    svc: &P,
+    ctx: &Context,
+) -> Option<String> {
+    use std::os::unix::fs::MetadataExt;
+    ctx.domain().group().ok().flatten()?;
+    let nodes = ctx.domain().root().ok()?.join("nodes");
+    let mut owner = None;
+    if let Err(e) = svc.nodes(|n| {
+        if let NodeState::Dead(v) = &n
+            && let Ok(md) = std::fs::symlink_metadata(nodes.join(v.id().value().to_string()))
+            && md.uid() != crate::domain_dir::euid()
+        {
+            owner = Some(crate::domain_dir::describe_user(md.uid()));
+        }
+        CallbackProgression::Continue
+    }) {
+        tracing::warn!(error = %e, "cannot list the nodes of a device");
+    }
+    owner
 }
 
 #[cfg(test)]

@@ -80,6 +80,7 @@ pub mod naming;
 pub mod qos;
 pub mod signals;
 pub mod testing;
+pub mod widen;
 
 pub use client::{
     ActArrayClient, Client, CommandError, ConnectError, DriverStatus, Freshness, GripperClient,

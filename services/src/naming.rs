@@ -57,7 +57,16 @@ fn valid_ident(s: &str, max: usize) -> bool {
 pub struct Domain {
     name: String,
     /// The iceoryx2 configuration, made on first use (it needs the domain's files).
-    config: Arc<OnceLock<(Config, String)>>,
+    config: Arc<OnceLock<Resolved>>,
+}
+
+/// A domain's iceoryx2 configuration, prefix and group, made once.
+#[derive(Debug)]
+struct Resolved {
+    config: Config,
+    prefix: String,
+    root: std::path::PathBuf,
+    group: Option<domain_dir::Group>,
 }
 
 impl Domain {
@@ -105,15 +114,37 @@ impl Domain {
     /// prefix of the domain's files, which are prepared (and checked) on the first call; see
     /// [`crate::domain_dir`].
     pub fn config(&self) -> Result<&Config, DomainError> {
-        Ok(&self.resolved()?.0)
+        Ok(&self.resolved()?.config)
     }
 
     /// The iceoryx2 prefix of this domain's files (`limber_<token>_`).
     pub fn prefix(&self) -> Result<&str, DomainError> {
-        Ok(&self.resolved()?.1)
+        Ok(&self.resolved()?.prefix)
     }
 
-    fn resolved(&self) -> Result<&(Config, String), DomainError> {
+    /// The iceoryx2 root path of this domain's files (`<runtime>/iceoryx2/`).
+    pub fn root(&self) -> Result<&std::path::Path, DomainError> {
+        Ok(&self.resolved()?.root)
+    }
+
+    /// The Unix group that shares this domain (group mode, `LIMBER_GROUP`), or None: the
+    /// domain is its user's alone.
+    pub fn group(&self) -> Result<Option<&domain_dir::Group>, DomainError> {
+        Ok(self.resolved()?.group.as_ref())
+    }
+
+    /// In group mode, opens this user's files of the domain to the group now (the watch of
+    /// [`crate::widen`] does as they appear; this covers the files a port made before a
+    /// short-lived process ends). Nothing otherwise.
+    pub(crate) fn widen_now(&self) {
+        if let Some(r) = self.config.get()
+            && let Some(g) = &r.group
+        {
+            crate::widen::sweep(&r.prefix, &r.root, g);
+        }
+    }
+
+    fn resolved(&self) -> Result<&Resolved, DomainError> {
         if let Some(c) = self.config.get() {
             return Ok(c);
         }
@@ -133,7 +164,18 @@ impl Domain {
         config.global.set_root_path(
             &IoxPath::new(root.as_bytes()).map_err(|_| bad("an invalid iceoryx2 root path"))?,
         );
-        Ok(self.config.get_or_init(|| (config, files.prefix)))
+        if files.group.is_some() {
+            // Each member cleans up after its own dead processes only (crate::widen).
+            config.global.node.cleanup_dead_nodes_on_creation = false;
+            config.global.node.cleanup_dead_nodes_on_destruction = false;
+            config.global.service.cleanup_dead_nodes_on_open = false;
+        }
+        Ok(self.config.get_or_init(|| Resolved {
+            config,
+            prefix: files.prefix,
+            root: files.root,
+            group: files.group,
+        }))
     }
 }
 

@@ -35,9 +35,16 @@ impl Proc {
 
     /// Spawns `exe` with `args` in domain `domain`, stdin and stdout piped.
     pub fn spawn(exe: &str, domain: &str, args: &[&str]) -> Proc {
-        let mut child = Command::new(exe)
-            .args(args)
-            .env("LIMBER_DOMAIN", domain)
+        let mut c = Command::new(exe);
+        c.args(args).env("LIMBER_DOMAIN", domain);
+        Proc::spawn_command(c)
+    }
+
+    /// Spawns a prepared command (its environment, working directory), stdin and stdout
+    /// piped, stderr inherited.
+    pub fn spawn_command(mut c: Command) -> Proc {
+        let exe = c.get_program().to_string_lossy().into_owned();
+        let mut child = c
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::inherit())
@@ -58,7 +65,7 @@ impl Proc {
             child,
             lines,
             stdin,
-            exe: exe.to_string(),
+            exe,
         }
     }
 

@@ -24,6 +24,11 @@ use crate::error::Iox2Error;
 use crate::naming::{Channel, DRIVER_NODE_PREFIX, DeviceName, attr};
 use crate::qos;
 
+/// In group mode, how long [`Client::connect`] tries again a service whose files are not
+/// open to the group yet (they are widened within milliseconds of being made; iceoryx2
+/// itself waits up to its `creation_timeout`, 1 s, for segments).
+pub const GROUP_PERMISSION_WAIT: Duration = Duration::from_secs(2);
+
 pub(super) const OUTCOME_SLOTS: usize = 16;
 
 /// The lease port of a client and the lease it holds.
@@ -92,7 +97,42 @@ pub type GripperClient = Client<Gripper>;
 impl<I: Interface> Client<I> {
     /// Connects to `device` ("robot/interface/index") in the context's domain. Fails with
     /// [`ConnectError::NoDriver`] at once if nobody offers it.
+    ///
+    /// In group mode (`LIMBER_GROUP`) a service whose files the member who made them has
+    /// not opened to the group yet (the instant after they were made) is tried again for up
+    /// to [`GROUP_PERMISSION_WAIT`] before [`ConnectError::Permission`].
     pub fn connect(ctx: &Context, device: &str) -> Result<Self, ConnectError> {
+        Self::connect_within(ctx, device, Instant::now() + GROUP_PERMISSION_WAIT)
+    }
+
+    fn connect_within(
+        ctx: &Context,
+        device: &str,
+        deadline: Instant,
+    ) -> Result<Self, ConnectError> {
+        let grouped = ctx.domain().group().ok().flatten().is_some();
+        let mut logged = false;
+        loop {
+            match Self::connect_once(ctx, device) {
+                Err(ConnectError::Permission { channel, .. })
+                    if grouped && Instant::now() < deadline =>
+                {
+                    if !logged {
+                        tracing::info!(
+                            device,
+                            channel,
+                            "group mode: the device's files are not open to the group yet; trying again"
+                        );
+                        logged = true;
+                    }
+                    std::thread::sleep(Duration::from_millis(10));
+                }
+                other => return other,
+            }
+        }
+    }
+
+    fn connect_once(ctx: &Context, device: &str) -> Result<Self, ConnectError> {
         let device: DeviceName = device.parse()?;
         if device.interface() != I::KIND {
             return Err(ConnectError::Incompatible {
@@ -113,8 +153,9 @@ impl<I: Interface> Client<I> {
         timeout: Duration,
     ) -> Result<Self, ConnectError> {
         let deadline = Instant::now() + timeout;
+        let permission_deadline = deadline.max(Instant::now() + GROUP_PERMISSION_WAIT);
         loop {
-            match Self::connect(ctx, device) {
+            match Self::connect_within(ctx, device, permission_deadline) {
                 Err(ConnectError::NoDriver { .. }) if Instant::now() < deadline => {
                     std::thread::sleep(Duration::from_millis(20));
                 }
@@ -132,6 +173,20 @@ impl<I: Interface> Client<I> {
                     device: dev.clone(),
                     domain: domain.clone(),
                     elsewhere: crate::domain_dir::elsewhere_note(&domain),
+                }
+            } else if e.is_permission_denied() {
+                let hint = match ctx.domain().group().ok().flatten() {
+                    Some(g) => format!(
+                        "in group mode ({}) the member who started the driver must run a limber with group mode, with LIMBER_GROUP={} set (README, Security)",
+                        g.name, g.name
+                    ),
+                    None => "they belong to another user; a domain is its owner's alone (README, Security)".to_string(),
+                };
+                ConnectError::Permission {
+                    device: dev.clone(),
+                    channel,
+                    hint,
+                    source: e,
                 }
             } else if e.is_incompatible() {
                 ConnectError::Incompatible {
@@ -204,6 +259,9 @@ impl<I: Interface> Client<I> {
             .event()
             .open_with_attributes(&layout)
             .map_err(|e| map("notify", e.into()))?;
+        // Group mode: open the files these ports made to the group at once (the watch of
+        // crate::widen would, a little later).
+        ctx.domain().widen_now();
         // Wake the driver so that it hands this new subscriber the latest state at once
         // (otherwise it does at its next publication: a delay, not a failure).
         if let Err(e) = wake.notify_with_custom_event_id(EventId::new(qos::EVENT_HELLO)) {
@@ -294,12 +352,15 @@ impl<I: Interface> Client<I> {
     /// cleaned up on the way, so that a restarted driver is picked up by this client.
     /// Costs tens of microseconds: not for every control cycle.
     pub fn driver_status(&self) -> DriverStatus {
-        driver_status_of(&self.data_svc)
+        driver_status_of(&self.data_svc, self.ctx.domain())
     }
 }
 
 /// The status of the driver attached to a device's data service.
-pub(super) fn driver_status_of<P: PortFactory<Service = ipc::Service>>(svc: &P) -> DriverStatus {
+pub(super) fn driver_status_of<P: PortFactory<Service = ipc::Service>>(
+    svc: &P,
+    domain: &crate::naming::Domain,
+) -> DriverStatus {
     let mut alive = false;
     let mut dead = false;
     let is_driver = |d: &Option<iceoryx2::node::NodeDetails>| {
@@ -322,7 +383,7 @@ pub(super) fn driver_status_of<P: PortFactory<Service = ipc::Service>>(svc: &P) 
     if alive {
         DriverStatus::Alive
     } else if dead {
-        svc.try_cleanup_dead_nodes();
+        crate::widen::cleanup_dead_nodes(svc, domain);
         DriverStatus::Dead
     } else {
         DriverStatus::Absent

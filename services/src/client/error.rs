@@ -42,6 +42,23 @@ pub enum ConnectError {
         #[source]
         reason: Incompatibility,
     },
+    /// iceoryx2 may not open a service's files: another user's (a domain is its owner's
+    /// alone), or in group mode a member's file that is still not opened to the group
+    /// (after the bounded wait of [`crate::Client::connect`]).
+    #[error(
+        "{device}: cannot open the {channel} channel: its files are not open to you ({source}); {hint}"
+    )]
+    Permission {
+        /// The device.
+        device: String,
+        /// The channel.
+        channel: &'static str,
+        /// What to do.
+        hint: String,
+        /// iceoryx2's error.
+        #[source]
+        source: Iox2Error,
+    },
     /// iceoryx2 failed to open a service or create a port.
     #[error("{device}: cannot open the {channel} channel: {source}")]
     Transport {
