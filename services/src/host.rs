@@ -221,6 +221,8 @@ pub struct HostStats {
     pub undelivered_replies: u64,
     /// State samples published.
     pub published: u64,
+    /// Outcome samples published (one per command, and one per preemption).
+    pub outcomes: u64,
     /// Notifications to waiting clients that failed (new state or reply ready; a client
     /// waiting with a timeout re-checks anyway, so each is a delay, not a loss).
     pub failed_notifies: u64,
@@ -248,6 +250,7 @@ impl core::ops::AddAssign for HostStats {
         self.requests += o.requests;
         self.undelivered_replies += o.undelivered_replies;
         self.published += o.published;
+        self.outcomes += o.outcomes;
         self.failed_notifies += o.failed_notifies;
         self.failed_connection_updates += o.failed_connection_updates;
         self.failed_outcomes += o.failed_outcomes;
@@ -870,6 +873,9 @@ impl<I: Interface> DeviceHost<I> {
             }
             Err(e) => Err(e.into()),
         };
+        if sent.is_ok() {
+            self.stats.outcomes += 1;
+        }
         if let Err(e) = sent {
             self.stats.failed_outcomes += 1;
             tracing::warn!(device = %self.device, client = client_id, seq = cmd_seq,

@@ -772,10 +772,11 @@ impl PioneerDriver {
         self.robot.arm.layout_mismatches
     }
 
-    /// State samples published by all devices (each costs iceoryx2 one small allocation,
-    /// see `tests/tests/alloc.rs`), and statistics samples.
+    /// Samples published by all devices, states and commands' outcomes (each costs
+    /// iceoryx2 one small allocation, see `tests/tests/alloc.rs`), and statistics samples.
     pub fn samples_published(&self) -> u64 {
-        self.stats.header.seq + self.hosts.stats().published
+        let h = self.hosts.stats();
+        self.stats.header.seq + h.published + h.outcomes
     }
 
     /// The loop's timing: periods, jitter, command-to-wire latencies.
@@ -1207,7 +1208,9 @@ impl PioneerDriver {
                         // comes (seen in the soak: a device's listener stopped waking the
                         // loop, and its commands and requests waited for ever) delays a
                         // command by one tick at most instead of freezing that device.
-                        let found = self.process_clients(false);
+                        // The polling variant: commands at every tick, requests at every
+                        // 16th, and nothing allocated when nothing waits.
+                        let found = self.process_clients(true);
                         self.note_tick_work(found);
                     }
                 }

@@ -7,6 +7,10 @@ use super::{Client, CommandError};
 use crate::context::monotonic_ns;
 use crate::qos;
 
+/// The shortest time between two new notifiers of a client whose wake-ups reach no
+/// driver (see `Client::wake_driver_with`).
+const WAKE_RETRY: std::time::Duration = std::time::Duration::from_millis(100);
+
 /// A command that was sent, to wait for its outcome.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Ticket {
@@ -52,9 +56,43 @@ impl<I: Interface> Client<I> {
 
     /// Wakes the driver's loop. A failure delays the command or request until the
     /// driver's next tick rather than losing it: logged, not fatal.
+    ///
+    /// A wake-up that reaches no listener while the driver has one means this notifier's
+    /// connection to it failed (iceoryx2 then retries only when a port joins or leaves the
+    /// service): a new notifier is made, which connects afresh, at most every
+    /// [`WAKE_RETRY`], and the wake-up sent again.
     pub(super) fn wake_driver_with(&self, event: usize) {
-        if let Err(e) = self.wake.notify_with_custom_event_id(EventId::new(event)) {
-            tracing::debug!(device = %self.device, error = %e, "cannot wake the driver");
+        let sent = self
+            .wake
+            .borrow()
+            .notify_with_custom_event_id(EventId::new(event));
+        match sent {
+            Ok(0) => {}
+            Ok(_) => return,
+            Err(e) => {
+                tracing::debug!(device = %self.device, error = %e, "cannot wake the driver");
+                return;
+            }
+        }
+        let now = std::time::Instant::now();
+        if self.wake_retry_at.get().is_some_and(|t| now < t) {
+            return;
+        }
+        self.wake_retry_at.set(Some(now + WAKE_RETRY));
+        if self.wake_svc.dynamic_config().number_of_listeners() == 0 {
+            return;
+        }
+        match self.wake_svc.notifier_builder().create() {
+            Ok(n) => {
+                tracing::debug!(device = %self.device, "a wake-up reached no driver: reconnected");
+                if let Err(e) = n.notify_with_custom_event_id(EventId::new(event)) {
+                    tracing::debug!(device = %self.device, error = %e, "cannot wake the driver");
+                }
+                *self.wake.borrow_mut() = n;
+            }
+            Err(e) => {
+                tracing::debug!(device = %self.device, error = %e, "cannot make a new notifier");
+            }
         }
     }
 }

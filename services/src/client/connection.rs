@@ -59,7 +59,12 @@ pub struct Client<I: Interface> {
     pub(super) latest: Option<Sample<ipc::Service, I::Data, ()>>,
     pub(super) commands: Publisher<ipc::Service, I::CmdMsg, ()>,
     pub(super) requests: IoxClient<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()>,
-    pub(super) wake: Notifier<ipc::Service>,
+    /// Wakes the driver; replaced when a wake-up reaches no listener (see
+    /// `Client::wake_driver_with`).
+    pub(super) wake: core::cell::RefCell<Notifier<ipc::Service>>,
+    pub(super) wake_svc: iceoryx2::service::port_factory::event::PortFactory<ipc::Service>,
+    /// No new notifier before then.
+    pub(super) wake_retry_at: core::cell::Cell<Option<std::time::Instant>>,
     pub(super) notify_svc: iceoryx2::service::port_factory::event::PortFactory<ipc::Service>,
     pub(super) notify: Option<Listener<ipc::Service>>,
     pub(super) cmd_seq: u64,
@@ -237,11 +242,12 @@ impl<I: Interface> Client<I> {
             .client_builder()
             .create()
             .map_err(|e| map("req", e.into()))?;
-        let wake = node
+        let wake_svc = node
             .service_builder(&device.service_name(Channel::Wake))
             .event()
             .open_with_attributes(&layout)
-            .map_err(|e| map("wake", e.into()))?
+            .map_err(|e| map("wake", e.into()))?;
+        let wake = wake_svc
             .notifier_builder()
             .create()
             .map_err(|e| map("wake", e.into()))?;
@@ -276,7 +282,9 @@ impl<I: Interface> Client<I> {
             latest: None,
             commands,
             requests,
-            wake,
+            wake: core::cell::RefCell::new(wake),
+            wake_svc,
+            wake_retry_at: core::cell::Cell::new(None),
             notify_svc,
             notify: None,
             cmd_seq: 0,
