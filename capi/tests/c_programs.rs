@@ -154,8 +154,13 @@ fn run_ok(cmd: Command, what: &str) -> Output {
 /// library is found by the run path linked into the program, as on a user's machine.
 fn run_in(p: &Pioneer, exe: &Path, args: &[&str]) -> Output {
     let mut cmd = Command::new(exe);
-    cmd.args(args)
-        .env("LIMBER_DOMAIN", p.name())
+    cmd.args(args);
+    run_in_cmd(p, cmd)
+}
+
+/// Runs `cmd` in the driver's domain within [`RUN_LIMIT`] (as [`run_in`]).
+fn run_in_cmd(p: &Pioneer, mut cmd: Command) -> Output {
+    cmd.env("LIMBER_DOMAIN", p.name())
         .env_remove("LD_LIBRARY_PATH");
     limber_bounded_run::output_within(cmd, RUN_LIMIT)
 }
@@ -718,10 +723,13 @@ fn a_handle_sees_its_driver_go() {
     let mut data = ActArrayData::default();
     // SAFETY: valid strings, and pointers to locals that outlive the calls.
     unsafe {
-        let c = limber_actarray_connect(
+        let c = limber_actarray_connect_checked(
             c"pioneer/actarray/0".as_ptr(),
             domain.as_ptr(),
             5000,
+            limber_interfaces::LAYOUT_VERSION,
+            size_of::<ActArrayData>(),
+            size_of::<limber_interfaces::prelude::ActArrayGeom>(),
             &mut h,
         );
         assert_eq!(c, LimberCode::Ok);
@@ -835,4 +843,150 @@ fn a_lease_refuses_the_other_client_by_name_and_preemption_and_the_deadman_are_t
     );
     assert!(out.contains("holder: lease_cpp"), "{out}");
     assert!(out.contains("all C++ lease steps ok"), "{out}");
+}
+
+/// The layout manifest with one field moved, as the rules of limber.h have it: the layout
+/// version bumped and every type name with it; in `ActArrayData`, `motor_state` now comes
+/// before `actuators_count` (each takes the other's offset: the sizes stay the same).
+fn manifest_with_a_field_moved() -> limber_interfaces::manifest::Manifest {
+    let mut m = limber_interfaces::manifest();
+    let (old, new) = (m.layout_version, m.layout_version + 1);
+    m.layout_version = new;
+    for st in &mut m.structs {
+        let renamed = st
+            .type_name
+            .replace(&format!("limber.v{old}."), &format!("limber.v{new}."));
+        assert_ne!(renamed, st.type_name, "a versioned type name");
+        st.type_name = Box::leak(renamed.into_boxed_str());
+        if st.name == "ActArrayData" {
+            let mut fields = st.fields.to_vec();
+            let at = |n: &str| fields.iter().position(|f| f.name == n).expect(n);
+            let (a, b) = (at("actuators_count"), at("motor_state"));
+            let (oa, ob) = (fields[a].offset, fields[b].offset);
+            fields.swap(a, b);
+            (fields[a].offset, fields[b].offset) = (oa, ob);
+            st.fields = Box::leak(fields.into_boxed_slice());
+        }
+    }
+    m
+}
+
+#[test]
+fn a_field_moved_in_a_message_makes_c_cpp_and_python_refuse_to_connect() {
+    // limber.h and _layout.py generated (by the generators of limber.h and _layout.py)
+    // from the manifest with a field moved; the C and C++ clients compiled against that
+    // header, the Python client run with that _layout.py; the driver and liblimber speak
+    // the real layout. Each refuses to connect and says why, instead of misreading.
+    let moved = manifest_with_a_field_moved();
+    let dir = scratch("moved");
+    let include = dir.join("include");
+    std::fs::create_dir_all(&include).unwrap();
+    let header = limber_interfaces::codegen::c_header(&moved);
+    assert!(header.contains("    uint32_t motor_state;\n    uint32_t actuators_count;\n"));
+    std::fs::write(include.join("limber.h"), header).unwrap();
+    // Python: the package as it is, with the moved _layout.py.
+    let package = dir.join("py/limber");
+    std::fs::create_dir_all(&package).unwrap();
+    for f in ["__init__.py", "client.py", "py.typed"] {
+        std::fs::copy(root().join("python/limber").join(f), package.join(f)).unwrap();
+    }
+    std::fs::write(
+        package.join("_layout.py"),
+        limber_interfaces::codegen::python_module(&moved),
+    )
+    .unwrap();
+    // C (joints.c, the client written from the header) and C++ (README.md's client),
+    // their moved limber.h found first.
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let cpp = dir.join("client.cpp");
+    std::fs::write(&cpp, readme_block(&readme, "cpp")).unwrap();
+    let (c_exe, cpp_exe) = (dir.join("joints"), dir.join("client_cpp"));
+    let flag = format!("-I{}", include.display());
+    // The same sources against the moved header (the -I before the source tree's).
+    for (src, exe, std, cc) in [
+        (
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/c/joints.c"),
+            &c_exe,
+            "-std=c11",
+            "gcc",
+        ),
+        (cpp.clone(), &cpp_exe, "-std=c++17", "g++"),
+    ] {
+        let lib = lib_dir();
+        let mut cmd = Command::new(cc);
+        cmd.args([std, "-Wall", "-Wextra", "-Werror", &flag, "-I"])
+            .arg(root().join("capi/include"))
+            .arg("-I")
+            .arg(root().join("interfaces/include"))
+            .arg(&src)
+            .arg("-o")
+            .arg(exe)
+            .arg("-L")
+            .arg(&lib)
+            .arg("-llimber")
+            .arg(format!("-Wl,-rpath,{}", lib.display()))
+            .arg("-lm");
+        run_ok(
+            cmd,
+            &format!("compiling {} against the moved limber.h", src.display()),
+        );
+    }
+    let p = Pioneer::start();
+    let version = limber_interfaces::LAYOUT_VERSION;
+    let detail = format!(
+        "this program was compiled against limber.h layout version {} (limber_actarray_data 1336 bytes, \
+         limber_actarray_geom 3384 bytes), but this liblimber speaks layout version {version} \
+         (1336 and 3384 bytes): rebuild the program against the limber.h installed with this library",
+        version + 1
+    );
+    let o = run_in(&p, &c_exe, &[]);
+    let out = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{}\n{out}", text(&o.stdout));
+    assert!(o.stdout.is_empty(), "C read something: {}", text(&o.stdout));
+    assert_eq!(
+        out,
+        format!(
+            "joints: connect: the device is of another interface or layout version: {detail}\n"
+        )
+    );
+    let o = run_in(&p, &cpp_exe, &[]);
+    let out = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{}\n{out}", text(&o.stdout));
+    assert!(
+        o.stdout.is_empty(),
+        "C++ read something: {}",
+        text(&o.stdout)
+    );
+    assert!(out.contains(&detail), "{out}");
+    assert!(
+        out.ends_with(&format!(
+            "(code {})\n",
+            limber::LimberCode::Incompatible as i32
+        )),
+        "{out}"
+    );
+
+    let Some(python) = python() else { return };
+    let mut cmd = Command::new(&python);
+    cmd.arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/py/connect.py"))
+        .env("PYTHONPATH", dir.join("py"));
+    let o = run_in_cmd(&p, cmd);
+    let out = text(&o.stdout);
+    assert_eq!(o.status.code(), Some(3), "{out}\n{}", text(&o.stderr));
+    assert!(
+        out.starts_with("incompatible: pioneer/actarray/0 is incompatible"),
+        "{out}"
+    );
+    assert!(
+        out.contains(&format!("layout version {}", version + 1)),
+        "{out}"
+    );
+    // The real package connects (the refusal is the layout's, not the script's).
+    let mut cmd = Command::new(&python);
+    cmd.arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/py/connect.py"))
+        .env("PYTHONPATH", root().join("python"));
+    let o = run_in_cmd(&p, cmd);
+    let out = text(&o.stdout);
+    assert!(o.status.success(), "{out}\n{}", text(&o.stderr));
+    assert!(out.starts_with("connected: joint 0 at "), "{out}");
 }

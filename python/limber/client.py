@@ -641,6 +641,22 @@ def list_devices(domain: "Optional[Domain | str]" = None) -> "list[DeviceInfo]":
     return out
 
 
+def _why_incompatible(dev: DeviceName, domain: Domain) -> str:
+    """Why a device's services did not open with this client's types: the layout version its
+    driver speaks (the ``limber.layout`` attribute of its services) against this client's."""
+    ours = L.LAYOUT_VERSION
+    try:
+        theirs = next((d.layout for d in list_devices(domain) if d.name == dev), "")
+    except LimberError:
+        theirs = ""
+    if theirs and theirs != str(ours):
+        return (
+            f"its driver speaks layout version {theirs}, this client layout version {ours} "
+            f"(limber/_layout.py): use the limber package of the driver's release"
+        )
+    return f"its services do not have this client's types of layout version {ours}"
+
+
 # ----- validation (the Rust constructors' rules) -----------------------------------------
 
 
@@ -842,9 +858,7 @@ class _Client(Generic[_D]):
                     f"(is the driver running? is {DOMAIN_ENV} the same?)"
                 )
             if "Incompatible" in text:
-                return IncompatibleError(
-                    f"{dev} is incompatible: {channel}: {text} (another layout version?)"
-                )
+                return IncompatibleError(f"{dev} is incompatible: {_why_incompatible(dev, domain)} ({channel}: {text})")
             return TransportError(f"{dev}: cannot open the {channel} channel: {text}")
 
         layout = iox2.AttributeVerifier.new().require(
