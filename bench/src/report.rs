@@ -213,6 +213,20 @@ pub const RATIOS: &[RatioDef] = &[
         pct: Pct::P50,
         goal: None,
     },
+    RatioDef {
+        label: "C command round trip / Rust command round trip (lang)",
+        num: "lang.c.rtt",
+        den: "lang.rust.rtt",
+        pct: Pct::P50,
+        goal: None,
+    },
+    RatioDef {
+        label: "Python command round trip / Rust command round trip (lang)",
+        num: "lang.python.rtt",
+        den: "lang.rust.rtt",
+        pct: Pct::P50,
+        goal: None,
+    },
 ];
 
 /// One point of a percentile curve.
@@ -308,7 +322,7 @@ fn floor_of(m: &Measurement, (spin, blocking): (&str, &str)) -> Option<String> {
         Metric::RoundTrip => "rtt",
         Metric::OneWay if m.id.ends_with(".back") => "back",
         Metric::OneWay => "oneway",
-        Metric::Solve => return None,
+        Metric::Solve | Metric::Read => return None,
     };
     Some(format!("floor.{k}.{what}"))
 }

@@ -10,6 +10,7 @@
 pub mod command;
 pub mod floor;
 pub mod ik;
+pub mod lang;
 pub mod peers;
 pub mod physical;
 pub mod pty_loop;
@@ -55,6 +56,7 @@ pub fn registry() -> Vec<Box<dyn Scenario>> {
         Box::new(ik::Ik),
         Box::new(request::Request),
         Box::new(pty_loop::Loop),
+        Box::new(lang::Lang),
     ]
 }
 

@@ -53,6 +53,8 @@ pub enum Metric {
     OneWay,
     /// Time of one computation.
     Solve,
+    /// Time of one local read (the latest state from shared memory into the program).
+    Read,
 }
 
 impl Metric {
@@ -62,6 +64,7 @@ impl Metric {
             Metric::RoundTrip => "round trip",
             Metric::OneWay => "one-way",
             Metric::Solve => "solve",
+            Metric::Read => "read",
         }
     }
 }

@@ -136,3 +136,83 @@ fn unknown_scenario_is_an_error_not_a_panic() {
     assert!(err.contains("unknown scenario"), "{err}");
     assert!(!err.contains("panicked"), "{err}");
 }
+
+/// `--only lang`: the Rust, C and Python clients' state reads and command round trips; a
+/// language that cannot run here is skipped with the reason (in CI, `CI=true`, with the
+/// venv of `.ci/run` in `LIMBER_PYTHON`, all three must run). And without a Python, the
+/// Python client is skipped with the reason while the others run.
+#[test]
+fn lang_measures_rust_c_and_python_or_says_why_not() {
+    let dir = std::env::temp_dir().join(format!("limber-bench-lang-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |json: &std::path::Path, python: Option<&str>| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_limber-bench"));
+        cmd.args([
+            "--quick",
+            "--scale",
+            "0.2",
+            "--no-progress",
+            "--only",
+            "lang",
+        ])
+        .arg("--json")
+        .arg(json);
+        if let Some(p) = python {
+            cmd.env("LIMBER_PYTHON", p);
+        }
+        let out = limber_bounded_run::output_within(cmd, Duration::from_secs(300));
+        assert!(
+            out.status.success(),
+            "limber-bench failed: {}\n{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+        let s = &v["scenarios"][0];
+        assert_eq!(s["name"], "lang");
+        assert_eq!(s["status"], "ok", "{s}");
+        let ids: Vec<String> = v["measurements"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| {
+                assert!(m["summary"]["count"].as_u64().unwrap() > 0, "{m}");
+                m["id"].as_str().unwrap().to_string()
+            })
+            .collect();
+        (
+            ids,
+            s["detail"].as_str().unwrap().to_string(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let ci = std::env::var("CI").as_deref() == Ok("true");
+    let (ids, detail, _) = run(&dir.join("lang.json"), None);
+    for lang in ["rust", "c", "python"] {
+        let measured = ids.contains(&format!("lang.{lang}.state"))
+            && ids.contains(&format!("lang.{lang}.rtt"));
+        let name = match lang {
+            "rust" => "Rust",
+            "c" => "C",
+            _ => "Python",
+        };
+        if lang == "rust" || ci {
+            assert!(measured, "{lang} not measured: {ids:?} ({detail})");
+        } else {
+            assert!(
+                measured || detail.contains(&format!("{name} skipped: ")),
+                "{ids:?} ({detail})"
+            );
+        }
+    }
+    // No Python: skipped, with the reason on stderr and in the report.
+    let (ids, detail, stderr) = run(&dir.join("nopy.json"), Some("/nonexistent/python3"));
+    assert!(ids.contains(&"lang.rust.rtt".to_string()), "{ids:?}");
+    assert!(!ids.iter().any(|i| i.starts_with("lang.python")), "{ids:?}");
+    assert!(
+        detail.contains("Python skipped: cannot start \"/nonexistent/python3\""),
+        "{detail}"
+    );
+    assert!(stderr.contains("lang: Python skipped: "), "{stderr}");
+    std::fs::remove_dir_all(&dir).expect("remove the test's directory");
+}

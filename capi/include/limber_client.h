@@ -353,18 +353,24 @@ const char *limber_status_text(uint32_t status);
 uint32_t limber_layout_version(void);
 
 /*
- Connects to the actuator array `device` ("robot/actarray/index") in `domain` (NULL:
- the `LIMBER_DOMAIN` environment variable, or "limber"), waiting up to `timeout_ms` for a
- driver to offer it. On success `*out` is the new handle; free it with
- `limber_actarray_disconnect`.
+ What `limber_actarray_connect` (an inline function of limber_client.h) calls, with the
+ layout the program was compiled against: `layout_version` (`LIMBER_LAYOUT_VERSION`),
+ `data_size` (`sizeof(limber_actarray_data)`) and `geom_size` (`sizeof(limber_actarray_geom)`). A
+ program compiled against another limber.h than this library's (a field moved, a
+ struct grown: another layout version) is refused with `LIMBER_CODE_INCOMPATIBLE`
+ before it connects, and `limber_last_error()` says which versions and sizes differ.
+ Otherwise as `limber_actarray_connect`: call that.
 
  # Safety
  `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
  */
-limber_code limber_actarray_connect(const char *device,
-                                    const char *domain,
-                                    uint64_t timeout_ms,
-                                    struct limber_actarray **out);
+limber_code limber_actarray_connect_checked(const char *device,
+                                            const char *domain,
+                                            uint64_t timeout_ms,
+                                            uint32_t layout_version,
+                                            size_t data_size,
+                                            size_t geom_size,
+                                            struct limber_actarray **out);
 
 /*
  Closes the connection and frees the handle (and any state borrowed from it). NULL is
@@ -678,18 +684,24 @@ limber_code limber_list_devices(const char *domain,
                                 size_t *count);
 
 /*
- Connects to the gripper `device` ("robot/gripper/index") in `domain` (NULL:
- the `LIMBER_DOMAIN` environment variable, or "limber"), waiting up to `timeout_ms` for a
- driver to offer it. On success `*out` is the new handle; free it with
- `limber_gripper_disconnect`.
+ What `limber_gripper_connect` (an inline function of limber_client.h) calls, with the
+ layout the program was compiled against: `layout_version` (`LIMBER_LAYOUT_VERSION`),
+ `data_size` (`sizeof(limber_gripper_data)`) and `geom_size` (`sizeof(limber_gripper_geom)`). A
+ program compiled against another limber.h than this library's (a field moved, a
+ struct grown: another layout version) is refused with `LIMBER_CODE_INCOMPATIBLE`
+ before it connects, and `limber_last_error()` says which versions and sizes differ.
+ Otherwise as `limber_gripper_connect`: call that.
 
  # Safety
  `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
  */
-limber_code limber_gripper_connect(const char *device,
-                                   const char *domain,
-                                   uint64_t timeout_ms,
-                                   struct limber_gripper **out);
+limber_code limber_gripper_connect_checked(const char *device,
+                                           const char *domain,
+                                           uint64_t timeout_ms,
+                                           uint32_t layout_version,
+                                           size_t data_size,
+                                           size_t geom_size,
+                                           struct limber_gripper **out);
 
 /*
  Closes the connection and frees the handle (and any state borrowed from it). NULL is
@@ -913,18 +925,24 @@ limber_code limber_gripper_preempted(struct limber_gripper *h,
                                      uint64_t *by_client);
 
 /*
- Connects to the limb `device` ("robot/limb/index") in `domain` (NULL:
- the `LIMBER_DOMAIN` environment variable, or "limber"), waiting up to `timeout_ms` for a
- driver to offer it. On success `*out` is the new handle; free it with
- `limber_limb_disconnect`.
+ What `limber_limb_connect` (an inline function of limber_client.h) calls, with the
+ layout the program was compiled against: `layout_version` (`LIMBER_LAYOUT_VERSION`),
+ `data_size` (`sizeof(limber_limb_data)`) and `geom_size` (`sizeof(limber_limb_geom)`). A
+ program compiled against another limber.h than this library's (a field moved, a
+ struct grown: another layout version) is refused with `LIMBER_CODE_INCOMPATIBLE`
+ before it connects, and `limber_last_error()` says which versions and sizes differ.
+ Otherwise as `limber_limb_connect`: call that.
 
  # Safety
  `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
  */
-limber_code limber_limb_connect(const char *device,
-                                const char *domain,
-                                uint64_t timeout_ms,
-                                struct limber_limb **out);
+limber_code limber_limb_connect_checked(const char *device,
+                                        const char *domain,
+                                        uint64_t timeout_ms,
+                                        uint32_t layout_version,
+                                        size_t data_size,
+                                        size_t geom_size,
+                                        struct limber_limb **out);
 
 /*
  Closes the connection and frees the handle (and any state borrowed from it). NULL is
@@ -1198,3 +1216,79 @@ limber_code limber_limb_preempted(struct limber_limb *h,
 #endif  // __cplusplus
 
 #endif  /* LIMBER_CLIENT_H */
+
+/* The connect functions: inline, so that they pass the layout this program is compiled
+ * against (see limber_*_connect_checked). */
+#ifndef LIMBER_CLIENT_CONNECT_H
+#define LIMBER_CLIENT_CONNECT_H
+
+/*
+ Connects to the actuator array `device` ("robot/actarray/index") in `domain` (NULL:
+ the `LIMBER_DOMAIN` environment variable, or "limber"), waiting up to `timeout_ms` for a
+ driver to offer it. On success `*out` is the new handle; free it with
+ `limber_actarray_disconnect`.
+
+ It first checks that this program and the library agree on the wire layout (the
+ LIMBER_LAYOUT_VERSION of the limber.h it was compiled with, sizeof(limber_actarray_data) and
+ sizeof(limber_actarray_geom)): a program built against another limber.h gets
+ LIMBER_CODE_INCOMPATIBLE, with the versions and sizes in limber_last_error(), instead
+ of states read with the wrong layout.
+
+ # Safety
+ `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
+ */
+static inline limber_code limber_actarray_connect(const char *device,
+                                                  const char *domain,
+                                                  uint64_t timeout_ms,
+                                                  limber_actarray **out) {
+    return limber_actarray_connect_checked(device, domain, timeout_ms, LIMBER_LAYOUT_VERSION,
+                                           sizeof(limber_actarray_data), sizeof(limber_actarray_geom), out);
+}
+
+/*
+ Connects to the limb `device` ("robot/limb/index") in `domain` (NULL:
+ the `LIMBER_DOMAIN` environment variable, or "limber"), waiting up to `timeout_ms` for a
+ driver to offer it. On success `*out` is the new handle; free it with
+ `limber_limb_disconnect`.
+
+ It first checks that this program and the library agree on the wire layout (the
+ LIMBER_LAYOUT_VERSION of the limber.h it was compiled with, sizeof(limber_limb_data) and
+ sizeof(limber_limb_geom)): a program built against another limber.h gets
+ LIMBER_CODE_INCOMPATIBLE, with the versions and sizes in limber_last_error(), instead
+ of states read with the wrong layout.
+
+ # Safety
+ `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
+ */
+static inline limber_code limber_limb_connect(const char *device,
+                                              const char *domain,
+                                              uint64_t timeout_ms,
+                                              limber_limb **out) {
+    return limber_limb_connect_checked(device, domain, timeout_ms, LIMBER_LAYOUT_VERSION,
+                                       sizeof(limber_limb_data), sizeof(limber_limb_geom), out);
+}
+
+/*
+ Connects to the gripper `device` ("robot/gripper/index") in `domain` (NULL:
+ the `LIMBER_DOMAIN` environment variable, or "limber"), waiting up to `timeout_ms` for a
+ driver to offer it. On success `*out` is the new handle; free it with
+ `limber_gripper_disconnect`.
+
+ It first checks that this program and the library agree on the wire layout (the
+ LIMBER_LAYOUT_VERSION of the limber.h it was compiled with, sizeof(limber_gripper_data) and
+ sizeof(limber_gripper_geom)): a program built against another limber.h gets
+ LIMBER_CODE_INCOMPATIBLE, with the versions and sizes in limber_last_error(), instead
+ of states read with the wrong layout.
+
+ # Safety
+ `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
+ */
+static inline limber_code limber_gripper_connect(const char *device,
+                                                 const char *domain,
+                                                 uint64_t timeout_ms,
+                                                 limber_gripper **out) {
+    return limber_gripper_connect_checked(device, domain, timeout_ms, LIMBER_LAYOUT_VERSION,
+                                          sizeof(limber_gripper_data), sizeof(limber_gripper_geom), out);
+}
+
+#endif  /* LIMBER_CLIENT_CONNECT_H */

@@ -5,8 +5,8 @@ use core::ffi::c_char;
 use limber_interfaces::prelude::*;
 
 use crate::{
-    Fail, Handle, LimberCode, LimberDriverStatus, LimberLeaseHolder, LimberLiveness, LimberTicket,
-    arg, guard, opt_str, req_str, sent,
+    CompiledLayout, Fail, Handle, LimberCode, LimberDriverStatus, LimberLeaseHolder,
+    LimberLiveness, LimberTicket, arg, guard, opt_str, req_str, sent,
 };
 
 /// A connection to an actuator array (opaque). Use it from one thread at a time.
@@ -27,18 +27,24 @@ unsafe fn values<'a>(p: *const f64, count: usize) -> Result<&'a [f64], Fail> {
     Ok(unsafe { core::slice::from_raw_parts(p, count) })
 }
 
-/// Connects to the actuator array `device` ("robot/actarray/index") in `domain` (NULL:
-/// the `LIMBER_DOMAIN` environment variable, or "limber"), waiting up to `timeout_ms` for a
-/// driver to offer it. On success `*out` is the new handle; free it with
-/// `limber_actarray_disconnect`.
+/// What `limber_actarray_connect` (an inline function of limber_client.h) calls, with the
+/// layout the program was compiled against: `layout_version` (`LIMBER_LAYOUT_VERSION`),
+/// `data_size` (`sizeof(limber_actarray_data)`) and `geom_size` (`sizeof(limber_actarray_geom)`). A
+/// program compiled against another limber.h than this library's (a field moved, a
+/// struct grown: another layout version) is refused with `LIMBER_CODE_INCOMPATIBLE`
+/// before it connects, and `limber_last_error()` says which versions and sizes differ.
+/// Otherwise as `limber_actarray_connect`: call that.
 ///
 /// # Safety
 /// `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn limber_actarray_connect(
+pub unsafe extern "C" fn limber_actarray_connect_checked(
     device: *const c_char,
     domain: *const c_char,
     timeout_ms: u64,
+    layout_version: u32,
+    data_size: usize,
+    geom_size: usize,
     out: *mut *mut LimberActArray,
 ) -> LimberCode {
     guard(|| {
@@ -50,6 +56,12 @@ pub unsafe extern "C" fn limber_actarray_connect(
                 arg(out, "out")?,
             )
         };
+        CompiledLayout {
+            version: layout_version,
+            data_size,
+            geom_size,
+        }
+        .check::<ActArrayData, ActArrayGeom>("limber_actarray_data", "limber_actarray_geom")?;
         let h = Handle::connect(device, domain, timeout_ms)?;
         *out = Box::into_raw(Box::new(LimberActArray(h)));
         Ok(())

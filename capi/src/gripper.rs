@@ -5,25 +5,31 @@ use core::ffi::c_char;
 use limber_interfaces::prelude::*;
 
 use crate::{
-    Handle, LimberCode, LimberDriverStatus, LimberLeaseHolder, LimberLiveness, LimberTicket, arg,
-    guard, opt_str, req_str, sent,
+    CompiledLayout, Handle, LimberCode, LimberDriverStatus, LimberLeaseHolder, LimberLiveness,
+    LimberTicket, arg, guard, opt_str, req_str, sent,
 };
 
 /// A connection to a gripper (opaque). Use it from one thread at a time.
 pub struct LimberGripper(Handle<Gripper>);
 
-/// Connects to the gripper `device` ("robot/gripper/index") in `domain` (NULL:
-/// the `LIMBER_DOMAIN` environment variable, or "limber"), waiting up to `timeout_ms` for a
-/// driver to offer it. On success `*out` is the new handle; free it with
-/// `limber_gripper_disconnect`.
+/// What `limber_gripper_connect` (an inline function of limber_client.h) calls, with the
+/// layout the program was compiled against: `layout_version` (`LIMBER_LAYOUT_VERSION`),
+/// `data_size` (`sizeof(limber_gripper_data)`) and `geom_size` (`sizeof(limber_gripper_geom)`). A
+/// program compiled against another limber.h than this library's (a field moved, a
+/// struct grown: another layout version) is refused with `LIMBER_CODE_INCOMPATIBLE`
+/// before it connects, and `limber_last_error()` says which versions and sizes differ.
+/// Otherwise as `limber_gripper_connect`: call that.
 ///
 /// # Safety
 /// `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn limber_gripper_connect(
+pub unsafe extern "C" fn limber_gripper_connect_checked(
     device: *const c_char,
     domain: *const c_char,
     timeout_ms: u64,
+    layout_version: u32,
+    data_size: usize,
+    geom_size: usize,
     out: *mut *mut LimberGripper,
 ) -> LimberCode {
     guard(|| {
@@ -35,6 +41,12 @@ pub unsafe extern "C" fn limber_gripper_connect(
                 arg(out, "out")?,
             )
         };
+        CompiledLayout {
+            version: layout_version,
+            data_size,
+            geom_size,
+        }
+        .check::<GripperData, GripperGeom>("limber_gripper_data", "limber_gripper_geom")?;
         let h = Handle::connect(device, domain, timeout_ms)?;
         *out = Box::into_raw(Box::new(LimberGripper(h)));
         Ok(())

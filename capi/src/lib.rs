@@ -234,6 +234,43 @@ pub extern "C" fn limber_layout_version() -> u32 {
     limber_interfaces::LAYOUT_VERSION
 }
 
+/// The layout a program was compiled against: the `LIMBER_LAYOUT_VERSION` of its limber.h
+/// and the sizes of the state and geometry structs it passes (`limber_*_connect`, the
+/// header's inline functions, fill them in).
+pub(crate) struct CompiledLayout {
+    /// `LIMBER_LAYOUT_VERSION` of the program's limber.h.
+    pub version: u32,
+    /// `sizeof` the state struct in the program.
+    pub data_size: usize,
+    /// `sizeof` the geometry struct in the program.
+    pub geom_size: usize,
+}
+
+impl CompiledLayout {
+    /// Refuses (`LIMBER_CODE_INCOMPATIBLE`) a program whose limber.h is not this library's:
+    /// another layout version, or a state or geometry struct of another size. A field moved
+    /// in a message bumps the layout version (the rule of limber.h), so such a program
+    /// cannot connect and misread the states.
+    pub(crate) fn check<D, G>(&self, data: &str, geom: &str) -> Result<(), Fail> {
+        let ours = (
+            limber_interfaces::LAYOUT_VERSION,
+            size_of::<D>(),
+            size_of::<G>(),
+        );
+        if (self.version, self.data_size, self.geom_size) == ours {
+            return Ok(());
+        }
+        let detail = format!(
+            "this program was compiled against limber.h layout version {} ({data} {} bytes, \
+             {geom} {} bytes), but this liblimber speaks layout version {} ({} and {} bytes): \
+             rebuild the program against the limber.h installed with this library",
+            self.version, self.data_size, self.geom_size, ours.0, ours.1, ours.2
+        );
+        tracing::warn!("{detail}");
+        Err(Fail::new(LimberCode::Incompatible, detail))
+    }
+}
+
 // ----- failures, recorded per thread ---------------------------------------------------
 
 thread_local! {

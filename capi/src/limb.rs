@@ -5,25 +5,31 @@ use core::ffi::c_char;
 use limber_interfaces::prelude::*;
 
 use crate::{
-    Fail, Handle, LimberCode, LimberDriverStatus, LimberLeaseHolder, LimberLiveness, LimberTicket,
-    arg, guard, opt_str, req_str, sent,
+    CompiledLayout, Fail, Handle, LimberCode, LimberDriverStatus, LimberLeaseHolder,
+    LimberLiveness, LimberTicket, arg, guard, opt_str, req_str, sent,
 };
 
 /// A connection to a limb (opaque). Use it from one thread at a time.
 pub struct LimberLimb(Handle<Limb>);
 
-/// Connects to the limb `device` ("robot/limb/index") in `domain` (NULL:
-/// the `LIMBER_DOMAIN` environment variable, or "limber"), waiting up to `timeout_ms` for a
-/// driver to offer it. On success `*out` is the new handle; free it with
-/// `limber_limb_disconnect`.
+/// What `limber_limb_connect` (an inline function of limber_client.h) calls, with the
+/// layout the program was compiled against: `layout_version` (`LIMBER_LAYOUT_VERSION`),
+/// `data_size` (`sizeof(limber_limb_data)`) and `geom_size` (`sizeof(limber_limb_geom)`). A
+/// program compiled against another limber.h than this library's (a field moved, a
+/// struct grown: another layout version) is refused with `LIMBER_CODE_INCOMPATIBLE`
+/// before it connects, and `limber_last_error()` says which versions and sizes differ.
+/// Otherwise as `limber_limb_connect`: call that.
 ///
 /// # Safety
 /// `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn limber_limb_connect(
+pub unsafe extern "C" fn limber_limb_connect_checked(
     device: *const c_char,
     domain: *const c_char,
     timeout_ms: u64,
+    layout_version: u32,
+    data_size: usize,
+    geom_size: usize,
     out: *mut *mut LimberLimb,
 ) -> LimberCode {
     guard(|| {
@@ -35,6 +41,12 @@ pub unsafe extern "C" fn limber_limb_connect(
                 arg(out, "out")?,
             )
         };
+        CompiledLayout {
+            version: layout_version,
+            data_size,
+            geom_size,
+        }
+        .check::<LimbData, LimbGeom>("limber_limb_data", "limber_limb_geom")?;
         let h = Handle::connect(device, domain, timeout_ms)?;
         *out = Box::into_raw(Box::new(LimberLimb(h)));
         Ok(())

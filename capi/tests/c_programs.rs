@@ -38,7 +38,7 @@ struct Pioneer {
     domain: Domain,
     stop: Arc<AtomicBool>,
     thread: Option<JoinHandle<()>>,
-    _emulator: Emulator,
+    emulator: Emulator,
 }
 
 impl Pioneer {
@@ -72,7 +72,7 @@ impl Pioneer {
             domain,
             stop,
             thread: Some(thread),
-            _emulator: emulator,
+            emulator,
         }
     }
 
@@ -154,8 +154,13 @@ fn run_ok(cmd: Command, what: &str) -> Output {
 /// library is found by the run path linked into the program, as on a user's machine.
 fn run_in(p: &Pioneer, exe: &Path, args: &[&str]) -> Output {
     let mut cmd = Command::new(exe);
-    cmd.args(args)
-        .env("LIMBER_DOMAIN", p.name())
+    cmd.args(args);
+    run_in_cmd(p, cmd)
+}
+
+/// Runs `cmd` in the driver's domain within [`RUN_LIMIT`] (as [`run_in`]).
+fn run_in_cmd(p: &Pioneer, mut cmd: Command) -> Output {
+    cmd.env("LIMBER_DOMAIN", p.name())
         .env_remove("LD_LIBRARY_PATH");
     limber_bounded_run::output_within(cmd, RUN_LIMIT)
 }
@@ -454,18 +459,19 @@ fn handles_work_from_threads_of_their_own() {
     assert_eq!(out, "threads ok\n");
 }
 
-/// A running program whose stdout lines arrive on a channel (disconnected at its end).
+/// A running program whose stdout lines arrive on a channel (disconnected at its end), and
+/// whose stdin the test writes.
 struct Running {
     child: Child,
     lines: mpsc::Receiver<String>,
 }
 
 impl Running {
-    fn spawn(p: &Pioneer, exe: &Path) -> Running {
-        let mut child = Command::new(exe)
+    fn spawn(p: &Pioneer, mut cmd: Command) -> Running {
+        let mut child = cmd
             .env("LIMBER_DOMAIN", p.name())
             .env_remove("LD_LIBRARY_PATH")
-            .stdin(Stdio::null())
+            .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .spawn()
             .expect("spawn");
@@ -479,6 +485,21 @@ impl Running {
             }
         });
         Running { child, lines }
+    }
+
+    /// The next line, within `limit`.
+    fn line(&self, limit: Duration) -> String {
+        self.lines
+            .recv_timeout(limit)
+            .unwrap_or_else(|e| panic!("no line from the program within {limit:?}: {e}"))
+    }
+
+    /// Writes `line` and a newline to the program's stdin.
+    fn send(&mut self, line: &str) {
+        use std::io::Write;
+        let stdin = self.child.stdin.as_mut().expect("its stdin");
+        writeln!(stdin, "{line}").expect("the program reads its stdin");
+        stdin.flush().expect("the program reads its stdin");
     }
 
     /// Every line until the program closed its stdout, within `limit`.
@@ -499,6 +520,19 @@ impl Running {
             }
         }
     }
+
+    /// Every remaining line, and the exit status, within `limit`.
+    fn finish(&mut self, limit: Duration) -> (String, std::process::ExitStatus) {
+        let out = self.rest(limit);
+        let deadline = Instant::now() + limit;
+        loop {
+            if let Some(status) = self.child.try_wait().expect("its status") {
+                return (out, status);
+            }
+            assert!(Instant::now() < deadline, "still running after:\n{out}");
+            std::thread::sleep(Duration::from_millis(10));
+        }
+    }
 }
 
 impl Drop for Running {
@@ -508,61 +542,172 @@ impl Drop for Running {
     }
 }
 
+/// A Python that imports iceoryx2, to run python/limber with: `LIMBER_PYTHON`, else the
+/// venv `.ci/run` makes (`target/py-venv`). None, with the reason printed, when there is
+/// none on a developer's machine; in CI (`CI=true`) a missing one fails the test.
+fn python() -> Option<PathBuf> {
+    let candidates: Vec<PathBuf> = match std::env::var_os("LIMBER_PYTHON") {
+        Some(p) => vec![PathBuf::from(p)],
+        None => vec![root().join("target/py-venv/bin/python")],
+    };
+    for py in &candidates {
+        let mut cmd = Command::new(py);
+        cmd.args(["-c", "import iceoryx2"]);
+        if py.is_file()
+            && limber_bounded_run::output_within(cmd, RUN_LIMIT)
+                .status
+                .success()
+        {
+            return Some(py.clone());
+        }
+    }
+    let reason = format!(
+        "no Python with iceoryx2 at {candidates:?}: set LIMBER_PYTHON, or run .ci/run once (it makes target/py-venv)"
+    );
+    assert!(std::env::var("CI").as_deref() != Ok("true"), "{reason}");
+    eprintln!("skipped: {reason}");
+    None
+}
+
+/// The joint positions and gripper state of a `seen:` line, as every client prints them
+/// (`%.9f` per joint, then `gripper <state>`).
+fn seen_line(arm: &ActArrayData, gripper: &GripperData) -> String {
+    let joints: Vec<String> = arm.actuators[..arm.actuators_count as usize]
+        .iter()
+        .map(|a| format!("{:.9}", a.position))
+        .collect();
+    format!("seen: {} gripper {}", joints.join(" "), gripper.state)
+}
+
 #[test]
-fn rust_c_and_cpp_clients_work_on_one_driver_at_once() {
-    // C commands the limb and the gripper (pick a block); C++ watches the gripper and asks
-    // for the arm's geometry meanwhile; Rust (here) reads the limb and the gripper. Each
-    // sees the gripper close, and the limb move.
+fn rust_python_c_and_cpp_clients_work_on_one_driver_at_once() {
+    // C commands the arm (joint 0 to 0.35 rad), C++ the arm gripper (close), Python asks
+    // for the arm's and the gripper's geometry over and over meanwhile, and Rust (here)
+    // reads the states throughout. Then, the arm at rest, each reports the joints and the
+    // gripper state it sees: all four agree, and show both commands carried out.
+    let Some(python) = python() else { return };
+    const JOINT: usize = 0;
+    const TARGET: f64 = 0.35;
     let dir = scratch("together");
-    let prefix = install(&dir);
-    let mut make = Command::new("make");
-    make.arg("-C")
-        .arg(root().join("examples/c"))
-        .arg(format!("OUT={}", dir.display()))
-        .env("PKG_CONFIG_PATH", prefix.join("lib/pkgconfig"));
-    run_ok(make, "make -C examples/c");
-    compile("watch.cpp", &dir.join("watch"), &[]);
+    let (arm_exe, gripper_exe) = (dir.join("arm"), dir.join("gripper"));
+    compile("arm.c", &arm_exe, &[]);
+    compile("gripper.cpp", &gripper_exe, &[]);
     let p = Pioneer::start();
     let ctx = Context::new(&p.domain, Role::Client, "capi-test").unwrap();
-    let mut limb = LimbClient::connect_timeout(&ctx, "pioneer/limb/0", T).unwrap();
+    let mut arm = ActArrayClient::connect_timeout(&ctx, "pioneer/actarray/0", T).unwrap();
     let mut gripper = GripperClient::connect_timeout(&ctx, "pioneer/gripper/1", T).unwrap();
+    let start = arm.current(T).unwrap().actuators[JOINT].position;
+    assert!(
+        (start - TARGET).abs() > 0.1,
+        "joint {JOINT} starts at {start}"
+    );
 
-    let mut watch = Running::spawn(&p, &dir.join("watch"));
-    let first = watch
-        .lines
-        .recv_timeout(RUN_LIMIT)
-        .expect("the watcher starts");
-    assert!(first.starts_with("watching"), "{first}");
-    let mut pick = Running::spawn(&p, &dir.join("pick_block"));
-    let (mut saw_closed, mut z_min, mut z_max) = (false, f64::MAX, f64::MIN);
+    let mut c = Command::new(&arm_exe);
+    c.args([JOINT.to_string(), TARGET.to_string()]);
+    let mut py = Command::new(&python);
+    py.arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/py/geometry.py"))
+        .env("PYTHONPATH", root().join("python"));
+    let mut clients = [
+        ("C", Running::spawn(&p, c)),
+        ("C++", Running::spawn(&p, Command::new(&gripper_exe))),
+        ("Python", Running::spawn(&p, py)),
+    ];
+    for (name, client) in &mut clients {
+        let first = client.line(RUN_LIMIT);
+        assert_eq!(first, "ready", "{name}");
+    }
+    for (_, client) in &mut clients {
+        client.send("go");
+    }
+
+    // Rust reads while the others work, until C and C++ say their commands are done.
+    let (mut lo, mut hi, mut saw_closed) = (f64::MAX, f64::MIN, false);
+    let mut said = String::new();
+    let mut done = [false, false];
     let deadline = Instant::now() + RUN_LIMIT;
-    let picked = loop {
-        if let Ok(g) = gripper.current(T) {
-            saw_closed |= g.gripper_state() == Ok(GripperState::Closed);
+    while done != [true, true] {
+        let q = arm.wait_state(T).expect("arm states").actuators[JOINT].position;
+        (lo, hi) = (lo.min(q), hi.max(q));
+        saw_closed |= gripper.current(T).unwrap().gripper_state() == Ok(GripperState::Closed);
+        for (i, (name, client)) in clients.iter_mut().enumerate() {
+            while let Ok(l) = client.lines.try_recv() {
+                if i < 2 {
+                    done[i] |= l.ends_with(": done");
+                }
+                said += &format!("{name}: {l}\n");
+            }
+            if let Some(status) = client.child.try_wait().unwrap() {
+                let e = p.emulator.state();
+                panic!(
+                    "{name} ended early ({status}):\n{said}the emulator (running: {}, stage {:?}, armpac mode {}, powered {}, autoparks {}): ticks {:?}, targets {:?}, {} commands, {:?}; arm flags {:x}",
+                    p.emulator.is_running(),
+                    e.robot.stage,
+                    e.robot.arm_status_mode,
+                    e.robot.arm_powered,
+                    e.robot.autoparks,
+                    e.robot.servo_ticks,
+                    e.robot.servo_targets,
+                    e.robot.commands,
+                    e.stats,
+                    arm.current(T).unwrap().header.flags
+                );
+            }
         }
-        let z = limb.wait_state(T).expect("limb states").position.z;
-        (z_min, z_max) = (z_min.min(z), z_max.max(z));
-        if let Some(status) = pick.child.try_wait().unwrap() {
-            break status;
+        assert!(
+            Instant::now() < deadline,
+            "the commands did not finish:\n{said}"
+        );
+    }
+    assert!(said.contains("C: arm: move ok\n"), "{said}");
+    assert!(said.contains("C++: gripper: close ok\n"), "{said}");
+    assert!(
+        lo <= start.min(TARGET) + 0.02 && hi >= start.max(TARGET) - 0.02,
+        "Rust did not see joint {JOINT} travel from {start} to {TARGET}: {lo}..{hi}"
+    );
+
+    // The arm at rest (every joint idle: the gripper's too), each client reports.
+    let deadline = Instant::now() + RUN_LIMIT;
+    while !arm.wait_state(T).unwrap().actuators[..6]
+        .iter()
+        .all(|a| a.flags() == Ok(ActuatorFlags::IDLE))
+    {
+        assert!(Instant::now() < deadline, "the arm never came to rest");
+    }
+    for (_, client) in &mut clients {
+        client.send("report");
+    }
+    let ours = seen_line(arm.wait_state(T).unwrap(), gripper.wait_state(T).unwrap());
+    let geometry = arm.geometry().unwrap();
+    for (name, client) in &mut clients {
+        let (out, status) = client.finish(RUN_LIMIT);
+        assert!(status.success(), "{name} failed ({status}):\n{out}");
+        let seen = out
+            .lines()
+            .find(|l| l.starts_with("seen: "))
+            .unwrap_or_else(|| panic!("{name} reported nothing:\n{out}"));
+        assert_eq!(seen, ours, "{name} and Rust disagree");
+        if *name == "Python" {
+            let a = &geometry.actuators[0];
+            let expected = format!(
+                "6 actuators, joint 0 in [{:.9}, {:.9}], gripper geometry ok",
+                a.min, a.max
+            );
+            assert!(out.contains(&expected), "{expected:?} not in:\n{out}");
+            let requests: u64 = out
+                .strip_prefix("geometry: ")
+                .and_then(|s| s.split(' ').next())
+                .and_then(|n| n.parse().ok())
+                .unwrap_or_else(|| panic!("no request count in:\n{out}"));
+            assert!(requests > 0, "{out}");
         }
-        assert!(Instant::now() < deadline, "pick_block did not finish");
-    };
-    let picked_out = pick.rest(T);
-    assert!(picked.success(), "{picked_out}");
-    assert!(
-        picked_out.contains("done: block picked up and put down"),
-        "{picked_out}"
-    );
-    let watched = watch.rest(RUN_LIMIT);
-    assert!(
-        watched.contains("saw the gripper close and open; the arm has 6 actuators"),
-        "{watched}"
-    );
-    assert!(watch.child.wait().unwrap().success(), "{watched}");
+    }
+    // Both commands carried out, as all four saw it.
+    let joint: f64 = ours.split(' ').nth(1 + JOINT).unwrap().parse().unwrap();
+    assert!((joint - TARGET).abs() < 0.02, "{ours}");
     assert!(saw_closed, "Rust never saw the gripper closed");
     assert!(
-        z_max - z_min > 0.04,
-        "the limb did not move: z {z_min}..{z_max}"
+        ours.ends_with(&format!(" gripper {}", GripperState::Closed as u32)),
+        "{ours}"
     );
 }
 
@@ -578,10 +723,13 @@ fn a_handle_sees_its_driver_go() {
     let mut data = ActArrayData::default();
     // SAFETY: valid strings, and pointers to locals that outlive the calls.
     unsafe {
-        let c = limber_actarray_connect(
+        let c = limber_actarray_connect_checked(
             c"pioneer/actarray/0".as_ptr(),
             domain.as_ptr(),
             5000,
+            limber_interfaces::LAYOUT_VERSION,
+            size_of::<ActArrayData>(),
+            size_of::<limber_interfaces::prelude::ActArrayGeom>(),
             &mut h,
         );
         assert_eq!(c, LimberCode::Ok);
@@ -695,4 +843,150 @@ fn a_lease_refuses_the_other_client_by_name_and_preemption_and_the_deadman_are_t
     );
     assert!(out.contains("holder: lease_cpp"), "{out}");
     assert!(out.contains("all C++ lease steps ok"), "{out}");
+}
+
+/// The layout manifest with one field moved, as the rules of limber.h have it: the layout
+/// version bumped and every type name with it; in `ActArrayData`, `motor_state` now comes
+/// before `actuators_count` (each takes the other's offset: the sizes stay the same).
+fn manifest_with_a_field_moved() -> limber_interfaces::manifest::Manifest {
+    let mut m = limber_interfaces::manifest();
+    let (old, new) = (m.layout_version, m.layout_version + 1);
+    m.layout_version = new;
+    for st in &mut m.structs {
+        let renamed = st
+            .type_name
+            .replace(&format!("limber.v{old}."), &format!("limber.v{new}."));
+        assert_ne!(renamed, st.type_name, "a versioned type name");
+        st.type_name = Box::leak(renamed.into_boxed_str());
+        if st.name == "ActArrayData" {
+            let mut fields = st.fields.to_vec();
+            let at = |n: &str| fields.iter().position(|f| f.name == n).expect(n);
+            let (a, b) = (at("actuators_count"), at("motor_state"));
+            let (oa, ob) = (fields[a].offset, fields[b].offset);
+            fields.swap(a, b);
+            (fields[a].offset, fields[b].offset) = (oa, ob);
+            st.fields = Box::leak(fields.into_boxed_slice());
+        }
+    }
+    m
+}
+
+#[test]
+fn a_field_moved_in_a_message_makes_c_cpp_and_python_refuse_to_connect() {
+    // limber.h and _layout.py generated (by the generators of limber.h and _layout.py)
+    // from the manifest with a field moved; the C and C++ clients compiled against that
+    // header, the Python client run with that _layout.py; the driver and liblimber speak
+    // the real layout. Each refuses to connect and says why, instead of misreading.
+    let moved = manifest_with_a_field_moved();
+    let dir = scratch("moved");
+    let include = dir.join("include");
+    std::fs::create_dir_all(&include).unwrap();
+    let header = limber_interfaces::codegen::c_header(&moved);
+    assert!(header.contains("    uint32_t motor_state;\n    uint32_t actuators_count;\n"));
+    std::fs::write(include.join("limber.h"), header).unwrap();
+    // Python: the package as it is, with the moved _layout.py.
+    let package = dir.join("py/limber");
+    std::fs::create_dir_all(&package).unwrap();
+    for f in ["__init__.py", "client.py", "py.typed"] {
+        std::fs::copy(root().join("python/limber").join(f), package.join(f)).unwrap();
+    }
+    std::fs::write(
+        package.join("_layout.py"),
+        limber_interfaces::codegen::python_module(&moved),
+    )
+    .unwrap();
+    // C (joints.c, the client written from the header) and C++ (README.md's client),
+    // their moved limber.h found first.
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let cpp = dir.join("client.cpp");
+    std::fs::write(&cpp, readme_block(&readme, "cpp")).unwrap();
+    let (c_exe, cpp_exe) = (dir.join("joints"), dir.join("client_cpp"));
+    let flag = format!("-I{}", include.display());
+    // The same sources against the moved header (the -I before the source tree's).
+    for (src, exe, std, cc) in [
+        (
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/c/joints.c"),
+            &c_exe,
+            "-std=c11",
+            "gcc",
+        ),
+        (cpp.clone(), &cpp_exe, "-std=c++17", "g++"),
+    ] {
+        let lib = lib_dir();
+        let mut cmd = Command::new(cc);
+        cmd.args([std, "-Wall", "-Wextra", "-Werror", &flag, "-I"])
+            .arg(root().join("capi/include"))
+            .arg("-I")
+            .arg(root().join("interfaces/include"))
+            .arg(&src)
+            .arg("-o")
+            .arg(exe)
+            .arg("-L")
+            .arg(&lib)
+            .arg("-llimber")
+            .arg(format!("-Wl,-rpath,{}", lib.display()))
+            .arg("-lm");
+        run_ok(
+            cmd,
+            &format!("compiling {} against the moved limber.h", src.display()),
+        );
+    }
+    let p = Pioneer::start();
+    let version = limber_interfaces::LAYOUT_VERSION;
+    let detail = format!(
+        "this program was compiled against limber.h layout version {} (limber_actarray_data 1336 bytes, \
+         limber_actarray_geom 3384 bytes), but this liblimber speaks layout version {version} \
+         (1336 and 3384 bytes): rebuild the program against the limber.h installed with this library",
+        version + 1
+    );
+    let o = run_in(&p, &c_exe, &[]);
+    let out = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{}\n{out}", text(&o.stdout));
+    assert!(o.stdout.is_empty(), "C read something: {}", text(&o.stdout));
+    assert_eq!(
+        out,
+        format!(
+            "joints: connect: the device is of another interface or layout version: {detail}\n"
+        )
+    );
+    let o = run_in(&p, &cpp_exe, &[]);
+    let out = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{}\n{out}", text(&o.stdout));
+    assert!(
+        o.stdout.is_empty(),
+        "C++ read something: {}",
+        text(&o.stdout)
+    );
+    assert!(out.contains(&detail), "{out}");
+    assert!(
+        out.ends_with(&format!(
+            "(code {})\n",
+            limber::LimberCode::Incompatible as i32
+        )),
+        "{out}"
+    );
+
+    let Some(python) = python() else { return };
+    let mut cmd = Command::new(&python);
+    cmd.arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/py/connect.py"))
+        .env("PYTHONPATH", dir.join("py"));
+    let o = run_in_cmd(&p, cmd);
+    let out = text(&o.stdout);
+    assert_eq!(o.status.code(), Some(3), "{out}\n{}", text(&o.stderr));
+    assert!(
+        out.starts_with("incompatible: pioneer/actarray/0 is incompatible"),
+        "{out}"
+    );
+    assert!(
+        out.contains(&format!("layout version {}", version + 1)),
+        "{out}"
+    );
+    // The real package connects (the refusal is the layout's, not the script's).
+    let mut cmd = Command::new(&python);
+    cmd.arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/py/connect.py"))
+        .env("PYTHONPATH", root().join("python"));
+    let o = run_in_cmd(&p, cmd);
+    let out = text(&o.stdout);
+    assert!(o.status.success(), "{out}\n{}", text(&o.stderr));
+    assert!(out.starts_with("connected: joint 0 at "), "{out}");
 }

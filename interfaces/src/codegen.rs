@@ -218,7 +218,7 @@ pub fn python_module(m: &Manifest) -> String {
         out!(s, "    ]\n");
         out!(
             s,
-            "    @staticmethod\n    def type_name():\n        return \"{}\"\n",
+            "    @staticmethod\n    def type_name() -> str:\n        return \"{}\"\n",
             st.type_name
         );
     }

@@ -166,7 +166,7 @@ class Vec3(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.Vec3"
 
 
@@ -180,7 +180,7 @@ class Orientation3(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.Orientation3"
 
 
@@ -193,7 +193,7 @@ class Pose3(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.Pose3"
 
 
@@ -207,7 +207,7 @@ class Bbox3(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.Bbox3"
 
 
@@ -222,7 +222,7 @@ class CmdOutcome(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.CmdOutcome"
 
 
@@ -238,7 +238,7 @@ class StateHeader(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.StateHeader"
 
 
@@ -254,7 +254,7 @@ class MsgMeta(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.MsgMeta"
 
 
@@ -270,7 +270,7 @@ class ReplyMeta(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.ReplyMeta"
 
 
@@ -287,7 +287,7 @@ class ActuatorState(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.ActuatorState"
 
 
@@ -302,7 +302,7 @@ class ActArrayData(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.ActArrayData"
 
 
@@ -316,7 +316,7 @@ class ActArrayPositionCmd(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.ActArrayPositionCmd"
 
 
@@ -330,7 +330,7 @@ class ActArrayMultiPositionCmd(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.ActArrayMultiPositionCmd"
 
 
@@ -344,7 +344,7 @@ class ActArraySpeedCmd(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.ActArraySpeedCmd"
 
 
@@ -358,7 +358,7 @@ class ActArrayMultiSpeedCmd(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.ActArrayMultiSpeedCmd"
 
 
@@ -371,7 +371,7 @@ class ActArrayHomeCmd(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.ActArrayHomeCmd"
 
 
@@ -385,7 +385,7 @@ class ActArrayCurrentCmd(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.ActArrayCurrentCmd"
 
 
@@ -399,7 +399,7 @@ class ActArrayMultiCurrentCmd(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.ActArrayMultiCurrentCmd"
 
 
@@ -412,7 +412,7 @@ class ActArrayCmdMsg(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.ActArrayCmdMsg"
 
 
@@ -424,7 +424,7 @@ class ActArrayPowerReq(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.ActArrayPowerReq"
 
 
@@ -436,7 +436,7 @@ class ActArrayBrakesReq(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.ActArrayBrakesReq"
 
 
@@ -450,7 +450,7 @@ class ActArraySpeedReq(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.ActArraySpeedReq"
 
 
@@ -464,7 +464,7 @@ class ActArrayAccelReq(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.ActArrayAccelReq"
 
 
@@ -477,7 +477,7 @@ class ActArrayReqMsg(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.ActArrayReqMsg"
 
 
@@ -498,7 +498,7 @@ class ActuatorGeom(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.ActuatorGeom"
 
 
@@ -514,7 +514,7 @@ class ActArrayGeom(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.ActArrayGeom"
 
 
@@ -527,7 +527,7 @@ class ActArrayReplyMsg(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.ActArrayReplyMsg"
 
 
@@ -545,7 +545,7 @@ class LimbData(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.LimbData"
 
 
@@ -559,7 +559,7 @@ class LimbSetPoseCmd(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.LimbSetPoseCmd"
 
 
@@ -571,7 +571,7 @@ class LimbSetPositionCmd(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.LimbSetPositionCmd"
 
 
@@ -584,7 +584,7 @@ class LimbVecMoveCmd(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.LimbVecMoveCmd"
 
 
@@ -597,7 +597,7 @@ class LimbCmdMsg(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.LimbCmdMsg"
 
 
@@ -609,7 +609,7 @@ class LimbPowerReq(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.LimbPowerReq"
 
 
@@ -621,7 +621,7 @@ class LimbBrakesReq(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.LimbBrakesReq"
 
 
@@ -633,7 +633,7 @@ class LimbSpeedReq(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.LimbSpeedReq"
 
 
@@ -647,7 +647,7 @@ class LimbReachReq(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.LimbReachReq"
 
 
@@ -660,7 +660,7 @@ class LimbReqMsg(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.LimbReqMsg"
 
 
@@ -672,7 +672,7 @@ class LimbGeom(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.LimbGeom"
 
 
@@ -691,7 +691,7 @@ class LimbReach(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.LimbReach"
 
 
@@ -704,7 +704,7 @@ class LimbReplyMsg(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.LimbReplyMsg"
 
 
@@ -720,7 +720,7 @@ class GripperData(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.GripperData"
 
 
@@ -733,7 +733,7 @@ class GripperCmdMsg(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.GripperCmdMsg"
 
 
@@ -746,7 +746,7 @@ class GripperReqMsg(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.GripperReqMsg"
 
 
@@ -762,7 +762,7 @@ class GripperGeom(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.GripperGeom"
 
 
@@ -775,7 +775,7 @@ class GripperReplyMsg(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.GripperReplyMsg"
 
 
@@ -814,7 +814,7 @@ class DriverStats(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.DriverStats"
 
 
@@ -832,7 +832,7 @@ class OutcomeMsg(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.OutcomeMsg"
 
 
@@ -851,7 +851,7 @@ class LeaseReq(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.LeaseReq"
 
 
@@ -870,7 +870,7 @@ class LeaseReply(ctypes.Structure):
     ]
 
     @staticmethod
-    def type_name():
+    def type_name() -> str:
         return "limber.v2.LeaseReply"
 
 

@@ -112,7 +112,7 @@ _OUTCOME_BUFFER = L.QOS_OUTCOME_BUFFER
 _IDENT = re.compile(r"^[A-Za-z0-9_-]+$")
 
 
-def _iox2():
+def _iox2() -> Any:
     """The iceoryx2 binding, imported on first use (so the layout classes work without it)."""
     import iceoryx2
 
@@ -417,7 +417,7 @@ def _domain_token(directory: str, domain: str) -> str:
     return token
 
 
-def _global_mgmt_files(prefix: str):
+def _global_mgmt_files(prefix: str) -> "list[str]":
     try:
         names = os.listdir("/dev/shm")
     except OSError:
@@ -477,7 +477,7 @@ class Domain:
         if not isinstance(name, str) or len(name) > MAX_DOMAIN_LEN or not _IDENT.match(name):
             raise ValueError(f"invalid domain {name!r}: use 1 to {MAX_DOMAIN_LEN} characters of [A-Za-z0-9_-]")
         self._name = name
-        self._prefix = None
+        self._prefix: Optional[str] = None
 
     @classmethod
     def from_env(cls) -> "Domain":
@@ -523,7 +523,7 @@ class Domain:
     def __repr__(self) -> str:
         return f"Domain({self._name!r})"
 
-    def __eq__(self, other) -> bool:
+    def __eq__(self, other: object) -> bool:
         return isinstance(other, Domain) and other._name == self._name
 
     def __hash__(self) -> int:
@@ -652,32 +652,48 @@ def list_devices(domain: "Optional[Domain | str]" = None) -> "list[DeviceInfo]":
     return out
 
 
+def _why_incompatible(dev: DeviceName, domain: Domain) -> str:
+    """Why a device's services did not open with this client's types: the layout version its
+    driver speaks (the ``limber.layout`` attribute of its services) against this client's."""
+    ours = L.LAYOUT_VERSION
+    try:
+        theirs = next((d.layout for d in list_devices(domain) if d.name == dev), "")
+    except LimberError:
+        theirs = ""
+    if theirs and theirs != str(ours):
+        return (
+            f"its driver speaks layout version {theirs}, this client layout version {ours} "
+            f"(limber/_layout.py): use the limber package of the driver's release"
+        )
+    return f"its services do not have this client's types of layout version {ours}"
+
+
 # ----- validation (the Rust constructors' rules) -----------------------------------------
 
 
-def _finite(field: str, v) -> float:
+def _finite(field: str, v: Any) -> float:
     f = float(v)
     if not math.isfinite(f):
         raise ValueError(f"{field} is not finite")
     return f
 
 
-def _joint(j) -> int:
+def _joint(j: Any) -> int:
     """A joint index within the array capacity (0..32), as Rust's ``joint()``."""
     if isinstance(j, bool):
         raise TypeError("a joint index must be an int, not bool")
-    j = operator.index(j)
-    if not 0 <= j < MAX_ACTUATORS:
-        raise ValueError(f"joint {j} is not a valid joint index (0..{MAX_ACTUATORS})")
-    return j
+    i: int = operator.index(j)
+    if not 0 <= i < MAX_ACTUATORS:
+        raise ValueError(f"joint {i} is not a valid joint index (0..{MAX_ACTUATORS})")
+    return i
 
 
-def _joint_sel(j) -> int:
+def _joint_sel(j: Any) -> int:
     """``None`` (every joint, -1 on the wire) or a joint index."""
     return -1 if j is None else _joint(j)
 
 
-def _values(field: str, values: Iterable) -> list:
+def _values(field: str, values: Iterable[Any]) -> "list[float]":
     vs = list(values)
     if len(vs) > MAX_ACTUATORS:
         raise ValueError(f"{field}: {len(vs)} values, at most {MAX_ACTUATORS} allowed")
@@ -687,7 +703,7 @@ def _values(field: str, values: Iterable) -> list:
     return out
 
 
-def _vec3(field: str, v: Sequence) -> "L.Vec3":
+def _vec3(field: str, v: Sequence[Any]) -> "L.Vec3":
     vs = list(v)
     if len(vs) != 3:
         raise ValueError(f"{field} needs 3 components, got {len(vs)}")
@@ -697,33 +713,36 @@ def _vec3(field: str, v: Sequence) -> "L.Vec3":
     return L.Vec3(x, y, z)
 
 
-def _direction(field: str, v: Sequence) -> "L.Vec3":
+def _direction(field: str, v: Sequence[Any]) -> "L.Vec3":
     d = _vec3(field, v)
     if math.sqrt(d.x * d.x + d.y * d.y + d.z * d.z) < MIN_VECTOR_NORM:
         raise ValueError(f"{field} has zero length")
     return d
 
 
-def _copy(cls, ptr: int):
+_S = TypeVar("_S", bound=ctypes.Structure)
+
+
+def _copy(cls: "Type[_S]", ptr: int) -> _S:
     """A copy of the ``cls`` struct at address ``ptr``."""
     out = cls()
     ctypes.memmove(ctypes.addressof(out), ptr, ctypes.sizeof(cls))
     return out
 
 
-def _body(cls, raw_body):
+def _body(cls: "Type[_S]", raw_body: Any) -> _S:
     """The ``cls`` struct at the front of an envelope's ``body`` (a copy)."""
     return cls.from_buffer_copy(bytes(raw_body)[: ctypes.sizeof(cls)])
 
 
-def _all_finite(*vals) -> bool:
+def _all_finite(*vals: float) -> bool:
     return all(math.isfinite(v) for v in vals)
 
 
 # ----- the generic client ----------------------------------------------------------------
 
 _client_seq = itertools.count(1)
-_open_clients: "weakref.WeakSet[_Client]" = weakref.WeakSet()
+_open_clients: "weakref.WeakSet[Any]" = weakref.WeakSet()
 
 
 def _new_client_id() -> int:
@@ -752,6 +771,21 @@ class _Client(Generic[_D]):
     CMD_MSG: ClassVar[type]
     REQ_MSG: ClassVar[type]
     REPLY_MSG: ClassVar[type]
+
+    # iceoryx2 objects (the binding has no types: Any), None until connected or once closed.
+    _lease_port: Any
+    _node: Any
+    _data_svc: Any
+    _states: Any
+    _commands: Any
+    _req_svc: Any
+    _requests: Any
+    _wake: Any
+    _notify_svc: Any
+    _notify: Any
+    _outcome_sub: Any
+    _lease_held: "Optional[tuple[float, float]]"  # heartbeat, last renewal
+    _latest: "Optional[_D]"
 
     def __init__(self) -> None:  # use connect()
         self._closed = True
@@ -830,9 +864,9 @@ class _Client(Generic[_D]):
         self._req_seq = 0
         self._outcomes = [(0, 0)] * _OUTCOME_SLOTS
         self._preemptions = [Outcome(0, Status.OK, 0, "")] * _OUTCOME_SLOTS
-        self._lease_port: Any = None
+        self._lease_port = None
         self._lease_seq = 0
-        self._lease_held: "Optional[tuple[float, float]]" = None  # heartbeat, last renewal
+        self._lease_held = None
         self._latest = None
         self.request_timeout = DEFAULT_REQUEST_TIMEOUT
         self.wake_driver = True
@@ -853,9 +887,7 @@ class _Client(Generic[_D]):
                     f"(is the driver running? is {DOMAIN_ENV} the same?)"
                 )
             if "Incompatible" in text:
-                return IncompatibleError(
-                    f"{dev} is incompatible: {channel}: {text} (another layout version?)"
-                )
+                return IncompatibleError(f"{dev} is incompatible: {_why_incompatible(dev, domain)} ({channel}: {text})")
             return TransportError(f"{dev}: cannot open the {channel} channel: {text}")
 
         layout = iox2.AttributeVerifier.new().require(
@@ -960,7 +992,7 @@ class _Client(Generic[_D]):
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def __del__(self):
+    def __del__(self) -> None:
         try:
             self.close()
         except Exception:
@@ -996,7 +1028,7 @@ class _Client(Generic[_D]):
         """Takes every state sample that arrived; returns True if there was a new one."""
         self._check_open()
         got = False
-        last = None
+        last: "Optional[_D]" = None
         while True:
             try:
                 s = self._states.receive()
@@ -1057,7 +1089,8 @@ class _Client(Generic[_D]):
         """Age of the latest state in seconds: now minus its acquisition time."""
         if self._latest is None:
             return None
-        return max(0, monotonic_ns() - self._latest.header.stamp_ns) / 1e9
+        stamp: int = self._latest.header.stamp_ns
+        return max(0, monotonic_ns() - stamp) / 1e9
 
     def freshness(self, max_age: float) -> Freshness:
         """Fresh (younger than ``max_age`` s), stale (older, driver alive), gone, or no data."""
@@ -1076,7 +1109,7 @@ class _Client(Generic[_D]):
         deadline = time.monotonic() + timeout
         next_check = time.monotonic() + LIVENESS_PERIOD
         while True:
-            if self.refresh():
+            if self.refresh() and self._latest is not None:
                 return self._latest
             now = time.monotonic()
             if now >= deadline:
@@ -1372,7 +1405,7 @@ class _Client(Generic[_D]):
 
     # ----- commands ---------------------------------------------------------------------
 
-    def _send(self, kind: int, body=None) -> Ticket:
+    def _send(self, kind: int, body: Optional[ctypes.Structure] = None) -> Ticket:
         """Sends a command of ``kind`` with ``body`` (a ctypes struct or None)."""
         self._check_open()
         iox2 = _iox2()
@@ -1406,7 +1439,9 @@ class _Client(Generic[_D]):
 
     # ----- requests ---------------------------------------------------------------------
 
-    def _request(self, kind: int, body=None, timeout: Optional[float] = None):
+    def _request(
+        self, kind: int, body: Optional[ctypes.Structure] = None, timeout: Optional[float] = None
+    ) -> Any:
         """Sends a request and waits for the reply; returns the reply envelope (a copy) of
         an ACK, raises :class:`NackError` for a NACK."""
         self._check_open()
@@ -1464,7 +1499,7 @@ class _Client(Generic[_D]):
             # Closes the request at once (frees the slot; max 4 in flight per client).
             pending.delete()
 
-    def _take_reply(self, pending):
+    def _take_reply(self, pending: Any) -> Any:
         try:
             r = pending.receive()
         except Exception as e:
@@ -1476,7 +1511,7 @@ class _Client(Generic[_D]):
         finally:
             r.delete()
 
-    def _check_reply(self, reply, kind: int):
+    def _check_reply(self, reply: Any, kind: int) -> Any:
         try:
             status = Status(reply.meta.status)
         except ValueError:
@@ -1586,7 +1621,7 @@ class ActArrayClient(_Client[L.ActArrayData]):
                 raise DecodeError("undecodable reply: a geometry value is not finite")
         return g
 
-    def positions(self) -> list:
+    def positions(self) -> "list[float]":
         """The positions of the valid actuators in the latest state (empty if none yet)."""
         s = self.state()
         if s is None:
@@ -1744,6 +1779,9 @@ class DriverStatsReader:
     ``diagnostics::StatsReader``). Open with :meth:`open`; close with :meth:`close` or
     ``with``."""
 
+    _sub: Any
+    _node: Any
+
     def __init__(self) -> None:  # use open()
         self._closed = True
         self._sub = None
@@ -1768,7 +1806,7 @@ class DriverStatsReader:
         node_name = (_CLIENT_NODE_PREFIX + _default_process_name())[: iox2.NodeName.max_len()]
         self._node = _join_domain(dom, node_name)
         self._closed = False
-        _open_clients.add(self)  # type: ignore[arg-type]
+        _open_clients.add(self)
         try:
             svc = (
                 self._node.service_builder(iox2.ServiceName.new(f"limber/{robot}/driver/0/data"))
@@ -1831,7 +1869,7 @@ class DriverStatsReader:
         self._node = None
         if not self._closed:
             self._closed = True
-            _open_clients.discard(self)  # type: ignore[arg-type]
+            _open_clients.discard(self)
 
     def __enter__(self) -> "DriverStatsReader":
         return self

@@ -1,0 +1,44 @@
+"""The Python client of ``limber bench``'s ``lang`` scenario (run with python/limber on
+PYTHONPATH). Usage: lang_client.py WARMUP COUNT OUT. Connects to bench/actarray/0 in
+$LIMBER_DOMAIN and, WARMUP + COUNT times each, times (CLOCK_MONOTONIC, ns) reading the
+latest state (``ActArrayClient.state()``, a copy) and a command's round trip (``move_to``,
+then ``wait_outcome``); writes the samples after the warm-up to OUT, one a line: "state NS"
+or "rtt NS". Exits 1 with the reason on stderr."""
+
+import sys
+import time
+
+from limber import ActArrayClient, LimberError, Status
+
+
+def main() -> int:
+    warm, count, path = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
+    now = time.monotonic_ns  # CLOCK_MONOTONIC
+    lines = []
+    try:
+        arm = ActArrayClient.connect("bench/actarray/0", timeout=15.0)
+        if arm.state() is None:
+            arm.wait_state(5.0)
+        for i in range(1, warm + count + 1):
+            t0 = now()
+            arm.state()
+            t1 = now()
+            t2 = now()
+            status = arm.wait_outcome(arm.move_to(0, -0.25 if i % 2 else 0.25), 2.0)
+            t3 = now()
+            if status != Status.OK:
+                print(f"lang_client.py: refused: {status.describe()}", file=sys.stderr)
+                return 1
+            if i > warm:
+                lines.append(f"state {t1 - t0}\nrtt {t3 - t2}\n")
+        arm.close()
+    except LimberError as e:
+        print(f"lang_client.py: {type(e).__name__}: {e}", file=sys.stderr)
+        return 1
+    with open(path, "w") as f:
+        f.writelines(lines)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,363 @@
+//! `lang`: the same two exchanges from a Rust, a C and a Python client, one after the
+//! other, against one event-driven driver child (`cmd-driver-event`, the `command`
+//! scenario's driver with its default linger):
+//!
+//! * **state read**: the latest arm state (1336 B) from shared memory into the program:
+//!   Rust `ActArrayClient::state()` (in place), C `limber_actarray_state` (a copy into the
+//!   caller's struct), Python `ActArrayClient.state()` (a ctypes copy). Each takes whatever
+//!   arrived first, as a control loop's read does.
+//! * **command round trip**: `move_to` then `wait_outcome`, each client with its defaults
+//!   (event-driven, the 30 µs spin budget).
+//!
+//! The C client is `bench/clients/lang_client.c`, compiled here with `cc` against the
+//! source tree's headers and the `liblimber.so` beside this executable (or in
+//! `LIMBER_LIB_DIR`); the Python client is `bench/clients/lang_client.py`, run by
+//! `LIMBER_PYTHON` (default `python3`) with the source tree's `python/` on `PYTHONPATH`.
+//! Each language that cannot run (no C compiler, no liblimber.so, no Python with
+//! iceoryx2) is skipped with the reason, printed and noted in the report; Rust always runs.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+use hdrhistogram::Histogram;
+use limber_interfaces::prelude::*;
+use limber_services::prelude::*;
+use limber_services::{Role, monotonic_ns};
+
+use super::command::DEVICE;
+use super::floor::BYTES;
+use super::{READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario};
+use crate::BenchError;
+use crate::child::{ChildProc, ChildSpec};
+use crate::progress::Progress;
+use crate::stats::{Measurement, Metric, Strategy, new_histogram};
+
+/// The C client's source.
+const C_CLIENT: &str = include_str!("../../clients/lang_client.c");
+/// The Python client's source.
+const PY_CLIENT: &str = include_str!("../../clients/lang_client.py");
+/// The source tree (the headers of capi/ and interfaces/, the python/ package).
+const TREE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+
+/// The `lang` scenario.
+#[derive(Debug, Clone, Copy)]
+pub struct Lang;
+
+impl Scenario for Lang {
+    fn name(&self) -> &'static str {
+        "lang"
+    }
+    fn description(&self) -> &'static str {
+        "reading the state and a command round trip from Rust, C (liblimber) and Python (python/limber), event-driven"
+    }
+    fn run(&self, ctx: &mut RunCtx) -> Result<(), BenchError> {
+        if !ctx.blocking_enabled() {
+            ctx.notes.push(
+                "lang runs the clients' defaults (event-driven); skipped by --strategy spin".into(),
+            );
+            return Ok(());
+        }
+        run(ctx)
+    }
+}
+
+fn err(what: &str, reason: impl std::fmt::Display) -> BenchError {
+    BenchError::Transport {
+        context: what.to_string(),
+        reason: reason.to_string(),
+    }
+}
+
+/// A language skipped: the reason, printed and kept for the report.
+fn skip(ctx: &mut RunCtx, lang: &str, why: String) {
+    let note = format!("{lang} skipped: {why}");
+    eprintln!("  lang: {note}");
+    ctx.notes.push(note);
+}
+
+fn run(ctx: &mut RunCtx) -> Result<(), BenchError> {
+    let domain = ctx.domain();
+    let (warm, n) = (ctx.count(500, 50), ctx.count(5_000, 300));
+    // Three clients, one after the other; Python's exchanges are the slowest (~100 µs).
+    let deadline = ctx.deadline_for(3 * (warm + n), Duration::from_micros(500));
+    let mut driver = ChildProc::spawn(&ChildSpec {
+        role: "cmd-driver-event".into(),
+        domain: Some(domain.name().to_string()),
+        out: Some(ctx.tmp_file("lang-driver.hdr")),
+        cpu: ctx.child_cpu(),
+        warmup: 0,
+        deadline,
+        linger: Some(limber_services::qos::DRIVER_LINGER),
+        ..Default::default()
+    })?;
+    driver.expect("ready", READY_TIMEOUT)?;
+    let cctx =
+        Context::new(&domain, Role::Client, "bench-lang").map_err(|e| err("client context", e))?;
+    let mut client = ActArrayClient::connect_timeout(&cctx, DEVICE, READY_TIMEOUT)
+        .map_err(|e| err("connect", e))?;
+    let r = (|| {
+        let (state, rtt) = rust_client(ctx, &mut client, warm, n)?;
+        push(ctx, "rust", "Rust", state, rtt);
+        match c_client(ctx) {
+            Err(why) => skip(ctx, "C", why),
+            Ok(exe) => {
+                let (state, rtt) =
+                    external(ctx, "C", Command::new(exe), &domain, warm, n, deadline)?;
+                push(ctx, "c", "C", state, rtt);
+            }
+        }
+        match python(ctx) {
+            Err(why) => skip(ctx, "Python", why),
+            Ok(cmd) => {
+                let (state, rtt) = external(ctx, "Python", cmd, &domain, warm, n, deadline)?;
+                push(ctx, "python", "Python", state, rtt);
+            }
+        }
+        Ok(())
+    })();
+    // HOME all joints stops the driver child (if it cannot be sent, its deadline does).
+    if let Err(e) = client.home(None) {
+        tracing::warn!("cannot tell the driver child to stop: {e}");
+    }
+    driver.finish(Duration::from_secs(10))?;
+    r
+}
+
+/// The Rust client's samples (this process): state reads and command round trips.
+fn rust_client(
+    ctx: &RunCtx,
+    client: &mut ActArrayClient,
+    warm: u64,
+    n: u64,
+) -> Result<(Histogram<u64>, Histogram<u64>), BenchError> {
+    client
+        .current(READY_TIMEOUT)
+        .map_err(|e| err("first state", e))?;
+    let (mut state, mut rtt) = (new_histogram()?, new_histogram()?);
+    let progress = Progress::new(ctx.progress, "lang Rust", warm + n);
+    for i in 1..=warm + n {
+        let t0 = monotonic_ns();
+        let p = client.state().map(|d| d.actuators[0].position);
+        let t1 = monotonic_ns();
+        std::hint::black_box(p);
+        let target = if i % 2 == 0 { 0.25 } else { -0.25 };
+        let t2 = monotonic_ns();
+        let ticket = client.move_to(0, target).map_err(|e| err("move_to", e))?;
+        let status = client
+            .wait_outcome(ticket, SAMPLE_TIMEOUT)
+            .map_err(|e| err("wait_outcome", e))?;
+        let t3 = monotonic_ns();
+        if status != Status::Ok {
+            return Err(err("command", format!("refused: {status}")));
+        }
+        if i > warm {
+            state.saturating_record(t1.saturating_sub(t0));
+            rtt.saturating_record(t3.saturating_sub(t2));
+        }
+        progress.tick(i);
+    }
+    progress.finish();
+    Ok((state, rtt))
+}
+
+/// Runs `cmd` to its end and returns its output; `Err(why)` when it cannot start or runs
+/// longer than `limit` (then it is killed).
+fn run_bounded(mut cmd: Command, limit: Duration) -> Result<std::process::Output, String> {
+    let mut child = cmd
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("cannot start {:?}: {e}", cmd.get_program()))?;
+    let until = Instant::now() + limit;
+    loop {
+        match child.try_wait() {
+            Ok(Some(_)) => break,
+            Ok(None) if Instant::now() < until => std::thread::sleep(Duration::from_millis(5)),
+            Ok(None) => {
+                if let Err(e) = child.kill() {
+                    tracing::warn!("cannot kill {:?}: {e}", cmd.get_program());
+                }
+                if let Err(e) = child.wait() {
+                    tracing::warn!("cannot reap {:?}: {e}", cmd.get_program());
+                }
+                return Err(format!("{:?} ran longer than {limit:?}", cmd.get_program()));
+            }
+            Err(e) => return Err(format!("waiting for {:?}: {e}", cmd.get_program())),
+        }
+    }
+    child
+        .wait_with_output()
+        .map_err(|e| format!("reading {:?}: {e}", cmd.get_program()))
+}
+
+/// The directory of `liblimber.so`: `LIMBER_LIB_DIR`, else beside this executable (where
+/// `cargo build -p limber-c` puts it), else its `deps/`.
+fn lib_dir() -> Result<PathBuf, String> {
+    let mut dirs = Vec::new();
+    if let Some(d) = std::env::var_os("LIMBER_LIB_DIR") {
+        dirs.push(PathBuf::from(d));
+    }
+    if let Some(d) = std::env::current_exe()
+        .ok()
+        .and_then(|e| e.parent().map(Path::to_path_buf))
+    {
+        // Beside the executable first, then its deps/.
+        let deps = d.join("deps");
+        dirs.push(d);
+        dirs.push(deps);
+    }
+    dirs.iter()
+        .find(|d| d.join("liblimber.so").is_file())
+        .cloned()
+        .ok_or_else(|| {
+            format!(
+                "no liblimber.so in {dirs:?} (build it with `cargo build --release -p limber-c`, or set LIMBER_LIB_DIR)"
+            )
+        })
+}
+
+/// The C client, compiled; `Err(why)` when it cannot be.
+fn c_client(ctx: &RunCtx) -> Result<PathBuf, String> {
+    let tree = Path::new(TREE);
+    let includes = [tree.join("capi/include"), tree.join("interfaces/include")];
+    if let Some(missing) = includes.iter().find(|d| !d.is_dir()) {
+        return Err(format!(
+            "the headers are not at {} (the source tree)",
+            missing.display()
+        ));
+    }
+    let lib = lib_dir()?;
+    let cc = std::env::var_os("CC").unwrap_or_else(|| "cc".into());
+    let src = ctx.tmp_file("lang_client.c");
+    let exe = ctx.tmp_file("lang_client");
+    std::fs::write(&src, C_CLIENT).map_err(|e| format!("{}: {e}", src.display()))?;
+    let mut cmd = Command::new(&cc);
+    cmd.args(["-std=c11", "-O2", "-Wall", "-Werror"]);
+    for d in &includes {
+        cmd.arg("-I").arg(d);
+    }
+    cmd.arg(&src)
+        .arg("-o")
+        .arg(&exe)
+        .arg("-L")
+        .arg(&lib)
+        .arg("-llimber")
+        .arg(format!("-Wl,-rpath,{}", lib.display()));
+    let o = run_bounded(cmd, Duration::from_secs(60)).map_err(|e| format!("no C compiler: {e}"))?;
+    if !o.status.success() {
+        return Err(format!(
+            "{cc:?} could not compile the C client: {}",
+            String::from_utf8_lossy(&o.stderr).trim()
+        ));
+    }
+    Ok(exe)
+}
+
+/// The Python client's command; `Err(why)` when there is no Python that imports limber
+/// (from the source tree) and iceoryx2.
+fn python(ctx: &RunCtx) -> Result<Command, String> {
+    let py = std::env::var_os("LIMBER_PYTHON").unwrap_or_else(|| "python3".into());
+    let path = Path::new(TREE).join("python");
+    let mut probe = Command::new(&py);
+    probe
+        .args(["-c", "import limber.client, iceoryx2"])
+        .env("PYTHONPATH", &path);
+    let o = run_bounded(probe, Duration::from_secs(60))?;
+    if !o.status.success() {
+        return Err(format!(
+            "{py:?} cannot import limber (from {}) and iceoryx2: {} (set LIMBER_PYTHON to a Python with iceoryx2 0.10, e.g. the venv of .ci/run)",
+            path.display(),
+            String::from_utf8_lossy(&o.stderr)
+                .lines()
+                .last()
+                .unwrap_or("")
+                .trim()
+        ));
+    }
+    let script = ctx.tmp_file("lang_client.py");
+    std::fs::write(&script, PY_CLIENT).map_err(|e| format!("{}: {e}", script.display()))?;
+    let mut cmd = Command::new(py);
+    cmd.arg(script).env("PYTHONPATH", path);
+    Ok(cmd)
+}
+
+/// Runs an external client (`cmd WARMUP COUNT OUT`) in the scenario's domain and reads its
+/// samples.
+fn external(
+    ctx: &RunCtx,
+    lang: &str,
+    mut cmd: Command,
+    domain: &limber_services::Domain,
+    warm: u64,
+    n: u64,
+    limit: Duration,
+) -> Result<(Histogram<u64>, Histogram<u64>), BenchError> {
+    let out = ctx.tmp_file(&format!("lang-{lang}.txt"));
+    if ctx.progress {
+        eprintln!("  lang {lang}: {} exchanges", warm + n);
+    }
+    cmd.arg(warm.to_string())
+        .arg(n.to_string())
+        .arg(&out)
+        .env("LIMBER_DOMAIN", domain.name());
+    let o = run_bounded(cmd, limit).map_err(|why| BenchError::ChildFailed {
+        role: format!("{lang} client"),
+        reason: why,
+    })?;
+    if !o.status.success() {
+        return Err(BenchError::ChildFailed {
+            role: format!("{lang} client"),
+            reason: format!(
+                "{}: {}",
+                o.status,
+                String::from_utf8_lossy(&o.stderr).trim()
+            ),
+        });
+    }
+    let text =
+        std::fs::read_to_string(&out).map_err(|e| BenchError::io(out.display().to_string(), e))?;
+    let (mut state, mut rtt) = (new_histogram()?, new_histogram()?);
+    for line in text.lines() {
+        let bad = || BenchError::ChildFailed {
+            role: format!("{lang} client"),
+            reason: format!("a bad sample line {line:?}"),
+        };
+        let (kind, ns) = line.split_once(' ').ok_or_else(bad)?;
+        let ns: u64 = ns.parse().map_err(|_| bad())?;
+        match kind {
+            "state" => state.saturating_record(ns),
+            "rtt" => rtt.saturating_record(ns),
+            _ => return Err(bad()),
+        }
+    }
+    if state.len() != n || rtt.len() != n {
+        return Err(BenchError::ChildFailed {
+            role: format!("{lang} client"),
+            reason: format!("{} and {} samples, not {n}", state.len(), rtt.len()),
+        });
+    }
+    Ok((state, rtt))
+}
+
+fn push(ctx: &mut RunCtx, key: &str, lang: &str, state: Histogram<u64>, rtt: Histogram<u64>) {
+    ctx.push(Measurement {
+        scenario: "lang",
+        id: format!("lang.{key}.state"),
+        label: format!("{lang}: read the latest state"),
+        strategy: Strategy::Compute,
+        metric: Metric::Read,
+        bytes: Some((0, BYTES.1)),
+        hist: state,
+    });
+    ctx.push(Measurement {
+        scenario: "lang",
+        id: format!("lang.{key}.rtt"),
+        label: format!("{lang}: command→outcome"),
+        strategy: Strategy::Blocking,
+        metric: Metric::RoundTrip,
+        bytes: Some(BYTES),
+        hist: rtt,
+    });
+}
