@@ -52,7 +52,7 @@ impl<I: Interface> Client<I> {
 
     /// Wakes the driver's loop. A failure delays the command or request until the
     /// driver's next tick rather than losing it: logged, not fatal.
-    pub(super) fn wake_driver_with(&self, event: usize) {
+    pub(crate) fn wake_driver_with(&self, event: usize) {
         if let Err(e) = self.wake.notify_with_custom_event_id(EventId::new(event)) {
             tracing::debug!(device = %self.device, error = %e, "cannot wake the driver");
         }
