@@ -101,7 +101,8 @@ enum Command {
     /// domain's devices on the network, `mirror` on another host hosts them in its domain
     /// under the same names.
     ///
-    /// Example: limber bridge expose   (then, elsewhere: limber bridge mirror --connect tcp/ROBOT:7447)
+    /// The walkthrough is in the README ("Between hosts"), the keys and payloads in
+    /// bridge/README.md.
     #[cfg(feature = "bridge")]
     Bridge(bridge::BridgeArgs),
 }
