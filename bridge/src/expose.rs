@@ -14,6 +14,7 @@ use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use limber_interfaces::Interface;
+use limber_interfaces::message::Message;
 use limber_interfaces::prelude::*;
 use limber_services::relay::PendingRelay;
 use limber_services::{Client, Context, DeviceName, Domain, Role, list_devices};
@@ -26,6 +27,7 @@ use zenoh::sample::Sample;
 use zenoh::{Session, bytes::ZBytes};
 use zerocopy::{FromBytes, IntoBytes};
 
+use crate::allow::Allow;
 use crate::keys::{self, TypeNames};
 use crate::session::{self, NetConfig, SessionError};
 
@@ -42,6 +44,8 @@ pub struct ExposeConfig {
     pub request_timeout: Duration,
     /// How often the domain is looked at for new devices.
     pub discovery_period: Duration,
+    /// What passes: devices, commands, requests that change a device.
+    pub allow: Allow,
 }
 
 impl Default for ExposeConfig {
@@ -53,6 +57,7 @@ impl Default for ExposeConfig {
             },
             request_timeout: Duration::from_millis(1500),
             discovery_period: Duration::from_millis(250),
+            allow: Allow::default(),
         }
     }
 }
@@ -159,6 +164,7 @@ struct Exposed<I: Interface> {
     client: Client<I>,
     state_pub: Publisher<'static>,
     names: TypeNames,
+    allow: Allow,
     ids: Ids,
     pending: Vec<(Query, PendingRelay<I>, Instant, u64)>,
     _token: LivelinessToken,
@@ -167,19 +173,34 @@ struct Exposed<I: Interface> {
 }
 
 trait ExposedDevice {
-    fn command(&mut self, origin: &str, payload: &[u8]);
+    fn command(&mut self, session: &Session, origin: &str, payload: &[u8]);
     fn query(&mut self, query: Query, timeout: Duration);
     fn poll(&mut self, session: &Session);
     fn alive(&self) -> bool;
 }
 
 impl<I: Interface> ExposedDevice for Exposed<I> {
-    fn command(&mut self, origin: &str, payload: &[u8]) {
+    fn command(&mut self, session: &Session, origin: &str, payload: &[u8]) {
         let Ok(mut cmd) = I::CmdMsg::read_from_bytes(payload) else {
             tracing::warn!(device = %self.device, origin, len = payload.len(),
                 "a command of the wrong size ({} expected): dropped", self.names.cmd);
             return;
         };
+        let meta = *cmd.meta();
+        if !self.allow.command(I::KIND, meta.kind) {
+            tracing::warn!(device = %self.device, origin, kind = meta.kind,
+                "a command this bridge does not let through: refused");
+            let o = OutcomeMsg {
+                client_id: meta.client_id,
+                cmd_seq: meta.seq,
+                stamp_ns: limber_services::monotonic_ns(),
+                kind: meta.kind,
+                status: Status::Unsupported.code(),
+                ..OutcomeMsg::default()
+            };
+            put_outcome(session, &self.device, origin, &o);
+            return;
+        }
         let meta = cmd.meta_mut();
         meta.client_id = self.ids.local(origin, meta.client_id);
         if let Err(e) = self.client.relay_send(&cmd) {
@@ -199,6 +220,18 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
             return;
         };
         let remote = req.meta().client_id;
+        if self.allow.read_only && !I::Request::read(&req).is_ok_and(|r| r.is_read_only()) {
+            tracing::warn!(device = %self.device, origin, "a request that changes the device: refused (read-only bridge)");
+            let out = keys::nack::<I>(&req, Status::Unsupported);
+            if let Err(e) = query
+                .reply(query.key_expr().clone(), out.as_bytes().to_vec())
+                .encoding(keys::encoding(self.names.reply))
+                .wait()
+            {
+                tracing::warn!(key = %query.key_expr(), error = %e, "cannot answer a query");
+            }
+            return;
+        }
         req.meta_mut().client_id = self.ids.local(&origin, remote);
         match self.client.relay_request(&req) {
             Ok(p) => self
@@ -232,14 +265,7 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
             if let Some((_, other)) = self.ids.to_remote.get(&o.other_client) {
                 o.other_client = *other;
             }
-            let key = keys::outcome_key(&self.device, &origin);
-            if let Err(e) = session
-                .put(&key, o.as_bytes().to_vec())
-                .encoding(keys::encoding(keys::outcome_type()))
-                .wait()
-            {
-                tracing::warn!(device = %self.device, error = %e, "cannot publish an outcome");
-            }
+            put_outcome(session, &self.device, &origin, &o);
         }
         let now = Instant::now();
         let names = self.names;
@@ -275,13 +301,30 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
     }
 }
 
+/// Puts outcome `o` for the commands of `origin`.
+fn put_outcome(session: &Session, device: &DeviceName, origin: &str, o: &OutcomeMsg) {
+    let key = keys::outcome_key(device, origin);
+    if let Err(e) = session
+        .put(&key, o.as_bytes().to_vec())
+        .encoding(keys::encoding(keys::outcome_type()))
+        .wait()
+    {
+        tracing::warn!(device = %device, error = %e, "cannot publish an outcome");
+    }
+}
+
 fn expose_device<I: Interface>(
+    allow: &Allow,
     ctx: &Context,
     session: &Session,
     device: &DeviceName,
     tx: &mpsc::Sender<Event>,
 ) -> Result<Box<dyn ExposedDevice>, String> {
     let client = Client::<I>::connect(ctx, &device.to_string()).map_err(|e| e.to_string())?;
+    // The same test as the one that withdraws it: a driver found dead is not exposed.
+    if !client.relay_driver_alive() {
+        return Err("its driver is not alive".into());
+    }
     let names = keys::type_names::<I>();
     let state_pub = session
         .declare_publisher(keys::device_key(device, "state"))
@@ -330,6 +373,7 @@ fn expose_device<I: Interface>(
         client,
         state_pub,
         names,
+        allow: allow.clone(),
         ids: Ids {
             ctx: ctx.clone(),
             to_local: HashMap::new(),
@@ -373,20 +417,33 @@ pub fn expose(
                     for info in list {
                         if !info.alive
                             || info.driver == MIRROR_DRIVER
+                            || !config.allow.device(&info.name)
                             || devices.contains_key(&info.name)
                         {
                             continue;
                         }
                         let made = match info.interface() {
-                            InterfaceKind::ActArray => {
-                                expose_device::<ActArray>(&ctx, &session, &info.name, &tx)
-                            }
-                            InterfaceKind::Limb => {
-                                expose_device::<Limb>(&ctx, &session, &info.name, &tx)
-                            }
-                            InterfaceKind::Gripper => {
-                                expose_device::<Gripper>(&ctx, &session, &info.name, &tx)
-                            }
+                            InterfaceKind::ActArray => expose_device::<ActArray>(
+                                &config.allow,
+                                &ctx,
+                                &session,
+                                &info.name,
+                                &tx,
+                            ),
+                            InterfaceKind::Limb => expose_device::<Limb>(
+                                &config.allow,
+                                &ctx,
+                                &session,
+                                &info.name,
+                                &tx,
+                            ),
+                            InterfaceKind::Gripper => expose_device::<Gripper>(
+                                &config.allow,
+                                &ctx,
+                                &session,
+                                &info.name,
+                                &tx,
+                            ),
                         };
                         match made {
                             Ok(d) => {
@@ -425,7 +482,7 @@ pub fn expose(
                             origin,
                             payload,
                         } => match devices.get_mut(&device) {
-                            Some(d) => d.command(&origin, &payload),
+                            Some(d) => d.command(&session, &origin, &payload),
                             None => tracing::debug!(device = %device, "command for a device gone"),
                         },
                         Event::Query { device, query } => match devices.get_mut(&device) {

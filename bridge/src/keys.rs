@@ -15,8 +15,11 @@
 //!
 //! Every sample's encoding is `application/octet-stream` with the type name as its schema.
 
-use limber_interfaces::WireStruct;
+use limber_interfaces::message::{Envelope, ReplyBody, ReplyEnvelope};
+use limber_interfaces::prelude::Status;
+use limber_interfaces::{Interface, WireStruct};
 use limber_services::DeviceName;
+use limber_services::monotonic_ns;
 
 /// The first chunk of every key.
 pub const ROOT: &str = "limber";
@@ -99,6 +102,18 @@ pub fn encoding(type_name: &str) -> zenoh::bytes::Encoding {
 
 /// The type name of an error reply to a query: a `Status` code as 4 bytes, little-endian.
 pub const STATUS_TYPE: &str = "limber.Status";
+
+/// The NACK of `req` with `status`.
+pub(crate) fn nack<I: Interface>(req: &I::ReqMsg, status: Status) -> I::ReplyMsg {
+    let mut out = I::ReplyMsg::default();
+    let meta = *req.meta();
+    I::Reply::write(meta.kind, Err(status), &mut out);
+    let m = out.meta_mut();
+    m.client_id = meta.client_id;
+    m.seq = meta.seq;
+    m.stamp_ns = monotonic_ns();
+    out
+}
 
 #[cfg(test)]
 mod tests {

@@ -13,11 +13,13 @@
 //! The payloads are the interfaces' fixed layouts as bytes; the key expressions are in
 //! [`keys`] and documented in this crate's README.
 
+pub mod allow;
 pub mod expose;
 pub mod keys;
 pub mod mirror;
 mod session;
 
+pub use allow::{Allow, AllowError, CommandKind, DevicePattern};
 pub use expose::{ExposeConfig, ExposeError, ExposeEvent, expose};
 pub use mirror::{MirrorConfig, MirrorError, MirrorEvent, mirror};
 pub use session::{NetConfig, SessionError};

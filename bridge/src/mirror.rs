@@ -14,7 +14,6 @@ use std::collections::HashMap;
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use limber_interfaces::message::ReplyBody;
 use limber_interfaces::prelude::*;
 use limber_interfaces::{HasHeader, Interface};
 use limber_services::relay::RelayedRequest;
@@ -143,18 +142,6 @@ trait MirroredDevice {
     fn poll(&mut self, session: &Session, origin: &str, timeout: Duration);
 }
 
-/// The NACK of `req` with `status`.
-fn nack<I: Interface>(req: &I::ReqMsg, status: Status) -> I::ReplyMsg {
-    let mut out = I::ReplyMsg::default();
-    let meta = *req.meta();
-    I::Reply::write(meta.kind, Err(status), &mut out);
-    let m = out.meta_mut();
-    m.client_id = meta.client_id;
-    m.seq = meta.seq;
-    m.stamp_ns = monotonic_ns();
-    out
-}
-
 /// The status an error reply of `expose` carries (4 bytes, little-endian).
 fn status_of(payload: &ZBytes) -> Status {
     let bytes = payload.to_bytes();
@@ -229,7 +216,7 @@ impl<I: Interface> MirroredDevice for Mirrored<I> {
                 Ok(replies) => self.pending.push((req, replies, Instant::now() + timeout)),
                 Err(e) => {
                     tracing::warn!(device = %self.local, error = %e, "cannot relay a request");
-                    let out = nack::<I>(req.message(), Status::LinkDown);
+                    let out = crate::keys::nack::<I>(req.message(), Status::LinkDown);
                     if let Err(e) = self.host.relay_answer(req, &out) {
                         tracing::debug!(device = %self.local, error = %e, "reply not delivered");
                     }
@@ -248,15 +235,15 @@ impl<I: Interface> MirroredDevice for Mirrored<I> {
                             Ok(r) => r,
                             Err(_) => {
                                 tracing::warn!(device = %self.local, "a reply of the wrong size");
-                                nack::<I>(req.message(), Status::LinkDown)
+                                crate::keys::nack::<I>(req.message(), Status::LinkDown)
                             }
                         }
                     }
-                    Err(err) => nack::<I>(req.message(), status_of(err.payload())),
+                    Err(err) => crate::keys::nack::<I>(req.message(), status_of(err.payload())),
                 }),
                 Ok(None) if now < *deadline => None,
                 // Nobody answered: in time or not at all.
-                Ok(None) | Err(_) => Some(nack::<I>(
+                Ok(None) | Err(_) => Some(crate::keys::nack::<I>(
                     req.message(),
                     if now >= *deadline {
                         Status::Timeout

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use clap::{Args, Subcommand};
 use limber_bridge::expose::ExposeEvent;
 use limber_bridge::mirror::MirrorEvent;
-use limber_bridge::{ExposeConfig, MirrorConfig, NetConfig};
+use limber_bridge::{Allow, CommandKind, DevicePattern, ExposeConfig, MirrorConfig, NetConfig};
 use limber_services::signals;
 
 use crate::out::noteln;
@@ -58,6 +58,19 @@ struct ExposeArgs {
     /// How long the driver has to answer a relayed request, in seconds.
     #[arg(long, default_value = "1.5", value_parser = parse_seconds, value_name = "S")]
     request_timeout: f64,
+    /// Expose only the devices that match (repeatable; robot/interface/index, each part a
+    /// name or *, e.g. pioneer/actarray/*). Default: every device.
+    #[arg(long = "device", value_name = "PATTERN")]
+    devices: Vec<DevicePattern>,
+    /// Let only these commands through (repeatable; interface:kind, e.g. actarray:pos,
+    /// gripper:open). Any other command is refused ("unsupported") to its sender. Default:
+    /// every command.
+    #[arg(long = "allow-command", value_name = "INTERFACE:KIND")]
+    allow_commands: Vec<CommandKind>,
+    /// Refuse every command and every request that changes a device (power, brakes,
+    /// speed); the state and read-only requests (geometry) still pass.
+    #[arg(long)]
+    read_only: bool,
 }
 
 #[derive(Debug, Args)]
@@ -107,6 +120,11 @@ pub fn run(args: BridgeArgs) -> Result<(), CliError> {
             let config = ExposeConfig {
                 net: net_config(a.net, &["tcp/127.0.0.1:7447"], &[]),
                 request_timeout: std::time::Duration::from_secs_f64(a.request_timeout),
+                allow: Allow {
+                    devices: a.devices,
+                    commands: (!a.allow_commands.is_empty()).then_some(a.allow_commands),
+                    read_only: a.read_only,
+                },
                 ..ExposeConfig::default()
             };
             let name = domain.name().to_string();

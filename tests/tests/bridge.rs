@@ -265,3 +265,83 @@ fn a_dead_driver_or_bridge_makes_the_mirrored_arm_gone() {
     );
     assert!(t0.elapsed() < Duration::from_secs(3), "the request hung");
 }
+
+/// `expose --device ... --allow-command ...`: only the allowed device is exposed, and a
+/// command not allowed is refused ("unsupported") to its sender; `--read-only` refuses
+/// every command and the requests that change the device, and lets geometry through.
+#[test]
+fn the_allow_list_keeps_devices_and_commands_out() {
+    let a = Domain::unique_for_test();
+    let _driver = start_driver(&a);
+
+    let b = Domain::unique_for_test();
+    let endpoint = format!("tcp/127.0.0.1:{}", free_port());
+    let mut expose = Proc::spawn(
+        CLI,
+        a.name(),
+        &[
+            "bridge",
+            "expose",
+            "--listen",
+            &endpoint,
+            "--device",
+            "pioneer/actarray/0",
+            "--allow-command",
+            "actarray:pos",
+        ],
+    );
+    assert!(
+        expose
+            .read_until(|l| l == "exposed pioneer/actarray/0")
+            .is_some()
+    );
+    let _mirror = start_mirror(&b, &endpoint);
+    let mut arm = arm_in(&b);
+    arm.geometry().expect("a read-only request passes");
+    let t = arm.move_to(2, 0.4).expect("send");
+    assert_eq!(
+        arm.wait_outcome(t, Duration::from_secs(5))
+            .expect("outcome"),
+        Status::Ok
+    );
+    let t = arm.home(None).expect("send");
+    assert_eq!(
+        arm.wait_outcome(t, Duration::from_secs(5))
+            .expect("outcome"),
+        Status::Unsupported
+    );
+    // One discovery pass found every device of A: it ends before the bridge does.
+    expose.signal(libc::SIGTERM);
+    assert_eq!(expose.wait_timeout(Duration::from_secs(20)), Some(0));
+    let rest = expose.rest_of_stdout();
+    assert!(!rest.contains("exposed "), "{rest}");
+
+    let b = Domain::unique_for_test();
+    let endpoint = format!("tcp/127.0.0.1:{}", free_port());
+    let mut expose = Proc::spawn(
+        CLI,
+        a.name(),
+        &["bridge", "expose", "--listen", &endpoint, "--read-only"],
+    );
+    assert!(
+        expose
+            .read_until(|l| l == "exposed pioneer/actarray/0")
+            .is_some()
+    );
+    let _mirror = start_mirror(&b, &endpoint);
+    let mut arm = arm_in(&b);
+    arm.geometry().expect("a read-only request passes");
+    assert!(
+        matches!(
+            arm.power(false),
+            Err(RequestError::Nack(Status::Unsupported))
+        ),
+        "power must be refused"
+    );
+    let t = arm.move_to(2, 0.2).expect("send");
+    assert_eq!(
+        arm.wait_outcome(t, Duration::from_secs(5))
+            .expect("outcome"),
+        Status::Unsupported
+    );
+}
