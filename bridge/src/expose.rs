@@ -167,6 +167,8 @@ struct Exposed<I: Interface> {
     allow: Allow,
     ids: Ids,
     pending: Vec<(Query, PendingRelay<I>, Instant, u64)>,
+    /// The last liveness check found the driver dead.
+    doubted: bool,
     _token: LivelinessToken,
     _commands: Subscriber<()>,
     _queries: Queryable<()>,
@@ -177,6 +179,8 @@ trait ExposedDevice {
     fn query(&mut self, query: Query, timeout: Duration);
     fn poll(&mut self, session: &Session);
     fn alive(&self) -> bool;
+    fn doubted(&self) -> bool;
+    fn set_doubted(&mut self, on: bool);
 }
 
 impl<I: Interface> ExposedDevice for Exposed<I> {
@@ -299,6 +303,14 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
     fn alive(&self) -> bool {
         self.client.relay_driver_alive()
     }
+
+    fn doubted(&self) -> bool {
+        self.doubted
+    }
+
+    fn set_doubted(&mut self, on: bool) {
+        self.doubted = on;
+    }
 }
 
 /// Puts outcome `o` for the commands of `origin`.
@@ -380,6 +392,7 @@ fn expose_device<I: Interface>(
             to_remote: HashMap::new(),
         },
         pending: Vec::new(),
+        doubted: false,
         _token: token,
         _commands: commands,
         _queries: queries,
@@ -462,13 +475,19 @@ pub fn expose(
         }
         if now >= next_liveness {
             next_liveness = now + Duration::from_millis(100);
+            // Withdrawn after two checks in a row find the driver dead (100 ms apart), so a
+            // passing doubt never makes a device flap.
             let gone: Vec<DeviceName> = devices
-                .iter()
-                .filter(|(_, d)| !d.alive())
-                .map(|(n, _)| n.clone())
+                .iter_mut()
+                .filter_map(|(n, d)| {
+                    let (alive, doubted) = (d.alive(), d.doubted());
+                    d.set_doubted(!alive);
+                    (!alive && doubted).then(|| n.clone())
+                })
                 .collect();
             for name in gone {
-                devices.remove(&name);
+                // The token is withdrawn (dropped) before anybody is told so.
+                drop(devices.remove(&name));
                 tracing::info!(device = %name, "driver gone: withdrawn");
                 report(ExposeEvent::Gone(name));
             }

@@ -418,7 +418,9 @@ pub fn mirror(
                             device,
                             present: false,
                         } => {
-                            if let Some((local, _)) = devices.remove(&device) {
+                            if let Some((local, host)) = devices.remove(&device) {
+                                // No longer offered before anybody is told so.
+                                drop(host);
                                 tracing::info!(local = %local, "remote device gone");
                                 report(MirrorEvent::Gone { local });
                             }

@@ -233,19 +233,25 @@ impl<I: Interface> Client<I> {
     pub fn relay_driver_alive(&self) -> bool {
         use iceoryx2::node::NodeView;
         use iceoryx2::service::port_factory::PortFactory;
-        let mut alive = false;
+        let (mut alive, mut dead, mut unknown) = (false, false, false);
+        let is_driver = |d: &Option<iceoryx2::node::NodeDetails>| {
+            d.as_ref()
+                .is_some_and(|d| d.name().as_str().starts_with(DRIVER_NODE_PREFIX))
+        };
         if let Err(e) = self.data_svc.nodes(|n| {
-            if let NodeState::Alive(v) = &n
-                && v.details()
-                    .as_ref()
-                    .is_some_and(|d| d.name().as_str().starts_with(DRIVER_NODE_PREFIX))
-            {
-                alive = true;
+            match &n {
+                NodeState::Alive(v) if is_driver(v.details()) => alive = true,
+                NodeState::Dead(v) if is_driver(v.details()) => dead = true,
+                NodeState::Inaccessible(_) | NodeState::Undefined(_) => unknown = true,
+                _ => {}
             }
             CallbackProgression::Continue
         }) {
+            // Not known to be dead: asked again at the next check.
             tracing::warn!(device = %self.device, error = %e, "cannot list the nodes of a device");
+            return true;
         }
-        alive
+        // A node whose state cannot be read (yet) may be the driver: not known to be dead.
+        alive || (unknown && !dead)
     }
 }
