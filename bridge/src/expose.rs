@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 use limber_interfaces::Interface;
 use limber_interfaces::message::Message;
 use limber_interfaces::prelude::*;
-use limber_services::relay::PendingRelay;
+use limber_services::relay::{PendingLease, PendingRelay};
 use limber_services::{Client, Context, DeviceName, Domain, Role, list_devices};
 use thiserror::Error;
 use zenoh::Wait;
@@ -103,6 +103,10 @@ enum Event {
         device: DeviceName,
         query: Query,
     },
+    Lease {
+        device: DeviceName,
+        query: Query,
+    },
 }
 
 /// The origin id of a command or query: its attachment, if it is a valid key chunk.
@@ -169,14 +173,17 @@ struct Exposed<I: Interface> {
     pending: Vec<(Query, PendingRelay<I>, Instant, u64)>,
     /// The last liveness check found the driver dead.
     doubted: bool,
+    leases: Vec<(Query, PendingLease, Instant)>,
     _token: LivelinessToken,
     _commands: Subscriber<()>,
     _queries: Queryable<()>,
+    _leases: Queryable<()>,
 }
 
 trait ExposedDevice {
     fn command(&mut self, session: &Session, origin: &str, payload: &[u8]);
     fn query(&mut self, query: Query, timeout: Duration);
+    fn lease(&mut self, query: Query, timeout: Duration);
     fn poll(&mut self, session: &Session);
     fn alive(&self) -> bool;
     fn doubted(&self) -> bool;
@@ -248,7 +255,35 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
         }
     }
 
+    fn lease(&mut self, query: Query, timeout: Duration) {
+        let Some(origin) = origin_of(query.attachment()) else {
+            refuse(&query, Status::InvalidArgument);
+            return;
+        };
+        let bytes = query.payload().map(|p| p.to_bytes().into_owned());
+        let Some(Ok(mut req)) = bytes.as_deref().map(LeaseReq::read_from_bytes) else {
+            tracing::warn!(device = %self.device, "a lease request of the wrong size: refused");
+            refuse(&query, Status::InvalidArgument);
+            return;
+        };
+        if self.allow.read_only || self.allow.commands.is_some() {
+            // A lease would let a remote client refuse the robot's own clients: only a
+            // bridge that lets every command through carries leases.
+            refuse(&query, Status::Unsupported);
+            return;
+        }
+        req.client_id = self.ids.local(&origin, req.client_id);
+        match self.client.relay_lease(&req) {
+            Ok(p) => self.leases.push((query, p, Instant::now() + timeout)),
+            Err(e) => {
+                tracing::warn!(device = %self.device, error = %e, "cannot relay a lease request");
+                refuse(&query, Status::LinkDown);
+            }
+        }
+    }
+
     fn poll(&mut self, session: &Session) {
+        self.poll_leases();
         let (device, state_pub) = (&self.device, &self.state_pub);
         if let Err(e) = self.client.relay_states(|d| {
             if let Err(e) = state_pub.put(d.as_bytes().to_vec()).wait() {
@@ -325,6 +360,44 @@ fn put_outcome(session: &Session, device: &DeviceName, origin: &str, o: &Outcome
     }
 }
 
+impl<I: Interface> Exposed<I> {
+    /// Answers the lease queries whose reply arrived (holder ids told as the remote
+    /// clients know them).
+    fn poll_leases(&mut self) {
+        let now = Instant::now();
+        let ids = &self.ids;
+        self.leases.retain(|(query, p, deadline)| {
+            match p.try_reply() {
+                Ok(Some(mut reply)) => {
+                    reply.holder_client = match ids.to_remote.get(&reply.holder_client) {
+                        Some((_, r)) => *r,
+                        None => reply.holder_client,
+                    };
+                    reply.set_holder_node(0);
+                    if let Err(e) = query
+                        .reply(query.key_expr().clone(), reply.as_bytes().to_vec())
+                        .encoding(keys::encoding(keys::lease_reply_type()))
+                        .wait()
+                    {
+                        tracing::warn!(key = %query.key_expr(), error = %e, "cannot answer a lease query");
+                    }
+                    false
+                }
+                Ok(None) if now < *deadline => true,
+                Ok(None) => {
+                    refuse(query, Status::Timeout);
+                    false
+                }
+                Err(e) => {
+                    tracing::warn!(key = %query.key_expr(), error = %e, "the driver did not answer a lease request");
+                    refuse(query, Status::LinkDown);
+                    false
+                }
+            }
+        });
+    }
+}
+
 fn expose_device<I: Interface>(
     allow: &Allow,
     ctx: &Context,
@@ -375,6 +448,19 @@ fn expose_device<I: Interface>(
         })
         .wait()
         .map_err(|e| e.to_string())?;
+    let (d, t) = (device.clone(), tx.clone());
+    let lease_queries = session
+        .declare_queryable(keys::device_key(device, "lease"))
+        .callback(move |query: Query| {
+            if let Err(mpsc::SendError(Event::Lease { query, .. })) = t.send(Event::Lease {
+                device: d.clone(),
+                query,
+            }) {
+                refuse(&query, Status::LinkDown);
+            }
+        })
+        .wait()
+        .map_err(|e| e.to_string())?;
     let token = session
         .liveliness()
         .declare_token(keys::device_key(device, "alive"))
@@ -393,6 +479,8 @@ fn expose_device<I: Interface>(
         },
         pending: Vec::new(),
         doubted: false,
+        leases: Vec::new(),
+        _leases: lease_queries,
         _token: token,
         _commands: commands,
         _queries: queries,
@@ -506,6 +594,10 @@ pub fn expose(
                         },
                         Event::Query { device, query } => match devices.get_mut(&device) {
                             Some(d) => d.query(query, config.request_timeout),
+                            None => refuse(&query, Status::LinkDown),
+                        },
+                        Event::Lease { device, query } => match devices.get_mut(&device) {
+                            Some(d) => d.lease(query, config.request_timeout),
                             None => refuse(&query, Status::LinkDown),
                         },
                     }

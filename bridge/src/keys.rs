@@ -7,6 +7,7 @@
 //! | `limber/<robot>/<interface>/<index>/cmd` | put by a remote client | the command envelope (e.g. `limber.v2.ActArrayCmdMsg`); attachment: the sender's origin id |
 //! | `limber/<robot>/<interface>/<index>/outcome/<origin>` | put by `expose` for each command of that origin | `limber.v2.OutcomeMsg` |
 //! | `limber/<robot>/<interface>/<index>/req` | queryable of `expose` | query: the request envelope; reply: the reply envelope |
+//! | `limber/<robot>/<interface>/<index>/lease` | queryable of `expose` | query: `limber.v2.LeaseReq`; reply: `limber.v2.LeaseReply` |
 //! | `limber/<robot>/<interface>/<index>/alive` | liveliness token of `expose` | none |
 //!
 //! A query that the driver does not answer in time (or cannot be relayed) gets an error
@@ -88,6 +89,16 @@ pub fn type_names<I: limber_interfaces::Interface>() -> TypeNames {
         req: <I::ReqMsg as WireStruct>::LAYOUT.type_name,
         reply: <I::ReplyMsg as WireStruct>::LAYOUT.type_name,
     }
+}
+
+/// The type name of a lease request.
+pub fn lease_req_type() -> &'static str {
+    <limber_interfaces::prelude::LeaseReq as WireStruct>::LAYOUT.type_name
+}
+
+/// The type name of a lease reply.
+pub fn lease_reply_type() -> &'static str {
+    <limber_interfaces::prelude::LeaseReply as WireStruct>::LAYOUT.type_name
 }
 
 /// The type name of an outcome.

@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 
 use limber_interfaces::prelude::*;
 use limber_interfaces::{HasHeader, Interface};
-use limber_services::relay::RelayedRequest;
+use limber_services::relay::{RelayedLease, RelayedRequest};
 use limber_services::{Context, DeviceHost, DeviceName, Domain, Role, monotonic_ns};
 use thiserror::Error;
 use zenoh::Wait;
@@ -132,8 +132,10 @@ struct Mirrored<I: Interface> {
     host: DeviceHost<I>,
     cmd_key: String,
     req_key: String,
+    lease_key: String,
     names: TypeNames,
     pending: Vec<(RelayedRequest<I>, FifoChannelHandler<Reply>, Instant)>,
+    leases: Vec<(RelayedLease, FifoChannelHandler<Reply>, Instant)>,
 }
 
 trait MirroredDevice {
@@ -223,6 +225,7 @@ impl<I: Interface> MirroredDevice for Mirrored<I> {
                 }
             }
         }
+        self.poll_leases(session, origin, timeout);
         let now = Instant::now();
         let mut done = Vec::new();
         let mut i = 0;
@@ -265,6 +268,79 @@ impl<I: Interface> MirroredDevice for Mirrored<I> {
     }
 }
 
+/// The refusal of lease request `req` with `status`.
+fn lease_nack(req: &LeaseReq, status: Status) -> LeaseReply {
+    LeaseReply {
+        seq: req.seq,
+        status: status.code(),
+        ..LeaseReply::default()
+    }
+}
+
+impl<I: Interface> Mirrored<I> {
+    /// Relays the clients' lease requests and answers those whose reply came.
+    fn poll_leases(&mut self, session: &Session, origin: &str, timeout: Duration) {
+        loop {
+            let req = match self.host.relay_take_lease() {
+                Ok(Some(r)) => r,
+                Ok(None) => break,
+                Err(e) => {
+                    tracing::warn!(device = %self.local, error = %e, "cannot take the lease requests");
+                    break;
+                }
+            };
+            match session
+                .get(&self.lease_key)
+                .payload(req.message().as_bytes().to_vec())
+                .encoding(keys::encoding(keys::lease_req_type()))
+                .attachment(origin)
+                .timeout(timeout)
+                .wait()
+            {
+                Ok(replies) => self.leases.push((req, replies, Instant::now() + timeout)),
+                Err(e) => {
+                    tracing::warn!(device = %self.local, error = %e, "cannot relay a lease request");
+                    let out = lease_nack(req.message(), Status::LinkDown);
+                    if let Err(e) = self.host.relay_answer_lease(req, &out) {
+                        tracing::debug!(device = %self.local, error = %e, "reply not delivered");
+                    }
+                }
+            }
+        }
+        let now = Instant::now();
+        let mut done = Vec::new();
+        let mut i = 0;
+        while i < self.leases.len() {
+            let (req, replies, deadline) = &self.leases[i];
+            let answer = match replies.try_recv() {
+                Ok(Some(reply)) => Some(match reply.result() {
+                    Ok(sample) => LeaseReply::read_from_bytes(&sample.payload().to_bytes())
+                        .unwrap_or_else(|_| lease_nack(req.message(), Status::LinkDown)),
+                    Err(err) => lease_nack(req.message(), status_of(err.payload())),
+                }),
+                Ok(None) if now < *deadline => None,
+                Ok(None) | Err(_) => Some(lease_nack(
+                    req.message(),
+                    if now >= *deadline {
+                        Status::Timeout
+                    } else {
+                        Status::LinkDown
+                    },
+                )),
+            };
+            match answer {
+                Some(a) => done.push((self.leases.swap_remove(i).0, a)),
+                None => i += 1,
+            }
+        }
+        for (req, reply) in done {
+            if let Err(e) = self.host.relay_answer_lease(req, &reply) {
+                tracing::debug!(device = %self.local, error = %e, "lease reply not delivered");
+            }
+        }
+    }
+}
+
 fn host_device<I: Interface>(
     ctx: &Context,
     remote: &DeviceName,
@@ -276,8 +352,10 @@ fn host_device<I: Interface>(
         host,
         cmd_key: keys::device_key(remote, "cmd"),
         req_key: keys::device_key(remote, "req"),
+        lease_key: keys::device_key(remote, "lease"),
         names: keys::type_names::<I>(),
         pending: Vec::new(),
+        leases: Vec::new(),
     }))
 }
 

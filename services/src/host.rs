@@ -696,6 +696,10 @@ impl<I: Interface> DeviceHost<I> {
         &self.publisher
     }
 
+    pub(crate) fn lease_port(&self) -> &Server<ipc::Service, LeaseReq, (), LeaseReply, ()> {
+        &self.lease_server
+    }
+
     pub(crate) fn notify_clients_of(&mut self, event: usize) {
         self.notify_clients(event);
     }

@@ -98,7 +98,7 @@ pub use host::{
     Origin, ProcessError, PublishError,
 };
 pub use naming::{Channel, DeviceName, Domain, NameError};
-pub use relay::{AnswerError, PendingRelay, RelayedRequest};
+pub use relay::{AnswerError, PendingLease, PendingRelay, RelayedLease, RelayedRequest};
 
 /// Everything a driver or client author needs, in one `use`.
 pub mod prelude {

@@ -14,7 +14,7 @@ use iceoryx2::prelude::*;
 use limber_interfaces::prelude::*;
 use thiserror::Error;
 
-use crate::client::{Client, CommandError, RequestError};
+use crate::client::{Client, CommandError, LeaseError, RequestError};
 use crate::error::Iox2Error;
 use crate::host::{DeviceHost, ProcessError, PublishError};
 use crate::naming::DRIVER_NODE_PREFIX;
@@ -253,5 +253,106 @@ impl<I: Interface> Client<I> {
         }
         // A node whose state cannot be read (yet) may be the driver: not known to be dead.
         alive || (unknown && !dead)
+    }
+}
+
+/// A lease request taken from a hosted device's clients, to be answered later
+/// ([`DeviceHost::relay_take_lease`], [`DeviceHost::relay_answer_lease`]).
+pub struct RelayedLease {
+    active: ActiveRequest<ipc::Service, LeaseReq, (), LeaseReply, ()>,
+}
+
+impl core::fmt::Debug for RelayedLease {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("RelayedLease")
+            .field("request", self.active.payload())
+            .finish()
+    }
+}
+
+impl RelayedLease {
+    /// The lease request as the client sent it.
+    pub fn message(&self) -> &LeaseReq {
+        self.active.payload()
+    }
+}
+
+impl<I: Interface> DeviceHost<I> {
+    /// Takes one pending lease request, to answer with [`DeviceHost::relay_answer_lease`]
+    /// (a relaying host keeps no lease of its own: the relayed device's driver does).
+    pub fn relay_take_lease(&mut self) -> Result<Option<RelayedLease>, ProcessError> {
+        match self.lease_port().receive() {
+            Ok(Some(active)) => Ok(Some(RelayedLease { active })),
+            Ok(None) => Ok(None),
+            Err(e) => Err(ProcessError::Receive(e)),
+        }
+    }
+
+    /// Answers a relayed lease request with `reply` as given, and wakes the clients.
+    pub fn relay_answer_lease(
+        &mut self,
+        req: RelayedLease,
+        reply: &LeaseReply,
+    ) -> Result<(), AnswerError> {
+        let sent = match req.active.loan_uninit() {
+            Ok(loan) => loan.write_payload(*reply).send().map_err(Iox2Error::from),
+            Err(e) => Err(e.into()),
+        };
+        self.notify_clients_of(qos::EVENT_REPLY);
+        sent.map_err(AnswerError::Undelivered)
+    }
+}
+
+/// A lease request sent by [`Client::relay_lease`], waiting for its reply.
+pub struct PendingLease {
+    pending: PendingResponse<ipc::Service, LeaseReq, (), LeaseReply, ()>,
+}
+
+impl core::fmt::Debug for PendingLease {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("PendingLease").finish_non_exhaustive()
+    }
+}
+
+impl PendingLease {
+    /// The reply, if it arrived; [`LeaseError::NoDriver`] once the driver left without
+    /// answering.
+    pub fn try_reply(&self) -> Result<Option<LeaseReply>, LeaseError> {
+        match self.pending.receive() {
+            Ok(Some(r)) => return Ok(Some(*r.payload())),
+            Ok(None) => {}
+            Err(e) => return Err(LeaseError::Transport(e.into())),
+        }
+        if self.pending.is_connected() {
+            return Ok(None);
+        }
+        match self.pending.receive() {
+            Ok(Some(r)) => Ok(Some(*r.payload())),
+            Ok(None) => Err(LeaseError::NoDriver),
+            Err(e) => Err(LeaseError::Transport(e.into())),
+        }
+    }
+}
+
+impl<I: Interface> Client<I> {
+    /// Sends lease request `req` as given, but as this client's node (the driver watches
+    /// the holder's node: a relayed holder's is the relay's), and returns at once. The
+    /// lease lives as long as the relayed holder's renewals keep arriving in time.
+    pub fn relay_lease(&mut self, req: &LeaseReq) -> Result<PendingLease, LeaseError> {
+        let mut req = *req;
+        req.set_node_id(self.context().node().id().value());
+        let side = self.lease_port()?;
+        let pending = side
+            .port
+            .loan_uninit()
+            .map_err(|e| LeaseError::Transport(e.into()))?
+            .write_payload(req)
+            .send()
+            .map_err(|e| LeaseError::Transport(e.into()))?;
+        if pending.number_of_server_connections() == 0 {
+            return Err(LeaseError::NoDriver);
+        }
+        self.wake_driver_with(qos::EVENT_REQUEST);
+        Ok(PendingLease { pending })
     }
 }

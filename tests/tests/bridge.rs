@@ -345,3 +345,70 @@ fn the_allow_list_keeps_devices_and_commands_out() {
         Status::Unsupported
     );
 }
+
+const CLIENT: &str = env!("CARGO_BIN_EXE_limber-test-client");
+
+/// Waits (bounded) until joint `j` has the flag `want` in three samples in a row.
+fn wait_joint_flag(a: &mut ActArrayClient, j: usize, want: ActuatorFlags, what: &str) {
+    let deadline = Instant::now() + Duration::from_secs(15);
+    let mut run = 0;
+    while run < 3 {
+        assert!(Instant::now() < deadline, "joint {j} never {what}");
+        let s = a.wait_state(Duration::from_secs(2)).expect("a state");
+        if ActuatorFlags::from_bits_truncate(s.actuators[j].state).contains(want) {
+            run += 1;
+        } else {
+            run = 0;
+        }
+    }
+}
+
+/// A client of domain B takes the arm of domain A through the bridges: B's other clients
+/// are refused with its name; when it dies mid-motion its renewals stop, and the driver's
+/// deadman stops the joint and frees the arm.
+#[test]
+fn a_remote_holder_that_dies_triggers_the_deadman() {
+    let s = setup();
+    let mut me = arm_in(&s.b);
+    me.current(Duration::from_secs(10)).expect("a first state");
+    let mut h = Proc::spawn(
+        CLIENT,
+        s.b.name(),
+        &[
+            "--robot",
+            "pioneer",
+            "own",
+            "--name",
+            "remote",
+            "--heartbeat-ms",
+            "1000",
+        ],
+    );
+    assert!(
+        h.read_until(|l| l.starts_with("owning")).is_some(),
+        "the holder did not take the arm through the bridge"
+    );
+    let held = me.holder().expect("ask").expect("held");
+    assert_eq!(held.name, "remote");
+    let t = me.move_to(2, 0.2).expect("send");
+    let o = me
+        .wait_outcome_detail(t, Duration::from_secs(5))
+        .expect("outcome");
+    assert_eq!(o.status, Status::Leased);
+    assert_eq!(o.other_name(), "remote");
+    wait_joint_flag(&mut me, 0, ActuatorFlags::MOVING, "moving");
+
+    h.signal(libc::SIGKILL);
+    wait_joint_flag(&mut me, 0, ActuatorFlags::IDLE, "stopped");
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while me.holder().expect("ask").is_some() {
+        assert!(Instant::now() < deadline, "the lease never ended");
+        let _ = me.wait_state(Duration::from_millis(100));
+    }
+    let t = me.move_to(0, 0.0).expect("send");
+    assert!(
+        me.wait_outcome(t, Duration::from_secs(5))
+            .expect("outcome")
+            .is_carried_out()
+    );
+}

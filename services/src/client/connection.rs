@@ -27,8 +27,8 @@ use crate::qos;
 pub(super) const OUTCOME_SLOTS: usize = 16;
 
 /// The lease port of a client and the lease it holds.
-pub(super) struct LeaseSide {
-    pub(super) port: IoxClient<ipc::Service, LeaseReq, (), LeaseReply, ()>,
+pub(crate) struct LeaseSide {
+    pub(crate) port: IoxClient<ipc::Service, LeaseReq, (), LeaseReply, ()>,
     pub(super) seq: u64,
     /// The heartbeat timeout and the time of the last renewal, while this client holds
     /// the device.
