@@ -1,6 +1,8 @@
-"""python/examples/zenoh_remote.py: a program with only Zenoh's Python package
-(`eclipse-zenoh`) reads the emulated Pioneer's state and commands it through
-`limber bridge expose`, and a refusal keeps its reason. Every wait has a timeout.
+"""Python across hosts: python/examples/zenoh_remote.py, a program with only Zenoh's
+Python package (`eclipse-zenoh`), reads the emulated Pioneer's state and commands it
+through `limber bridge expose`, and a refusal keeps its reason; and the unchanged Python
+client (iceoryx2) in another domain commands the arm through `limber bridge mirror`.
+Every wait has a timeout.
 """
 
 import itertools
@@ -97,7 +99,11 @@ def bridge():
     driver.wait_line(lambda l: l.endswith("ready"))
     expose = Job(domain, "bridge", "expose", "--listen", endpoint)
     expose.wait_line(lambda l: l == "exposed pioneer/actarray/0")
-    yield endpoint
+    mirror_domain = f"limber_tpyz{os.getpid()}_{next(_n)}"
+    mirror = Job(mirror_domain, "bridge", "mirror", "--connect", endpoint)
+    mirror.wait_line(lambda l: l == "mirrored pioneer/actarray/0 as pioneer/actarray/0")
+    yield endpoint, mirror_domain
+    assert mirror.stop() == 0
     assert expose.stop() == 0
     assert driver.stop() == 0
 
@@ -108,7 +114,7 @@ def run_example(endpoint, *args):
 
 
 def test_state_is_read_and_a_command_is_carried_out(bridge):
-    r = run_example(bridge, "pioneer/actarray/0", "1", "0.3")
+    r = run_example(bridge[0], "pioneer/actarray/0", "1", "0.3")
     assert r.returncode == 0, r.stderr
     lines = r.stdout.splitlines()
     assert lines[0].startswith("state #") and len(lines[0].split()) == 2 + 6, r.stdout
@@ -116,6 +122,20 @@ def test_state_is_read_and_a_command_is_carried_out(bridge):
 
 
 def test_a_refusal_keeps_its_reason(bridge):
-    r = run_example(bridge, "pioneer/actarray/0", "1", "9")
+    r = run_example(bridge[0], "pioneer/actarray/0", "1", "9")
     assert r.returncode == 5, r.stdout + r.stderr
     assert r.stdout.splitlines()[-1] == "refused: beyond limits", r.stdout
+
+
+def test_the_python_client_commands_the_arm_through_a_mirror(bridge):
+    from limber import ActArrayClient, Status
+
+    with ActArrayClient.connect("pioneer/actarray/0", bridge[1], timeout=T) as arm:
+        assert arm.geometry().actuators_count == 6
+        t = arm.move_to(2, 0.4)
+        assert arm.wait_outcome(t, T) is Status.OK
+        deadline = time.monotonic() + T
+        while abs(arm.wait_state(T).actuators[2].position - 0.4) > 0.02:
+            assert time.monotonic() < deadline, "joint 2 never reached 0.4"
+        t = arm.move_to(1, 9.0)
+        assert arm.wait_outcome(t, T) is Status.BEYOND_LIMITS
