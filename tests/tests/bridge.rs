@@ -413,3 +413,92 @@ fn a_remote_holder_that_dies_triggers_the_deadman() {
             .is_carried_out()
     );
 }
+
+/// Zenoh's user/password authentication, as bridge/README.md sets it up: a mirror with the
+/// wrong password gets nothing, one with the right password mirrors the arm.
+#[test]
+fn a_mirror_with_the_wrong_password_gets_nothing() {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("bridge-usrpwd-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a scratch directory");
+    let users = dir.join("users.txt");
+    std::fs::write(&users, "robot:a long secret\n").expect("write the users");
+    let config = |name: &str, password: &str, dictionary: bool| {
+        let path = dir.join(name);
+        let dict = if dictionary {
+            format!(", dictionary_file: \"{}\"", users.display())
+        } else {
+            String::new()
+        };
+        let text = format!(
+            "{{ transport: {{ auth: {{ usrpwd: {{ user: \"robot\", password: \"{password}\"{dict} }} }} }} }}\n"
+        );
+        std::fs::write(&path, text).expect("write a Zenoh configuration");
+        path.display().to_string()
+    };
+    let robot = config("robot.json5", "a long secret", true);
+    let good = config("good.json5", "a long secret", false);
+    let bad = config("bad.json5", "a guess", false);
+
+    let a = Domain::unique_for_test();
+    let _driver = start_driver(&a);
+    let endpoint = format!("tcp/127.0.0.1:{}", free_port());
+    let mut expose = Proc::spawn(
+        CLI,
+        a.name(),
+        &[
+            "bridge",
+            "expose",
+            "--listen",
+            &endpoint,
+            "--zenoh-config",
+            &robot,
+        ],
+    );
+    assert!(
+        expose
+            .read_until(|l| l == "exposed pioneer/actarray/0")
+            .is_some()
+    );
+    let b_bad = Domain::unique_for_test();
+    let mut intruder = Proc::spawn(
+        CLI,
+        b_bad.name(),
+        &[
+            "bridge",
+            "mirror",
+            "--connect",
+            &endpoint,
+            "--zenoh-config",
+            &bad,
+        ],
+    );
+    assert!(
+        intruder
+            .read_until(|l| l.starts_with("mirroring into"))
+            .is_some()
+    );
+    let b = Domain::unique_for_test();
+    let mut mirror = Proc::spawn(
+        CLI,
+        b.name(),
+        &[
+            "bridge",
+            "mirror",
+            "--connect",
+            &endpoint,
+            "--zenoh-config",
+            &good,
+        ],
+    );
+    wait_mirrored(&mut mirror);
+    let mut arm = arm_in(&b);
+    arm.geometry()
+        .expect("the geometry with the right password");
+    // The intruder started first and had as long: it mirrored nothing.
+    intruder.signal(libc::SIGTERM);
+    assert_eq!(intruder.wait_timeout(Duration::from_secs(20)), Some(0));
+    let rest = intruder.rest_of_stdout();
+    assert!(!rest.contains("mirrored"), "{rest}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
