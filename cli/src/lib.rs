@@ -10,6 +10,8 @@ use std::sync::OnceLock;
 use clap::{Parser, Subcommand};
 use limber_services::{Context, Domain, Role};
 
+#[cfg(feature = "bridge")]
+mod bridge;
 mod demo;
 mod device;
 mod echo;
@@ -97,6 +99,14 @@ enum Command {
     /// Measure latency: the command and state paths, requests, the loop through the
     /// emulator and IK, beside raw iceoryx2 (the floor) and Unix/TCP sockets (the peers).
     Bench(limber_bench::BenchArgs),
+    /// Carry devices between hosts over Zenoh: `expose` on the robot's PC puts this
+    /// domain's devices on the network, `mirror` on another host hosts them in its domain
+    /// under the same names.
+    ///
+    /// The walkthrough is in the README ("Between hosts"), the keys and payloads in
+    /// bridge/README.md.
+    #[cfg(feature = "bridge")]
+    Bridge(bridge::BridgeArgs),
 }
 
 /// Runs the `limber` command line with the process's arguments.
@@ -137,6 +147,8 @@ where
         Command::Pioneer(args) => pioneer::run(args),
         Command::Emulator(args) => emulator::run(args),
         Command::Simarm(args) => simarm::run(args),
+        #[cfg(feature = "bridge")]
+        Command::Bridge(args) => bridge::run(args),
         Command::Bench(args) => {
             limber_bench::run_cli(args).map_err(|e| CliError::new(exit::FAILURE, e.to_string()))
         }

@@ -13,7 +13,10 @@
 //!   the block gets one first (`limber pioneer --emulated`, `limber simarm`), as the
 //!   README's "in another terminal" says.
 //! * `CMD &` runs in the background until `kill %N` (SIGTERM; it must exit 0) or the end
-//!   of the block; a driver must print its "ready" line first.
+//!   of the block; a driver must print its "ready" line first, `limber bridge expose` its
+//!   first "exposed" line and `limber bridge mirror` its first "mirrored" line.
+//! * `--domain NAME` names a domain of the block's own (NAME prefixed with the block's
+//!   unique domain), so that a block may use several domains without meeting others.
 //! * `CMD > FILE`: CMD's output must equal FILE (the generated files are up to date).
 //! * `limber echo` without `--count` runs until its first sample, then gets Ctrl-C (SIGINT)
 //!   and must exit 0.
@@ -288,6 +291,19 @@ impl Drop for Job {
     }
 }
 
+/// The verb of `limber ARGS` and the word after it, past a leading `--domain NAME`.
+fn verb(args: &[String]) -> (Option<&str>, Option<&str>) {
+    let skip = match args.first().map(String::as_str) {
+        Some("--domain") => 2,
+        Some(a) if a.starts_with("--domain=") => 1,
+        _ => 0,
+    };
+    (
+        args.get(skip).map(String::as_str),
+        args.get(skip + 1).map(String::as_str),
+    )
+}
+
 /// A shell session: a domain of its own and the background jobs.
 struct Session {
     domain: Domain,
@@ -308,17 +324,43 @@ impl Session {
 
     fn background(&mut self, exe: &Path, args: &[String], what: &str) -> Result<(), String> {
         let mut job = Job::start(exe, args, self.domain.name(), what);
-        let driver = args
-            .first()
-            .is_some_and(|a| a == "pioneer" || a == "simarm");
-        if driver {
+        let (verb, role) = verb(args);
+        if verb == Some("pioneer") || verb == Some("simarm") {
             job.wait_line(|l| l.ends_with("ready"), START_TIMEOUT)
                 .map_err(|seen| format!("{what}: no \"ready\" line:\n{seen}"))?;
-            self.pioneer |= args[0] == "pioneer";
-            self.simarm |= args[0] == "simarm";
+            self.pioneer |= verb == Some("pioneer");
+            self.simarm |= verb == Some("simarm");
+        }
+        if verb == Some("bridge") {
+            let first = match role {
+                Some("expose") => "exposed ",
+                _ => "mirrored ",
+            };
+            job.wait_line(|l| l.starts_with(first), START_TIMEOUT)
+                .map_err(|seen| format!("{what}: no \"{first}\" line:\n{seen}"))?;
         }
         self.jobs.push(job);
         Ok(())
+    }
+
+    /// `--domain NAME` becomes a domain of this session's own.
+    fn own_domains(&self, args: Vec<String>) -> Vec<String> {
+        let mut out = Vec::with_capacity(args.len());
+        let mut it = args.into_iter();
+        while let Some(a) = it.next() {
+            let own = |n: &str| format!("{}_{n}", self.domain.name());
+            if a == "--domain" {
+                out.push(a);
+                if let Some(n) = it.next() {
+                    out.push(own(&n));
+                }
+            } else if let Some(n) = a.strip_prefix("--domain=") {
+                out.push(format!("--domain={}", own(n)));
+            } else {
+                out.push(a);
+            }
+        }
+        out
     }
 
     /// Starts the driver a command's device needs, if none runs yet.
@@ -357,17 +399,14 @@ impl Session {
         };
         let words: Vec<&str> = cmd.split_whitespace().collect();
         let (exe, args) = program(&words).ok_or(format!("{cmd}: not a command this test runs"))?;
-        if !(args
-            .first()
-            .is_some_and(|a| a == "pioneer" || a == "simarm")
-            && background)
-        {
+        let args = self.own_domains(args);
+        if !(matches!(verb(&args).0, Some("pioneer" | "simarm")) && background) {
             self.driver_for(cmd)?;
         }
         if background {
             return self.background(&exe, &args, cmd);
         }
-        if args.first().is_some_and(|a| a == "echo") && !args.iter().any(|a| a == "--count") {
+        if verb(&args).0 == Some("echo") && !args.iter().any(|a| a == "--count") {
             // Runs until Ctrl-C: one sample, then SIGINT; it exits 0 or dies of SIGINT, as
             // a shell's Ctrl-C expects.
             let mut job = Job::start(&exe, &args, self.domain.name(), cmd);

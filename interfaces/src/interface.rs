@@ -19,6 +19,18 @@ use crate::limb::{
     LimbCmdMsg, LimbCommand, LimbData, LimbReply, LimbReplyMsg, LimbReqMsg, LimbRequest,
 };
 use crate::message::{Envelope, Message, ReplyBody, ReplyEnvelope};
+use crate::wire::WireStruct;
+
+/// The byte view of a wire struct: its fixed layout as bytes, both ways (what a bridge
+/// carries over a network).
+pub trait WireBytes:
+    zerocopy::IntoBytes + zerocopy::FromBytes + zerocopy::Immutable + WireStruct
+{
+}
+impl<T: zerocopy::IntoBytes + zerocopy::FromBytes + zerocopy::Immutable + WireStruct> WireBytes
+    for T
+{
+}
 
 /// Which interface a device offers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -91,17 +103,17 @@ pub trait Interface: 'static {
     /// Which one.
     const KIND: InterfaceKind;
     /// The state (channel `data`).
-    type Data: HasHeader + Default + Copy + Debug + ZeroCopySend + Send + 'static;
+    type Data: HasHeader + Default + Copy + Debug + ZeroCopySend + Send + WireBytes + 'static;
     /// The command envelope (channel `cmd`).
-    type CmdMsg: Envelope + Debug + ZeroCopySend;
+    type CmdMsg: Envelope + Debug + ZeroCopySend + WireBytes;
     /// The typed command.
     type Command: Message<Raw = Self::CmdMsg> + Debug;
     /// The request envelope (channel `req`).
-    type ReqMsg: Envelope + Debug + ZeroCopySend;
+    type ReqMsg: Envelope + Debug + ZeroCopySend + WireBytes;
     /// The typed request.
     type Request: Message<Raw = Self::ReqMsg> + Debug;
     /// The reply envelope (channel `req`).
-    type ReplyMsg: ReplyEnvelope + Debug + ZeroCopySend;
+    type ReplyMsg: ReplyEnvelope + Debug + ZeroCopySend + WireBytes;
     /// The typed payload of an ACK.
     type Reply: ReplyBody<Raw = Self::ReplyMsg> + Debug;
 }

@@ -54,7 +54,7 @@ pub use common::{
     Vec3, device_flag,
 };
 pub use error::{DecodeError, ValueError};
-pub use interface::{ActArray, Gripper, HasHeader, Interface, InterfaceKind, Limb};
+pub use interface::{ActArray, Gripper, HasHeader, Interface, InterfaceKind, Limb, WireBytes};
 pub use manifest::Manifest;
 pub use message::{Envelope, Message, ReplyBody, ReplyEnvelope};
 pub use wire::{WireField, WireStruct};

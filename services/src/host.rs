@@ -690,6 +690,42 @@ impl<I: Interface> DeviceHost<I> {
         Ok(())
     }
 
+    /// Publishes the state as it is, header included (a relayed device's), and notifies.
+    pub(crate) fn publish_verbatim(&mut self) -> Result<(), PublishError> {
+        let sample = self.publisher.loan_uninit().map_err(PublishError::Loan)?;
+        sample
+            .write_payload(self.state)
+            .send()
+            .map_err(PublishError::Send)?;
+        self.stats.published += 1;
+        self.notify_clients(qos::EVENT_STATE);
+        Ok(())
+    }
+
+    pub(crate) fn commands_port(&self) -> &Subscriber<ipc::Service, I::CmdMsg, ()> {
+        &self.commands
+    }
+
+    pub(crate) fn server_port(&self) -> &Server<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()> {
+        &self.server
+    }
+
+    pub(crate) fn outcome_port(&self) -> &Publisher<ipc::Service, OutcomeMsg, ()> {
+        &self.outcomes
+    }
+
+    pub(crate) fn data_port(&self) -> &Publisher<ipc::Service, I::Data, ()> {
+        &self.publisher
+    }
+
+    pub(crate) fn lease_port(&self) -> &Server<ipc::Service, LeaseReq, (), LeaseReply, ()> {
+        &self.lease_server
+    }
+
+    pub(crate) fn notify_clients_of(&mut self, event: usize) {
+        self.notify_clients(event);
+    }
+
     /// Notifies waiting clients; a failure is counted and logged.
     fn notify_clients(&mut self, event: usize) {
         if let Err(e) = self.notify.notify_with_custom_event_id(EventId::new(event)) {

@@ -13,6 +13,7 @@
 //! * [`client`]: [`ActArrayClient`], [`LimbClient`], [`GripperClient`], in the spirit of
 //!   Player's proxies, with typed errors and timeouts on every wait.
 //! * [`discovery`]: [`list_devices`], with liveness.
+//! * [`relay`]: the raw side of a host and a client, for bridges to other domains.
 //! * [`error`]: [`Iox2Error`], the iceoryx2 cause kept inside every transport error.
 //!
 //! Every fallible operation has its own error enum; none is flattened into text, and
@@ -78,6 +79,7 @@ pub mod event_loop;
 pub mod host;
 pub mod naming;
 pub mod qos;
+pub mod relay;
 pub mod signals;
 pub mod testing;
 pub mod widen;
@@ -97,6 +99,7 @@ pub use host::{
     Origin, ProcessError, PublishError,
 };
 pub use naming::{Channel, DeviceName, Domain, NameError};
+pub use relay::{AnswerError, PendingLease, PendingRelay, RelayedLease, RelayedRequest};
 
 /// Everything a driver or client author needs, in one `use`.
 pub mod prelude {

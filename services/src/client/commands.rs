@@ -61,7 +61,7 @@ impl<I: Interface> Client<I> {
     /// connection to it failed (iceoryx2 then retries only when a port joins or leaves the
     /// service): a new notifier is made, which connects afresh, at most every
     /// [`WAKE_RETRY`], and the wake-up sent again.
-    pub(super) fn wake_driver_with(&self, event: usize) {
+    pub(crate) fn wake_driver_with(&self, event: usize) {
         let sent = self
             .wake
             .borrow()

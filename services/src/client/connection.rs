@@ -32,8 +32,8 @@ pub const GROUP_PERMISSION_WAIT: Duration = Duration::from_secs(2);
 pub(super) const OUTCOME_SLOTS: usize = 16;
 
 /// The lease port of a client and the lease it holds.
-pub(super) struct LeaseSide {
-    pub(super) port: IoxClient<ipc::Service, LeaseReq, (), LeaseReply, ()>,
+pub(crate) struct LeaseSide {
+    pub(crate) port: IoxClient<ipc::Service, LeaseReq, (), LeaseReply, ()>,
     pub(super) seq: u64,
     /// The heartbeat timeout and the time of the last renewal, while this client holds
     /// the device.
@@ -52,13 +52,13 @@ type DataSvc<I> = iceoryx2::service::port_factory::publish_subscribe::PortFactor
 /// either. Not `Send`: create it on the thread that uses it.
 pub struct Client<I: Interface> {
     pub(super) ctx: Context,
-    pub(super) device: DeviceName,
+    pub(crate) device: DeviceName,
     pub(super) client_id: u64,
-    pub(super) data_svc: DataSvc<I>,
-    pub(super) states: Subscriber<ipc::Service, I::Data, ()>,
+    pub(crate) data_svc: DataSvc<I>,
+    pub(crate) states: Subscriber<ipc::Service, I::Data, ()>,
     pub(super) latest: Option<Sample<ipc::Service, I::Data, ()>>,
-    pub(super) commands: Publisher<ipc::Service, I::CmdMsg, ()>,
-    pub(super) requests: IoxClient<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()>,
+    pub(crate) commands: Publisher<ipc::Service, I::CmdMsg, ()>,
+    pub(crate) requests: IoxClient<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()>,
     /// Wakes the driver; replaced when a wake-up reaches no listener (see
     /// `Client::wake_driver_with`).
     pub(super) wake: core::cell::RefCell<Notifier<ipc::Service>>,
@@ -69,7 +69,7 @@ pub struct Client<I: Interface> {
     pub(super) notify: Option<Listener<ipc::Service>>,
     pub(super) cmd_seq: u64,
     pub(super) req_seq: u64,
-    pub(super) outcome_sub: Subscriber<ipc::Service, OutcomeMsg, ()>,
+    pub(crate) outcome_sub: Subscriber<ipc::Service, OutcomeMsg, ()>,
     pub(super) outcomes: [Outcome; OUTCOME_SLOTS],
     pub(super) preemptions: [Outcome; OUTCOME_SLOTS],
     pub(super) max_seen_seq: u64,

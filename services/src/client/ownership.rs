@@ -167,7 +167,7 @@ impl<I: Interface> Client<I> {
     }
 
     /// Opens the lease port on first use.
-    fn lease_port(&mut self) -> Result<&mut LeaseSide, LeaseError> {
+    pub(crate) fn lease_port(&mut self) -> Result<&mut LeaseSide, LeaseError> {
         if self.lease.is_none() {
             let layout = AttributeVerifier::new()
                 .require(

@@ -1,0 +1,619 @@
+//! `limber bridge expose`: a domain's devices on Zenoh.
+//!
+//! The bridge joins the domain as a client of every device it finds (as `limber list`
+//! does, skipping devices that a mirror hosts), and per device:
+//! publishes each state sample on `.../state`; takes commands from `.../cmd` and sends them
+//! to the driver under a client id of its own per remote client (so the driver tells
+//! remote clients apart: their outcomes and preemptions come back to each one on
+//! `.../outcome/<origin>`); answers queries on `.../req` with the driver's reply, or with
+//! an error carrying a status code when the driver does not answer in time; and holds a
+//! liveliness token `.../alive` while the driver lives.
+
+use std::collections::HashMap;
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use limber_interfaces::Interface;
+use limber_interfaces::message::Message;
+use limber_interfaces::prelude::*;
+use limber_services::relay::{PendingLease, PendingRelay};
+use limber_services::{Client, Context, DeviceName, Domain, Role, list_devices};
+use thiserror::Error;
+use zenoh::Wait;
+use zenoh::liveliness::LivelinessToken;
+use zenoh::pubsub::{Publisher, Subscriber};
+use zenoh::query::{Query, Queryable};
+use zenoh::sample::Sample;
+use zenoh::{Session, bytes::ZBytes};
+use zerocopy::{FromBytes, IntoBytes};
+
+use crate::allow::Allow;
+use crate::keys::{self, TypeNames};
+use crate::session::{self, NetConfig, SessionError};
+
+/// The driver name a mirror hosts its devices under; `expose` skips such devices so that a
+/// mirror and an exposing bridge in one domain do not loop.
+pub const MIRROR_DRIVER: &str = "bridge";
+
+/// How `expose` runs.
+#[derive(Debug, Clone)]
+pub struct ExposeConfig {
+    /// The network side.
+    pub net: NetConfig,
+    /// How long the driver has to answer a relayed request.
+    pub request_timeout: Duration,
+    /// How often the domain is looked at for new devices.
+    pub discovery_period: Duration,
+    /// What passes: devices, commands, requests that change a device.
+    pub allow: Allow,
+}
+
+impl Default for ExposeConfig {
+    fn default() -> Self {
+        ExposeConfig {
+            net: NetConfig {
+                listen: vec!["tcp/127.0.0.1:7447".into()],
+                ..NetConfig::default()
+            },
+            request_timeout: Duration::from_millis(1500),
+            discovery_period: Duration::from_millis(250),
+            allow: Allow::default(),
+        }
+    }
+}
+
+/// What `expose` reports as it runs.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ExposeEvent {
+    /// The Zenoh session is open.
+    Ready {
+        /// This bridge's Zenoh id.
+        zid: String,
+    },
+    /// A device is on Zenoh now.
+    Exposed(DeviceName),
+    /// A device's driver is gone: its token is withdrawn.
+    Gone(DeviceName),
+}
+
+/// `expose` failed.
+#[derive(Debug, Error)]
+pub enum ExposeError {
+    /// The Zenoh session could not be opened.
+    #[error(transparent)]
+    Session(#[from] SessionError),
+    /// The domain could not be joined.
+    #[error("cannot join domain {domain}: {source}")]
+    Domain {
+        /// The domain.
+        domain: String,
+        /// Why.
+        #[source]
+        source: limber_services::ContextError,
+    },
+}
+
+enum Event {
+    Command {
+        device: DeviceName,
+        origin: String,
+        payload: Vec<u8>,
+    },
+    Query {
+        device: DeviceName,
+        query: Query,
+    },
+    Lease {
+        device: DeviceName,
+        query: Query,
+    },
+}
+
+/// The origin id of a command or query: its attachment, if it is a valid key chunk.
+fn origin_of(attachment: Option<&ZBytes>) -> Option<String> {
+    match attachment {
+        None => Some(keys::ANONYMOUS_ORIGIN.to_string()),
+        Some(a) => a
+            .try_to_string()
+            .ok()
+            .map(|s| s.into_owned())
+            .filter(|s| keys::valid_chunk(s)),
+    }
+}
+
+/// Replies to `query` with an error carrying `status` (4 bytes, little-endian).
+fn refuse(query: &Query, status: Status) {
+    let payload = status.code().to_le_bytes().to_vec();
+    if let Err(e) = query
+        .reply_err(payload)
+        .encoding(keys::encoding(keys::STATUS_TYPE))
+        .wait()
+    {
+        tracing::warn!(key = %query.key_expr(), error = %e, "cannot answer a query");
+    }
+}
+
+/// The ids remote clients have in the domain: one local client id per (origin, remote
+/// client id), so the driver tells them apart.
+struct Ids {
+    ctx: Context,
+    to_local: HashMap<(String, u64), u64>,
+    to_remote: HashMap<u64, (String, u64)>,
+}
+
+/// At most this many remote clients are remembered per device; past it the table starts
+/// anew (outcomes of the forgotten ones' earlier commands are dropped).
+const MAX_REMOTE_CLIENTS: usize = 4096;
+
+impl Ids {
+    fn local(&mut self, origin: &str, remote: u64) -> u64 {
+        if let Some(id) = self.to_local.get(&(origin.to_string(), remote)) {
+            return *id;
+        }
+        if self.to_local.len() >= MAX_REMOTE_CLIENTS {
+            tracing::warn!("more than {MAX_REMOTE_CLIENTS} remote clients: forgetting them");
+            self.to_local.clear();
+            self.to_remote.clear();
+        }
+        let id = self.ctx.new_client_id();
+        self.to_local.insert((origin.to_string(), remote), id);
+        self.to_remote.insert(id, (origin.to_string(), remote));
+        id
+    }
+}
+
+/// One device put on Zenoh.
+struct Exposed<I: Interface> {
+    device: DeviceName,
+    client: Client<I>,
+    state_pub: Publisher<'static>,
+    names: TypeNames,
+    allow: Allow,
+    ids: Ids,
+    pending: Vec<(Query, PendingRelay<I>, Instant, u64)>,
+    /// The last liveness check found the driver dead.
+    doubted: bool,
+    leases: Vec<(Query, PendingLease, Instant)>,
+    _token: LivelinessToken,
+    _commands: Subscriber<()>,
+    _queries: Queryable<()>,
+    _leases: Queryable<()>,
+}
+
+trait ExposedDevice {
+    fn command(&mut self, session: &Session, origin: &str, payload: &[u8]);
+    fn query(&mut self, query: Query, timeout: Duration);
+    fn lease(&mut self, query: Query, timeout: Duration);
+    fn poll(&mut self, session: &Session);
+    fn alive(&self) -> bool;
+    fn doubted(&self) -> bool;
+    fn set_doubted(&mut self, on: bool);
+}
+
+impl<I: Interface> ExposedDevice for Exposed<I> {
+    fn command(&mut self, session: &Session, origin: &str, payload: &[u8]) {
+        let Ok(mut cmd) = I::CmdMsg::read_from_bytes(payload) else {
+            tracing::warn!(device = %self.device, origin, len = payload.len(),
+                "a command of the wrong size ({} expected): dropped", self.names.cmd);
+            return;
+        };
+        let meta = *cmd.meta();
+        if !self.allow.command(I::KIND, meta.kind) {
+            tracing::warn!(device = %self.device, origin, kind = meta.kind,
+                "a command this bridge does not let through: refused");
+            let o = OutcomeMsg {
+                client_id: meta.client_id,
+                cmd_seq: meta.seq,
+                stamp_ns: limber_services::monotonic_ns(),
+                kind: meta.kind,
+                status: Status::Unsupported.code(),
+                ..OutcomeMsg::default()
+            };
+            put_outcome(session, &self.device, origin, &o);
+            return;
+        }
+        let meta = cmd.meta_mut();
+        meta.client_id = self.ids.local(origin, meta.client_id);
+        if let Err(e) = self.client.relay_send(&cmd) {
+            tracing::warn!(device = %self.device, origin, error = %e, "cannot relay a command");
+        }
+    }
+
+    fn query(&mut self, query: Query, timeout: Duration) {
+        let Some(origin) = origin_of(query.attachment()) else {
+            refuse(&query, Status::InvalidArgument);
+            return;
+        };
+        let bytes = query.payload().map(|p| p.to_bytes().into_owned());
+        let Some(Ok(mut req)) = bytes.as_deref().map(I::ReqMsg::read_from_bytes) else {
+            tracing::warn!(device = %self.device, "a request of the wrong size: refused");
+            refuse(&query, Status::InvalidArgument);
+            return;
+        };
+        let remote = req.meta().client_id;
+        if self.allow.read_only && !I::Request::read(&req).is_ok_and(|r| r.is_read_only()) {
+            tracing::warn!(device = %self.device, origin, "a request that changes the device: refused (read-only bridge)");
+            let out = keys::nack::<I>(&req, Status::Unsupported);
+            if let Err(e) = query
+                .reply(query.key_expr().clone(), out.as_bytes().to_vec())
+                .encoding(keys::encoding(self.names.reply))
+                .wait()
+            {
+                tracing::warn!(key = %query.key_expr(), error = %e, "cannot answer a query");
+            }
+            return;
+        }
+        req.meta_mut().client_id = self.ids.local(&origin, remote);
+        match self.client.relay_request(&req) {
+            Ok(p) => self
+                .pending
+                .push((query, p, Instant::now() + timeout, remote)),
+            Err(e) => {
+                tracing::warn!(device = %self.device, error = %e, "cannot relay a request");
+                refuse(&query, Status::LinkDown);
+            }
+        }
+    }
+
+    fn lease(&mut self, query: Query, timeout: Duration) {
+        let Some(origin) = origin_of(query.attachment()) else {
+            refuse(&query, Status::InvalidArgument);
+            return;
+        };
+        let bytes = query.payload().map(|p| p.to_bytes().into_owned());
+        let Some(Ok(mut req)) = bytes.as_deref().map(LeaseReq::read_from_bytes) else {
+            tracing::warn!(device = %self.device, "a lease request of the wrong size: refused");
+            refuse(&query, Status::InvalidArgument);
+            return;
+        };
+        if self.allow.read_only || self.allow.commands.is_some() {
+            // A lease would let a remote client refuse the robot's own clients: only a
+            // bridge that lets every command through carries leases.
+            refuse(&query, Status::Unsupported);
+            return;
+        }
+        req.client_id = self.ids.local(&origin, req.client_id);
+        match self.client.relay_lease(&req) {
+            Ok(p) => self.leases.push((query, p, Instant::now() + timeout)),
+            Err(e) => {
+                tracing::warn!(device = %self.device, error = %e, "cannot relay a lease request");
+                refuse(&query, Status::LinkDown);
+            }
+        }
+    }
+
+    fn poll(&mut self, session: &Session) {
+        self.poll_leases();
+        let (device, state_pub) = (&self.device, &self.state_pub);
+        if let Err(e) = self.client.relay_states(|d| {
+            if let Err(e) = state_pub.put(d.as_bytes().to_vec()).wait() {
+                tracing::warn!(device = %device, error = %e, "cannot publish a state on Zenoh");
+            }
+        }) {
+            tracing::warn!(device = %self.device, error = %e, "cannot take the states");
+        }
+        let mut outcomes = Vec::new();
+        if let Err(e) = self.client.relay_outcomes(|o| outcomes.push(*o)) {
+            tracing::warn!(device = %self.device, error = %e, "cannot take the outcomes");
+        }
+        for mut o in outcomes {
+            let Some((origin, remote)) = self.ids.to_remote.get(&o.client_id).cloned() else {
+                continue; // a local client's
+            };
+            o.client_id = remote;
+            if let Some((_, other)) = self.ids.to_remote.get(&o.other_client) {
+                o.other_client = *other;
+            }
+            put_outcome(session, &self.device, &origin, &o);
+        }
+        let now = Instant::now();
+        let names = self.names;
+        self.pending.retain(|(query, p, deadline, remote)| {
+            match p.try_reply() {
+                Ok(Some(mut reply)) => {
+                    reply.meta_mut().client_id = *remote;
+                    if let Err(e) = query
+                        .reply(query.key_expr().clone(), reply.as_bytes().to_vec())
+                        .encoding(keys::encoding(names.reply))
+                        .wait()
+                    {
+                        tracing::warn!(key = %query.key_expr(), error = %e, "cannot answer a query");
+                    }
+                    false
+                }
+                Ok(None) if now < *deadline => true,
+                Ok(None) => {
+                    refuse(query, Status::Timeout);
+                    false
+                }
+                Err(e) => {
+                    tracing::warn!(key = %query.key_expr(), error = %e, "the driver did not answer");
+                    refuse(query, Status::LinkDown);
+                    false
+                }
+            }
+        });
+    }
+
+    fn alive(&self) -> bool {
+        self.client.relay_driver_alive()
+    }
+
+    fn doubted(&self) -> bool {
+        self.doubted
+    }
+
+    fn set_doubted(&mut self, on: bool) {
+        self.doubted = on;
+    }
+}
+
+/// Puts outcome `o` for the commands of `origin`.
+fn put_outcome(session: &Session, device: &DeviceName, origin: &str, o: &OutcomeMsg) {
+    let key = keys::outcome_key(device, origin);
+    if let Err(e) = session
+        .put(&key, o.as_bytes().to_vec())
+        .encoding(keys::encoding(keys::outcome_type()))
+        .wait()
+    {
+        tracing::warn!(device = %device, error = %e, "cannot publish an outcome");
+    }
+}
+
+impl<I: Interface> Exposed<I> {
+    /// Answers the lease queries whose reply arrived (holder ids told as the remote
+    /// clients know them).
+    fn poll_leases(&mut self) {
+        let now = Instant::now();
+        let ids = &self.ids;
+        self.leases.retain(|(query, p, deadline)| {
+            match p.try_reply() {
+                Ok(Some(mut reply)) => {
+                    reply.holder_client = match ids.to_remote.get(&reply.holder_client) {
+                        Some((_, r)) => *r,
+                        None => reply.holder_client,
+                    };
+                    reply.set_holder_node(0);
+                    if let Err(e) = query
+                        .reply(query.key_expr().clone(), reply.as_bytes().to_vec())
+                        .encoding(keys::encoding(keys::lease_reply_type()))
+                        .wait()
+                    {
+                        tracing::warn!(key = %query.key_expr(), error = %e, "cannot answer a lease query");
+                    }
+                    false
+                }
+                Ok(None) if now < *deadline => true,
+                Ok(None) => {
+                    refuse(query, Status::Timeout);
+                    false
+                }
+                Err(e) => {
+                    tracing::warn!(key = %query.key_expr(), error = %e, "the driver did not answer a lease request");
+                    refuse(query, Status::LinkDown);
+                    false
+                }
+            }
+        });
+    }
+}
+
+fn expose_device<I: Interface>(
+    allow: &Allow,
+    ctx: &Context,
+    session: &Session,
+    device: &DeviceName,
+    tx: &mpsc::Sender<Event>,
+) -> Result<Box<dyn ExposedDevice>, String> {
+    let client = Client::<I>::connect(ctx, &device.to_string()).map_err(|e| e.to_string())?;
+    // The same test as the one that withdraws it: a driver found dead is not exposed.
+    if !client.relay_driver_alive() {
+        return Err("its driver is not alive".into());
+    }
+    let names = keys::type_names::<I>();
+    let state_pub = session
+        .declare_publisher(keys::device_key(device, "state"))
+        .encoding(keys::encoding(names.data))
+        .wait()
+        .map_err(|e| e.to_string())?;
+    let (d, t) = (device.clone(), tx.clone());
+    let commands = session
+        .declare_subscriber(keys::device_key(device, "cmd"))
+        .callback(move |s: Sample| {
+            let Some(origin) = origin_of(s.attachment()) else {
+                tracing::warn!(device = %d, "a command with an invalid origin: dropped");
+                return;
+            };
+            let ev = Event::Command {
+                device: d.clone(),
+                origin,
+                payload: s.payload().to_bytes().into_owned(),
+            };
+            if t.send(ev).is_err() {
+                tracing::debug!(device = %d, "the bridge is ending: command dropped");
+            }
+        })
+        .wait()
+        .map_err(|e| e.to_string())?;
+    let (d, t) = (device.clone(), tx.clone());
+    let queries = session
+        .declare_queryable(keys::device_key(device, "req"))
+        .callback(move |query: Query| {
+            if let Err(mpsc::SendError(Event::Query { query, .. })) = t.send(Event::Query {
+                device: d.clone(),
+                query,
+            }) {
+                refuse(&query, Status::LinkDown);
+            }
+        })
+        .wait()
+        .map_err(|e| e.to_string())?;
+    let (d, t) = (device.clone(), tx.clone());
+    let lease_queries = session
+        .declare_queryable(keys::device_key(device, "lease"))
+        .callback(move |query: Query| {
+            if let Err(mpsc::SendError(Event::Lease { query, .. })) = t.send(Event::Lease {
+                device: d.clone(),
+                query,
+            }) {
+                refuse(&query, Status::LinkDown);
+            }
+        })
+        .wait()
+        .map_err(|e| e.to_string())?;
+    let token = session
+        .liveliness()
+        .declare_token(keys::device_key(device, "alive"))
+        .wait()
+        .map_err(|e| e.to_string())?;
+    Ok(Box::new(Exposed::<I> {
+        device: device.clone(),
+        client,
+        state_pub,
+        names,
+        allow: allow.clone(),
+        ids: Ids {
+            ctx: ctx.clone(),
+            to_local: HashMap::new(),
+            to_remote: HashMap::new(),
+        },
+        pending: Vec::new(),
+        doubted: false,
+        leases: Vec::new(),
+        _leases: lease_queries,
+        _token: token,
+        _commands: commands,
+        _queries: queries,
+    }))
+}
+
+/// Puts the devices of `domain` on Zenoh until `stop` returns true; `report` hears of
+/// each device that comes and goes.
+pub fn expose(
+    domain: &Domain,
+    config: &ExposeConfig,
+    stop: &dyn Fn() -> bool,
+    report: &mut dyn FnMut(ExposeEvent),
+) -> Result<(), ExposeError> {
+    let ctx = Context::new(domain, Role::Client, "bridge-expose").map_err(|source| {
+        ExposeError::Domain {
+            domain: domain.name().to_string(),
+            source,
+        }
+    })?;
+    let session = session::open(&config.net)?;
+    report(ExposeEvent::Ready {
+        zid: session.zid().to_string(),
+    });
+    let (tx, rx) = mpsc::channel::<Event>();
+    let mut devices: HashMap<DeviceName, Box<dyn ExposedDevice>> = HashMap::new();
+    let mut next_discovery = Instant::now();
+    let mut next_liveness = Instant::now();
+    while !stop() {
+        let now = Instant::now();
+        if now >= next_discovery {
+            next_discovery = now + config.discovery_period;
+            match list_devices(domain) {
+                Ok(list) => {
+                    for info in list {
+                        if !info.alive
+                            || info.driver == MIRROR_DRIVER
+                            || !config.allow.device(&info.name)
+                            || devices.contains_key(&info.name)
+                        {
+                            continue;
+                        }
+                        let made = match info.interface() {
+                            InterfaceKind::ActArray => expose_device::<ActArray>(
+                                &config.allow,
+                                &ctx,
+                                &session,
+                                &info.name,
+                                &tx,
+                            ),
+                            InterfaceKind::Limb => expose_device::<Limb>(
+                                &config.allow,
+                                &ctx,
+                                &session,
+                                &info.name,
+                                &tx,
+                            ),
+                            InterfaceKind::Gripper => expose_device::<Gripper>(
+                                &config.allow,
+                                &ctx,
+                                &session,
+                                &info.name,
+                                &tx,
+                            ),
+                        };
+                        match made {
+                            Ok(d) => {
+                                tracing::info!(device = %info.name, "exposed");
+                                devices.insert(info.name.clone(), d);
+                                report(ExposeEvent::Exposed(info.name));
+                            }
+                            Err(e) => {
+                                tracing::warn!(device = %info.name, error = %e, "cannot expose")
+                            }
+                        }
+                    }
+                }
+                Err(e) => tracing::warn!(error = %e, "cannot list the devices"),
+            }
+        }
+        if now >= next_liveness {
+            next_liveness = now + Duration::from_millis(100);
+            // Withdrawn after two checks in a row find the driver dead (100 ms apart), so a
+            // passing doubt never makes a device flap.
+            let gone: Vec<DeviceName> = devices
+                .iter_mut()
+                .filter_map(|(n, d)| {
+                    let (alive, doubted) = (d.alive(), d.doubted());
+                    d.set_doubted(!alive);
+                    (!alive && doubted).then(|| n.clone())
+                })
+                .collect();
+            for name in gone {
+                // The token is withdrawn (dropped) before anybody is told so.
+                drop(devices.remove(&name));
+                tracing::info!(device = %name, "driver gone: withdrawn");
+                report(ExposeEvent::Gone(name));
+            }
+        }
+        match rx.recv_timeout(Duration::from_millis(1)) {
+            Ok(first) => {
+                for ev in std::iter::once(first).chain(rx.try_iter()) {
+                    match ev {
+                        Event::Command {
+                            device,
+                            origin,
+                            payload,
+                        } => match devices.get_mut(&device) {
+                            Some(d) => d.command(&session, &origin, &payload),
+                            None => tracing::debug!(device = %device, "command for a device gone"),
+                        },
+                        Event::Query { device, query } => match devices.get_mut(&device) {
+                            Some(d) => d.query(query, config.request_timeout),
+                            None => refuse(&query, Status::LinkDown),
+                        },
+                        Event::Lease { device, query } => match devices.get_mut(&device) {
+                            Some(d) => d.lease(query, config.request_timeout),
+                            None => refuse(&query, Status::LinkDown),
+                        },
+                    }
+                }
+            }
+            Err(mpsc::RecvTimeoutError::Timeout) => {}
+            // Not while `tx` lives.
+            Err(mpsc::RecvTimeoutError::Disconnected) => break,
+        }
+        for d in devices.values_mut() {
+            d.poll(&session);
+        }
+    }
+    drop(devices);
+    if let Err(e) = session.close().wait() {
+        tracing::warn!(error = %e, "cannot close the Zenoh session");
+    }
+    Ok(())
+}

@@ -1,0 +1,146 @@
+//! The Zenoh key expressions of a device `robot/interface/index` and the type names of
+//! their payloads.
+//!
+//! | key | what | payload |
+//! | --- | --- | --- |
+//! | `limber/<robot>/<interface>/<index>/state` | put by `expose` on every state sample | the interface's state struct (e.g. `limber.v2.ActArrayData`) |
+//! | `limber/<robot>/<interface>/<index>/cmd` | put by a remote client | the command envelope (e.g. `limber.v2.ActArrayCmdMsg`); attachment: the sender's origin id |
+//! | `limber/<robot>/<interface>/<index>/outcome/<origin>` | put by `expose` for each command of that origin | `limber.v2.OutcomeMsg` |
+//! | `limber/<robot>/<interface>/<index>/req` | queryable of `expose` | query: the request envelope; reply: the reply envelope |
+//! | `limber/<robot>/<interface>/<index>/lease` | queryable of `expose` | query: `limber.v2.LeaseReq`; reply: `limber.v2.LeaseReply` |
+//! | `limber/<robot>/<interface>/<index>/alive` | liveliness token of `expose` | none |
+//!
+//! A query that the driver does not answer in time (or cannot be relayed) gets an error
+//! reply whose payload is a `Status` code, 4 bytes little-endian (encoding schema
+//! `limber.Status`).
+//!
+//! Every sample's encoding is `application/octet-stream` with the type name as its schema.
+
+use limber_interfaces::message::{Envelope, ReplyBody, ReplyEnvelope};
+use limber_interfaces::prelude::Status;
+use limber_interfaces::{Interface, WireStruct};
+use limber_services::DeviceName;
+use limber_services::monotonic_ns;
+
+/// The first chunk of every key.
+pub const ROOT: &str = "limber";
+
+/// The origin used for a command that carries no attachment.
+pub const ANONYMOUS_ORIGIN: &str = "_";
+
+/// The key of one channel of `device` (`state`, `cmd`, `req`, `alive`).
+pub fn device_key(device: &DeviceName, channel: &str) -> String {
+    format!(
+        "{ROOT}/{}/{}/{}/{channel}",
+        device.robot(),
+        device.interface().name(),
+        device.index()
+    )
+}
+
+/// The key of the outcomes of `device` for the commands of `origin`.
+pub fn outcome_key(device: &DeviceName, origin: &str) -> String {
+    format!("{}/{origin}", device_key(device, "outcome"))
+}
+
+/// The key expression that matches channel `channel` of every device.
+pub fn all_devices(channel: &str) -> String {
+    format!("{ROOT}/*/*/*/{channel}")
+}
+
+/// The device and the channel (everything after the index) of a key, if it is one of
+/// ours.
+pub fn parse(key: &str) -> Option<(DeviceName, &str)> {
+    let rest = key.strip_prefix(ROOT)?.strip_prefix('/')?;
+    let mut parts = rest.splitn(4, '/');
+    let (robot, interface, index) = (parts.next()?, parts.next()?, parts.next()?);
+    let channel = parts.next()?;
+    let device = format!("{robot}/{interface}/{index}").parse().ok()?;
+    Some((device, channel))
+}
+
+/// Whether `s` may be one chunk of a key expression chosen by a peer (an origin id): no
+/// wildcard, separator or special character.
+pub fn valid_chunk(s: &str) -> bool {
+    !s.is_empty()
+        && s.len() <= 64
+        && s.bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-' || b == b'.')
+}
+
+/// The type names of the payloads of one interface.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TypeNames {
+    /// The state.
+    pub data: &'static str,
+    /// The command envelope.
+    pub cmd: &'static str,
+    /// The request envelope.
+    pub req: &'static str,
+    /// The reply envelope.
+    pub reply: &'static str,
+}
+
+/// The type names of interface `I`'s payloads.
+pub fn type_names<I: limber_interfaces::Interface>() -> TypeNames {
+    TypeNames {
+        data: <I::Data as WireStruct>::LAYOUT.type_name,
+        cmd: <I::CmdMsg as WireStruct>::LAYOUT.type_name,
+        req: <I::ReqMsg as WireStruct>::LAYOUT.type_name,
+        reply: <I::ReplyMsg as WireStruct>::LAYOUT.type_name,
+    }
+}
+
+/// The type name of a lease request.
+pub fn lease_req_type() -> &'static str {
+    <limber_interfaces::prelude::LeaseReq as WireStruct>::LAYOUT.type_name
+}
+
+/// The type name of a lease reply.
+pub fn lease_reply_type() -> &'static str {
+    <limber_interfaces::prelude::LeaseReply as WireStruct>::LAYOUT.type_name
+}
+
+/// The type name of an outcome.
+pub fn outcome_type() -> &'static str {
+    <limber_interfaces::prelude::OutcomeMsg as WireStruct>::LAYOUT.type_name
+}
+
+/// The encoding of a payload of type `type_name`.
+pub fn encoding(type_name: &str) -> zenoh::bytes::Encoding {
+    zenoh::bytes::Encoding::APPLICATION_OCTET_STREAM.with_schema(type_name)
+}
+
+/// The type name of an error reply to a query: a `Status` code as 4 bytes, little-endian.
+pub const STATUS_TYPE: &str = "limber.Status";
+
+/// The NACK of `req` with `status`.
+pub(crate) fn nack<I: Interface>(req: &I::ReqMsg, status: Status) -> I::ReplyMsg {
+    let mut out = I::ReplyMsg::default();
+    let meta = *req.meta();
+    I::Reply::write(meta.kind, Err(status), &mut out);
+    let m = out.meta_mut();
+    m.client_id = meta.client_id;
+    m.seq = meta.seq;
+    m.stamp_ns = monotonic_ns();
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keys_round_trip() {
+        let d: DeviceName = "pioneer/actarray/0".parse().unwrap();
+        assert_eq!(device_key(&d, "state"), "limber/pioneer/actarray/0/state");
+        assert_eq!(
+            parse("limber/pioneer/actarray/0/state"),
+            Some((d.clone(), "state"))
+        );
+        assert_eq!(parse(&outcome_key(&d, "abc")), Some((d, "outcome/abc")));
+        assert_eq!(parse("limber/pioneer/arm/0/state"), None);
+        assert_eq!(parse("other/pioneer/actarray/0/state"), None);
+        assert!(!valid_chunk("a/b") && !valid_chunk("*") && valid_chunk("0f3a"));
+    }
+}

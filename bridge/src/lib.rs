@@ -1,0 +1,25 @@
+//! # limber-bridge: a domain's devices over Zenoh
+//!
+//! limber is shared memory on one PC. This crate carries devices to other hosts over
+//! [Zenoh](https://zenoh.io) (the `zenoh` crate, 1.x, TCP only), in two roles:
+//!
+//! * [`expose`]: on the robot's PC, joins domain A as a client of every device there and
+//!   publishes each device's state, takes commands and requests from Zenoh and hands them
+//!   to the driver, and holds a liveliness token per device.
+//! * [`mirror`]: on another host, hosts every remote device in domain B under the same
+//!   name (or with a prefix on the robot name), as a driver would, so that unchanged
+//!   clients use it: their commands, requests and outcomes travel to the robot and back.
+//!
+//! The payloads are the interfaces' fixed layouts as bytes; the key expressions are in
+//! [`keys`] and documented in this crate's README.
+
+pub mod allow;
+pub mod expose;
+pub mod keys;
+pub mod mirror;
+mod session;
+
+pub use allow::{Allow, AllowError, CommandKind, DevicePattern};
+pub use expose::{ExposeConfig, ExposeError, ExposeEvent, expose};
+pub use mirror::{MirrorConfig, MirrorError, MirrorEvent, mirror};
+pub use session::{NetConfig, SessionError};

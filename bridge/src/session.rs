@@ -1,0 +1,86 @@
+//! Opening the Zenoh session: peer mode, TCP on the given endpoints, multicast scouting off.
+
+use thiserror::Error;
+use zenoh::{Config, Session, Wait};
+
+/// Where a bridge listens and what it connects to (Zenoh endpoints, e.g.
+/// `tcp/127.0.0.1:7447`).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct NetConfig {
+    /// Endpoints to listen on (none: loopback on a port of the system's choosing).
+    pub listen: Vec<String>,
+    /// Endpoints to connect to.
+    pub connect: Vec<String>,
+    /// A Zenoh configuration file (JSON5) to start from (TLS, user/password, ...); the
+    /// endpoints above and the scouting setting are applied on top of it.
+    pub config_file: Option<std::path::PathBuf>,
+}
+
+/// The Zenoh session could not be opened.
+#[derive(Debug, Error)]
+pub enum SessionError {
+    /// The configuration file could not be read or is invalid.
+    #[error("cannot load the Zenoh configuration {path}: {source}")]
+    ConfigFile {
+        /// The file.
+        path: String,
+        /// Zenoh's error.
+        #[source]
+        source: zenoh::Error,
+    },
+    /// An endpoint or setting was refused.
+    #[error("invalid Zenoh setting {key} = {value}: {source}")]
+    Setting {
+        /// The setting.
+        key: &'static str,
+        /// Its value.
+        value: String,
+        /// Zenoh's error.
+        #[source]
+        source: zenoh::Error,
+    },
+    /// The session could not be opened (an endpoint to listen on is taken, ...).
+    #[error("cannot open the Zenoh session: {0}")]
+    Open(#[source] zenoh::Error),
+}
+
+fn json_list(items: &[String]) -> String {
+    let quoted: Vec<String> = items
+        .iter()
+        .map(|s| format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\"")))
+        .collect();
+    format!("[{}]", quoted.join(","))
+}
+
+/// Opens a peer session with `net`.
+pub(crate) fn open(net: &NetConfig) -> Result<Session, SessionError> {
+    let mut config = match &net.config_file {
+        Some(p) => Config::from_file(p).map_err(|source| SessionError::ConfigFile {
+            path: p.display().to_string(),
+            source,
+        })?,
+        None => Config::default(),
+    };
+    let listen = if net.listen.is_empty() {
+        vec!["tcp/127.0.0.1:0".to_string()]
+    } else {
+        net.listen.clone()
+    };
+    let settings: [(&'static str, String); 6] = [
+        ("mode", "\"peer\"".into()),
+        ("listen/endpoints", json_list(&listen)),
+        ("connect/endpoints", json_list(&net.connect)),
+        ("scouting/multicast/enabled", "false".into()),
+        // A peer that vanishes without closing its connection is declared gone after
+        // this long (its liveliness tokens with it).
+        ("transport/link/tx/lease", "3000".into()),
+        // Do not wait for the connect endpoints at start: retry them in the background.
+        ("connect/exit_on_failure", "false".into()),
+    ];
+    for (key, value) in settings {
+        config
+            .insert_json5(key, &value)
+            .map_err(|source| SessionError::Setting { key, value, source })?;
+    }
+    zenoh::open(config).wait().map_err(SessionError::Open)
+}

@@ -1,0 +1,164 @@
+//! `limber bridge`: a domain's devices over Zenoh (`expose`), and remote devices hosted in
+//! this domain (`mirror`).
+
+use std::path::PathBuf;
+
+use clap::{Args, Subcommand};
+use limber_bridge::expose::ExposeEvent;
+use limber_bridge::mirror::MirrorEvent;
+use limber_bridge::{Allow, CommandKind, DevicePattern, ExposeConfig, MirrorConfig, NetConfig};
+use limber_services::signals;
+
+use crate::out::noteln;
+use crate::{CliError, domain, exit, parse_seconds};
+
+/// Arguments of `limber bridge`.
+#[derive(Debug, Args)]
+pub struct BridgeArgs {
+    #[command(subcommand)]
+    role: Role,
+}
+
+#[derive(Debug, Subcommand)]
+enum Role {
+    /// On the robot's PC: put every device of this domain on Zenoh (state, commands,
+    /// requests, a liveliness token per device). Listens on loopback unless told otherwise.
+    ///
+    /// Runs until SIGINT/SIGTERM; prints "exposed DEVICE" and "gone DEVICE" as drivers come
+    /// and go.
+    Expose(ExposeArgs),
+    /// On another host: host the devices of a remote `expose` in this domain under the same
+    /// names, so that unchanged clients use them.
+    ///
+    /// Runs until SIGINT/SIGTERM; prints "mirrored DEVICE as NAME" and "gone NAME" as
+    /// remote devices come and go.
+    Mirror(MirrorArgs),
+}
+
+/// The network flags of both roles.
+#[derive(Debug, Args)]
+struct Net {
+    /// A Zenoh endpoint to listen on (repeatable), e.g. tcp/127.0.0.1:7447; use a
+    /// non-loopback address only with TLS and authentication (bridge/README.md).
+    #[arg(long, value_name = "ENDPOINT")]
+    listen: Vec<String>,
+    /// A Zenoh endpoint to connect to (repeatable), e.g. tcp/192.168.1.10:7447.
+    #[arg(long, value_name = "ENDPOINT")]
+    connect: Vec<String>,
+    /// A Zenoh configuration file (JSON5) for TLS, user/password and the like; the
+    /// endpoints given here apply on top of it.
+    #[arg(long, value_name = "FILE")]
+    zenoh_config: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+struct ExposeArgs {
+    #[command(flatten)]
+    net: Net,
+    /// How long the driver has to answer a relayed request, in seconds.
+    #[arg(long, default_value = "1.5", value_parser = parse_seconds, value_name = "S")]
+    request_timeout: f64,
+    /// Expose only the devices that match (repeatable; robot/interface/index, each part a
+    /// name or *, e.g. pioneer/actarray/*). Default: every device.
+    #[arg(long = "device", value_name = "PATTERN")]
+    devices: Vec<DevicePattern>,
+    /// Let only these commands through (repeatable; interface:kind, e.g. actarray:pos,
+    /// gripper:open). Any other command is refused ("unsupported") to its sender. Default:
+    /// every command.
+    #[arg(long = "allow-command", value_name = "INTERFACE:KIND")]
+    allow_commands: Vec<CommandKind>,
+    /// Refuse every command and every request that changes a device (power, brakes,
+    /// speed); the state and read-only requests (geometry) still pass.
+    #[arg(long)]
+    read_only: bool,
+}
+
+#[derive(Debug, Args)]
+struct MirrorArgs {
+    #[command(flatten)]
+    net: Net,
+    /// Prepended to each remote robot name, where local names would collide (e.g.
+    /// "lab_" hosts pioneer/actarray/0 as lab_pioneer/actarray/0).
+    #[arg(long, default_value = "", value_name = "PREFIX")]
+    prefix: String,
+    /// How long a relayed request may take before its client is told "timeout", in
+    /// seconds.
+    #[arg(long, default_value = "1.8", value_parser = parse_seconds, value_name = "S")]
+    request_timeout: f64,
+}
+
+fn net_config(net: Net, default_listen: &[&str], default_connect: &[&str]) -> NetConfig {
+    let defaults = |v: &[&str]| v.iter().map(|s| s.to_string()).collect();
+    let nothing_given = net.listen.is_empty() && net.connect.is_empty();
+    NetConfig {
+        listen: if nothing_given {
+            defaults(default_listen)
+        } else {
+            net.listen
+        },
+        connect: if nothing_given {
+            defaults(default_connect)
+        } else {
+            net.connect
+        },
+        config_file: net.zenoh_config,
+    }
+}
+
+/// Runs `limber bridge`.
+pub fn run(args: BridgeArgs) -> Result<(), CliError> {
+    let domain = domain()?;
+    if let Err(e) = signals::install() {
+        return Err(CliError::new(
+            exit::FAILURE,
+            format!("cannot install the signal handlers: {e}"),
+        ));
+    }
+    let stop = signals::termination_requested;
+    match args.role {
+        Role::Expose(a) => {
+            let config = ExposeConfig {
+                net: net_config(a.net, &["tcp/127.0.0.1:7447"], &[]),
+                request_timeout: std::time::Duration::from_secs_f64(a.request_timeout),
+                allow: Allow {
+                    devices: a.devices,
+                    commands: (!a.allow_commands.is_empty()).then_some(a.allow_commands),
+                    read_only: a.read_only,
+                },
+                ..ExposeConfig::default()
+            };
+            let name = domain.name().to_string();
+            limber_bridge::expose(&domain, &config, &stop, &mut |ev| match ev {
+                ExposeEvent::Ready { zid } => noteln!(
+                    "exposing domain {name} on Zenoh (id {zid}, listening on {})",
+                    config.net.listen.join(", ")
+                ),
+                ExposeEvent::Exposed(d) => noteln!("exposed {d}"),
+                ExposeEvent::Gone(d) => noteln!("gone {d}"),
+            })
+            .map_err(|e| CliError::new(exit::FAILURE, e.to_string()))
+        }
+        Role::Mirror(a) => {
+            let config = MirrorConfig {
+                net: net_config(a.net, &[], &["tcp/127.0.0.1:7447"]),
+                prefix: a.prefix,
+                request_timeout: std::time::Duration::from_secs_f64(a.request_timeout),
+            };
+            let name = domain.name().to_string();
+            limber_bridge::mirror(&domain, &config, &stop, &mut |ev| match ev {
+                MirrorEvent::Ready { zid } => noteln!(
+                    "mirroring into domain {name} (Zenoh id {zid}, connecting to {})",
+                    config.net.connect.join(", ")
+                ),
+                MirrorEvent::Mirrored { remote, local } => {
+                    noteln!("mirrored {remote} as {local}")
+                }
+                MirrorEvent::Gone { local } => noteln!("gone {local}"),
+                MirrorEvent::Refused { remote, reason } => {
+                    noteln!("cannot mirror {remote}: {reason}")
+                }
+            })
+            .map_err(|e| CliError::new(exit::FAILURE, e.to_string()))
+        }
+    }
+}

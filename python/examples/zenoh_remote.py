@@ -1,0 +1,118 @@
+#!/usr/bin/env python3
+"""Read an arm's state and command one joint over Zenoh alone: no iceoryx2, no limber
+domain on this host, only `eclipse-zenoh` and the wire layouts of `limber/_layout.py`
+(pure ctypes, loaded by path so that the `limber` package and its iceoryx2 binding are not
+imported).
+
+The robot's PC runs `limber bridge expose` (see bridge/README.md for the keys and payloads):
+
+    python3 python/examples/zenoh_remote.py --connect tcp/127.0.0.1:7447 \
+        pioneer/actarray/0 1 0.3
+
+prints the joints' positions, sends "move joint 1 to 0.3 rad" and prints the driver's
+outcome. Exit status: 0 carried out, 5 refused (the reason is printed), 6 no state or no
+outcome in time.
+"""
+
+import argparse
+import ctypes
+import importlib.util
+import json
+import os
+import queue
+import random
+import sys
+import time
+
+import zenoh
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+_spec = importlib.util.spec_from_file_location(
+    "limber_layout", os.path.join(HERE, "..", "limber", "_layout.py"))
+L = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(L)
+
+STATUS_NAMES = {v: k[len("STATUS_"):].lower().replace("_", " ")
+                for k, v in vars(L).items() if k.startswith("STATUS_")}
+CARRIED_OUT = {L.STATUS_OK, L.STATUS_CLAMPED, L.STATUS_ADJUSTED}
+
+
+def key(device, channel):
+    return f"limber/{device}/{channel}"
+
+
+def open_session(endpoint):
+    conf = zenoh.Config()
+    conf.insert_json5("mode", '"client"')
+    conf.insert_json5("connect/endpoints", json.dumps([endpoint]))
+    conf.insert_json5("scouting/multicast/enabled", "false")
+    return zenoh.open(conf)
+
+
+def first(q, timeout):
+    try:
+        return q.get(timeout=timeout)
+    except queue.Empty:
+        return None
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--connect", default="tcp/127.0.0.1:7447", help="the bridge's endpoint")
+    p.add_argument("--timeout", type=float, default=5.0, help="seconds per wait")
+    p.add_argument("device", help="an actarray, e.g. pioneer/actarray/0")
+    p.add_argument("joint", type=int)
+    p.add_argument("position", type=float, help="radians (metres for a linear joint)")
+    a = p.parse_args()
+
+    origin = f"py{random.getrandbits(48):012x}"  # where our outcomes come back
+    client_id = random.getrandbits(63) | 1
+    session = open_session(a.connect)
+    try:
+        states, outcomes = queue.Queue(), queue.Queue()
+        session.declare_subscriber(key(a.device, "state"),
+                                   lambda s: states.put(s.payload.to_bytes()))
+        session.declare_subscriber(key(a.device, f"outcome/{origin}"),
+                                   lambda s: outcomes.put(s.payload.to_bytes()))
+
+        raw = first(states, a.timeout)
+        if raw is None or len(raw) != ctypes.sizeof(L.ActArrayData):
+            print(f"no state of {a.device} within {a.timeout} s", file=sys.stderr)
+            return 6
+        state = L.ActArrayData.from_buffer_copy(raw)
+        joints = " ".join(f"{state.actuators[i].position:+.3f}"
+                          for i in range(state.actuators_count))
+        print(f"state #{state.header.seq}: {joints}")
+
+        msg = L.ActArrayCmdMsg()
+        body = L.ActArrayPositionCmd(joint=a.joint, position=a.position)
+        ctypes.memmove(msg.body, ctypes.addressof(body), ctypes.sizeof(body))
+        msg.meta.client_id = client_id
+        msg.meta.seq = 1
+        msg.meta.stamp_ns = time.monotonic_ns()
+        msg.meta.kind = L.ACTARRAY_CMD_POS
+        msg.meta.body_len = ctypes.sizeof(body)
+        session.put(key(a.device, "cmd"), bytes(msg), attachment=origin.encode(),
+                    encoding=zenoh.Encoding("application/octet-stream;" + msg.type_name()))
+
+        deadline = time.monotonic() + a.timeout
+        while True:
+            raw = first(outcomes, max(0.0, deadline - time.monotonic()))
+            if raw is None:
+                print(f"no outcome within {a.timeout} s", file=sys.stderr)
+                return 6
+            o = L.OutcomeMsg.from_buffer_copy(raw)
+            if o.client_id == client_id and o.cmd_seq == 1 and o.status != L.STATUS_PREEMPTED:
+                break
+        name = STATUS_NAMES.get(o.status, f"status {o.status}")
+        if o.status in CARRIED_OUT:
+            print(name)
+            return 0
+        print(f"refused: {name}")
+        return 5
+    finally:
+        session.close()
+
+
+if __name__ == "__main__":
+    sys.exit(main())

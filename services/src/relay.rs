@@ -1,0 +1,358 @@
+//! Relaying: the raw side of a [`DeviceHost`] and of a [`Client`], for a bridge that carries
+//! a device's channels to another domain (e.g. over a network) without decoding them.
+//!
+//! A bridge on the driver's side uses a [`Client`] to take every state sample and every
+//! outcome (of all clients) and to send commands and requests whose metadata it fills in
+//! itself; a bridge on the far side hosts the device with a [`DeviceHost`] whose state and
+//! outcomes come from the relay and whose commands and requests go to it. The messages are
+//! the fixed layouts of the interfaces, unchanged.
+
+use iceoryx2::active_request::ActiveRequest;
+use iceoryx2::pending_response::PendingResponse;
+use iceoryx2::port::update_connections::UpdateConnections;
+use iceoryx2::prelude::*;
+use limber_interfaces::prelude::*;
+use thiserror::Error;
+
+use crate::client::{Client, CommandError, LeaseError, RequestError};
+use crate::error::Iox2Error;
+use crate::host::{DeviceHost, ProcessError, PublishError};
+use crate::naming::DRIVER_NODE_PREFIX;
+use crate::qos;
+
+/// A request taken from a hosted device's clients, to be answered later
+/// ([`DeviceHost::relay_take_request`], [`DeviceHost::relay_answer`]). Dropping it without
+/// an answer leaves the client to its timeout.
+pub struct RelayedRequest<I: Interface> {
+    active: ActiveRequest<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()>,
+}
+
+impl<I: Interface> core::fmt::Debug for RelayedRequest<I> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("RelayedRequest")
+            .field("request", self.active.payload())
+            .finish()
+    }
+}
+
+impl<I: Interface> RelayedRequest<I> {
+    /// The request as the client sent it.
+    pub fn message(&self) -> &I::ReqMsg {
+        self.active.payload()
+    }
+}
+
+/// Answering a relayed request failed ([`DeviceHost::relay_answer`]).
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum AnswerError {
+    /// The reply could not be delivered (the client gave up or died).
+    #[error("cannot deliver the reply: {0}")]
+    Undelivered(#[source] Iox2Error),
+}
+
+impl<I: Interface> DeviceHost<I> {
+    /// Publishes `state` exactly as given (header included: sequence number, last command,
+    /// flags and stamp are the relayed device's) and notifies the clients.
+    pub fn relay_publish(&mut self, state: &I::Data) -> Result<(), PublishError> {
+        *self.state_mut() = *state;
+        self.publish_verbatim()
+    }
+
+    /// Takes every pending command without decoding it, in arrival order.
+    pub fn relay_commands(
+        &mut self,
+        mut each: impl FnMut(&I::CmdMsg),
+    ) -> Result<usize, ProcessError> {
+        let mut n = 0;
+        loop {
+            match self.commands_port().receive() {
+                Ok(Some(sample)) => {
+                    each(&sample);
+                    n += 1;
+                }
+                Ok(None) => return Ok(n),
+                Err(e) => return Err(ProcessError::Receive(e)),
+            }
+        }
+    }
+
+    /// Takes one pending request, to answer with [`DeviceHost::relay_answer`].
+    pub fn relay_take_request(&mut self) -> Result<Option<RelayedRequest<I>>, ProcessError> {
+        match self.server_port().receive() {
+            Ok(Some(active)) => Ok(Some(RelayedRequest { active })),
+            Ok(None) => Ok(None),
+            Err(e) => Err(ProcessError::Receive(e)),
+        }
+    }
+
+    /// Answers a relayed request with `reply` as given, and wakes the clients.
+    pub fn relay_answer(
+        &mut self,
+        req: RelayedRequest<I>,
+        reply: &I::ReplyMsg,
+    ) -> Result<(), AnswerError> {
+        let sent = match req.active.loan_uninit() {
+            Ok(loan) => loan.write_payload(*reply).send().map_err(Iox2Error::from),
+            Err(e) => Err(e.into()),
+        };
+        self.notify_clients_of(qos::EVENT_REPLY);
+        sent.map_err(AnswerError::Undelivered)
+    }
+
+    /// Publishes one outcome exactly as given (its `client_id` picks the client).
+    pub fn relay_outcome(&mut self, msg: &OutcomeMsg) -> Result<(), PublishError> {
+        let loan = self
+            .outcome_port()
+            .loan_uninit()
+            .map_err(PublishError::Loan)?;
+        loan.write_payload(*msg)
+            .send()
+            .map_err(PublishError::Send)?;
+        self.notify_clients_of(qos::EVENT_STATE);
+        Ok(())
+    }
+
+    /// Connects the state and outcome publishers to clients that came since the last call
+    /// and consumes the clients' wake-ups (a relaying host polls instead).
+    pub fn relay_housekeeping(&mut self) {
+        if let Err(e) = self.data_port().update_connections() {
+            tracing::debug!(device = %self.device(), error = %e, "cannot connect new clients");
+        }
+        if let Err(e) = self.outcome_port().update_connections() {
+            tracing::debug!(device = %self.device(), error = %e, "cannot connect new clients");
+        }
+        self.consume_wakeups();
+    }
+}
+
+/// A request sent by [`Client::relay_request`], waiting for its reply.
+pub struct PendingRelay<I: Interface> {
+    pending: PendingResponse<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()>,
+}
+
+impl<I: Interface> core::fmt::Debug for PendingRelay<I> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("PendingRelay").finish_non_exhaustive()
+    }
+}
+
+impl<I: Interface> PendingRelay<I> {
+    /// The reply, if it arrived; [`RequestError::DriverGone`] once the driver left
+    /// without answering.
+    pub fn try_reply(&self) -> Result<Option<I::ReplyMsg>, RequestError> {
+        match self.pending.receive() {
+            Ok(Some(r)) => return Ok(Some(*r.payload())),
+            Ok(None) => {}
+            Err(e) => return Err(RequestError::Transport(e.into())),
+        }
+        if self.pending.is_connected() {
+            return Ok(None);
+        }
+        // The driver may have answered and closed in between: look once more.
+        match self.pending.receive() {
+            Ok(Some(r)) => Ok(Some(*r.payload())),
+            Ok(None) => Err(RequestError::DriverGone),
+            Err(e) => Err(RequestError::Transport(e.into())),
+        }
+    }
+}
+
+impl<I: Interface> Client<I> {
+    /// Sends `cmd` exactly as given (its metadata is the caller's) and wakes the driver;
+    /// returns how many drivers received it.
+    pub fn relay_send(&mut self, cmd: &I::CmdMsg) -> Result<usize, CommandError> {
+        let loan = self
+            .commands
+            .loan_uninit()
+            .map_err(|e| CommandError::Transport(e.into()))?;
+        let receivers = loan
+            .write_payload(*cmd)
+            .send()
+            .map_err(|e| CommandError::Transport(e.into()))?;
+        self.wake_driver_with(qos::EVENT_COMMAND);
+        if receivers == 0 {
+            return Err(CommandError::NoDriver);
+        }
+        Ok(receivers)
+    }
+
+    /// Sends `req` exactly as given and returns at once; poll the reply with
+    /// [`PendingRelay::try_reply`].
+    pub fn relay_request(&mut self, req: &I::ReqMsg) -> Result<PendingRelay<I>, RequestError> {
+        let loan = self
+            .requests
+            .loan_uninit()
+            .map_err(|e| RequestError::Transport(e.into()))?;
+        let pending = loan
+            .write_payload(*req)
+            .send()
+            .map_err(|e| RequestError::Transport(e.into()))?;
+        if pending.number_of_server_connections() == 0 {
+            return Err(RequestError::NoDriver);
+        }
+        self.wake_driver_with(qos::EVENT_REQUEST);
+        Ok(PendingRelay { pending })
+    }
+
+    /// Takes every state sample that arrived, oldest first.
+    pub fn relay_states(&mut self, mut each: impl FnMut(&I::Data)) -> Result<usize, Iox2Error> {
+        let mut n = 0;
+        loop {
+            match self.states.receive() {
+                Ok(Some(s)) => {
+                    each(&s);
+                    n += 1;
+                }
+                Ok(None) => return Ok(n),
+                Err(e) => return Err(e.into()),
+            }
+        }
+    }
+
+    /// Takes every outcome that arrived, of every client.
+    pub fn relay_outcomes(
+        &mut self,
+        mut each: impl FnMut(&OutcomeMsg),
+    ) -> Result<usize, Iox2Error> {
+        let mut n = 0;
+        loop {
+            match self.outcome_sub.receive() {
+                Ok(Some(s)) => {
+                    each(&s);
+                    n += 1;
+                }
+                Ok(None) => return Ok(n),
+                Err(e) => return Err(e.into()),
+            }
+        }
+    }
+
+    /// Whether the device's driver process is alive. Unlike [`Client::driver_status`], a
+    /// dead driver's resources are not cleaned up on the way (that can take seconds): a
+    /// bridge must learn of the death at once.
+    pub fn relay_driver_alive(&self) -> bool {
+        use iceoryx2::node::NodeView;
+        use iceoryx2::service::port_factory::PortFactory;
+        let (mut alive, mut dead, mut unknown) = (false, false, false);
+        let is_driver = |d: &Option<iceoryx2::node::NodeDetails>| {
+            d.as_ref()
+                .is_some_and(|d| d.name().as_str().starts_with(DRIVER_NODE_PREFIX))
+        };
+        if let Err(e) = self.data_svc.nodes(|n| {
+            match &n {
+                NodeState::Alive(v) if is_driver(v.details()) => alive = true,
+                NodeState::Dead(v) if is_driver(v.details()) => dead = true,
+                NodeState::Inaccessible(_) | NodeState::Undefined(_) => unknown = true,
+                _ => {}
+            }
+            CallbackProgression::Continue
+        }) {
+            // Not known to be dead: asked again at the next check.
+            tracing::warn!(device = %self.device, error = %e, "cannot list the nodes of a device");
+            return true;
+        }
+        // A node whose state cannot be read (yet) may be the driver: not known to be dead.
+        alive || (unknown && !dead)
+    }
+}
+
+/// A lease request taken from a hosted device's clients, to be answered later
+/// ([`DeviceHost::relay_take_lease`], [`DeviceHost::relay_answer_lease`]).
+pub struct RelayedLease {
+    active: ActiveRequest<ipc::Service, LeaseReq, (), LeaseReply, ()>,
+}
+
+impl core::fmt::Debug for RelayedLease {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("RelayedLease")
+            .field("request", self.active.payload())
+            .finish()
+    }
+}
+
+impl RelayedLease {
+    /// The lease request as the client sent it.
+    pub fn message(&self) -> &LeaseReq {
+        self.active.payload()
+    }
+}
+
+impl<I: Interface> DeviceHost<I> {
+    /// Takes one pending lease request, to answer with [`DeviceHost::relay_answer_lease`]
+    /// (a relaying host keeps no lease of its own: the relayed device's driver does).
+    pub fn relay_take_lease(&mut self) -> Result<Option<RelayedLease>, ProcessError> {
+        match self.lease_port().receive() {
+            Ok(Some(active)) => Ok(Some(RelayedLease { active })),
+            Ok(None) => Ok(None),
+            Err(e) => Err(ProcessError::Receive(e)),
+        }
+    }
+
+    /// Answers a relayed lease request with `reply` as given, and wakes the clients.
+    pub fn relay_answer_lease(
+        &mut self,
+        req: RelayedLease,
+        reply: &LeaseReply,
+    ) -> Result<(), AnswerError> {
+        let sent = match req.active.loan_uninit() {
+            Ok(loan) => loan.write_payload(*reply).send().map_err(Iox2Error::from),
+            Err(e) => Err(e.into()),
+        };
+        self.notify_clients_of(qos::EVENT_REPLY);
+        sent.map_err(AnswerError::Undelivered)
+    }
+}
+
+/// A lease request sent by [`Client::relay_lease`], waiting for its reply.
+pub struct PendingLease {
+    pending: PendingResponse<ipc::Service, LeaseReq, (), LeaseReply, ()>,
+}
+
+impl core::fmt::Debug for PendingLease {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("PendingLease").finish_non_exhaustive()
+    }
+}
+
+impl PendingLease {
+    /// The reply, if it arrived; [`LeaseError::NoDriver`] once the driver left without
+    /// answering.
+    pub fn try_reply(&self) -> Result<Option<LeaseReply>, LeaseError> {
+        match self.pending.receive() {
+            Ok(Some(r)) => return Ok(Some(*r.payload())),
+            Ok(None) => {}
+            Err(e) => return Err(LeaseError::Transport(e.into())),
+        }
+        if self.pending.is_connected() {
+            return Ok(None);
+        }
+        match self.pending.receive() {
+            Ok(Some(r)) => Ok(Some(*r.payload())),
+            Ok(None) => Err(LeaseError::NoDriver),
+            Err(e) => Err(LeaseError::Transport(e.into())),
+        }
+    }
+}
+
+impl<I: Interface> Client<I> {
+    /// Sends lease request `req` as given, but as this client's node (the driver watches
+    /// the holder's node: a relayed holder's is the relay's), and returns at once. The
+    /// lease lives as long as the relayed holder's renewals keep arriving in time.
+    pub fn relay_lease(&mut self, req: &LeaseReq) -> Result<PendingLease, LeaseError> {
+        let mut req = *req;
+        req.set_node_id(self.context().node().id().value());
+        let side = self.lease_port()?;
+        let pending = side
+            .port
+            .loan_uninit()
+            .map_err(|e| LeaseError::Transport(e.into()))?
+            .write_payload(req)
+            .send()
+            .map_err(|e| LeaseError::Transport(e.into()))?;
+        if pending.number_of_server_connections() == 0 {
+            return Err(LeaseError::NoDriver);
+        }
+        self.wake_driver_with(qos::EVENT_REQUEST);
+        Ok(PendingLease { pending })
+    }
+}

@@ -1,0 +1,504 @@
+//! `limber bridge` (issue 17): the emulated Pioneer in domain A, `bridge expose` there,
+//! `bridge mirror` into domain B over TCP loopback, and unchanged clients in domain B
+//! (the Rust client, the CLI) commanding the arm. Killing the driver or either bridge
+//! makes the mirrored devices gone for B's clients, within a bound, without a hang.
+//!
+//! Each test uses its own two domains and its own port; every wait is bounded.
+
+use std::time::{Duration, Instant};
+
+use limber_services::prelude::*;
+use limber_services::{DriverStatus, RequestError};
+use limber_tests::Proc;
+
+const CLI: &str = env!("CARGO_BIN_EXE_limber-test-cli");
+
+/// How long a mirrored device may take to be gone after its driver or a bridge dies.
+const GONE_BOUND: Duration = Duration::from_secs(10);
+
+/// A TCP port on loopback that was free a moment ago.
+fn free_port() -> u16 {
+    std::net::TcpListener::bind("127.0.0.1:0")
+        .and_then(|l| l.local_addr())
+        .map(|a| a.port())
+        .expect("a free loopback port")
+}
+
+struct Setup {
+    a: Domain,
+    b: Domain,
+    endpoint: String,
+    driver: Proc,
+    expose: Proc,
+    mirror: Proc,
+}
+
+fn start_driver(a: &Domain) -> Proc {
+    let mut d = Proc::spawn(CLI, a.name(), &["pioneer", "--emulated"]);
+    assert!(
+        d.read_until(|l| l.ends_with("ready")).is_some(),
+        "the driver did not start"
+    );
+    d
+}
+
+fn start_expose(a: &Domain, endpoint: &str) -> Proc {
+    let mut e = Proc::spawn(CLI, a.name(), &["bridge", "expose", "--listen", endpoint]);
+    assert!(
+        e.read_until(|l| l == "exposed pioneer/actarray/0")
+            .is_some(),
+        "expose did not expose the arm"
+    );
+    e
+}
+
+fn start_mirror(b: &Domain, endpoint: &str) -> Proc {
+    let mut m = Proc::spawn(CLI, b.name(), &["bridge", "mirror", "--connect", endpoint]);
+    wait_mirrored(&mut m);
+    m
+}
+
+fn wait_mirrored(m: &mut Proc) {
+    assert!(
+        m.read_until(|l| l == "mirrored pioneer/actarray/0 as pioneer/actarray/0")
+            .is_some(),
+        "mirror did not host the arm"
+    );
+}
+
+fn setup() -> Setup {
+    let a = Domain::unique_for_test();
+    let b = Domain::unique_for_test();
+    let endpoint = format!("tcp/127.0.0.1:{}", free_port());
+    let driver = start_driver(&a);
+    let expose = start_expose(&a, &endpoint);
+    let mirror = start_mirror(&b, &endpoint);
+    Setup {
+        a,
+        b,
+        endpoint,
+        driver,
+        expose,
+        mirror,
+    }
+}
+
+fn arm_in(b: &Domain) -> ActArrayClient {
+    let ctx = Context::new(b, Role::Client, "bridge-test").expect("join domain B");
+    ActArrayClient::connect_timeout(&ctx, "pioneer/actarray/0", Duration::from_secs(10))
+        .expect("the mirrored arm")
+}
+
+/// Waits (bounded) until joint `j` of the arm is within 0.02 rad of `target`.
+fn wait_joint(arm: &mut ActArrayClient, j: usize, target: f64) {
+    let deadline = Instant::now() + Duration::from_secs(20);
+    loop {
+        let s = arm.wait_state(Duration::from_secs(2)).expect("a state");
+        let p = s.actuators[j].position;
+        if (p - target).abs() < 0.02 {
+            return;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "joint {j} at {p}, not {target}, after 20 s"
+        );
+    }
+}
+
+fn cli_in(b: &Domain, args: &[&str]) -> (Option<i32>, String) {
+    let mut p = Proc::spawn(CLI, b.name(), args);
+    let code = p.wait_timeout(Duration::from_secs(20));
+    (code, p.rest_of_stdout())
+}
+
+/// The issue's "done when": in domain B, the Rust client and `limber actarray ... pos 1
+/// 0.3` move the arm of domain A and see its state; a request (geometry) works; a
+/// refusal keeps its reason; a preemption reaches the client whose motion was cut short.
+#[test]
+fn clients_in_another_domain_command_the_arm_through_a_bridge_pair() {
+    let s = setup();
+    let mut arm = arm_in(&s.b);
+    arm.current(Duration::from_secs(10)).expect("a first state");
+
+    // A request through the bridge.
+    let geom = arm.geometry().expect("the geometry through the bridge");
+    assert_eq!(geom.actuators_count, 6);
+
+    // A command: accepted, and the state shows it done.
+    let t = arm.move_to(2, 0.5).expect("send");
+    assert_eq!(
+        arm.wait_outcome(t, Duration::from_secs(5))
+            .expect("outcome"),
+        Status::Ok
+    );
+    wait_joint(&mut arm, 2, 0.5);
+
+    // A refusal keeps its reason.
+    let t = arm.move_to(1, 9.0).expect("send");
+    assert_eq!(
+        arm.wait_outcome(t, Duration::from_secs(5))
+            .expect("outcome"),
+        Status::BeyondLimits
+    );
+
+    // The CLI, unchanged, in domain B.
+    let (code, out) = cli_in(&s.b, &["actarray", "pioneer/actarray/0", "pos", "1", "0.3"]);
+    assert_eq!(code, Some(0), "limber actarray pos: {out}");
+    assert!(out.contains("ok"), "{out}");
+    wait_joint(&mut arm, 1, 0.3);
+    let (code, out) = cli_in(&s.b, &["list"]);
+    assert_eq!(code, Some(0));
+    assert!(
+        out.lines()
+            .any(|l| l.starts_with("pioneer/actarray/0") && l.contains("alive")),
+        "{out}"
+    );
+
+    // Two clients of B: the second cuts the first's motion short, and the first is told.
+    let mut other = arm_in(&s.b);
+    let first = arm.move_to(0, 1.5).expect("send");
+    assert_eq!(
+        arm.wait_outcome(first, Duration::from_secs(5))
+            .expect("outcome"),
+        Status::Ok
+    );
+    // Wait until the first motion runs before cutting it short.
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while arm
+        .wait_state(Duration::from_secs(2))
+        .expect("a state")
+        .actuators[0]
+        .position
+        < 0.2
+    {
+        assert!(Instant::now() < deadline, "joint 0 did not start moving");
+    }
+    let second = other.move_to(0, -0.5).expect("send");
+    assert_eq!(
+        other
+            .wait_outcome(second, Duration::from_secs(5))
+            .expect("outcome"),
+        Status::Ok
+    );
+    let deadline = Instant::now() + Duration::from_secs(5);
+    loop {
+        if let Some(p) = arm.preempted(first).expect("outcomes") {
+            assert_eq!(p.status, Status::Preempted);
+            break;
+        }
+        assert!(Instant::now() < deadline, "the preemption did not arrive");
+        let _ = arm.wait_state(Duration::from_millis(200));
+    }
+    drop(s);
+}
+
+/// Kill the driver in A, then (after a restart) the exposing bridge, then the mirror:
+/// each time B's clients learn the arm is gone within a bound, and never hang.
+#[test]
+fn a_dead_driver_or_bridge_makes_the_mirrored_arm_gone() {
+    let mut s = setup();
+    let mut arm = arm_in(&s.b);
+    arm.current(Duration::from_secs(10)).expect("a first state");
+
+    // The driver dies.
+    s.driver.signal(libc::SIGKILL);
+    assert!(
+        s.mirror
+            .read_until_within(GONE_BOUND, |l| l == "gone pioneer/actarray/0")
+            .is_some()
+    );
+    assert_ne!(arm.driver_status(), DriverStatus::Alive);
+    let t0 = Instant::now();
+    let r = arm.geometry();
+    assert!(
+        matches!(r, Err(RequestError::NoDriver | RequestError::DriverGone)),
+        "{r:?}"
+    );
+    assert!(t0.elapsed() < Duration::from_secs(3), "the request hung");
+    let (code, _) = cli_in(&s.b, &["actarray", "pioneer/actarray/0", "geom"]);
+    assert!(
+        matches!(code, Some(3 | 4)),
+        "the CLI says no driver or driver gone: {code:?}"
+    );
+
+    // It comes back, and so does the mirrored arm.
+    s.driver = start_driver(&s.a);
+    wait_mirrored(&mut s.mirror);
+    let mut arm = arm_in(&s.b);
+    arm.geometry().expect("the geometry after the restart");
+
+    // The exposing bridge dies.
+    s.expose.signal(libc::SIGKILL);
+    assert!(
+        s.mirror
+            .read_until_within(GONE_BOUND, |l| l == "gone pioneer/actarray/0")
+            .is_some()
+    );
+    let t0 = Instant::now();
+    let r = arm.geometry();
+    assert!(
+        matches!(r, Err(RequestError::NoDriver | RequestError::DriverGone)),
+        "{r:?}"
+    );
+    assert!(t0.elapsed() < Duration::from_secs(3), "the request hung");
+
+    // It comes back; then the mirror dies.
+    s.expose = start_expose(&s.a, &s.endpoint);
+    wait_mirrored(&mut s.mirror);
+    let mut arm = arm_in(&s.b);
+    arm.geometry()
+        .expect("the geometry after the bridge's restart");
+    s.mirror.signal(libc::SIGKILL);
+    let deadline = Instant::now() + GONE_BOUND;
+    while arm.driver_status() == DriverStatus::Alive {
+        assert!(
+            Instant::now() < deadline,
+            "the dead mirror still looks alive"
+        );
+        let _ = arm.wait_state(Duration::from_millis(100));
+    }
+    let t0 = Instant::now();
+    let r = arm.geometry();
+    assert!(
+        matches!(r, Err(RequestError::NoDriver | RequestError::DriverGone)),
+        "{r:?}"
+    );
+    assert!(t0.elapsed() < Duration::from_secs(3), "the request hung");
+}
+
+/// `expose --device ... --allow-command ...`: only the allowed device is exposed, and a
+/// command not allowed is refused ("unsupported") to its sender; `--read-only` refuses
+/// every command and the requests that change the device, and lets geometry through.
+#[test]
+fn the_allow_list_keeps_devices_and_commands_out() {
+    let a = Domain::unique_for_test();
+    let _driver = start_driver(&a);
+
+    let b = Domain::unique_for_test();
+    let endpoint = format!("tcp/127.0.0.1:{}", free_port());
+    let mut expose = Proc::spawn(
+        CLI,
+        a.name(),
+        &[
+            "bridge",
+            "expose",
+            "--listen",
+            &endpoint,
+            "--device",
+            "pioneer/actarray/0",
+            "--allow-command",
+            "actarray:pos",
+        ],
+    );
+    assert!(
+        expose
+            .read_until(|l| l == "exposed pioneer/actarray/0")
+            .is_some()
+    );
+    let _mirror = start_mirror(&b, &endpoint);
+    let mut arm = arm_in(&b);
+    arm.geometry().expect("a read-only request passes");
+    let t = arm.move_to(2, 0.4).expect("send");
+    assert_eq!(
+        arm.wait_outcome(t, Duration::from_secs(5))
+            .expect("outcome"),
+        Status::Ok
+    );
+    let t = arm.home(None).expect("send");
+    assert_eq!(
+        arm.wait_outcome(t, Duration::from_secs(5))
+            .expect("outcome"),
+        Status::Unsupported
+    );
+    // One discovery pass found every device of A: it ends before the bridge does.
+    expose.signal(libc::SIGTERM);
+    assert_eq!(expose.wait_timeout(Duration::from_secs(20)), Some(0));
+    let rest = expose.rest_of_stdout();
+    assert!(!rest.contains("exposed "), "{rest}");
+
+    let b = Domain::unique_for_test();
+    let endpoint = format!("tcp/127.0.0.1:{}", free_port());
+    let mut expose = Proc::spawn(
+        CLI,
+        a.name(),
+        &["bridge", "expose", "--listen", &endpoint, "--read-only"],
+    );
+    assert!(
+        expose
+            .read_until(|l| l == "exposed pioneer/actarray/0")
+            .is_some()
+    );
+    let _mirror = start_mirror(&b, &endpoint);
+    let mut arm = arm_in(&b);
+    arm.geometry().expect("a read-only request passes");
+    assert!(
+        matches!(
+            arm.power(false),
+            Err(RequestError::Nack(Status::Unsupported))
+        ),
+        "power must be refused"
+    );
+    let t = arm.move_to(2, 0.2).expect("send");
+    assert_eq!(
+        arm.wait_outcome(t, Duration::from_secs(5))
+            .expect("outcome"),
+        Status::Unsupported
+    );
+}
+
+const CLIENT: &str = env!("CARGO_BIN_EXE_limber-test-client");
+
+/// Waits (bounded) until joint `j` has the flag `want` in three samples in a row.
+fn wait_joint_flag(a: &mut ActArrayClient, j: usize, want: ActuatorFlags, what: &str) {
+    let deadline = Instant::now() + Duration::from_secs(15);
+    let mut run = 0;
+    while run < 3 {
+        assert!(Instant::now() < deadline, "joint {j} never {what}");
+        let s = a.wait_state(Duration::from_secs(2)).expect("a state");
+        if ActuatorFlags::from_bits_truncate(s.actuators[j].state).contains(want) {
+            run += 1;
+        } else {
+            run = 0;
+        }
+    }
+}
+
+/// A client of domain B takes the arm of domain A through the bridges: B's other clients
+/// are refused with its name; when it dies mid-motion its renewals stop, and the driver's
+/// deadman stops the joint and frees the arm.
+#[test]
+fn a_remote_holder_that_dies_triggers_the_deadman() {
+    let s = setup();
+    let mut me = arm_in(&s.b);
+    me.current(Duration::from_secs(10)).expect("a first state");
+    let mut h = Proc::spawn(
+        CLIENT,
+        s.b.name(),
+        &[
+            "--robot",
+            "pioneer",
+            "own",
+            "--name",
+            "remote",
+            // Generous: renewals cross two bridges on a loaded machine.
+            "--heartbeat-ms",
+            "3000",
+        ],
+    );
+    assert!(
+        h.read_until(|l| l.starts_with("owning")).is_some(),
+        "the holder did not take the arm through the bridge"
+    );
+    let held = me.holder().expect("ask").expect("held");
+    assert_eq!(held.name, "remote");
+    let t = me.move_to(2, 0.2).expect("send");
+    let o = me
+        .wait_outcome_detail(t, Duration::from_secs(5))
+        .expect("outcome");
+    assert_eq!(o.status, Status::Leased);
+    assert_eq!(o.other_name(), "remote");
+    wait_joint_flag(&mut me, 0, ActuatorFlags::MOVING, "moving");
+
+    h.signal(libc::SIGKILL);
+    wait_joint_flag(&mut me, 0, ActuatorFlags::IDLE, "stopped");
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while me.holder().expect("ask").is_some() {
+        assert!(Instant::now() < deadline, "the lease never ended");
+        let _ = me.wait_state(Duration::from_millis(100));
+    }
+    let t = me.move_to(0, 0.0).expect("send");
+    assert!(
+        me.wait_outcome(t, Duration::from_secs(5))
+            .expect("outcome")
+            .is_carried_out()
+    );
+}
+
+/// Zenoh's user/password authentication, as bridge/README.md sets it up: a mirror with the
+/// wrong password gets nothing, one with the right password mirrors the arm.
+#[test]
+fn a_mirror_with_the_wrong_password_gets_nothing() {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("bridge-usrpwd-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a scratch directory");
+    let users = dir.join("users.txt");
+    std::fs::write(&users, "robot:a long secret\n").expect("write the users");
+    let config = |name: &str, password: &str, dictionary: bool| {
+        let path = dir.join(name);
+        let dict = if dictionary {
+            format!(", dictionary_file: \"{}\"", users.display())
+        } else {
+            String::new()
+        };
+        let text = format!(
+            "{{ transport: {{ auth: {{ usrpwd: {{ user: \"robot\", password: \"{password}\"{dict} }} }} }} }}\n"
+        );
+        std::fs::write(&path, text).expect("write a Zenoh configuration");
+        path.display().to_string()
+    };
+    let robot = config("robot.json5", "a long secret", true);
+    let good = config("good.json5", "a long secret", false);
+    let bad = config("bad.json5", "a guess", false);
+
+    let a = Domain::unique_for_test();
+    let _driver = start_driver(&a);
+    let endpoint = format!("tcp/127.0.0.1:{}", free_port());
+    let mut expose = Proc::spawn(
+        CLI,
+        a.name(),
+        &[
+            "bridge",
+            "expose",
+            "--listen",
+            &endpoint,
+            "--zenoh-config",
+            &robot,
+        ],
+    );
+    assert!(
+        expose
+            .read_until(|l| l == "exposed pioneer/actarray/0")
+            .is_some()
+    );
+    let b_bad = Domain::unique_for_test();
+    let mut intruder = Proc::spawn(
+        CLI,
+        b_bad.name(),
+        &[
+            "bridge",
+            "mirror",
+            "--connect",
+            &endpoint,
+            "--zenoh-config",
+            &bad,
+        ],
+    );
+    assert!(
+        intruder
+            .read_until(|l| l.starts_with("mirroring into"))
+            .is_some()
+    );
+    let b = Domain::unique_for_test();
+    let mut mirror = Proc::spawn(
+        CLI,
+        b.name(),
+        &[
+            "bridge",
+            "mirror",
+            "--connect",
+            &endpoint,
+            "--zenoh-config",
+            &good,
+        ],
+    );
+    wait_mirrored(&mut mirror);
+    let mut arm = arm_in(&b);
+    arm.geometry()
+        .expect("the geometry with the right password");
+    // The intruder started first and had as long: it mirrored nothing.
+    intruder.signal(libc::SIGTERM);
+    assert_eq!(intruder.wait_timeout(Duration::from_secs(20)), Some(0));
+    let rest = intruder.rest_of_stdout();
+    assert!(!rest.contains("mirrored"), "{rest}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
