@@ -122,6 +122,17 @@ fn origin_of(attachment: Option<&ZBytes>) -> Option<String> {
 }
 
 /// Replies to `query` with an error carrying `status` (4 bytes, little-endian).
+/// Answers `query` with `bytes` of the type `type_name`; a failure is logged.
+fn answer(query: &Query, bytes: &[u8], type_name: &str) {
+    if let Err(e) = query
+        .reply(query.key_expr().clone(), bytes.to_vec())
+        .encoding(keys::encoding(type_name))
+        .wait()
+    {
+        tracing::warn!(key = %query.key_expr(), error = %e, "cannot answer a query");
+    }
+}
+
 fn refuse(query: &Query, status: Status) {
     let payload = status.code().to_le_bytes().to_vec();
     if let Err(e) = query
@@ -312,13 +323,7 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
             match p.try_reply() {
                 Ok(Some(mut reply)) => {
                     reply.meta_mut().client_id = *remote;
-                    if let Err(e) = query
-                        .reply(query.key_expr().clone(), reply.as_bytes().to_vec())
-                        .encoding(keys::encoding(names.reply))
-                        .wait()
-                    {
-                        tracing::warn!(key = %query.key_expr(), error = %e, "cannot answer a query");
-                    }
+                    answer(query, reply.as_bytes(), names.reply);
                     false
                 }
                 Ok(None) if now < *deadline => true,
@@ -374,13 +379,7 @@ impl<I: Interface> Exposed<I> {
                         None => reply.holder_client,
                     };
                     reply.set_holder_node(0);
-                    if let Err(e) = query
-                        .reply(query.key_expr().clone(), reply.as_bytes().to_vec())
-                        .encoding(keys::encoding(keys::lease_reply_type()))
-                        .wait()
-                    {
-                        tracing::warn!(key = %query.key_expr(), error = %e, "cannot answer a lease query");
-                    }
+                    answer(query, reply.as_bytes(), keys::lease_reply_type());
                     false
                 }
                 Ok(None) if now < *deadline => true,
