@@ -136,23 +136,39 @@ impl<I: Interface> core::fmt::Debug for PendingRelay<I> {
     }
 }
 
+/// The reply of `pending` if it arrived, `Ok(None)` while the driver may still answer;
+/// `Err(None)` once the driver left without answering, `Err(Some(_))` if receiving failed.
+fn poll_reply<Q, R>(
+    pending: &PendingResponse<ipc::Service, Q, (), R, ()>,
+) -> Result<Option<R>, Option<Iox2Error>>
+where
+    Q: core::fmt::Debug + ZeroCopySend,
+    R: core::fmt::Debug + ZeroCopySend + Copy,
+{
+    match pending.receive() {
+        Ok(Some(r)) => return Ok(Some(*r.payload())),
+        Ok(None) => {}
+        Err(e) => return Err(Some(e.into())),
+    }
+    if pending.is_connected() {
+        return Ok(None);
+    }
+    // The driver may have answered and closed in between: look once more.
+    match pending.receive() {
+        Ok(Some(r)) => Ok(Some(*r.payload())),
+        Ok(None) => Err(None),
+        Err(e) => Err(Some(e.into())),
+    }
+}
+
 impl<I: Interface> PendingRelay<I> {
     /// The reply, if it arrived; [`RequestError::DriverGone`] once the driver left
     /// without answering.
     pub fn try_reply(&self) -> Result<Option<I::ReplyMsg>, RequestError> {
-        match self.pending.receive() {
-            Ok(Some(r)) => return Ok(Some(*r.payload())),
-            Ok(None) => {}
-            Err(e) => return Err(RequestError::Transport(e.into())),
-        }
-        if self.pending.is_connected() {
-            return Ok(None);
-        }
-        // The driver may have answered and closed in between: look once more.
-        match self.pending.receive() {
-            Ok(Some(r)) => Ok(Some(*r.payload())),
-            Ok(None) => Err(RequestError::DriverGone),
-            Err(e) => Err(RequestError::Transport(e.into())),
+        match poll_reply(&self.pending) {
+            Ok(r) => Ok(r),
+            Err(None) => Err(RequestError::DriverGone),
+            Err(Some(e)) => Err(RequestError::Transport(e)),
         }
     }
 }
@@ -318,18 +334,10 @@ impl PendingLease {
     /// The reply, if it arrived; [`LeaseError::NoDriver`] once the driver left without
     /// answering.
     pub fn try_reply(&self) -> Result<Option<LeaseReply>, LeaseError> {
-        match self.pending.receive() {
-            Ok(Some(r)) => return Ok(Some(*r.payload())),
-            Ok(None) => {}
-            Err(e) => return Err(LeaseError::Transport(e.into())),
-        }
-        if self.pending.is_connected() {
-            return Ok(None);
-        }
-        match self.pending.receive() {
-            Ok(Some(r)) => Ok(Some(*r.payload())),
-            Ok(None) => Err(LeaseError::NoDriver),
-            Err(e) => Err(LeaseError::Transport(e.into())),
+        match poll_reply(&self.pending) {
+            Ok(r) => Ok(r),
+            Err(None) => Err(LeaseError::NoDriver),
+            Err(Some(e)) => Err(LeaseError::Transport(e)),
         }
     }
 }

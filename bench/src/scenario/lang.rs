@@ -72,7 +72,7 @@ fn err(what: &str, reason: impl std::fmt::Display) -> BenchError {
 /// A language skipped: the reason, printed and kept for the report.
 fn skip(ctx: &mut RunCtx, lang: &str, why: String) {
     let note = format!("{lang} skipped: {why}");
-    eprintln!("  lang: {note}");
+    tracing::warn!("lang: {note}");
     ctx.notes.push(note);
 }
 
@@ -295,9 +295,8 @@ fn external(
     limit: Duration,
 ) -> Result<(Histogram<u64>, Histogram<u64>), BenchError> {
     let out = ctx.tmp_file(&format!("lang-{lang}.txt"));
-    if ctx.progress {
-        eprintln!("  lang {lang}: {} exchanges", warm + n);
-    }
+    // The exchanges run in the client's process: announced, not ticked.
+    crate::progress::Progress::new(ctx.progress, &format!("lang {lang}"), warm + n).finish();
     cmd.arg(warm.to_string())
         .arg(n.to_string())
         .arg(&out)
