@@ -447,6 +447,21 @@ def _join_domain(domain: "Domain", node_name: str) -> Any:
     return node
 
 
+def _open_error_kind(e: BaseException) -> Optional[str]:
+    """The iceoryx2 variant of a failed service open (``"DoesNotExist"``,
+    ``"IncompatibleTypes"``, ...), or None for any other error.
+
+    The PyPI binding raises one exception class per operation and carries the Rust enum's
+    variant as its only argument (``PublishSubscribeOpenError('DoesNotExist')``): that
+    variant is the typed cause, read here instead of the error's text.
+    """
+    iox2 = _iox2()
+    opens = (iox2.PublishSubscribeOpenError, iox2.RequestResponseOpenError, iox2.EventOpenError)
+    if isinstance(e, opens) and len(e.args) == 1 and isinstance(e.args[0], str):
+        return e.args[0]
+    return None
+
+
 def _secure_shm(prefix: str) -> None:
     """Refuses a node counter of the domain owned by someone else; narrows ours to 0600
     (iceoryx2 makes it 0666)."""
@@ -880,15 +895,15 @@ class _Client(Generic[_D]):
         _open_clients.add(self)
 
         def fail(channel: str, e: Exception) -> LimberError:
-            text = repr(e)
-            if "DoesNotExist" in text:
+            kind = _open_error_kind(e)
+            if kind == "DoesNotExist":
                 return NoDriverError(
                     f"no driver offers {dev} in domain {domain} "
                     f"(is the driver running? is {DOMAIN_ENV} the same?)"
                 )
-            if "Incompatible" in text:
-                return IncompatibleError(f"{dev} is incompatible: {_why_incompatible(dev, domain)} ({channel}: {text})")
-            return TransportError(f"{dev}: cannot open the {channel} channel: {text}")
+            if kind is not None and kind.startswith("Incompatible"):
+                return IncompatibleError(f"{dev} is incompatible: {_why_incompatible(dev, domain)} ({channel}: {e!r})")
+            return TransportError(f"{dev}: cannot open the {channel} channel: {e!r}")
 
         layout = iox2.AttributeVerifier.new().require(
             iox2.AttributeKey.new(_LAYOUT_ATTR), iox2.AttributeValue.new(str(L.LAYOUT_VERSION))
@@ -1315,7 +1330,7 @@ class _Client(Generic[_D]):
                 self._lease_port = svc.client_builder().create()
                 del svc
             except Exception as e:
-                if "DoesNotExist" in repr(e):
+                if _open_error_kind(e) == "DoesNotExist":
                     raise NoDriverError(f"no driver offers leases of {self._device}") from None
                 raise TransportError(f"{self._device}: cannot open the lease channel: {e!r}") from None
         self._lease_seq += 1
@@ -1817,7 +1832,7 @@ class DriverStatsReader:
             del svc
         except Exception as e:
             self.close()
-            if "DoesNotExist" in repr(e):
+            if _open_error_kind(e) == "DoesNotExist":
                 raise NoDriverError(
                     f"no driver of robot {robot} publishes statistics in domain {dom}"
                 ) from None

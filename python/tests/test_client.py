@@ -652,3 +652,17 @@ def test_python_and_rust_clients_command_one_device_together(own_driver):
     assert len(theirs) == 1  # one Rust client, with another id
     assert len(log) == 2 * n + 1
     assert "overflows=0" in d.output
+
+
+def test_an_open_error_is_classified_by_its_variant_not_its_text() -> None:
+    """The binding's exception class and variant decide, never words in a message."""
+    import iceoryx2 as iox2
+
+    from limber.client import _open_error_kind
+
+    assert _open_error_kind(iox2.PublishSubscribeOpenError("DoesNotExist")) == "DoesNotExist"
+    assert _open_error_kind(iox2.EventOpenError("DoesNotExist")) == "DoesNotExist"
+    assert _open_error_kind(iox2.RequestResponseOpenError("IncompatibleTypes")) == "IncompatibleTypes"
+    # Another error that merely mentions the word is not a missing service.
+    assert _open_error_kind(RuntimeError("DoesNotExist")) is None
+    assert _open_error_kind(iox2.PublisherCreateError("DoesNotExist")) is None
