@@ -499,3 +499,181 @@ fn a_mirror_with_the_wrong_password_gets_nothing() {
     assert!(!rest.contains("mirrored"), "{rest}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Two network namespaces joined by a veth pair, made (as root) by the test and removed when
+/// it ends: the robot's host (the driver and `bridge expose`) in one, the operator's host
+/// (`bridge mirror` and the clients of domain B) in the other. Their only link is the veth
+/// pair, on link-local addresses that exist nowhere else.
+struct NetnsPair {
+    robot: String,
+    operator: String,
+}
+
+/// The address of the robot's end of the veth pair; the operator's end is .2.
+const ROBOT_ADDR: &str = "169.254.77.1";
+
+impl NetnsPair {
+    /// Makes the pair; None (with the reason printed) when not root. As root, a step that
+    /// fails fails the test: CI runs as root, and must run this test.
+    fn create() -> Option<NetnsPair> {
+        if limber_services::domain_dir::euid() != 0 {
+            eprintln!(
+                "SKIPPED: network namespaces and a veth pair need root (this test runs as root in CI)"
+            );
+            return None;
+        }
+        let id = std::process::id();
+        let pair = NetnsPair {
+            robot: format!("limber-robot-{id}"),
+            operator: format!("limber-op-{id}"),
+        };
+        // Interface names have at most 15 bytes.
+        let (va, vb) = (format!("lbr{id}"), format!("lbo{id}"));
+        let ip = |args: &[&str]| {
+            let out = limber_bounded_run::output_within(
+                std::process::Command::new("ip").args(args),
+                Duration::from_secs(20),
+            );
+            assert!(
+                out.status.success(),
+                "ip {}: {}",
+                args.join(" "),
+                String::from_utf8_lossy(&out.stderr)
+            );
+        };
+        ip(&["netns", "add", &pair.robot]);
+        ip(&["netns", "add", &pair.operator]);
+        ip(&["link", "add", &va, "type", "veth", "peer", "name", &vb]);
+        ip(&["link", "set", &va, "netns", &pair.robot]);
+        ip(&["link", "set", &vb, "netns", &pair.operator]);
+        for (ns, dev, addr) in [
+            (&pair.robot, &va, format!("{ROBOT_ADDR}/30")),
+            (&pair.operator, &vb, "169.254.77.2/30".to_string()),
+        ] {
+            ip(&["-n", ns, "addr", "add", &addr, "dev", dev]);
+            ip(&["-n", ns, "link", "set", dev, "up"]);
+            ip(&["-n", ns, "link", "set", "lo", "up"]);
+        }
+        Some(pair)
+    }
+
+    /// `limber <args>` in domain `domain`, inside namespace `ns`.
+    fn spawn(ns: &str, domain: &Domain, args: &[&str]) -> Proc {
+        let mut c = std::process::Command::new("ip");
+        c.args(["netns", "exec", ns, CLI])
+            .args(args)
+            .env("LIMBER_DOMAIN", domain.name());
+        Proc::spawn_command(c)
+    }
+}
+
+impl Drop for NetnsPair {
+    fn drop(&mut self) {
+        // Removing a namespace removes its end of the veth pair, and so the pair.
+        for ns in [&self.robot, &self.operator] {
+            let out = limber_bounded_run::output_within(
+                std::process::Command::new("ip").args(["netns", "del", ns]),
+                Duration::from_secs(20),
+            );
+            if !out.status.success() {
+                eprintln!(
+                    "could not remove network namespace {ns}: {}",
+                    String::from_utf8_lossy(&out.stderr)
+                );
+            }
+        }
+    }
+}
+
+/// Issue 17, item 4: the same as on loopback, between two network namespaces joined by a
+/// veth pair. The robot's namespace runs the emulated Pioneer and `bridge expose` on its
+/// veth address; the operator's runs `bridge mirror`, and there `limber actarray ... pos`
+/// moves the arm and `limber list` sees it. Killing the driver, then the exposing bridge,
+/// makes the arm gone in the operator's domain, and requests there end at once.
+#[test]
+fn a_bridge_pair_between_two_network_namespaces_moves_the_arm() {
+    // Declared first, dropped last: every process below ends before the namespaces go.
+    let Some(net) = NetnsPair::create() else {
+        return;
+    };
+    let a = Domain::unique_for_test();
+    let b = Domain::unique_for_test();
+    let endpoint = format!("tcp/{ROBOT_ADDR}:{}", free_port());
+
+    let mut driver = NetnsPair::spawn(&net.robot, &a, &["pioneer", "--emulated"]);
+    assert!(
+        driver.read_until(|l| l.ends_with("ready")).is_some(),
+        "the driver did not start in the robot's namespace"
+    );
+    let mut expose = NetnsPair::spawn(&net.robot, &a, &["bridge", "expose", "--listen", &endpoint]);
+    assert!(
+        expose
+            .read_until(|l| l == "exposed pioneer/actarray/0")
+            .is_some(),
+        "expose did not expose the arm on the veth address"
+    );
+    let mut mirror = NetnsPair::spawn(
+        &net.operator,
+        &b,
+        &["bridge", "mirror", "--connect", &endpoint],
+    );
+    wait_mirrored(&mut mirror);
+
+    // The CLI in the operator's namespace and domain moves the arm.
+    let mut pos = NetnsPair::spawn(
+        &net.operator,
+        &b,
+        &["actarray", "pioneer/actarray/0", "pos", "1", "0.3"],
+    );
+    let code = pos.wait_timeout(Duration::from_secs(20));
+    let out = pos.rest_of_stdout();
+    assert_eq!(
+        code,
+        Some(0),
+        "limber actarray pos in the operator's namespace: {out}"
+    );
+    assert!(out.contains("ok"), "{out}");
+    let mut arm = arm_in(&b);
+    wait_joint(&mut arm, 1, 0.3);
+    let mut list = NetnsPair::spawn(&net.operator, &b, &["list"]);
+    assert_eq!(list.wait_timeout(Duration::from_secs(20)), Some(0));
+    let out = list.rest_of_stdout();
+    assert!(
+        out.lines()
+            .any(|l| l.starts_with("pioneer/actarray/0") && l.contains("alive")),
+        "{out}"
+    );
+
+    // The driver dies: the operator's clients learn it; it comes back, and so does the arm.
+    driver.signal(libc::SIGKILL);
+    assert!(
+        mirror
+            .read_until_within(GONE_BOUND, |l| l == "gone pioneer/actarray/0")
+            .is_some(),
+        "the mirror did not say the arm is gone after the driver died"
+    );
+    assert_ne!(arm.driver_status(), DriverStatus::Alive);
+    let mut driver = NetnsPair::spawn(&net.robot, &a, &["pioneer", "--emulated"]);
+    assert!(
+        driver.read_until(|l| l.ends_with("ready")).is_some(),
+        "the driver did not restart"
+    );
+    wait_mirrored(&mut mirror);
+    let mut arm = arm_in(&b);
+    arm.geometry().expect("the geometry after the restart");
+
+    // The exposing bridge dies: the operator's clients learn the arm is gone.
+    expose.signal(libc::SIGKILL);
+    assert!(
+        mirror
+            .read_until_within(GONE_BOUND, |l| l == "gone pioneer/actarray/0")
+            .is_some(),
+        "the mirror did not say the arm is gone"
+    );
+    let r = arm.geometry();
+    assert!(
+        matches!(r, Err(RequestError::NoDriver | RequestError::DriverGone)),
+        "{r:?}"
+    );
+    drop((driver, mirror));
+}
