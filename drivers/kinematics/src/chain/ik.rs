@@ -10,8 +10,8 @@ impl Chain {
     pub(super) fn fk_jacobian(&self, q: &[f64], w: f64, jac: &mut Jacobian) -> Pose {
         let mut axes = [Vector3::zeros(); MAX_JOINTS];
         let mut points = [Vector3::zeros(); MAX_JOINTS];
-        let tip = self.walk(q, |i, before, _| {
-            axes[i] = before.rotation * self.joints[i].axis.into_inner();
+        let tip = self.walk_axes(q, |i, before, _, axis| {
+            axes[i] = *axis;
             points[i] = before.position;
         });
         jac.fill(0.0);
