@@ -154,6 +154,28 @@ fn numeric_ik_solves_the_5dof_pioneer_chain() {
     check_rate(&Chain::pioneer5(), 100, false, 6);
 }
 
+/// A wrist joint that the solver drives onto a limit, while the target lies across the
+/// gap of its range, crosses the gap and the first attempt converges (it used to stall
+/// there and cost two restarts).
+#[test]
+fn a_joint_stalled_on_a_limit_crosses_its_gap() {
+    let c = Chain::default_7dof();
+    let mut goal = c.home();
+    goal[6] = -1.5;
+    let mut seed = c.home();
+    seed[6] = 2.85;
+    let target = c.fk(&goal).unwrap();
+    let s = c
+        .ik(&IkTarget::Pose(target), &seed, &NumericIkOptions::default())
+        .unwrap();
+    assert_eq!(s.restarts, 0);
+    assert!(s.q[6] < 0.0, "j7 {} stayed on the seed's side", s.q[6]);
+    assert!(c.within_limits(&s.q));
+    let got = c.fk(&s.q).unwrap();
+    assert!(got.position_error(&target) <= 1e-6);
+    assert!(got.orientation_error(&target) <= 1e-6);
+}
+
 #[test]
 fn numeric_ik_is_deterministic() {
     let c = Chain::default_7dof();

@@ -141,6 +141,10 @@ impl Chain {
                 .filter(|j| j.kind == JointKind::Linear)
                 .map(|j| j.min.abs().max(j.max.abs()))
                 .sum::<f64>();
+        let turns = joints
+            .iter()
+            .map(|j| (Turn::of(&j.rest), Axis::of(&j.axis)))
+            .collect();
         Ok(Chain {
             name: file.name,
             description: file.description,
@@ -149,6 +153,7 @@ impl Chain {
             tool,
             gripper,
             reach,
+            turns,
         })
     }
 

@@ -10,8 +10,8 @@ impl Chain {
     pub(super) fn fk_jacobian(&self, q: &[f64], w: f64, jac: &mut Jacobian) -> Pose {
         let mut axes = [Vector3::zeros(); MAX_JOINTS];
         let mut points = [Vector3::zeros(); MAX_JOINTS];
-        let tip = self.walk(q, |i, before, _| {
-            axes[i] = before.rotation * self.joints[i].axis.into_inner();
+        let tip = self.walk_axes(q, |i, before, _, axis| {
+            axes[i] = *axis;
             points[i] = before.position;
         });
         jac.fill(0.0);
@@ -32,9 +32,14 @@ impl Chain {
     /// `max_restarts` attempts start at deterministic random configurations. Each
     /// attempt is Levenberg–Marquardt on the damped least-squares step
     /// `Δq = Jᵀ(JJᵀ + λI)⁻¹e` with λ adapted to the cost, the step limited to 0.5 rad
-    /// (or m) per joint, abandoned when the cost falls by less than half in 10
-    /// iterations, joints pushing against a limit frozen for that step, and the
-    /// result clamped into the limits. No allocation.
+    /// (or m) per joint, joints pushing against a limit frozen for that step, and the
+    /// result clamped into the limits. An attempt has stalled when the cost falls by
+    /// less than half in 10 iterations, or by less than a fifth in 3 while a joint
+    /// sits on a limit. The first time it stalls, rotary joints on a limit whose
+    /// range leaves a gap of at most 0.4π (or none) to a full turn are moved across
+    /// it (by a full turn, clamped into the limits: the same angle when the range
+    /// spans a turn) and the attempt goes on; the second time, the next attempt
+    /// starts. No allocation.
     // The error carries the best configuration on the stack (136 bytes) so that a
     // failed solve does not allocate either.
     #[allow(clippy::result_large_err)]
@@ -129,13 +134,37 @@ impl Chain {
             let mut cost = e.norm_squared();
             let mut lambda = 1e-3;
             let mut checkpoint = cost;
+            let mut recent = cost;
+            let mut crossed = false;
             for it in 0..=options.max_iterations {
-                // Stalled (less than half the cost gone in 10 iterations): restart.
+                // Stalled: less than half the cost gone in 10 iterations, or less than a
+                // fifth in 3 while a joint sits on a limit (a minimum on the boundary).
+                let mut stalled = false;
+                if it > 0 && it % PINNED_EVERY == 0 {
+                    stalled = cost > PINNED_STALL * recent && self.on_a_limit(&q);
+                    recent = cost;
+                }
                 if it > 0 && it % 10 == 0 {
-                    if cost > STALL * checkpoint {
+                    stalled |= cost > STALL * checkpoint;
+                    checkpoint = cost;
+                }
+                if stalled {
+                    // Once per attempt, wide joints on a limit cross their gap and the
+                    // attempt goes on from there; otherwise the next restart.
+                    if cost < best_cost {
+                        best_cost = cost;
+                        best_q = q;
+                    }
+                    if crossed || !self.cross_gaps(&mut q) {
                         break;
                     }
+                    crossed = true;
+                    pose = self.fk_jacobian(&q, w, &mut jac);
+                    e = residual(&pose);
+                    cost = e.norm_squared();
+                    lambda = 1e-3;
                     checkpoint = cost;
+                    recent = cost;
                 }
                 if !cost.is_finite() {
                     break;
@@ -239,12 +268,60 @@ impl Chain {
     }
 }
 
-/// An attempt of [`Chain::ik`] is abandoned for the next restart when 10 iterations
-/// leave more than this fraction of the cost: a start that creeps (towards a limit or a
+/// An attempt of [`Chain::ik`] has stalled when 10 iterations leave more than this
+/// fraction of the cost: a start that creeps (towards a limit or a
 /// local minimum) costs a restart less than it costs to follow (0.9 before, which let
 /// failing attempts run several times longer than converging ones; 0.3 lost
 /// solutions).
 const STALL: f64 = 0.5;
+
+/// An attempt of [`Chain::ik`] with a joint on a limit has stalled when, over
+/// [`PINNED_EVERY`] iterations, the cost keeps more than this fraction: a minimum on
+/// the boundary of the limits, which the rest of the attempt rarely leaves (checked
+/// every 10 iterations instead, such attempts ran 20-40 iterations and made most of
+/// the 7-joint chain's tail).
+const PINNED_STALL: f64 = 0.8;
+
+/// Iterations between two checks of [`PINNED_STALL`].
+const PINNED_EVERY: u32 = 3;
+
+/// Largest gap, rad, between a rotary joint's range and a full turn for
+/// [`Chain::ik`] to move the joint across it when it stalls on a limit (0.4π: the
+/// 7-joint arm's ±166° joints, not its ±101° one).
+const CROSSABLE_GAP: f64 = 0.4 * std::f64::consts::PI;
+
+impl Chain {
+    /// True when a joint of `q` sits on one of its limits.
+    fn on_a_limit(&self, q: &[f64]) -> bool {
+        q.iter()
+            .zip(&self.joints)
+            .any(|(v, j)| *v <= j.min || *v >= j.max)
+    }
+
+    /// Moves every rotary joint of `q` that sits on a limit, and whose range leaves a
+    /// gap of at most [`CROSSABLE_GAP`] to a full turn, by a full turn away from that
+    /// limit, clamped into the limits. Returns whether one moved.
+    fn cross_gaps(&self, q: &mut [f64]) -> bool {
+        let mut moved = false;
+        for (v, j) in q.iter_mut().zip(&self.joints) {
+            let crossable = j.kind == JointKind::Rotary
+                && j.max - j.min >= std::f64::consts::TAU - CROSSABLE_GAP;
+            if !crossable {
+                continue;
+            }
+            let turned = if *v >= j.max {
+                *v - std::f64::consts::TAU
+            } else if *v <= j.min {
+                *v + std::f64::consts::TAU
+            } else {
+                continue;
+            };
+            *v = turned.clamp(j.min, j.max);
+            moved = true;
+        }
+        moved
+    }
+}
 
 /// `Jᵀ (J Jᵀ + λ I)⁻¹ e` over the first `n` columns, `None` if the 6×6 system is not
 /// positive definite. Plain loops and a hand-written Cholesky: small, allocation-free

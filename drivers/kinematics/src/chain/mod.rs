@@ -106,6 +106,8 @@ pub struct Chain {
     tool: Pose,
     gripper: Option<GripperSpec>,
     reach: f64,
+    /// Per joint: its rest orientation and axis in their cheapest form, for the walk.
+    turns: Vec<(Turn, Axis)>,
 }
 
 /// Why a chain could not be loaded.
@@ -332,6 +334,8 @@ mod ik;
 use ik::sample_range;
 mod nearest;
 pub use nearest::{NearestOptions, NearestSolution};
+mod turn;
+use turn::{Axis, Turn};
 
 type Jacobian = SMatrix<f64, 6, MAX_JOINTS>;
 impl Chain {
@@ -479,20 +483,35 @@ impl Chain {
 
     /// Walks the chain; `visit(i, joint_frame_before_motion, frame_after_motion)`.
     fn walk(&self, q: &[f64], mut visit: impl FnMut(usize, &Pose, &Pose)) -> Pose {
-        let mut r = self.base.rotation;
+        self.walk_axes(q, |i, before, after, _| visit(i, before, after))
+    }
+
+    /// [`Chain::walk`], also giving `visit` the joint's axis in the world frame.
+    fn walk_axes(
+        &self,
+        q: &[f64],
+        mut visit: impl FnMut(usize, &Pose, &Pose, &Vector3<f64>),
+    ) -> Pose {
+        let mut r = *self.base.rotation.matrix();
         let mut p = self.base.position;
-        for (i, (j, v)) in self.joints.iter().zip(q).enumerate() {
+        for (i, ((j, (rest, axis)), v)) in self.joints.iter().zip(&self.turns).zip(q).enumerate() {
             p += r * j.origin;
-            r *= j.rest;
-            let before = Pose::new(p, r);
+            rest.apply(&mut r);
+            let before = Pose::new(p, Rotation3::from_matrix_unchecked(r));
+            let world_axis = axis.in_frame(&r);
             match j.kind {
-                JointKind::Rotary => r *= Rotation3::from_axis_angle(&j.axis, *v),
-                JointKind::Linear => p += r * (j.axis.into_inner() * *v),
+                JointKind::Rotary => axis.turn(&mut r, *v),
+                JointKind::Linear => p += world_axis * *v,
             }
-            visit(i, &before, &Pose::new(p, r));
+            visit(
+                i,
+                &before,
+                &Pose::new(p, Rotation3::from_matrix_unchecked(r)),
+                &world_axis,
+            );
         }
         p += r * self.tool.position;
-        r *= self.tool.rotation;
-        Pose::new(p, r)
+        r *= self.tool.rotation.matrix();
+        Pose::new(p, Rotation3::from_matrix_unchecked(r))
     }
 }

@@ -205,10 +205,22 @@ impl Default for Arm {
     }
 }
 
+/// √(a² + b²): the plain formula for the arm's lengths and unit vectors' components,
+/// `hypot` (slower: it guards every call) only when the squares overflow or underflow.
+#[inline]
+fn hyp(a: f64, b: f64) -> f64 {
+    let s = a * a + b * b;
+    if s.is_finite() && s >= f64::MIN_POSITIVE {
+        s.sqrt()
+    } else {
+        a.hypot(b)
+    }
+}
+
 /// (sin, cos) of `atan2(y, x)` by normalisation; (0, 1) for the zero vector, as
 /// `atan2(0, 0) = 0`.
 pub(super) fn unit(y: f64, x: f64) -> (f64, f64) {
-    let h = y.hypot(x);
+    let h = hyp(y, x);
     if h > 0.0 { (y / h, x / h) } else { (0.0, 1.0) }
 }
 
@@ -337,7 +349,7 @@ impl PioneerGeometry {
             WristGoal::Approach(a) => *a,
         };
         let w = p - a * self.l5;
-        let h = w.x.hypot(w.y);
+        let h = hyp(w.x, w.y);
         let yaw = if h < 1e-12 {
             current[0]
         } else {
@@ -354,7 +366,7 @@ impl PioneerGeometry {
             let (s1, c1) = t1.sin_cos();
             let r = c1 * w.x + s1 * w.y - self.l1;
             let z = w.z;
-            let d = r.hypot(z);
+            let d = hyp(r, z);
             if shoulder == Shoulder::Front {
                 front_distance = d;
             }
@@ -406,7 +418,7 @@ impl PioneerGeometry {
                 if let WristGoal::Frame(pose) = goal {
                     let n = pose.normal();
                     let (ax, bx) = (-(c1 * n.x + s1 * n.y), n.z);
-                    if s3.abs() < 1e-3 && ax.hypot(bx) > 1e-2 {
+                    if s3.abs() < 1e-3 && hyp(ax, bx) > 1e-2 {
                         let mut t23 = ax.atan2(bx);
                         if wrap_pi(t23 - (t2 + t3)).abs() > FRAC_PI_2 {
                             t23 = wrap_pi(t23 + PI);
@@ -507,7 +519,7 @@ impl PioneerGeometry {
                         push(t4, (s4, c4), vz.atan2(vx), unit(vz, vx), Wrist::Normal);
                     }
                     WristGoal::Approach(_) => {
-                        let s5 = al.y.hypot(al.z);
+                        let s5 = hyp(al.y, al.z);
                         let t5 = s5.atan2(al.x);
                         let (t4, (s4, c4)) = if s5 < 1e-12 {
                             (current[3], current[3].sin_cos())
