@@ -2,6 +2,7 @@
 //! implements for each interface it serves.
 
 use core::marker::PhantomData;
+use core::mem::MaybeUninit;
 
 use iceoryx2::active_request::ActiveRequest;
 use iceoryx2::node::NodeView;
@@ -13,6 +14,7 @@ use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::port::{LoanError, ReceiveError, SendError};
 use iceoryx2::prelude::*;
+use iceoryx2::sample_mut_uninit::SampleMutUninit;
 use iceoryx2::service::attribute::{AttributeKey, AttributeValue};
 use limber_interfaces::control::{get_name, put_name};
 use limber_interfaces::prelude::*;
@@ -334,6 +336,25 @@ impl ClientTable {
     }
 }
 
+/// Loans a sample ahead of its use: a loan (taking back the samples that clients released,
+/// allocating the chunk, iceoryx2's bookkeeping) costs about as much as the send, so a
+/// host loans the next outcome and state samples right after it published, and a command
+/// finds them ready. A failure is logged; the publication then loans for itself (and
+/// reports its own failure). Clients loan their next command sample so too.
+pub(crate) fn loan_ahead<T: core::fmt::Debug + ZeroCopySend>(
+    port: &Publisher<ipc::Service, T, ()>,
+    device: &DeviceName,
+    what: &'static str,
+) -> Option<SampleMutUninit<ipc::Service, MaybeUninit<T>, ()>> {
+    match port.loan_uninit() {
+        Ok(l) => Some(l),
+        Err(e) => {
+            tracing::debug!(device = %device, error = %e, "cannot loan the next {what} sample ahead");
+            None
+        }
+    }
+}
+
 /// Offers one device of interface `I`: publishes its state, drains its commands in
 /// arrival order, answers its requests, and wakes its clients.
 ///
@@ -372,6 +393,10 @@ pub struct DeviceHost<I: Interface> {
     stats: HostStats,
     publish_each_outcome: bool,
     spin_calls: u32,
+    /// A state sample loaned ahead, for the next publication (see `loan_ahead`).
+    state_loan: Option<SampleMutUninit<ipc::Service, MaybeUninit<I::Data>, ()>>,
+    /// An outcome sample loaned ahead, for the next command's outcome.
+    outcome_loan: Option<SampleMutUninit<ipc::Service, MaybeUninit<OutcomeMsg>, ()>>,
     _i: PhantomData<I>,
 }
 
@@ -461,9 +486,10 @@ impl<I: Interface> DeviceHost<I> {
                 return Err(HostError::AlreadyServed { device: dev });
             }
         }
+        // One sample loaned ahead for the next publication, one for anybody else.
         let publisher = data_svc
             .publisher_builder()
-            .max_loaned_samples(1)
+            .max_loaned_samples(2)
             .create()
             .map_err(|e| transport("data", e.into()))?;
 
@@ -540,7 +566,7 @@ impl<I: Interface> DeviceHost<I> {
             .open_or_create_with_attributes(&verifier)
             .map_err(|e| transport("outcome", e.into()))?
             .publisher_builder()
-            .max_loaned_samples(1)
+            .max_loaned_samples(2)
             .create()
             .map_err(|e| transport("outcome", e.into()))?;
 
@@ -585,6 +611,8 @@ impl<I: Interface> DeviceHost<I> {
             stats: HostStats::default(),
             publish_each_outcome: true,
             spin_calls: 0,
+            state_loan: None,
+            outcome_loan: None,
             _i: PhantomData,
         })
     }
@@ -681,24 +709,24 @@ impl<I: Interface> DeviceHost<I> {
                 0
             };
         h.cmd_overflows = self.stats.overflows.min(u32::MAX as u64) as u32;
-        let sample = self.publisher.loan_uninit().map_err(PublishError::Loan)?;
-        let sample = sample.write_payload(self.state);
-        sample.send().map_err(PublishError::Send)?;
-        self.stats.published += 1;
-        // A client that waits with a timeout re-checks anyway: counted, not fatal.
-        self.notify_clients(qos::EVENT_STATE);
-        Ok(())
+        self.publish_verbatim()
     }
 
-    /// Publishes the state as it is, header included (a relayed device's), and notifies.
+    /// Publishes the state as it is, header included (a relayed device's), and notifies;
+    /// then loans the sample of the next publication, off the clients' path.
     pub(crate) fn publish_verbatim(&mut self) -> Result<(), PublishError> {
-        let sample = self.publisher.loan_uninit().map_err(PublishError::Loan)?;
+        let sample = match self.state_loan.take() {
+            Some(s) => s,
+            None => self.publisher.loan_uninit().map_err(PublishError::Loan)?,
+        };
         sample
             .write_payload(self.state)
             .send()
             .map_err(PublishError::Send)?;
         self.stats.published += 1;
+        // A client that waits with a timeout re-checks anyway: counted, not fatal.
         self.notify_clients(qos::EVENT_STATE);
+        self.state_loan = loan_ahead(&self.publisher, &self.device, "state");
         Ok(())
     }
 
@@ -839,6 +867,10 @@ impl<I: Interface> DeviceHost<I> {
             if self.publish_each_outcome {
                 self.publish()?;
             }
+            // The next command's outcome sample, loaned now rather than on its path.
+            if self.outcome_loan.is_none() {
+                self.outcome_loan = loan_ahead(&self.outcomes, &self.device, "outcome");
+            }
         }
         Ok(n)
     }
@@ -891,7 +923,11 @@ impl<I: Interface> DeviceHost<I> {
         other_client: u64,
         other_name: Option<&[u8; 32]>,
     ) {
-        let sent = match self.outcomes.loan_uninit() {
+        let loan = match self.outcome_loan.take() {
+            Some(l) => Ok(l),
+            None => self.outcomes.loan_uninit(),
+        };
+        let sent = match loan {
             Ok(loan) => {
                 let mut msg = OutcomeMsg {
                     client_id,

@@ -16,8 +16,10 @@
 //!
 //! Round trip: client clock before `move_to` to after `wait_outcome`. One-way
 //! client→driver: `MsgMeta.stamp_ns` (set in `Client::send`) against the driver's clock
-//! at the top of the handler. One-way driver→client: the state stamp (set in the handler)
-//! against the client's clock when `wait_outcome` returned.
+//! at the top of the handler. One-way driver→client: the outcome's stamp
+//! (`Outcome::stamp_ns`, taken when the driver publishes it) against the client's clock
+//! when `wait_outcome_detail` returned. (The state sample that follows the outcome is not
+//! what the client waits for: its stamp may belong to the previous command.)
 
 use std::ops::ControlFlow;
 use std::time::{Duration, Instant};
@@ -183,8 +185,8 @@ fn run_variant(
         let ticket = client
             .move_to(0, target)
             .map_err(|e| ctx_err("move_to")(e.to_string()))?;
-        let status = client
-            .wait_outcome(ticket, SAMPLE_TIMEOUT)
+        let outcome = client
+            .wait_outcome_detail(ticket, SAMPLE_TIMEOUT)
             .map_err(|e| match e {
                 limber_services::WaitError::Timeout(t) => BenchError::Timeout {
                     what: format!("outcome of command {i}"),
@@ -193,14 +195,12 @@ fn run_variant(
                 other => ctx_err("wait_outcome")(other.to_string()),
             })?;
         let t1 = monotonic_ns();
-        if status != Status::Ok {
-            return Err(ctx_err("command")(format!("refused: {status}")));
+        if outcome.status != Status::Ok {
+            return Err(ctx_err("command")(format!("refused: {}", outcome.status)));
         }
         if i > warm {
             rtt.saturating_record(t1.saturating_sub(t0));
-            if let Some(s) = client.last_state() {
-                back.saturating_record(t1.saturating_sub(s.header.stamp_ns));
-            }
+            back.saturating_record(t1.saturating_sub(outcome.stamp_ns));
         }
         progress.tick(i);
     }
@@ -284,7 +284,7 @@ impl DeviceHandler<ActArray> for BenchArm {
             }
             _ => Status::Unsupported,
         };
-        // The state is "acquired" now: its stamp is the start of the driver→client leg.
+        // The state is "acquired" now.
         state.header.stamp_ns = monotonic_ns();
         status
     }

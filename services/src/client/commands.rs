@@ -26,10 +26,13 @@ impl<I: Interface> Client<I> {
     /// Sends a typed command. Returns at once (commands are not acknowledged; see
     /// [`Client::wait_outcome`]).
     pub fn send(&mut self, cmd: &I::Command) -> Result<Ticket, CommandError> {
-        let loan = self
-            .commands
-            .loan_uninit()
-            .map_err(|e| CommandError::Transport(e.into()))?;
+        let loan = match self.cmd_loan.take() {
+            Some(l) => l,
+            None => self
+                .commands
+                .loan_uninit()
+                .map_err(|e| CommandError::Transport(e.into()))?,
+        };
         let mut sample = loan.write_payload(I::CmdMsg::default());
         let raw: &mut I::CmdMsg = sample.payload_mut();
         cmd.write(raw);
@@ -43,6 +46,12 @@ impl<I: Interface> Client<I> {
             .map_err(|e| CommandError::Transport(e.into()))?;
         if self.wake_driver {
             self.wake_driver_with(qos::EVENT_COMMAND);
+        }
+        // A spinning client has a core of its own: it loans the next command's sample
+        // while the driver handles this one. (A client in event mode may share the
+        // driver's core, which would wait for that loan: it loans when it sends.)
+        if self.wait_mode == super::WaitMode::Spin {
+            self.cmd_loan = crate::host::loan_ahead(&self.commands, &self.device, "command");
         }
         self.sent();
         if receivers == 0 {

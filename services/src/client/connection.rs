@@ -81,7 +81,17 @@ pub struct Client<I: Interface> {
     pub(super) spin_budget: Duration,
     /// Busy-poll until then (set by a send), then block.
     pub(super) spin_until: Option<std::time::Instant>,
+    /// The next command's sample, loaned right after the previous command was sent
+    /// (`crate::host::loan_ahead`).
+    pub(super) cmd_loan: Option<CmdLoan<I>>,
 }
+
+/// A command sample loaned ahead of its command.
+pub(super) type CmdLoan<I> = iceoryx2::sample_mut_uninit::SampleMutUninit<
+    ipc::Service,
+    core::mem::MaybeUninit<<I as Interface>::CmdMsg>,
+    (),
+>;
 
 impl<I: Interface> core::fmt::Debug for Client<I> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
@@ -230,7 +240,8 @@ impl<I: Interface> Client<I> {
             .open_with_attributes(&layout)
             .map_err(|e| map("cmd", e.into()))?
             .publisher_builder()
-            .max_loaned_samples(1)
+            // One sample loaned ahead for the next command, one for a relayed command.
+            .max_loaned_samples(2)
             .create()
             .map_err(|e| map("cmd", e.into()))?;
         let requests = node
@@ -299,6 +310,7 @@ impl<I: Interface> Client<I> {
             request_timeout: DEFAULT_REQUEST_TIMEOUT,
             spin_budget: crate::qos::default_spin_budget(),
             spin_until: None,
+            cmd_loan: None,
         })
     }
 

@@ -26,6 +26,8 @@ pub struct Outcome {
     /// ([`Status::Preempted`]) or the one holding the device ([`Status::Leased`]); 0 if
     /// none.
     pub other_client: u64,
+    /// When the driver published it (`CLOCK_MONOTONIC` ns; 0 for none yet).
+    pub stamp_ns: u64,
     other_name: [u8; 32],
 }
 
@@ -34,6 +36,7 @@ impl Outcome {
         seq: 0,
         status: Status::Ok,
         other_client: 0,
+        stamp_ns: 0,
         other_name: [0; 32],
     };
 
@@ -46,6 +49,7 @@ impl Outcome {
                 Status::InvalidArgument
             }),
             other_client: m.other_client,
+            stamp_ns: m.stamp_ns,
             other_name: m.other_name,
         }
     }
