@@ -163,7 +163,10 @@ fn rust_client(
 
 /// Runs `cmd` to its end and returns its output; `Err(why)` when it cannot start or runs
 /// longer than `limit` (then it is killed).
-fn run_bounded(mut cmd: Command, limit: Duration) -> Result<std::process::Output, String> {
+pub(crate) fn run_bounded(
+    mut cmd: Command,
+    limit: Duration,
+) -> Result<std::process::Output, String> {
     let mut child = cmd
         .stdin(std::process::Stdio::null())
         .stdout(std::process::Stdio::piped())
