@@ -554,9 +554,7 @@ pub fn expose(
     };
     let result = exposer.run(&inbox, stop, report);
     drop(exposer);
-    if let Err(e) = session.close().wait() {
-        tracing::warn!(error = %e, "cannot close the Zenoh session");
-    }
+    session::close(&session);
     result
 }
 

@@ -578,9 +578,7 @@ pub fn mirror(
     };
     let result = mirrorer.run(&inbox, stop, report);
     drop(mirrorer);
-    if let Err(e) = session.close().wait() {
-        tracing::warn!(error = %e, "cannot close the Zenoh session");
-    }
+    session::close(&session);
     result
 }
 

@@ -22,12 +22,12 @@ use limber_interfaces::prelude::*;
 use limber_services::prelude::*;
 use limber_services::{Role, monotonic_ns};
 
-use super::command::DEVICE;
+use super::command::{DEVICE, start_event_driver};
 use super::floor::BYTES;
 use super::lang::run_bounded;
 use super::{READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario};
 use crate::BenchError;
-use crate::child::{ChildProc, ChildSpec};
+use crate::child::ChildProc;
 use crate::progress::Progress;
 use crate::stats::{Measurement, Metric, Strategy, new_histogram};
 
@@ -127,17 +127,7 @@ fn run(ctx: &mut RunCtx, exe: &Path) -> Result<(), BenchError> {
     let (warm, n) = (ctx.count(300, 50), ctx.count(3_000, 300));
     // Two clients, one after the other; through the bridge an exchange takes ~1 ms or less.
     let deadline = ctx.deadline_for(2 * (warm + n), Duration::from_millis(1));
-    let mut driver = ChildProc::spawn(&ChildSpec {
-        role: "cmd-driver-event".into(),
-        domain: Some(a.name().to_string()),
-        out: Some(ctx.tmp_file("bridge-driver.hdr")),
-        cpu: ctx.child_cpu(),
-        warmup: 0,
-        deadline,
-        linger: Some(limber_services::qos::DRIVER_LINGER),
-        ..Default::default()
-    })?;
-    driver.expect("ready", READY_TIMEOUT)?;
+    let driver = start_event_driver(ctx, &a, "bridge-driver.hdr", deadline)?;
     let cctx_a = Context::new(&a, Role::Client, "bench-bridge")
         .map_err(|e| err("client context in A", e))?;
     let mut direct = ActArrayClient::connect_timeout(&cctx_a, DEVICE, READY_TIMEOUT)
