@@ -65,7 +65,9 @@ impl Default for ExposeConfig {
                 ..NetConfig::default()
             },
             request_timeout: Duration::from_millis(1500),
-            discovery_period: Duration::from_millis(250),
+            // Listing a domain reads every service file of iceoryx2's root (those of every
+            // domain of the user): the bridge's main cost when idle, so not too often.
+            discovery_period: Duration::from_secs(1),
             allow: Allow::default(),
         }
     }
