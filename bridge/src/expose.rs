@@ -19,6 +19,7 @@ use iceoryx2::prelude::ipc;
 use limber_interfaces::Interface;
 use limber_interfaces::message::Message;
 use limber_interfaces::prelude::*;
+use limber_services::diagnostics::StatsReader;
 use limber_services::relay::{PendingLease, PendingRelay};
 use limber_services::{Client, Context, DeviceName, Domain, Role, list_devices};
 use thiserror::Error;
@@ -551,6 +552,7 @@ pub fn expose(
         session: &session,
         tx,
         devices: HashMap::new(),
+        stats: HashMap::new(),
         next_discovery: Instant::now(),
         next_liveness: Instant::now(),
     };
@@ -568,6 +570,8 @@ struct Exposer<'a> {
     session: &'a Session,
     tx: Sender<Event>,
     devices: HashMap<DeviceName, Box<dyn ExposedDevice>>,
+    /// Per robot with an exposed device, its driver statistics and where they go.
+    stats: HashMap<String, (StatsReader, Publisher<'static>)>,
     next_discovery: Instant,
     next_liveness: Instant,
 }
@@ -661,8 +665,53 @@ impl Exposer<'_> {
             for d in self.devices.values_mut() {
                 d.poll(self.session);
             }
+            self.relay_stats();
         }
         changed
+    }
+
+    /// Puts the driver statistics that arrived (about once a second) on Zenoh, for the
+    /// robots with an exposed device; forgets the robots that have none left.
+    fn relay_stats(&mut self) {
+        let devices = &self.devices;
+        self.stats
+            .retain(|robot, _| devices.keys().any(|d| d.robot() == robot.as_str()));
+        for robot in self.devices.keys().map(|d| d.robot().to_string()) {
+            if self.stats.contains_key(&robot) {
+                continue;
+            }
+            // A driver without statistics (not every driver has them) is asked again at
+            // the next check.
+            let Ok(reader) = StatsReader::open(&self.ctx, &robot) else {
+                continue;
+            };
+            match self
+                .session
+                .declare_publisher(keys::driver_stats_key(&robot))
+                .encoding(keys::encoding(keys::driver_stats_type()))
+                .wait()
+            {
+                Ok(p) => {
+                    self.stats.insert(robot, (reader, p));
+                }
+                Err(e) => {
+                    tracing::warn!(robot, error = %e, "cannot put driver statistics on Zenoh")
+                }
+            }
+        }
+        for (robot, (reader, publisher)) in &mut self.stats {
+            match reader.refresh() {
+                Ok(true) => {
+                    if let Some(s) = reader.latest()
+                        && let Err(e) = publisher.put(s.as_bytes().to_vec()).wait()
+                    {
+                        tracing::warn!(robot, error = %e, "cannot publish driver statistics");
+                    }
+                }
+                Ok(false) => {}
+                Err(e) => tracing::warn!(robot, error = %e, "cannot read driver statistics"),
+            }
+        }
     }
 
     /// Exposes the devices of the domain not exposed yet; returns whether there were any.

@@ -17,8 +17,10 @@ use std::time::{Duration, Instant};
 
 use iceoryx2::port::listener::Listener;
 use iceoryx2::prelude::ipc;
+use limber_interfaces::diagnostics::DriverStats;
 use limber_interfaces::prelude::*;
 use limber_interfaces::{HasHeader, Interface};
+use limber_services::diagnostics::StatsPublisher;
 use limber_services::relay::{RelayedLease, RelayedRequest};
 use limber_services::{Context, DeviceHost, DeviceName, Domain, Role, monotonic_ns};
 use thiserror::Error;
@@ -156,6 +158,11 @@ enum Event {
         exchange: Exchange,
         id: u64,
         reply: Reply,
+    },
+    /// A robot's driver statistics.
+    Stats {
+        robot: String,
+        payload: Vec<u8>,
     },
     /// Relayed query `id` is over: answered, timed out, or nobody was there to ask.
     Done {
@@ -563,6 +570,20 @@ pub fn mirror(
         })
         .wait()
         .map_err(|source| MirrorError::Subscribe { key, source })?;
+    let t = tx.clone();
+    let key = keys::all_driver_stats();
+    let _stats = session
+        .declare_subscriber(&key)
+        .callback(move |s: Sample| {
+            if let Some(robot) = keys::parse_driver_stats(s.key_expr().as_str()) {
+                let (robot, payload) = (robot.to_string(), s.payload().to_bytes().into_owned());
+                if t.send(Event::Stats { robot, payload }).is_err() {
+                    tracing::debug!("the bridge is ending: driver statistics dropped");
+                }
+            }
+        })
+        .wait()
+        .map_err(|source| MirrorError::Subscribe { key, source })?;
     report(MirrorEvent::Ready {
         zid: origin.clone(),
     });
@@ -574,6 +595,7 @@ pub fn mirror(
         origin,
         tx,
         devices: HashMap::new(),
+        stats: HashMap::new(),
         gone: Vec::new(),
     };
     let result = mirrorer.run(&inbox, stop, report);
@@ -591,6 +613,8 @@ struct Mirrorer<'a> {
     tx: Sender<Event>,
     /// By remote name: the local name and the hosted device.
     devices: HashMap<DeviceName, (DeviceName, Box<dyn MirroredDevice>)>,
+    /// Per remote robot with a hosted device, its driver statistics in this domain.
+    stats: HashMap<String, StatsPublisher>,
     /// Devices no longer hosted, reported once the loop no longer waits on them.
     gone: Vec<DeviceName>,
 }
@@ -647,6 +671,39 @@ impl Mirrorer<'_> {
         Ok(())
     }
 
+    /// Publishes a remote robot's driver statistics here (under the prefixed robot name),
+    /// while one of its devices is hosted.
+    fn stats_arrived(&mut self, robot: &str, payload: &[u8]) {
+        if !self.devices.keys().any(|d| d.robot() == robot) {
+            return;
+        }
+        let Ok(mut stats) = DriverStats::read_from_bytes(payload) else {
+            tracing::warn!(
+                robot,
+                len = payload.len(),
+                "driver statistics of the wrong size: dropped"
+            );
+            return;
+        };
+        if !self.stats.contains_key(robot) {
+            let local = format!("{}{robot}", self.config.prefix);
+            match StatsPublisher::new(&self.ctx, &local) {
+                Ok(p) => {
+                    self.stats.insert(robot.to_string(), p);
+                }
+                Err(e) => {
+                    tracing::warn!(robot = local, error = %e, "cannot offer driver statistics");
+                    return;
+                }
+            }
+        }
+        if let Some(p) = self.stats.get_mut(robot)
+            && let Err(e) = p.publish(&mut stats)
+        {
+            tracing::warn!(robot, error = %e, "cannot publish driver statistics");
+        }
+    }
+
     /// Handles one delivery from Zenoh; returns whether devices came or went.
     fn handle(&mut self, ev: Event, report: &mut dyn FnMut(MirrorEvent)) -> bool {
         match ev {
@@ -697,11 +754,18 @@ impl Mirrorer<'_> {
             } => match self.devices.remove(&device) {
                 Some((local, host)) => {
                     drop(host);
+                    let devices = &self.devices;
+                    self.stats
+                        .retain(|robot, _| devices.keys().any(|d| d.robot() == robot.as_str()));
                     self.gone.push(local);
                     true
                 }
                 None => false,
             },
+            Event::Stats { robot, payload } => {
+                self.stats_arrived(&robot, &payload);
+                false
+            }
             Event::State { device, payload } => {
                 if let Some((_, d)) = self.devices.get_mut(&device) {
                     d.state(&payload);
