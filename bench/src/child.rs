@@ -95,11 +95,22 @@ impl ChildProc {
         c.arg("--count").arg(spec.count.to_string());
         c.arg("--deadline-ms")
             .arg(spec.deadline.as_millis().to_string());
+        Self::start(&spec.role, c, spec.deadline)
+    }
+
+    /// Starts another program, `cmd` as given, as a child called `role`: its stdout lines
+    /// are read as a role's are ([`ChildProc::expect`]), and it is killed `deadline` (and
+    /// a little) after its start if still running.
+    pub fn spawn_program(role: &str, cmd: Command, deadline: Duration) -> Result<Self, BenchError> {
+        Self::start(role, cmd, deadline)
+    }
+
+    fn start(role: &str, mut c: Command, deadline: Duration) -> Result<Self, BenchError> {
         c.stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::inherit());
         let mut child = c.spawn().map_err(|source| BenchError::Spawn {
-            role: spec.role.clone(),
+            role: role.to_string(),
             source,
         })?;
         let stdout = child.stdout.take();
@@ -120,11 +131,11 @@ impl ChildProc {
             });
         }
         Ok(ChildProc {
-            role: spec.role.clone(),
+            role: role.to_string(),
             child,
             stdin,
             lines: rx,
-            kill_at: Instant::now() + spec.deadline + Duration::from_secs(5),
+            kill_at: Instant::now() + deadline + Duration::from_secs(5),
         })
     }
 
@@ -218,6 +229,26 @@ impl ChildProc {
                 Err(e) => return Err(BenchError::io(format!("waiting for {}", self.role), e)),
             }
         }
+    }
+
+    /// Asks the child to end (SIGTERM, by its pid), then [`ChildProc::finish`]es it.
+    pub fn terminate(mut self, timeout: Duration) -> Result<(), BenchError> {
+        if let Ok(None) = self.child.try_wait() {
+            let pid = i32::try_from(self.child.id())
+                .ok()
+                .and_then(rustix::process::Pid::from_raw);
+            match pid {
+                Some(pid) => {
+                    if let Err(e) =
+                        rustix::process::kill_process(pid, rustix::process::Signal::TERM)
+                    {
+                        tracing::warn!("cannot ask {} to end: {e}", self.role);
+                    }
+                }
+                None => tracing::warn!("{} has no valid pid", self.role),
+            }
+        }
+        self.finish(timeout)
     }
 
     fn kill(&mut self) {

@@ -227,6 +227,27 @@ pub const RATIOS: &[RatioDef] = &[
         pct: Pct::P50,
         goal: None,
     },
+    RatioDef {
+        label: "command round trip through the Zenoh bridge pair / direct (bridge)",
+        num: "bridge.zenoh.rtt",
+        den: "bridge.direct.rtt",
+        pct: Pct::P50,
+        goal: None,
+    },
+    RatioDef {
+        label: "command round trip through the Zenoh bridge pair / direct (bridge)",
+        num: "bridge.zenoh.rtt",
+        den: "bridge.direct.rtt",
+        pct: Pct::P99,
+        goal: None,
+    },
+    RatioDef {
+        label: "command round trip through the Zenoh bridge pair / TCP loopback blocking round trip",
+        num: "bridge.zenoh.rtt",
+        den: "peers.tcp.blocking.rtt",
+        pct: Pct::P50,
+        goal: None,
+    },
 ];
 
 /// One point of a percentile curve.

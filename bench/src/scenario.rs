@@ -7,6 +7,7 @@
 //! examples with a driver child). Ratios against the floor and
 //! the peers are defined in [`crate::report::RATIOS`].
 
+pub mod bridge;
 pub mod command;
 pub mod floor;
 pub mod ik;
@@ -57,6 +58,7 @@ pub fn registry() -> Vec<Box<dyn Scenario>> {
         Box::new(request::Request),
         Box::new(pty_loop::Loop),
         Box::new(lang::Lang),
+        Box::new(bridge::Bridge),
     ]
 }
 

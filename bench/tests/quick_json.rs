@@ -146,45 +146,8 @@ fn lang_measures_rust_c_and_python_or_says_why_not() {
     let dir = std::env::temp_dir().join(format!("limber-bench-lang-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let run = |json: &std::path::Path, python: Option<&str>| {
-        let mut cmd = Command::new(env!("CARGO_BIN_EXE_limber-bench"));
-        cmd.args([
-            "--quick",
-            "--scale",
-            "0.2",
-            "--no-progress",
-            "--only",
-            "lang",
-        ])
-        .arg("--json")
-        .arg(json);
-        if let Some(p) = python {
-            cmd.env("LIMBER_PYTHON", p);
-        }
-        let out = limber_bounded_run::output_within(cmd, Duration::from_secs(300));
-        assert!(
-            out.status.success(),
-            "limber-bench failed: {}\n{}",
-            String::from_utf8_lossy(&out.stdout),
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let v: Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
-        let s = &v["scenarios"][0];
-        assert_eq!(s["name"], "lang");
-        assert_eq!(s["status"], "ok", "{s}");
-        let ids: Vec<String> = v["measurements"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|m| {
-                assert!(m["summary"]["count"].as_u64().unwrap() > 0, "{m}");
-                m["id"].as_str().unwrap().to_string()
-            })
-            .collect();
-        (
-            ids,
-            s["detail"].as_str().unwrap().to_string(),
-            String::from_utf8_lossy(&out.stderr).into_owned(),
-        )
+        let (s, ids, _, stderr) = run_only("lang", json, python.map(|p| ("LIMBER_PYTHON", p)));
+        (ids, s["detail"].as_str().unwrap().to_string(), stderr)
     };
     let ci = std::env::var("CI").as_deref() == Ok("true");
     let (ids, detail, _) = run(&dir.join("lang.json"), None);
@@ -215,4 +178,100 @@ fn lang_measures_rust_c_and_python_or_says_why_not() {
     );
     assert!(stderr.contains("lang: Python skipped: "), "{stderr}");
     std::fs::remove_dir_all(&dir).expect("remove the test's directory");
+}
+
+/// `--only bridge`: the command round trip through a `limber bridge expose` + `mirror` pair
+/// over TCP loopback, and the same client direct; without a `limber` that runs `bridge`
+/// (here: `LIMBER_BIN` naming none), skipped with the reason. In CI (`CI=true`) the
+/// workspace's `limber` is built beside `limber-bench`, and both rows must be there.
+#[test]
+fn bridge_measures_through_a_bridge_pair_or_says_why_not() {
+    let dir = std::env::temp_dir().join(format!("limber-bench-bridge-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |json: &std::path::Path, limber: Option<&str>| {
+        let (s, ids, v, stderr) = run_only("bridge", json, limber.map(|p| ("LIMBER_BIN", p)));
+        for m in v["measurements"].as_array().unwrap() {
+            assert_eq!(m["strategy"], "blocking", "{m}");
+        }
+        let ratio = v["ratios"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|r| r["num"] == "bridge.zenoh.rtt" && r["den"] == "bridge.direct.rtt");
+        (
+            ids,
+            ratio,
+            s["detail"].as_str().unwrap().to_string(),
+            stderr,
+        )
+    };
+    let ci = std::env::var("CI").as_deref() == Ok("true");
+    let (ids, ratio, detail, _) = run(&dir.join("bridge.json"), None);
+    let measured = ids.contains(&"bridge.direct.rtt".to_string())
+        && ids.contains(&"bridge.zenoh.rtt".to_string());
+    if ci {
+        assert!(measured, "the bridge rows are missing: {ids:?} ({detail})");
+    } else {
+        assert!(
+            measured || detail.contains("bridge skipped: "),
+            "{ids:?} ({detail})"
+        );
+    }
+    if measured {
+        assert!(ratio, "no bridge/direct ratio");
+    }
+    // No limber: skipped, with the reason on stderr and in the report.
+    let (ids, _, detail, stderr) = run(&dir.join("nolimber.json"), Some("/nonexistent/limber"));
+    assert!(ids.is_empty(), "{ids:?}");
+    assert!(
+        detail.contains("bridge skipped: no limber executable with `bridge`"),
+        "{detail}"
+    );
+    assert!(stderr.contains("bridge skipped: "), "{stderr}");
+    std::fs::remove_dir_all(&dir).expect("remove the test's directory");
+}
+
+/// What a `--quick --scale 0.2 --only <scenario>` run gave: its one scenario's status
+/// entry, the ids of its measurements (each checked to have samples), the whole report,
+/// and its stderr. `env`, if given, is set for the run.
+fn run_only(
+    scenario: &str,
+    json: &std::path::Path,
+    env: Option<(&str, &str)>,
+) -> (Value, Vec<String>, Value, String) {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_limber-bench"));
+    cmd.args([
+        "--quick",
+        "--scale",
+        "0.2",
+        "--no-progress",
+        "--only",
+        scenario,
+    ])
+    .arg("--json")
+    .arg(json);
+    if let Some((k, v)) = env {
+        cmd.env(k, v);
+    }
+    let out = limber_bounded_run::output_within(cmd, Duration::from_secs(300));
+    assert!(
+        out.status.success(),
+        "limber-bench failed: {}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+    let s = v["scenarios"][0].clone();
+    assert_eq!(s["name"], scenario);
+    assert_eq!(s["status"], "ok", "{s}");
+    let ids: Vec<String> = v["measurements"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| {
+            assert!(m["summary"]["count"].as_u64().unwrap() > 0, "{m}");
+            m["id"].as_str().unwrap().to_string()
+        })
+        .collect();
+    (s, ids, v, String::from_utf8_lossy(&out.stderr).into_owned())
 }

@@ -10,12 +10,16 @@
 //! liveliness token `.../alive` while the driver lives.
 
 use std::collections::HashMap;
-use std::sync::mpsc;
+use std::rc::Rc;
 use std::time::{Duration, Instant};
+
+use iceoryx2::port::listener::Listener;
+use iceoryx2::prelude::ipc;
 
 use limber_interfaces::Interface;
 use limber_interfaces::message::Message;
 use limber_interfaces::prelude::*;
+use limber_services::diagnostics::StatsReader;
 use limber_services::relay::{PendingLease, PendingRelay};
 use limber_services::{Client, Context, DeviceName, Domain, Role, list_devices};
 use thiserror::Error;
@@ -28,8 +32,14 @@ use zenoh::{Session, bytes::ZBytes};
 use zerocopy::{FromBytes, IntoBytes};
 
 use crate::allow::Allow;
+use crate::inbox::{Inbox, InboxError, Sender};
 use crate::keys::{self, TypeNames};
 use crate::session::{self, NetConfig, SessionError};
+use crate::waiting::{Attached, with_waitset};
+
+/// How often each exposed device's driver is checked for life (a dead driver's token is
+/// withdrawn after two checks in a row find it dead).
+const LIVENESS_PERIOD: Duration = Duration::from_millis(100);
 
 /// The driver name a mirror hosts its devices under; `expose` skips such devices so that a
 /// mirror and an exposing bridge in one domain do not loop.
@@ -56,7 +66,9 @@ impl Default for ExposeConfig {
                 ..NetConfig::default()
             },
             request_timeout: Duration::from_millis(1500),
-            discovery_period: Duration::from_millis(250),
+            // Listing a domain reads every service file of iceoryx2's root (those of every
+            // domain of the user): the bridge's main cost when idle, so not too often.
+            discovery_period: Duration::from_secs(1),
             allow: Allow::default(),
         }
     }
@@ -91,6 +103,12 @@ pub enum ExposeError {
         #[source]
         source: limber_services::ContextError,
     },
+    /// The loop's wake-up could not be made.
+    #[error(transparent)]
+    Inbox(#[from] InboxError),
+    /// The loop's WaitSet could not be set up or waited on.
+    #[error(transparent)]
+    Loop(#[from] limber_services::event_loop::LoopError),
 }
 
 enum Event {
@@ -185,6 +203,8 @@ struct Exposed<I: Interface> {
     /// The last liveness check found the driver dead.
     doubted: bool,
     leases: Vec<(Query, PendingLease, Instant)>,
+    /// Notified when the driver published a state or an outcome, or answered.
+    listener: Rc<Listener<ipc::Service>>,
     _token: LivelinessToken,
     _commands: Subscriber<()>,
     _queries: Queryable<()>,
@@ -196,6 +216,9 @@ trait ExposedDevice {
     fn query(&mut self, query: Query, timeout: Duration);
     fn lease(&mut self, query: Query, timeout: Duration);
     fn poll(&mut self, session: &Session);
+    /// The earliest deadline of a relayed request or lease request.
+    fn next_deadline(&self) -> Option<Instant>;
+    fn listener(&self) -> Rc<Listener<ipc::Service>>;
     fn alive(&self) -> bool;
     fn doubted(&self) -> bool;
     fn set_doubted(&mut self, on: bool);
@@ -340,6 +363,16 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
         });
     }
 
+    fn next_deadline(&self) -> Option<Instant> {
+        let requests = self.pending.iter().map(|(_, _, t, _)| *t);
+        let leases = self.leases.iter().map(|(_, _, t)| *t);
+        requests.chain(leases).min()
+    }
+
+    fn listener(&self) -> Rc<Listener<ipc::Service>> {
+        Rc::clone(&self.listener)
+    }
+
     fn alive(&self) -> bool {
         self.client.relay_driver_alive()
     }
@@ -402,9 +435,10 @@ fn expose_device<I: Interface>(
     ctx: &Context,
     session: &Session,
     device: &DeviceName,
-    tx: &mpsc::Sender<Event>,
+    tx: &Sender<Event>,
 ) -> Result<Box<dyn ExposedDevice>, String> {
     let client = Client::<I>::connect(ctx, &device.to_string()).map_err(|e| e.to_string())?;
+    let listener = client.relay_listener().map_err(|e| e.to_string())?;
     // The same test as the one that withdraws it: a driver found dead is not exposed.
     if !client.relay_driver_alive() {
         return Err("its driver is not alive".into());
@@ -438,7 +472,7 @@ fn expose_device<I: Interface>(
     let queries = session
         .declare_queryable(keys::device_key(device, "req"))
         .callback(move |query: Query| {
-            if let Err(mpsc::SendError(Event::Query { query, .. })) = t.send(Event::Query {
+            if let Err(Event::Query { query, .. }) = t.send(Event::Query {
                 device: d.clone(),
                 query,
             }) {
@@ -451,7 +485,7 @@ fn expose_device<I: Interface>(
     let lease_queries = session
         .declare_queryable(keys::device_key(device, "lease"))
         .callback(move |query: Query| {
-            if let Err(mpsc::SendError(Event::Lease { query, .. })) = t.send(Event::Lease {
+            if let Err(Event::Lease { query, .. }) = t.send(Event::Lease {
                 device: d.clone(),
                 query,
             }) {
@@ -479,6 +513,7 @@ fn expose_device<I: Interface>(
         pending: Vec::new(),
         doubted: false,
         leases: Vec::new(),
+        listener: Rc::new(listener),
         _leases: lease_queries,
         _token: token,
         _commands: commands,
@@ -488,6 +523,11 @@ fn expose_device<I: Interface>(
 
 /// Puts the devices of `domain` on Zenoh until `stop` returns true; `report` hears of
 /// each device that comes and goes.
+///
+/// The loop sleeps until Zenoh delivers something, a driver notifies (a state, an outcome,
+/// a reply), or one of its deadlines comes: the next look for new devices
+/// ([`ExposeConfig::discovery_period`]), the next check of the drivers' life, a relayed
+/// request's timeout. `stop` is asked at each wake-up (a signal interrupts the wait).
 pub fn expose(
     domain: &Domain,
     config: &ExposeConfig,
@@ -504,67 +544,109 @@ pub fn expose(
     report(ExposeEvent::Ready {
         zid: session.zid().to_string(),
     });
-    let (tx, rx) = mpsc::channel::<Event>();
-    let mut devices: HashMap<DeviceName, Box<dyn ExposedDevice>> = HashMap::new();
-    let mut next_discovery = Instant::now();
-    let mut next_liveness = Instant::now();
-    while !stop() {
-        let now = Instant::now();
-        if now >= next_discovery {
-            next_discovery = now + config.discovery_period;
-            match list_devices(domain) {
-                Ok(list) => {
-                    for info in list {
-                        if !info.alive
-                            || info.driver == MIRROR_DRIVER
-                            || !config.allow.device(&info.name)
-                            || devices.contains_key(&info.name)
-                        {
-                            continue;
+    let (inbox, tx) = Inbox::<Event>::new()?;
+    let mut exposer = Exposer {
+        domain,
+        config,
+        ctx,
+        session: &session,
+        tx,
+        devices: HashMap::new(),
+        stats: HashMap::new(),
+        next_discovery: Instant::now(),
+        next_liveness: Instant::now(),
+    };
+    let result = exposer.run(&inbox, stop, report);
+    drop(exposer);
+    session::close(&session);
+    result
+}
+
+/// The state of a running `expose`.
+struct Exposer<'a> {
+    domain: &'a Domain,
+    config: &'a ExposeConfig,
+    ctx: Context,
+    session: &'a Session,
+    tx: Sender<Event>,
+    devices: HashMap<DeviceName, Box<dyn ExposedDevice>>,
+    /// Per robot with an exposed device, its driver statistics and where they go.
+    stats: HashMap<String, (StatsReader, Publisher<'static>)>,
+    next_discovery: Instant,
+    next_liveness: Instant,
+}
+
+impl Exposer<'_> {
+    /// The loop, until `stop`; the WaitSet is built anew whenever devices come or go.
+    fn run(
+        &mut self,
+        inbox: &Inbox<Event>,
+        stop: &dyn Fn() -> bool,
+        report: &mut dyn FnMut(ExposeEvent),
+    ) -> Result<(), ExposeError> {
+        while !stop() {
+            let attached: Attached = self
+                .devices
+                .iter()
+                .map(|(n, d)| (n.clone(), d.listener()))
+                .collect();
+            with_waitset(
+                inbox.source(),
+                &attached,
+                |wait| -> Result<(), ExposeError> {
+                    loop {
+                        // Devices came or went: the WaitSet is built anew.
+                        if self.timers(report) {
+                            return Ok(());
                         }
-                        let made = match info.interface() {
-                            InterfaceKind::ActArray => expose_device::<ActArray>(
-                                &config.allow,
-                                &ctx,
-                                &session,
-                                &info.name,
-                                &tx,
-                            ),
-                            InterfaceKind::Limb => expose_device::<Limb>(
-                                &config.allow,
-                                &ctx,
-                                &session,
-                                &info.name,
-                                &tx,
-                            ),
-                            InterfaceKind::Gripper => expose_device::<Gripper>(
-                                &config.allow,
-                                &ctx,
-                                &session,
-                                &info.name,
-                                &tx,
-                            ),
-                        };
-                        match made {
-                            Ok(d) => {
-                                tracing::info!(device = %info.name, "exposed");
-                                devices.insert(info.name.clone(), d);
-                                report(ExposeEvent::Exposed(info.name));
+                        if stop() {
+                            return Ok(());
+                        }
+                        let due = self
+                            .devices
+                            .values()
+                            .filter_map(|d| d.next_deadline())
+                            .fold(self.next_discovery.min(self.next_liveness), Instant::min);
+                        let woken = wait(due.saturating_duration_since(Instant::now()))?;
+                        for name in &woken.devices {
+                            if let Some(d) = self.devices.get_mut(name) {
+                                d.poll(self.session);
                             }
-                            Err(e) => {
-                                tracing::warn!(device = %info.name, error = %e, "cannot expose")
+                        }
+                        if woken.mail {
+                            for ev in inbox.drain() {
+                                self.handle(ev);
+                            }
+                        }
+                        // Relayed requests whose time is up are answered "timeout".
+                        let now = Instant::now();
+                        for d in self.devices.values_mut() {
+                            if d.next_deadline().is_some_and(|t| t <= now) {
+                                d.poll(self.session);
                             }
                         }
                     }
-                }
-                Err(e) => tracing::warn!(error = %e, "cannot list the devices"),
-            }
+                },
+            )??;
         }
-        if now >= next_liveness {
-            next_liveness = now + Duration::from_millis(100);
-            // Withdrawn after two checks in a row find the driver dead (100 ms apart), so a
-            // passing doubt never makes a device flap.
-            let gone: Vec<DeviceName> = devices
+        Ok(())
+    }
+
+    /// Looks for new devices and checks the drivers' life when their time has come;
+    /// returns whether devices came or went.
+    fn timers(&mut self, report: &mut dyn FnMut(ExposeEvent)) -> bool {
+        let now = Instant::now();
+        let mut changed = false;
+        if now >= self.next_discovery {
+            self.next_discovery = now + self.config.discovery_period;
+            changed |= self.discover(report);
+        }
+        if now >= self.next_liveness {
+            self.next_liveness = now + LIVENESS_PERIOD;
+            // Withdrawn after two checks in a row find the driver dead, so a passing doubt
+            // never makes a device flap.
+            let gone: Vec<DeviceName> = self
+                .devices
                 .iter_mut()
                 .filter_map(|(n, d)| {
                     let (alive, doubted) = (d.alive(), d.doubted());
@@ -574,45 +656,128 @@ pub fn expose(
                 .collect();
             for name in gone {
                 // The token is withdrawn (dropped) before anybody is told so.
-                drop(devices.remove(&name));
+                drop(self.devices.remove(&name));
                 tracing::info!(device = %name, "driver gone: withdrawn");
                 report(ExposeEvent::Gone(name));
+                changed = true;
             }
+            // What a notification could not tell: a driver that left without answering.
+            for d in self.devices.values_mut() {
+                d.poll(self.session);
+            }
+            self.relay_stats();
         }
-        match rx.recv_timeout(Duration::from_millis(1)) {
-            Ok(first) => {
-                for ev in std::iter::once(first).chain(rx.try_iter()) {
-                    match ev {
-                        Event::Command {
-                            device,
-                            origin,
-                            payload,
-                        } => match devices.get_mut(&device) {
-                            Some(d) => d.command(&session, &origin, &payload),
-                            None => tracing::debug!(device = %device, "command for a device gone"),
-                        },
-                        Event::Query { device, query } => match devices.get_mut(&device) {
-                            Some(d) => d.query(query, config.request_timeout),
-                            None => refuse(&query, Status::LinkDown),
-                        },
-                        Event::Lease { device, query } => match devices.get_mut(&device) {
-                            Some(d) => d.lease(query, config.request_timeout),
-                            None => refuse(&query, Status::LinkDown),
-                        },
-                    }
+        changed
+    }
+
+    /// Puts the driver statistics that arrived (about once a second) on Zenoh, for the
+    /// robots with an exposed device; forgets the robots that have none left.
+    fn relay_stats(&mut self) {
+        let devices = &self.devices;
+        self.stats
+            .retain(|robot, _| devices.keys().any(|d| d.robot() == robot.as_str()));
+        for robot in self.devices.keys().map(|d| d.robot().to_string()) {
+            if self.stats.contains_key(&robot) {
+                continue;
+            }
+            // A driver without statistics (not every driver has them) is asked again at
+            // the next check.
+            let Ok(reader) = StatsReader::open(&self.ctx, &robot) else {
+                continue;
+            };
+            match self
+                .session
+                .declare_publisher(keys::driver_stats_key(&robot))
+                .encoding(keys::encoding(keys::driver_stats_type()))
+                .wait()
+            {
+                Ok(p) => {
+                    self.stats.insert(robot, (reader, p));
+                }
+                Err(e) => {
+                    tracing::warn!(robot, error = %e, "cannot put driver statistics on Zenoh")
                 }
             }
-            Err(mpsc::RecvTimeoutError::Timeout) => {}
-            // Not while `tx` lives.
-            Err(mpsc::RecvTimeoutError::Disconnected) => break,
         }
-        for d in devices.values_mut() {
-            d.poll(&session);
+        for (robot, (reader, publisher)) in &mut self.stats {
+            match reader.refresh() {
+                Ok(true) => {
+                    if let Some(s) = reader.latest()
+                        && let Err(e) = publisher.put(s.as_bytes().to_vec()).wait()
+                    {
+                        tracing::warn!(robot, error = %e, "cannot publish driver statistics");
+                    }
+                }
+                Ok(false) => {}
+                Err(e) => tracing::warn!(robot, error = %e, "cannot read driver statistics"),
+            }
         }
     }
-    drop(devices);
-    if let Err(e) = session.close().wait() {
-        tracing::warn!(error = %e, "cannot close the Zenoh session");
+
+    /// Exposes the devices of the domain not exposed yet; returns whether there were any.
+    fn discover(&mut self, report: &mut dyn FnMut(ExposeEvent)) -> bool {
+        let list = match list_devices(self.domain) {
+            Ok(list) => list,
+            Err(e) => {
+                tracing::warn!(error = %e, "cannot list the devices");
+                return false;
+            }
+        };
+        let mut added = false;
+        let config = self.config;
+        for info in list {
+            if !info.alive
+                || info.driver == MIRROR_DRIVER
+                || !config.allow.device(&info.name)
+                || self.devices.contains_key(&info.name)
+            {
+                continue;
+            }
+            let (ctx, session, tx) = (&self.ctx, self.session, &self.tx);
+            let made = match info.interface() {
+                InterfaceKind::ActArray => {
+                    expose_device::<ActArray>(&config.allow, ctx, session, &info.name, tx)
+                }
+                InterfaceKind::Limb => {
+                    expose_device::<Limb>(&config.allow, ctx, session, &info.name, tx)
+                }
+                InterfaceKind::Gripper => {
+                    expose_device::<Gripper>(&config.allow, ctx, session, &info.name, tx)
+                }
+            };
+            match made {
+                Ok(d) => {
+                    tracing::info!(device = %info.name, "exposed");
+                    self.devices.insert(info.name.clone(), d);
+                    report(ExposeEvent::Exposed(info.name));
+                    added = true;
+                }
+                Err(e) => tracing::warn!(device = %info.name, error = %e, "cannot expose"),
+            }
+        }
+        added
     }
-    Ok(())
+
+    /// Relays one command or query that came from Zenoh.
+    fn handle(&mut self, ev: Event) {
+        let timeout = self.config.request_timeout;
+        match ev {
+            Event::Command {
+                device,
+                origin,
+                payload,
+            } => match self.devices.get_mut(&device) {
+                Some(d) => d.command(self.session, &origin, &payload),
+                None => tracing::debug!(device = %device, "command for a device gone"),
+            },
+            Event::Query { device, query } => match self.devices.get_mut(&device) {
+                Some(d) => d.query(query, timeout),
+                None => refuse(&query, Status::LinkDown),
+            },
+            Event::Lease { device, query } => match self.devices.get_mut(&device) {
+                Some(d) => d.lease(query, timeout),
+                None => refuse(&query, Status::LinkDown),
+            },
+        }
+    }
 }

@@ -9,6 +9,7 @@
 //! | `limber/<robot>/<interface>/<index>/req` | queryable of `expose` | query: the request envelope; reply: the reply envelope |
 //! | `limber/<robot>/<interface>/<index>/lease` | queryable of `expose` | query: `limber.v2.LeaseReq`; reply: `limber.v2.LeaseReply` |
 //! | `limber/<robot>/<interface>/<index>/alive` | liveliness token of `expose` | none |
+//! | `limber/<robot>/driver/0/stats` | put by `expose` about once a second | `limber.v2.DriverStats` |
 //!
 //! A query that the driver does not answer in time (or cannot be relayed) gets an error
 //! reply whose payload is a `Status` code, 4 bytes little-endian (encoding schema
@@ -41,6 +42,25 @@ pub fn device_key(device: &DeviceName, channel: &str) -> String {
 /// The key of the outcomes of `device` for the commands of `origin`.
 pub fn outcome_key(device: &DeviceName, origin: &str) -> String {
     format!("{}/{origin}", device_key(device, "outcome"))
+}
+
+/// The key of the driver statistics of `robot` (`limber.v2.DriverStats`, put by `expose`
+/// about once a second).
+pub fn driver_stats_key(robot: &str) -> String {
+    format!("{ROOT}/{robot}/driver/0/stats")
+}
+
+/// The key expression that matches the driver statistics of every robot.
+pub fn all_driver_stats() -> String {
+    format!("{ROOT}/*/driver/0/stats")
+}
+
+/// The robot of a driver statistics key.
+pub fn parse_driver_stats(key: &str) -> Option<&str> {
+    key.strip_prefix(ROOT)?
+        .strip_prefix('/')?
+        .strip_suffix("/driver/0/stats")
+        .filter(|r| valid_chunk(r))
 }
 
 /// The key expression that matches channel `channel` of every device.
@@ -101,6 +121,11 @@ pub fn lease_reply_type() -> &'static str {
     <limber_interfaces::prelude::LeaseReply as WireStruct>::LAYOUT.type_name
 }
 
+/// The type name of a driver's statistics.
+pub fn driver_stats_type() -> &'static str {
+    <limber_interfaces::diagnostics::DriverStats as WireStruct>::LAYOUT.type_name
+}
+
 /// The type name of an outcome.
 pub fn outcome_type() -> &'static str {
     <limber_interfaces::prelude::OutcomeMsg as WireStruct>::LAYOUT.type_name
@@ -142,5 +167,10 @@ mod tests {
         assert_eq!(parse("limber/pioneer/arm/0/state"), None);
         assert_eq!(parse("other/pioneer/actarray/0/state"), None);
         assert!(!valid_chunk("a/b") && !valid_chunk("*") && valid_chunk("0f3a"));
+        assert_eq!(
+            parse_driver_stats(&driver_stats_key("pioneer")),
+            Some("pioneer")
+        );
+        assert_eq!(parse_driver_stats("limber/a/b/driver/0/stats"), None);
     }
 }

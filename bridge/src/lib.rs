@@ -15,11 +15,14 @@
 
 pub mod allow;
 pub mod expose;
+mod inbox;
 pub mod keys;
 pub mod mirror;
 mod session;
+mod waiting;
 
 pub use allow::{Allow, AllowError, CommandKind, DevicePattern};
 pub use expose::{ExposeConfig, ExposeError, ExposeEvent, expose};
+pub use inbox::InboxError;
 pub use mirror::{MirrorConfig, MirrorError, MirrorEvent, mirror};
 pub use session::{NetConfig, SessionError};

@@ -11,24 +11,35 @@
 //! longer hosted here: its clients see its driver gone.
 
 use std::collections::HashMap;
-use std::sync::mpsc;
+use std::rc::Rc;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
+use iceoryx2::port::listener::Listener;
+use iceoryx2::prelude::ipc;
+use limber_interfaces::diagnostics::DriverStats;
 use limber_interfaces::prelude::*;
 use limber_interfaces::{HasHeader, Interface};
+use limber_services::diagnostics::StatsPublisher;
 use limber_services::relay::{RelayedLease, RelayedRequest};
 use limber_services::{Context, DeviceHost, DeviceName, Domain, Role, monotonic_ns};
 use thiserror::Error;
 use zenoh::Wait;
-use zenoh::handlers::FifoChannelHandler;
-use zenoh::query::Reply;
+use zenoh::handlers::CallbackDrop;
+use zenoh::query::{ConsolidationMode, Reply, ReplyError};
 use zenoh::sample::{Sample, SampleKind};
 use zenoh::{Session, bytes::ZBytes};
 use zerocopy::{FromBytes, IntoBytes};
 
 use crate::expose::MIRROR_DRIVER;
+use crate::inbox::{Inbox, InboxError, Sender};
 use crate::keys::{self, TypeNames};
 use crate::session::{self, NetConfig, SessionError};
+use crate::waiting::{Attached, with_waitset};
+
+/// The longest the loop sleeps with nothing to do, between two looks at `stop` (a signal
+/// wakes it at once).
+const IDLE_WAIT: Duration = Duration::from_millis(250);
 
 /// How `mirror` runs.
 #[derive(Debug, Clone)]
@@ -110,8 +121,24 @@ pub enum MirrorError {
         #[source]
         source: zenoh::Error,
     },
+    /// The loop's wake-up could not be made.
+    #[error(transparent)]
+    Inbox(#[from] InboxError),
+    /// The loop's WaitSet could not be set up or waited on.
+    #[error(transparent)]
+    Loop(#[from] limber_services::event_loop::LoopError),
 }
 
+/// Which kind of query a reply belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Exchange {
+    /// A request (`.../req`).
+    Request,
+    /// A lease request (`.../lease`).
+    Lease,
+}
+
+/// What Zenoh delivers to the loop (remote device names).
 enum Event {
     Alive {
         device: DeviceName,
@@ -125,32 +152,125 @@ enum Event {
         device: DeviceName,
         payload: Vec<u8>,
     },
+    /// A reply to relayed query `id`.
+    Reply {
+        device: DeviceName,
+        exchange: Exchange,
+        id: u64,
+        reply: Reply,
+    },
+    /// A robot's driver statistics.
+    Stats {
+        robot: String,
+        payload: Vec<u8>,
+    },
+    /// Relayed query `id` is over: answered, timed out, or nobody was there to ask.
+    Done {
+        device: DeviceName,
+        exchange: Exchange,
+        id: u64,
+    },
 }
 
 struct Mirrored<I: Interface> {
     local: DeviceName,
+    remote: DeviceName,
     host: DeviceHost<I>,
     cmd_key: String,
     req_key: String,
     lease_key: String,
     names: TypeNames,
-    pending: Vec<(RelayedRequest<I>, FifoChannelHandler<Reply>, Instant)>,
-    leases: Vec<(RelayedLease, FifoChannelHandler<Reply>, Instant)>,
+    tx: Sender<Event>,
+    requests: HashMap<u64, (RelayedRequest<I>, Instant)>,
+    leases: HashMap<u64, (RelayedLease, Instant)>,
+    /// Notified when a local client sent a command, a request or a lease request, or came.
+    listener: Rc<Listener<ipc::Service>>,
 }
 
 trait MirroredDevice {
     fn state(&mut self, payload: &[u8]);
     fn outcome(&mut self, payload: &[u8]);
-    fn poll(&mut self, session: &Session, origin: &str, timeout: Duration);
+    /// Relays what the local clients sent: commands, requests, lease requests.
+    fn relay(&mut self, session: &Session, origin: &str, timeout: Duration);
+    fn reply(&mut self, exchange: Exchange, id: u64, reply: &Reply);
+    fn done(&mut self, exchange: Exchange, id: u64);
+    fn listener(&self) -> Rc<Listener<ipc::Service>>;
 }
 
-/// The status an error reply of `expose` carries (4 bytes, little-endian).
-fn status_of(payload: &ZBytes) -> Status {
-    let bytes = payload.to_bytes();
-    <[u8; 4]>::try_from(bytes.as_ref())
+/// The status of a relayed query that got no reply: `Timeout` once its deadline has
+/// passed, `LinkDown` before (nobody was there to ask).
+fn unanswered(deadline: Instant) -> Status {
+    if Instant::now() >= deadline {
+        Status::Timeout
+    } else {
+        Status::LinkDown
+    }
+}
+
+/// The status an error reply carries: `expose`'s is a `Status` code (4 bytes,
+/// little-endian, schema `limber.Status`); Zenoh's own (its timeout) counts as no reply.
+fn status_of(err: &ReplyError, deadline: Instant) -> Status {
+    if *err.encoding() != keys::encoding(keys::STATUS_TYPE) {
+        return unanswered(deadline);
+    }
+    let bytes: &ZBytes = err.payload();
+    <[u8; 4]>::try_from(bytes.to_bytes().as_ref())
         .ok()
         .and_then(|b| Status::try_from(u32::from_le_bytes(b)).ok())
         .unwrap_or(Status::LinkDown)
+}
+
+/// A new id for a relayed query, never given before in this process (so that the end of
+/// a query of a device that went and came back is never taken for a new one's).
+fn next_query_id() -> u64 {
+    static NEXT: AtomicU64 = AtomicU64::new(1);
+    NEXT.fetch_add(1, Ordering::Relaxed)
+}
+
+/// Sends query `id` of `device` on `key`; its replies and its end come back through `tx`.
+fn ask(
+    session: &Session,
+    tx: &Sender<Event>,
+    (device, exchange, id): (&DeviceName, Exchange, u64),
+    key: &str,
+    (payload, type_name): (&[u8], &str),
+    origin: &str,
+    timeout: Duration,
+) -> Result<(), zenoh::Error> {
+    let (on_reply, on_done) = (tx.clone(), tx.clone());
+    let (d1, d2) = (device.clone(), device.clone());
+    session
+        .get(key)
+        .payload(payload.to_vec())
+        .encoding(keys::encoding(type_name))
+        .attachment(origin)
+        .timeout(timeout)
+        // One reply is expected: delivered as it arrives, not held until the query ends.
+        .consolidation(ConsolidationMode::None)
+        .with(CallbackDrop {
+            callback: move |reply: Reply| {
+                let ev = Event::Reply {
+                    device: d1.clone(),
+                    exchange,
+                    id,
+                    reply,
+                };
+                if on_reply.send(ev).is_err() {
+                    tracing::debug!("the bridge is ending: reply dropped");
+                }
+            },
+            drop: move || {
+                let ev = Event::Done {
+                    device: d2.clone(),
+                    exchange,
+                    id,
+                };
+                if on_done.send(ev).is_err() {
+                    tracing::debug!("the bridge is ending: end of a query dropped");
+                }
+            },
+        })
+        .wait()
 }
 
 impl<I: Interface> MirroredDevice for Mirrored<I> {
@@ -179,7 +299,7 @@ impl<I: Interface> MirroredDevice for Mirrored<I> {
         }
     }
 
-    fn poll(&mut self, session: &Session, origin: &str, timeout: Duration) {
+    fn relay(&mut self, session: &Session, origin: &str, timeout: Duration) {
         self.host.relay_housekeeping();
         let mut commands = Vec::new();
         if let Err(e) = self
@@ -207,64 +327,112 @@ impl<I: Interface> MirroredDevice for Mirrored<I> {
                     break;
                 }
             };
-            match session
-                .get(&self.req_key)
-                .payload(req.message().as_bytes().to_vec())
-                .encoding(keys::encoding(self.names.req))
-                .attachment(origin)
-                .timeout(timeout)
-                .wait()
-            {
-                Ok(replies) => self.pending.push((req, replies, Instant::now() + timeout)),
+            let id = next_query_id();
+            let deadline = Instant::now() + timeout;
+            match ask(
+                session,
+                &self.tx,
+                (&self.remote, Exchange::Request, id),
+                &self.req_key,
+                (req.message().as_bytes(), self.names.req),
+                origin,
+                timeout,
+            ) {
+                Ok(()) => {
+                    self.requests.insert(id, (req, deadline));
+                }
                 Err(e) => {
                     tracing::warn!(device = %self.local, error = %e, "cannot relay a request");
-                    let out = crate::keys::nack::<I>(req.message(), Status::LinkDown);
+                    let out = keys::nack::<I>(req.message(), Status::LinkDown);
                     if let Err(e) = self.host.relay_answer(req, &out) {
                         tracing::debug!(device = %self.local, error = %e, "reply not delivered");
                     }
                 }
             }
         }
-        self.poll_leases(session, origin, timeout);
-        let now = Instant::now();
-        let mut done = Vec::new();
-        let mut i = 0;
-        while i < self.pending.len() {
-            let (req, replies, deadline) = &self.pending[i];
-            let answer = match replies.try_recv() {
-                Ok(Some(reply)) => Some(match reply.result() {
-                    Ok(sample) => {
-                        match I::ReplyMsg::read_from_bytes(&sample.payload().to_bytes()) {
-                            Ok(r) => r,
-                            Err(_) => {
-                                tracing::warn!(device = %self.local, "a reply of the wrong size");
-                                crate::keys::nack::<I>(req.message(), Status::LinkDown)
-                            }
-                        }
-                    }
-                    Err(err) => crate::keys::nack::<I>(req.message(), status_of(err.payload())),
-                }),
-                Ok(None) if now < *deadline => None,
-                // Nobody answered: in time or not at all.
-                Ok(None) | Err(_) => Some(crate::keys::nack::<I>(
-                    req.message(),
-                    if now >= *deadline {
-                        Status::Timeout
-                    } else {
-                        Status::LinkDown
-                    },
-                )),
+        loop {
+            let req = match self.host.relay_take_lease() {
+                Ok(Some(r)) => r,
+                Ok(None) => break,
+                Err(e) => {
+                    tracing::warn!(device = %self.local, error = %e, "cannot take the lease requests");
+                    break;
+                }
             };
-            match answer {
-                Some(a) => done.push((self.pending.swap_remove(i).0, a)),
-                None => i += 1,
+            let id = next_query_id();
+            let deadline = Instant::now() + timeout;
+            match ask(
+                session,
+                &self.tx,
+                (&self.remote, Exchange::Lease, id),
+                &self.lease_key,
+                (req.message().as_bytes(), keys::lease_req_type()),
+                origin,
+                timeout,
+            ) {
+                Ok(()) => {
+                    self.leases.insert(id, (req, deadline));
+                }
+                Err(e) => {
+                    tracing::warn!(device = %self.local, error = %e, "cannot relay a lease request");
+                    let out = lease_nack(req.message(), Status::LinkDown);
+                    if let Err(e) = self.host.relay_answer_lease(req, &out) {
+                        tracing::debug!(device = %self.local, error = %e, "reply not delivered");
+                    }
+                }
             }
         }
-        for (req, reply) in done {
-            if let Err(e) = self.host.relay_answer(req, &reply) {
-                tracing::debug!(device = %self.local, error = %e, "reply not delivered");
+    }
+
+    fn reply(&mut self, exchange: Exchange, id: u64, reply: &Reply) {
+        match exchange {
+            Exchange::Request => {
+                let Some((req, deadline)) = self.requests.remove(&id) else {
+                    return; // answered already
+                };
+                let answer = match reply.result() {
+                    Ok(sample) => I::ReplyMsg::read_from_bytes(&sample.payload().to_bytes())
+                        .unwrap_or_else(|_| {
+                            tracing::warn!(device = %self.local, "a reply of the wrong size");
+                            keys::nack::<I>(req.message(), Status::LinkDown)
+                        }),
+                    Err(err) => keys::nack::<I>(req.message(), status_of(err, deadline)),
+                };
+                self.answer(req, &answer);
+            }
+            Exchange::Lease => {
+                let Some((req, deadline)) = self.leases.remove(&id) else {
+                    return;
+                };
+                let answer = match reply.result() {
+                    Ok(sample) => LeaseReply::read_from_bytes(&sample.payload().to_bytes())
+                        .unwrap_or_else(|_| lease_nack(req.message(), Status::LinkDown)),
+                    Err(err) => lease_nack(req.message(), status_of(err, deadline)),
+                };
+                self.answer_lease(req, &answer);
             }
         }
+    }
+
+    fn done(&mut self, exchange: Exchange, id: u64) {
+        match exchange {
+            Exchange::Request => {
+                if let Some((req, deadline)) = self.requests.remove(&id) {
+                    let out = keys::nack::<I>(req.message(), unanswered(deadline));
+                    self.answer(req, &out);
+                }
+            }
+            Exchange::Lease => {
+                if let Some((req, deadline)) = self.leases.remove(&id) {
+                    let out = lease_nack(req.message(), unanswered(deadline));
+                    self.answer_lease(req, &out);
+                }
+            }
+        }
+    }
+
+    fn listener(&self) -> Rc<Listener<ipc::Service>> {
+        Rc::clone(&self.listener)
     }
 }
 
@@ -278,65 +446,15 @@ fn lease_nack(req: &LeaseReq, status: Status) -> LeaseReply {
 }
 
 impl<I: Interface> Mirrored<I> {
-    /// Relays the clients' lease requests and answers those whose reply came.
-    fn poll_leases(&mut self, session: &Session, origin: &str, timeout: Duration) {
-        loop {
-            let req = match self.host.relay_take_lease() {
-                Ok(Some(r)) => r,
-                Ok(None) => break,
-                Err(e) => {
-                    tracing::warn!(device = %self.local, error = %e, "cannot take the lease requests");
-                    break;
-                }
-            };
-            match session
-                .get(&self.lease_key)
-                .payload(req.message().as_bytes().to_vec())
-                .encoding(keys::encoding(keys::lease_req_type()))
-                .attachment(origin)
-                .timeout(timeout)
-                .wait()
-            {
-                Ok(replies) => self.leases.push((req, replies, Instant::now() + timeout)),
-                Err(e) => {
-                    tracing::warn!(device = %self.local, error = %e, "cannot relay a lease request");
-                    let out = lease_nack(req.message(), Status::LinkDown);
-                    if let Err(e) = self.host.relay_answer_lease(req, &out) {
-                        tracing::debug!(device = %self.local, error = %e, "reply not delivered");
-                    }
-                }
-            }
+    fn answer(&mut self, req: RelayedRequest<I>, reply: &I::ReplyMsg) {
+        if let Err(e) = self.host.relay_answer(req, reply) {
+            tracing::debug!(device = %self.local, error = %e, "reply not delivered");
         }
-        let now = Instant::now();
-        let mut done = Vec::new();
-        let mut i = 0;
-        while i < self.leases.len() {
-            let (req, replies, deadline) = &self.leases[i];
-            let answer = match replies.try_recv() {
-                Ok(Some(reply)) => Some(match reply.result() {
-                    Ok(sample) => LeaseReply::read_from_bytes(&sample.payload().to_bytes())
-                        .unwrap_or_else(|_| lease_nack(req.message(), Status::LinkDown)),
-                    Err(err) => lease_nack(req.message(), status_of(err.payload())),
-                }),
-                Ok(None) if now < *deadline => None,
-                Ok(None) | Err(_) => Some(lease_nack(
-                    req.message(),
-                    if now >= *deadline {
-                        Status::Timeout
-                    } else {
-                        Status::LinkDown
-                    },
-                )),
-            };
-            match answer {
-                Some(a) => done.push((self.leases.swap_remove(i).0, a)),
-                None => i += 1,
-            }
-        }
-        for (req, reply) in done {
-            if let Err(e) = self.host.relay_answer_lease(req, &reply) {
-                tracing::debug!(device = %self.local, error = %e, "lease reply not delivered");
-            }
+    }
+
+    fn answer_lease(&mut self, req: RelayedLease, reply: &LeaseReply) {
+        if let Err(e) = self.host.relay_answer_lease(req, reply) {
+            tracing::debug!(device = %self.local, error = %e, "lease reply not delivered");
         }
     }
 }
@@ -345,17 +463,24 @@ fn host_device<I: Interface>(
     ctx: &Context,
     remote: &DeviceName,
     local: &DeviceName,
+    tx: &Sender<Event>,
 ) -> Result<Box<dyn MirroredDevice>, String> {
-    let host = DeviceHost::<I>::new(ctx, local, MIRROR_DRIVER).map_err(|e| e.to_string())?;
+    let mut host = DeviceHost::<I>::new(ctx, local, MIRROR_DRIVER).map_err(|e| e.to_string())?;
+    let listener = host
+        .take_wake_listener()
+        .ok_or_else(|| "the host has no wake listener".to_string())?;
     Ok(Box::new(Mirrored::<I> {
         local: local.clone(),
+        remote: remote.clone(),
         host,
         cmd_key: keys::device_key(remote, "cmd"),
         req_key: keys::device_key(remote, "req"),
         lease_key: keys::device_key(remote, "lease"),
         names: keys::type_names::<I>(),
-        pending: Vec::new(),
-        leases: Vec::new(),
+        tx: tx.clone(),
+        requests: HashMap::new(),
+        leases: HashMap::new(),
+        listener: Rc::new(listener),
     }))
 }
 
@@ -373,6 +498,11 @@ fn local_name(remote: &DeviceName, prefix: &str) -> Option<DeviceName> {
 
 /// Hosts the remote devices in `domain` until `stop` returns true; `report` hears of each
 /// device that comes and goes.
+///
+/// The loop sleeps until Zenoh delivers something (a state, an outcome, a reply, a
+/// liveliness change) or a local client wakes a hosted device (a command, a request, a
+/// lease request, a new client); `stop` is asked at each wake-up and at least every
+/// 250 ms (a signal interrupts the wait).
 pub fn mirror(
     domain: &Domain,
     config: &MirrorConfig,
@@ -394,7 +524,7 @@ pub fn mirror(
     })?;
     let session = session::open(&config.net)?;
     let origin = session.zid().to_string();
-    let (tx, rx) = mpsc::channel::<Event>();
+    let (inbox, tx) = Inbox::<Event>::new()?;
 
     let t = tx.clone();
     let key = keys::all_devices("state");
@@ -440,93 +570,235 @@ pub fn mirror(
         })
         .wait()
         .map_err(|source| MirrorError::Subscribe { key, source })?;
+    let t = tx.clone();
+    let key = keys::all_driver_stats();
+    let _stats = session
+        .declare_subscriber(&key)
+        .callback(move |s: Sample| {
+            if let Some(robot) = keys::parse_driver_stats(s.key_expr().as_str()) {
+                let (robot, payload) = (robot.to_string(), s.payload().to_bytes().into_owned());
+                if t.send(Event::Stats { robot, payload }).is_err() {
+                    tracing::debug!("the bridge is ending: driver statistics dropped");
+                }
+            }
+        })
+        .wait()
+        .map_err(|source| MirrorError::Subscribe { key, source })?;
     report(MirrorEvent::Ready {
         zid: origin.clone(),
     });
 
-    let mut devices: HashMap<DeviceName, (DeviceName, Box<dyn MirroredDevice>)> = HashMap::new();
-    while !stop() {
-        match rx.recv_timeout(Duration::from_millis(1)) {
-            Ok(first) => {
-                for ev in std::iter::once(first).chain(rx.try_iter()) {
-                    match ev {
-                        Event::Alive {
-                            device,
-                            present: true,
-                        } => {
-                            if devices.contains_key(&device) {
-                                continue;
-                            }
-                            let Some(local) = local_name(&device, &config.prefix) else {
-                                report(MirrorEvent::Refused {
-                                    remote: device,
-                                    reason: "the prefixed robot name is invalid".into(),
-                                });
-                                continue;
-                            };
-                            let made = match device.interface() {
-                                InterfaceKind::ActArray => {
-                                    host_device::<ActArray>(&ctx, &device, &local)
-                                }
-                                InterfaceKind::Limb => host_device::<Limb>(&ctx, &device, &local),
-                                InterfaceKind::Gripper => {
-                                    host_device::<Gripper>(&ctx, &device, &local)
-                                }
-                            };
-                            match made {
-                                Ok(d) => {
-                                    tracing::info!(remote = %device, local = %local, "mirrored");
-                                    devices.insert(device.clone(), (local.clone(), d));
-                                    report(MirrorEvent::Mirrored {
-                                        remote: device,
-                                        local,
-                                    });
-                                }
-                                Err(reason) => {
-                                    tracing::warn!(remote = %device, error = %reason,
-                                        "cannot host a remote device");
-                                    report(MirrorEvent::Refused {
-                                        remote: device,
-                                        reason,
-                                    });
-                                }
+    let mut mirrorer = Mirrorer {
+        config,
+        ctx,
+        session: &session,
+        origin,
+        tx,
+        devices: HashMap::new(),
+        stats: HashMap::new(),
+        gone: Vec::new(),
+    };
+    let result = mirrorer.run(&inbox, stop, report);
+    drop(mirrorer);
+    session::close(&session);
+    result
+}
+
+/// The state of a running `mirror`.
+struct Mirrorer<'a> {
+    config: &'a MirrorConfig,
+    ctx: Context,
+    session: &'a Session,
+    origin: String,
+    tx: Sender<Event>,
+    /// By remote name: the local name and the hosted device.
+    devices: HashMap<DeviceName, (DeviceName, Box<dyn MirroredDevice>)>,
+    /// Per remote robot with a hosted device, its driver statistics in this domain.
+    stats: HashMap<String, StatsPublisher>,
+    /// Devices no longer hosted, reported once the loop no longer waits on them.
+    gone: Vec<DeviceName>,
+}
+
+impl Mirrorer<'_> {
+    /// The loop, until `stop`; the WaitSet is built anew whenever devices come or go.
+    fn run(
+        &mut self,
+        inbox: &Inbox<Event>,
+        stop: &dyn Fn() -> bool,
+        report: &mut dyn FnMut(MirrorEvent),
+    ) -> Result<(), MirrorError> {
+        while !stop() {
+            let attached: Attached = self
+                .devices
+                .iter()
+                .map(|(remote, (_, d))| (remote.clone(), d.listener()))
+                .collect();
+            let ended = with_waitset(
+                inbox.source(),
+                &attached,
+                |wait| -> Result<(), MirrorError> {
+                    loop {
+                        if stop() {
+                            return Ok(());
+                        }
+                        let woken = wait(IDLE_WAIT)?;
+                        let timeout = self.config.request_timeout;
+                        for remote in &woken.devices {
+                            if let Some((_, d)) = self.devices.get_mut(remote) {
+                                d.relay(self.session, &self.origin, timeout);
                             }
                         }
-                        Event::Alive {
-                            device,
-                            present: false,
-                        } => {
-                            if let Some((local, host)) = devices.remove(&device) {
-                                // No longer offered before anybody is told so.
-                                drop(host);
-                                tracing::info!(local = %local, "remote device gone");
-                                report(MirrorEvent::Gone { local });
+                        let mut changed = false;
+                        if woken.mail {
+                            for ev in inbox.drain() {
+                                changed |= self.handle(ev, report);
                             }
                         }
-                        Event::State { device, payload } => {
-                            if let Some((_, d)) = devices.get_mut(&device) {
-                                d.state(&payload);
-                            }
+                        if changed {
+                            return Ok(());
                         }
-                        Event::Outcome { device, payload } => {
-                            if let Some((_, d)) = devices.get_mut(&device) {
-                                d.outcome(&payload);
-                            }
-                        }
+                    }
+                },
+            );
+            drop(attached);
+            // No longer waited on (nor offered) before anybody is told so.
+            for local in self.gone.drain(..) {
+                tracing::info!(local = %local, "remote device gone");
+                report(MirrorEvent::Gone { local });
+            }
+            ended??;
+        }
+        Ok(())
+    }
+
+    /// Publishes a remote robot's driver statistics here (under the prefixed robot name),
+    /// while one of its devices is hosted.
+    fn stats_arrived(&mut self, robot: &str, payload: &[u8]) {
+        if !self.devices.keys().any(|d| d.robot() == robot) {
+            return;
+        }
+        let Ok(mut stats) = DriverStats::read_from_bytes(payload) else {
+            tracing::warn!(
+                robot,
+                len = payload.len(),
+                "driver statistics of the wrong size: dropped"
+            );
+            return;
+        };
+        if !self.stats.contains_key(robot) {
+            let local = format!("{}{robot}", self.config.prefix);
+            match StatsPublisher::new(&self.ctx, &local) {
+                Ok(p) => {
+                    self.stats.insert(robot.to_string(), p);
+                }
+                Err(e) => {
+                    tracing::warn!(robot = local, error = %e, "cannot offer driver statistics");
+                    return;
+                }
+            }
+        }
+        if let Some(p) = self.stats.get_mut(robot)
+            && let Err(e) = p.publish(&mut stats)
+        {
+            tracing::warn!(robot, error = %e, "cannot publish driver statistics");
+        }
+    }
+
+    /// Handles one delivery from Zenoh; returns whether devices came or went.
+    fn handle(&mut self, ev: Event, report: &mut dyn FnMut(MirrorEvent)) -> bool {
+        match ev {
+            Event::Alive {
+                device,
+                present: true,
+            } => {
+                if self.devices.contains_key(&device) {
+                    return false;
+                }
+                let Some(local) = local_name(&device, &self.config.prefix) else {
+                    report(MirrorEvent::Refused {
+                        remote: device,
+                        reason: "the prefixed robot name is invalid".into(),
+                    });
+                    return false;
+                };
+                let (ctx, tx) = (&self.ctx, &self.tx);
+                let made = match device.interface() {
+                    InterfaceKind::ActArray => host_device::<ActArray>(ctx, &device, &local, tx),
+                    InterfaceKind::Limb => host_device::<Limb>(ctx, &device, &local, tx),
+                    InterfaceKind::Gripper => host_device::<Gripper>(ctx, &device, &local, tx),
+                };
+                match made {
+                    Ok(d) => {
+                        tracing::info!(remote = %device, local = %local, "mirrored");
+                        self.devices.insert(device.clone(), (local.clone(), d));
+                        report(MirrorEvent::Mirrored {
+                            remote: device,
+                            local,
+                        });
+                        true
+                    }
+                    Err(reason) => {
+                        tracing::warn!(remote = %device, error = %reason,
+                            "cannot host a remote device");
+                        report(MirrorEvent::Refused {
+                            remote: device,
+                            reason,
+                        });
+                        false
                     }
                 }
             }
-            Err(mpsc::RecvTimeoutError::Timeout) => {}
-            // Not while `tx` lives.
-            Err(mpsc::RecvTimeoutError::Disconnected) => break,
-        }
-        for (_, d) in devices.values_mut() {
-            d.poll(&session, &origin, config.request_timeout);
+            Event::Alive {
+                device,
+                present: false,
+            } => match self.devices.remove(&device) {
+                Some((local, host)) => {
+                    drop(host);
+                    let devices = &self.devices;
+                    self.stats
+                        .retain(|robot, _| devices.keys().any(|d| d.robot() == robot.as_str()));
+                    self.gone.push(local);
+                    true
+                }
+                None => false,
+            },
+            Event::Stats { robot, payload } => {
+                self.stats_arrived(&robot, &payload);
+                false
+            }
+            Event::State { device, payload } => {
+                if let Some((_, d)) = self.devices.get_mut(&device) {
+                    d.state(&payload);
+                }
+                false
+            }
+            Event::Outcome { device, payload } => {
+                if let Some((_, d)) = self.devices.get_mut(&device) {
+                    d.outcome(&payload);
+                }
+                false
+            }
+            Event::Reply {
+                device,
+                exchange,
+                id,
+                reply,
+            } => {
+                if let Some((_, d)) = self.devices.get_mut(&device) {
+                    d.reply(exchange, id, &reply);
+                }
+                false
+            }
+            Event::Done {
+                device,
+                exchange,
+                id,
+            } => {
+                if let Some((_, d)) = self.devices.get_mut(&device) {
+                    d.done(exchange, id);
+                }
+                false
+            }
         }
     }
-    drop(devices);
-    if let Err(e) = session.close().wait() {
-        tracing::warn!(error = %e, "cannot close the Zenoh session");
-    }
-    Ok(())
 }

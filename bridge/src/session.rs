@@ -84,3 +84,10 @@ pub(crate) fn open(net: &NetConfig) -> Result<Session, SessionError> {
     }
     zenoh::open(config).wait().map_err(SessionError::Open)
 }
+
+/// Closes `session`; a failure is logged (the bridge is ending anyway).
+pub(crate) fn close(session: &Session) {
+    if let Err(e) = session.close().wait() {
+        tracing::warn!(error = %e, "cannot close the Zenoh session");
+    }
+}

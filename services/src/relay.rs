@@ -9,6 +9,7 @@
 
 use iceoryx2::active_request::ActiveRequest;
 use iceoryx2::pending_response::PendingResponse;
+use iceoryx2::port::listener::Listener;
 use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::prelude::*;
 use limber_interfaces::prelude::*;
@@ -241,6 +242,13 @@ impl<I: Interface> Client<I> {
                 Err(e) => return Err(e.into()),
             }
         }
+    }
+
+    /// A listener of its own on the device's notifications (the driver published a state
+    /// or an outcome, or answered a request), for a relay's WaitSet: the relay sleeps until
+    /// the driver has something for it instead of polling.
+    pub fn relay_listener(&self) -> Result<Listener<ipc::Service>, Iox2Error> {
+        Ok(self.notify_svc.listener_builder().create()?)
     }
 
     /// Whether the device's driver process is alive. Unlike [`Client::driver_status`], a

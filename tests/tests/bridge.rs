@@ -192,6 +192,36 @@ fn clients_in_another_domain_command_the_arm_through_a_bridge_pair() {
     drop(s);
 }
 
+/// The driver statistics cross the bridge pair: in domain B, the robot's `driver` channel
+/// (what `limber monitor` and `limber echo pioneer/driver` read) carries the remote
+/// driver's loop statistics.
+#[test]
+fn the_remote_drivers_statistics_reach_the_other_domain() {
+    let s = setup();
+    let ctx = Context::new(&s.b, Role::Client, "bridge-test").expect("join domain B");
+    let deadline = Instant::now() + Duration::from_secs(10);
+    let mut reader = loop {
+        match limber_services::diagnostics::StatsReader::open(&ctx, "pioneer") {
+            Ok(r) => break r,
+            Err(e) => {
+                assert!(
+                    Instant::now() < deadline,
+                    "no driver statistics in domain B: {e}"
+                );
+                std::thread::sleep(Duration::from_millis(50));
+            }
+        }
+    };
+    let stats = reader
+        .wait(Duration::from_secs(5))
+        .expect("statistics through the bridge");
+    assert!(stats.cycles > 0, "the remote driver's loop has run");
+    assert_ne!(
+        stats.header.flags & limber_interfaces::prelude::device_flag::LINK_UP,
+        0
+    );
+}
+
 /// Kill the driver in A, then (after a restart) the exposing bridge, then the mirror:
 /// each time B's clients learn the arm is gone within a bound, and never hang.
 #[test]

@@ -248,6 +248,28 @@ fn run_variant(
     Ok(())
 }
 
+/// Starts the event-driven driver child (`cmd-driver-event`, the default linger) in
+/// `domain`, writing its histogram to the scratch file `out`, and waits for its `ready`.
+pub(crate) fn start_event_driver(
+    ctx: &RunCtx,
+    domain: &Domain,
+    out: &str,
+    deadline: Duration,
+) -> Result<ChildProc, BenchError> {
+    let mut driver = ChildProc::spawn(&ChildSpec {
+        role: "cmd-driver-event".into(),
+        domain: Some(domain.name().to_string()),
+        out: Some(ctx.tmp_file(out)),
+        cpu: ctx.child_cpu(),
+        warmup: 0,
+        deadline,
+        linger: Some(limber_services::qos::DRIVER_LINGER),
+        ..Default::default()
+    })?;
+    driver.expect("ready", READY_TIMEOUT)?;
+    Ok(driver)
+}
+
 /// The benchmark arm: 6 joints that move at once; records the one-way latency of every
 /// command after the warm-up; HOME (all joints) asks the driver to stop.
 struct BenchArm {

@@ -25,11 +25,10 @@ use limber_interfaces::prelude::*;
 use limber_services::prelude::*;
 use limber_services::{Role, monotonic_ns};
 
-use super::command::DEVICE;
+use super::command::{DEVICE, start_event_driver};
 use super::floor::BYTES;
 use super::{READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario};
 use crate::BenchError;
-use crate::child::{ChildProc, ChildSpec};
 use crate::progress::Progress;
 use crate::stats::{Measurement, Metric, Strategy, new_histogram};
 
@@ -81,17 +80,7 @@ fn run(ctx: &mut RunCtx) -> Result<(), BenchError> {
     let (warm, n) = (ctx.count(500, 50), ctx.count(5_000, 300));
     // Three clients, one after the other; Python's exchanges are the slowest (~100 µs).
     let deadline = ctx.deadline_for(3 * (warm + n), Duration::from_micros(500));
-    let mut driver = ChildProc::spawn(&ChildSpec {
-        role: "cmd-driver-event".into(),
-        domain: Some(domain.name().to_string()),
-        out: Some(ctx.tmp_file("lang-driver.hdr")),
-        cpu: ctx.child_cpu(),
-        warmup: 0,
-        deadline,
-        linger: Some(limber_services::qos::DRIVER_LINGER),
-        ..Default::default()
-    })?;
-    driver.expect("ready", READY_TIMEOUT)?;
+    let driver = start_event_driver(ctx, &domain, "lang-driver.hdr", deadline)?;
     let cctx =
         Context::new(&domain, Role::Client, "bench-lang").map_err(|e| err("client context", e))?;
     let mut client = ActArrayClient::connect_timeout(&cctx, DEVICE, READY_TIMEOUT)
@@ -163,7 +152,10 @@ fn rust_client(
 
 /// Runs `cmd` to its end and returns its output; `Err(why)` when it cannot start or runs
 /// longer than `limit` (then it is killed).
-fn run_bounded(mut cmd: Command, limit: Duration) -> Result<std::process::Output, String> {
+pub(crate) fn run_bounded(
+    mut cmd: Command,
+    limit: Duration,
+) -> Result<std::process::Output, String> {
     let mut child = cmd
         .stdin(std::process::Stdio::null())
         .stdout(std::process::Stdio::piped())

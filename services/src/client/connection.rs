@@ -65,7 +65,7 @@ pub struct Client<I: Interface> {
     pub(super) wake_svc: iceoryx2::service::port_factory::event::PortFactory<ipc::Service>,
     /// No new notifier before then.
     pub(super) wake_retry_at: core::cell::Cell<Option<std::time::Instant>>,
-    pub(super) notify_svc: iceoryx2::service::port_factory::event::PortFactory<ipc::Service>,
+    pub(crate) notify_svc: iceoryx2::service::port_factory::event::PortFactory<ipc::Service>,
     pub(super) notify: Option<Listener<ipc::Service>>,
     pub(super) cmd_seq: u64,
     pub(super) req_seq: u64,

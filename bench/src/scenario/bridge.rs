@@ -1,0 +1,228 @@
+//! `bridge`: the command round trip (`move_to` then a blocking `wait_outcome`, as a client
+//! does) through a `limber bridge expose` + `limber bridge mirror` pair over TCP loopback
+//! (Zenoh), beside the same client against the driver directly, in the same run.
+//!
+//! The driver is the `command` scenario's event-driven driver child (`cmd-driver-event`,
+//! its default linger) in domain A, with `bridge expose` in A; `bridge mirror` hosts the
+//! arm in domain B, where this process is the client. The client in A runs first (the
+//! direct row), then the one in B (the bridge row); the report sets the bridge row beside
+//! the TCP loopback peer row of the same run (`peers`).
+//!
+//! The bridges are the `limber` executable: `$LIMBER_BIN` if set, else this executable if
+//! it is `limber`, else `limber` beside it. If none can run `limber bridge` (e.g.
+//! `limber-bench` alone, or a `limber` built without its `bridge` feature), the scenario
+//! is skipped with the reason, printed and noted in the report.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Duration;
+
+use hdrhistogram::Histogram;
+use limber_interfaces::prelude::*;
+use limber_services::prelude::*;
+use limber_services::{Role, monotonic_ns};
+
+use super::command::{DEVICE, start_event_driver};
+use super::floor::BYTES;
+use super::lang::run_bounded;
+use super::{READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario};
+use crate::BenchError;
+use crate::child::ChildProc;
+use crate::progress::Progress;
+use crate::stats::{Measurement, Metric, Strategy, new_histogram};
+
+/// The `bridge` scenario.
+#[derive(Debug, Clone, Copy)]
+pub struct Bridge;
+
+impl Scenario for Bridge {
+    fn name(&self) -> &'static str {
+        "bridge"
+    }
+    fn description(&self) -> &'static str {
+        "command round trip through limber bridge expose + mirror (Zenoh, TCP loopback), beside the same client direct"
+    }
+    fn run(&self, ctx: &mut RunCtx) -> Result<(), BenchError> {
+        if !ctx.blocking_enabled() {
+            ctx.notes
+                .push("bridge runs blocking clients; skipped by --strategy spin".into());
+            return Ok(());
+        }
+        match limber_exe() {
+            Ok(exe) => run(ctx, &exe),
+            Err(why) => {
+                let note = format!("bridge skipped: {why}");
+                tracing::warn!("{note}");
+                ctx.notes.push(note);
+                Ok(())
+            }
+        }
+    }
+}
+
+fn err(what: &str, reason: impl std::fmt::Display) -> BenchError {
+    BenchError::Transport {
+        context: what.to_string(),
+        reason: reason.to_string(),
+    }
+}
+
+/// The `limber` executable that runs the bridges; `Err(why)` when there is none that can.
+fn limber_exe() -> Result<PathBuf, String> {
+    let exe = if let Some(p) = std::env::var_os("LIMBER_BIN") {
+        PathBuf::from(p)
+    } else {
+        let me =
+            std::env::current_exe().map_err(|e| format!("cannot find this executable: {e}"))?;
+        if me.file_name().is_some_and(|n| n == "limber") {
+            me
+        } else {
+            me.with_file_name("limber")
+        }
+    };
+    let mut probe = Command::new(&exe);
+    probe.args(["bridge", "--help"]);
+    let out = run_bounded(probe, Duration::from_secs(30))
+        .map_err(|why| format!("no limber executable with `bridge` ({why})"))?;
+    if !out.status.success() {
+        return Err(format!(
+            "{} cannot run `limber bridge` ({}; built without its `bridge` feature?)",
+            exe.display(),
+            out.status
+        ));
+    }
+    Ok(exe)
+}
+
+/// A TCP port on loopback that was free a moment ago.
+fn free_port() -> Result<u16, BenchError> {
+    std::net::TcpListener::bind("127.0.0.1:0")
+        .and_then(|l| l.local_addr())
+        .map(|a| a.port())
+        .map_err(|e| BenchError::io("a free loopback port", e))
+}
+
+/// `limber --domain <domain> bridge <args>`, started as a child that must print `line`.
+fn start_bridge(
+    exe: &Path,
+    role: &str,
+    domain: &Domain,
+    args: &[&str],
+    line: &str,
+    deadline: Duration,
+) -> Result<ChildProc, BenchError> {
+    let mut cmd = Command::new(exe);
+    cmd.arg("--domain")
+        .arg(domain.name())
+        .arg("bridge")
+        .args(args)
+        .env_remove("LIMBER_DOMAIN");
+    let mut child = ChildProc::spawn_program(role, cmd, deadline)?;
+    child.expect(line, READY_TIMEOUT)?;
+    Ok(child)
+}
+
+fn run(ctx: &mut RunCtx, exe: &Path) -> Result<(), BenchError> {
+    let (a, b) = (ctx.domain(), ctx.domain());
+    let (warm, n) = (ctx.count(300, 50), ctx.count(3_000, 300));
+    // Two clients, one after the other; through the bridge an exchange takes ~1 ms or less.
+    let deadline = ctx.deadline_for(2 * (warm + n), Duration::from_millis(1));
+    let driver = start_event_driver(ctx, &a, "bridge-driver.hdr", deadline)?;
+    let cctx_a = Context::new(&a, Role::Client, "bench-bridge")
+        .map_err(|e| err("client context in A", e))?;
+    let mut direct = ActArrayClient::connect_timeout(&cctx_a, DEVICE, READY_TIMEOUT)
+        .map_err(|e| err("connect in A", e))?;
+    let r = (|| {
+        let endpoint = format!("tcp/127.0.0.1:{}", free_port()?);
+        let expose = start_bridge(
+            exe,
+            "bridge expose",
+            &a,
+            &["expose", "--listen", &endpoint],
+            &format!("exposed {DEVICE}"),
+            deadline,
+        )?;
+        let mirror = start_bridge(
+            exe,
+            "bridge mirror",
+            &b,
+            &["mirror", "--connect", &endpoint],
+            &format!("mirrored {DEVICE} as {DEVICE}"),
+            deadline,
+        )?;
+        let rtt_direct = round_trips(ctx, &mut direct, "bridge direct", warm, n)?;
+        let cctx_b = Context::new(&b, Role::Client, "bench-bridge")
+            .map_err(|e| err("client context in B", e))?;
+        let mut remote = ActArrayClient::connect_timeout(&cctx_b, DEVICE, READY_TIMEOUT)
+            .map_err(|e| err("connect in B", e))?;
+        let rtt_bridge = round_trips(ctx, &mut remote, "bridge zenoh", warm, n)?;
+        drop(remote);
+        mirror.terminate(Duration::from_secs(10))?;
+        expose.terminate(Duration::from_secs(10))?;
+        Ok((rtt_direct, rtt_bridge))
+    })();
+    // HOME all joints stops the driver child (if it cannot be sent, its deadline does).
+    if let Err(e) = direct.home(None) {
+        tracing::warn!("cannot tell the driver child to stop: {e}");
+    }
+    driver.finish(Duration::from_secs(10))?;
+    let (rtt_direct, rtt_bridge) = r?;
+    push(
+        ctx,
+        "bridge.direct.rtt",
+        "command→outcome, client in the driver's domain",
+        rtt_direct,
+    );
+    push(
+        ctx,
+        "bridge.zenoh.rtt",
+        "command→outcome through bridge expose+mirror (Zenoh, TCP loopback)",
+        rtt_bridge,
+    );
+    Ok(())
+}
+
+fn push(ctx: &mut RunCtx, id: &str, label: &str, hist: Histogram<u64>) {
+    ctx.push(Measurement {
+        scenario: "bridge",
+        id: id.to_string(),
+        label: label.to_string(),
+        strategy: Strategy::Blocking,
+        metric: Metric::RoundTrip,
+        bytes: Some(BYTES),
+        hist,
+    });
+}
+
+/// `warm` + `n` command round trips of `client` with its defaults; the last `n` recorded.
+fn round_trips(
+    ctx: &RunCtx,
+    client: &mut ActArrayClient,
+    what: &str,
+    warm: u64,
+    n: u64,
+) -> Result<Histogram<u64>, BenchError> {
+    client
+        .current(READY_TIMEOUT)
+        .map_err(|e| err("first state", e))?;
+    let mut rtt = new_histogram()?;
+    let progress = Progress::new(ctx.progress, what, warm + n);
+    for i in 1..=warm + n {
+        let target = if i % 2 == 0 { 0.25 } else { -0.25 };
+        let t0 = monotonic_ns();
+        let ticket = client.move_to(0, target).map_err(|e| err("move_to", e))?;
+        let status = client
+            .wait_outcome(ticket, SAMPLE_TIMEOUT)
+            .map_err(|e| err(&format!("outcome of command {i} ({what})"), e))?;
+        let t1 = monotonic_ns();
+        if status != Status::Ok {
+            return Err(err("command", format!("refused: {status}")));
+        }
+        if i > warm {
+            rtt.saturating_record(t1.saturating_sub(t0));
+        }
+        progress.tick(i);
+    }
+    progress.finish();
+    Ok(rtt)
+}
