@@ -255,6 +255,7 @@ impl core::fmt::Debug for DeviceSet {
 enum Drain {
     All,
     Spin,
+    Linger,
 }
 
 impl DeviceSet {
@@ -410,6 +411,15 @@ impl DeviceSet {
         self.process_with(handler, Drain::All)
     }
 
+    /// For the linger of an event-driven loop after activity: [`DeviceHost::process_linger`]
+    /// on every device (requests answered on every call).
+    pub fn process_linger<H: DeviceSetHandler + ?Sized>(
+        &mut self,
+        handler: &mut H,
+    ) -> Result<Activity, DeviceError<ProcessError>> {
+        self.process_with(handler, Drain::Linger)
+    }
+
     /// For a busy-polling loop: [`DeviceHost::process_spin`] on every device.
     pub fn process_spin<H: DeviceSetHandler + ?Sized>(
         &mut self,
@@ -433,6 +443,7 @@ impl DeviceSet {
             let r = match drain {
                 Drain::All => host.process(handler),
                 Drain::Spin => host.process_spin(handler),
+                Drain::Linger => host.process_linger(handler),
             };
             match r {
                 Ok(a) => *total += a,

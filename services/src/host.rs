@@ -809,6 +809,25 @@ impl<I: Interface> DeviceHost<I> {
         Ok(Activity { commands, requests })
     }
 
+    /// For the linger of an event-driven loop after activity ([`crate::event_loop::linger`]):
+    /// drains the commands and answers the requests and lease operations on every call, so
+    /// that a client's next request in a tight loop is answered within one poll instead of
+    /// up to [`SPIN_REQUEST_EVERY`] polls; connects new clients and checks the lease only on
+    /// every [`SPIN_REQUEST_EVERY`]th call. Never blocks.
+    pub fn process_linger<H: DeviceHandler<I>>(
+        &mut self,
+        handler: &mut H,
+    ) -> Result<Activity, ProcessError> {
+        self.spin_calls = self.spin_calls.wrapping_add(1);
+        if self.spin_calls.is_multiple_of(SPIN_REQUEST_EVERY) {
+            self.update_connections();
+            self.check_lease(handler)?;
+        }
+        let commands = self.process_commands(handler)?;
+        let requests = self.process_requests(handler)? + self.process_leases()?;
+        Ok(Activity { commands, requests })
+    }
+
     /// Drains every pending command. A command that does not decode is refused with the
     /// matching status without reaching the handler.
     pub fn process_commands<H: DeviceHandler<I>>(

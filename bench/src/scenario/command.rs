@@ -375,7 +375,7 @@ pub fn driver_role(args: &BenchArgs, spin: bool) -> Result<(), BenchError> {
                 if arm.stop || failure.is_some() {
                     return false;
                 }
-                match host.process_spin(&mut arm) {
+                match host.process_linger(&mut arm) {
                     Ok(a) => a.commands + a.requests > 0,
                     Err(e) => {
                         failure = Some(e.to_string());

@@ -386,6 +386,19 @@ impl core::fmt::Debug for PioneerDriver {
 // The handler of every device: borrows the robot model for the duration of a `process`
 // call. `actarray/0` is the arm, `actarray/1` the lift, `gripper/0` the body gripper and
 // `gripper/1` the arm gripper.
+/// How [`PioneerDriver::process_clients`] polls the devices.
+#[derive(Clone, Copy)]
+enum Drain {
+    /// Everything pending ([`DeviceSet::process`]): after a wake-up.
+    All,
+    /// Commands on every call, requests on every 16th ([`DeviceSet::process_spin`]): the
+    /// spinning loop and the tick.
+    Spin,
+    /// Commands and requests on every call ([`DeviceSet::process_linger`]): the linger
+    /// after activity, where a client's next request must not wait 16 polls.
+    Linger,
+}
+
 struct Serve<'a>(&'a mut RobotModel);
 
 impl DeviceSetHandler for Serve<'_> {
@@ -897,15 +910,14 @@ impl PioneerDriver {
         }
     }
 
-    /// Handles the pending commands and requests of every device. Spinning: commands on
-    /// every call, requests on every 16th ([`DeviceSet::process_spin`]).
-    /// Handles what the clients sent; returns whether there was any.
-    fn process_clients(&mut self, spin: bool) -> bool {
+    /// Handles the pending commands and requests of every device, the way `how` says;
+    /// returns whether there was any.
+    fn process_clients(&mut self, how: Drain) -> bool {
         let mut handler = Serve(&mut self.robot);
-        let r = if spin {
-            self.hosts.process_spin(&mut handler)
-        } else {
-            self.hosts.process(&mut handler)
+        let r = match how {
+            Drain::All => self.hosts.process(&mut handler),
+            Drain::Spin => self.hosts.process_spin(&mut handler),
+            Drain::Linger => self.hosts.process_linger(&mut handler),
         };
         match r {
             Ok(a) => a.commands + a.requests > 0,
@@ -1190,11 +1202,11 @@ impl PioneerDriver {
                     }
                     Wake::Clients => {
                         self.woken_since_tick = true;
-                        if self.process_clients(false) {
+                        if self.process_clients(Drain::All) {
                             // A client in a tight loop sends its next command within the
                             // linger: picked up without a wake-up.
                             let linger = Duration::from_micros(self.robot.cfg.linger_us.into());
-                            event_loop::linger(linger, || self.process_clients(true));
+                            event_loop::linger(linger, || self.process_clients(Drain::Linger));
                         }
                     }
                     Wake::Tick(n) => {
@@ -1210,7 +1222,7 @@ impl PioneerDriver {
                         // command by one tick at most instead of freezing that device.
                         // The polling variant: commands at every tick, requests at every
                         // 16th, and nothing allocated when nothing waits.
-                        let found = self.process_clients(true);
+                        let found = self.process_clients(Drain::Spin);
                         self.note_tick_work(found);
                     }
                 }
@@ -1250,7 +1262,7 @@ impl PioneerDriver {
             if self.robot.conn.is_some() && !self.read_link(now) {
                 self.link_failed("read failed");
             }
-            self.process_clients(true);
+            self.process_clients(Drain::Spin);
             if now >= next_tick {
                 let missed = (now.duration_since(next_tick).as_nanos() as u64) / nominal.max(1);
                 self.robot.stats.tick(now, nominal, 1 + missed);

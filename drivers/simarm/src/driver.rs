@@ -256,7 +256,7 @@ impl SimArm {
                         // linger: picked up without a wake-up. A failure ends the linger;
                         // the next wake-up meets it again and counts it.
                         event_loop::linger(qos::DRIVER_LINGER, || {
-                            match self.hosts.process_spin(&mut Serve(&mut self.model)) {
+                            match self.hosts.process_linger(&mut Serve(&mut self.model)) {
                                 Ok(a) => a.total() > 0,
                                 Err(e) => {
                                     tracing::debug!(error = %e, "processing while lingering");
