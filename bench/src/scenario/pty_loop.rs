@@ -99,6 +99,10 @@ fn run_variant(ctx: &mut RunCtx, variant: Variant) -> Result<(), BenchError> {
         domain: Some(domain.name().to_string()),
         out: Some(out.clone()),
         cpu: ctx.child_cpu(),
+        // Pinned, the emulator thread runs on the client's core, not on the driver's:
+        // the client waits on events, the driver may spin (and a reader woken on the
+        // writer's core preempts it as its write returns, before its clock read).
+        emulator_cpu: ctx.client_cpu(),
         deadline: ctx.deadline_for(warm + n, Duration::from_millis(20)),
         ..Default::default()
     })?;
