@@ -112,6 +112,14 @@ pub fn write_histogram(
         .out
         .as_ref()
         .ok_or_else(|| BenchError::Args("--out is required for this role".into()))?;
+    write_histogram_to(path, h)
+}
+
+/// Writes `h` to `path`, for the parent's [`crate::child::read_histogram`].
+pub fn write_histogram_to(
+    path: &std::path::Path,
+    h: &hdrhistogram::Histogram<u64>,
+) -> Result<(), BenchError> {
     let bytes = crate::stats::serialize(h)?;
     std::fs::write(path, bytes).map_err(|e| BenchError::io(path.display().to_string(), e))
 }

@@ -140,14 +140,19 @@ pub fn driver_role(args: &BenchArgs, mode: LoopMode) -> Result<(), BenchError> {
             _ => Instant::now() > deadline,
         }
     });
-    // The driver's own cost per command (arrival → bytes on the pty), for `loop`.
+    // The driver's own cost per command (arrival → bytes on the pty) and, inside it, the
+    // link's send alone, for `loop`.
     let written = match &args.out {
         Some(_) => {
-            let mut h = new_histogram()?;
-            for ns in driver.loop_stats().arrival_to_wire.samples() {
-                h.saturating_record(*ns);
+            let stats = driver.loop_stats();
+            let (mut own, mut send) = (new_histogram()?, new_histogram()?);
+            for ns in stats.arrival_to_wire.samples() {
+                own.saturating_record(*ns);
             }
-            Some(h)
+            for ns in stats.link_write.samples() {
+                send.saturating_record(*ns);
+            }
+            Some((own, send))
         }
         None => None,
     };
@@ -157,8 +162,16 @@ pub fn driver_role(args: &BenchArgs, mode: LoopMode) -> Result<(), BenchError> {
     }
     r.map(|_| ())
         .map_err(|e| err("pioneer driver loop", e.to_string()))?;
-    match written {
-        Some(h) => roles::write_histogram(args, &h),
-        None => Ok(()),
+    match (written, &args.out) {
+        (Some((own, send)), Some(out)) => {
+            roles::write_histogram_to(&link_write_path(out), &send)?;
+            roles::write_histogram(args, &own)
+        }
+        _ => Ok(()),
     }
+}
+
+/// Where the Pioneer driver child writes the histogram of its link sends, beside `out`.
+pub fn link_write_path(out: &std::path::Path) -> std::path::PathBuf {
+    out.with_extension("send.hdr")
 }

@@ -40,7 +40,9 @@ fn read_exactly(r: &mut impl Read, n: usize) -> Vec<u8> {
             Err(e)
                 if matches!(
                     e.kind(),
-                    io::ErrorKind::TimedOut | io::ErrorKind::WouldBlock | io::ErrorKind::Interrupted
+                    io::ErrorKind::TimedOut
+                        | io::ErrorKind::WouldBlock
+                        | io::ErrorKind::Interrupted
                 ) => {}
             Err(e) => panic!("reading the other end: {e}"),
         }
@@ -91,7 +93,10 @@ fn full_device_times_out_then_recovers(what: &str, link: Link, mut other: impl O
         (got, other)
     });
     let (got, mut other) = drained;
-    assert!(got.iter().all(|&b| b == 0x5A), "{what}: other bytes arrived");
+    assert!(
+        got.iter().all(|&b| b == 0x5A),
+        "{what}: other bytes arrived"
+    );
     link.send(&Command::Pulse)
         .unwrap_or_else(|e| panic!("{what}: the link did not recover: {e}"));
     let pulse = Command::Pulse.encode().unwrap();
@@ -157,5 +162,8 @@ fn a_closed_other_end_is_closed_not_a_timeout() {
         (sent, received)
     });
     assert!(matches!(sent, Err(LinkError::Closed)), "send: {sent:?}");
-    assert!(matches!(received, Err(LinkError::Closed)), "recv: {received:?}");
+    assert!(
+        matches!(received, Err(LinkError::Closed)),
+        "recv: {received:?}"
+    );
 }
