@@ -34,6 +34,8 @@ pub struct ChildSpec {
     pub linger: Option<Duration>,
     /// The core to pin to.
     pub cpu: Option<usize>,
+    /// The core a Pioneer driver child pins its emulator thread to.
+    pub emulator_cpu: Option<usize>,
     /// Samples to discard before recording.
     pub warmup: u64,
     /// Samples to produce.
@@ -90,6 +92,9 @@ impl ChildProc {
         }
         if let Some(cpu) = spec.cpu {
             c.arg("--cpu").arg(cpu.to_string());
+        }
+        if let Some(cpu) = spec.emulator_cpu {
+            c.arg("--emulator-cpu").arg(cpu.to_string());
         }
         c.arg("--warmup").arg(spec.warmup.to_string());
         c.arg("--count").arg(spec.count.to_string());

@@ -206,6 +206,9 @@ pub struct BenchArgs {
     /// Internal: the core a child pins itself to.
     #[arg(long, hide = true)]
     pub cpu: Option<usize>,
+    /// Internal: the core a Pioneer driver child pins its emulator thread to.
+    #[arg(long, hide = true)]
+    pub emulator_cpu: Option<usize>,
     /// Internal: samples a child discards before recording.
     #[arg(long, hide = true, default_value_t = 0)]
     pub warmup: u64,

@@ -54,16 +54,18 @@ pub fn run_role(role: &str, args: &BenchArgs) -> Result<(), BenchError> {
     r
 }
 
-/// Pins the calling thread to core `cpu` (ignored if impossible).
+/// Pins the calling thread to core `cpu` (ignored if impossible). Any online core: not
+/// only those of the inherited affinity (a pinned parent's children inherit its one
+/// core).
 pub fn pin_to(cpu: usize) {
-    if let Some(id) =
-        core_affinity::get_core_ids().and_then(|ids| ids.into_iter().find(|c| c.id == cpu))
-    {
-        if !core_affinity::set_for_current(id) {
-            tracing::warn!("cannot pin to CPU {cpu}: running unpinned");
-        }
-    } else {
+    if cpu >= rustix::thread::CpuSet::MAX_CPU {
         tracing::warn!("no CPU {cpu}: running unpinned");
+        return;
+    }
+    let mut set = rustix::thread::CpuSet::new();
+    set.set(cpu);
+    if let Err(e) = rustix::thread::sched_setaffinity(None, &set) {
+        tracing::warn!("cannot pin to CPU {cpu} ({e}): running unpinned");
     }
 }
 
@@ -110,6 +112,14 @@ pub fn write_histogram(
         .out
         .as_ref()
         .ok_or_else(|| BenchError::Args("--out is required for this role".into()))?;
+    write_histogram_to(path, h)
+}
+
+/// Writes `h` to `path`, for the parent's [`crate::child::read_histogram`].
+pub fn write_histogram_to(
+    path: &std::path::Path,
+    h: &hdrhistogram::Histogram<u64>,
+) -> Result<(), BenchError> {
     let bytes = crate::stats::serialize(h)?;
     std::fs::write(path, bytes).map_err(|e| BenchError::io(path.display().to_string(), e))
 }

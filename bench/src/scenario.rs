@@ -134,6 +134,9 @@ pub struct RunCtx {
     pub strategy: StrategyArg,
     /// Pinning requested and possible.
     pub pin: bool,
+    /// When pinned: the client's core and the driver/echo child's, probed before this
+    /// process pinned itself (afterwards its affinity names one core only).
+    pinned: Option<[usize; 2]>,
     /// Progress output on stderr.
     pub progress: bool,
     /// Scratch directory (histograms of children, socket files), removed at the end.
@@ -150,13 +153,16 @@ impl RunCtx {
         // Probe before pinning: the core count is read from this process's affinity.
         let mut machine = Machine::probe(String::new(), String::new());
         let mut pin = false;
+        let mut pinned = None;
         let pinning = if args.pin {
             match core_affinity::get_core_ids() {
                 Some(ids) if ids.len() >= 2 && core_affinity::set_for_current(ids[0]) => {
                     pin = true;
+                    pinned = Some([ids[0].id, ids[1].id]);
                     format!(
-                        "client/publisher side on core {}, driver/echo child on core {}, state subscribers unpinned",
-                        ids[0].id, ids[1].id
+                        "client/publisher side on core {}, driver/echo child on core {}, \
+                         the loop's emulator thread on core {}, state subscribers unpinned",
+                        ids[0].id, ids[1].id, ids[0].id
                     )
                 }
                 _ => "requested but not possible (fewer than 2 cores or refused)".into(),
@@ -183,6 +189,7 @@ impl RunCtx {
             scale: args.scale,
             strategy: args.strategy(),
             pin,
+            pinned,
             progress: !args.no_progress,
             tmp,
             notes: Vec::new(),
@@ -201,12 +208,14 @@ impl RunCtx {
         Domain::unique_for_test()
     }
 
-    /// The core a driver/echo child pins itself to.
+    /// The core a driver/echo child pins itself to (when pinning).
     pub fn child_cpu(&self) -> Option<usize> {
-        if !self.pin {
-            return None;
-        }
-        core_affinity::get_core_ids().and_then(|ids| ids.get(1).map(|c| c.id))
+        self.pinned.map(|[_, child]| child)
+    }
+
+    /// The core this process (the client side) is pinned to (when pinning).
+    pub fn client_cpu(&self) -> Option<usize> {
+        self.pinned.map(|[client, _]| client)
     }
 
     /// Whether spinning variants run: asked for, and at least 2 cores (never more

@@ -126,6 +126,7 @@ impl EmulatorArgs {
                 slow_wire_baud: self.slow_wire,
                 drop_arm_info_replies: self.drop_arm_info,
                 no_config: self.no_config,
+                deaf: false,
             },
             watchdog: self.watchdog_ms.map(Duration::from_millis),
             timing: if self.fast {

@@ -287,6 +287,64 @@ fn silence_and_garbage_are_detected_and_survived() {
     );
 }
 
+#[test]
+fn a_robot_that_stops_reading_is_a_send_timeout_not_a_frozen_loop() {
+    let domain = Domain::unique_for_test();
+    let emu = Emulator::start_pty(EmulatorConfig::fast()).unwrap();
+    let _driver = start(&domain, &emu, "deaf");
+    let c = ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
+    assert!(wait_flag(&mut arm, true, T));
+    arm.power(true).unwrap();
+
+    // The robot stops reading but keeps talking: the driver's commands fill the pty (some
+    // 20 KB, about 2000 commands), then a send waits the link's write timeout and that
+    // command is refused as LINK_DOWN. Every command gets its outcome meanwhile.
+    emu.set_faults(Faults {
+        deaf: true,
+        ..Faults::default()
+    });
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let mut sent = 0u32;
+    loop {
+        assert!(
+            Instant::now() < deadline,
+            "no command refused after {sent} sent to a robot that reads nothing"
+        );
+        let target = if sent.is_multiple_of(2) { 0.1 } else { -0.1 };
+        let t = arm.move_to(0, target).unwrap();
+        sent += 1;
+        match arm.wait_outcome(t, T).unwrap() {
+            Status::Ok => {}
+            Status::LinkDown => break,
+            other => panic!("command {sent}: {other:?}"),
+        }
+    }
+    assert!(
+        sent > 100,
+        "refused after {sent} commands: the pty was not full"
+    );
+    // The loop still answers requests.
+    assert_eq!(arm.geometry().unwrap().actuators_count, 6);
+    // The robot reads again: commands are carried out.
+    emu.set_faults(Faults::default());
+    assert!(
+        wait_flag(&mut arm, true, Duration::from_secs(15)),
+        "not recovered"
+    );
+    arm.power(true).unwrap();
+    let deadline = Instant::now() + Duration::from_secs(15);
+    loop {
+        let t = arm.move_to(0, 0.3).unwrap();
+        match arm.wait_outcome(t, T).unwrap() {
+            Status::Ok => break,
+            // The pty may still be draining the commands of the deaf phase.
+            Status::LinkDown => assert!(Instant::now() < deadline, "commands still refused"),
+            other => panic!("after recovery: {other:?}"),
+        }
+    }
+}
+
 /// `sig` ends the driver with exit 0 after it stopped the arm (ARM_STOP) and closed the
 /// link (CLOSE), while a joint was moving at a slow speed.
 fn a_termination_signal_stops_the_arm(sig: i32, name: &str) {

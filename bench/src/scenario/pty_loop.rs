@@ -12,14 +12,26 @@
 //! * `command arrival → bytes on the pty`: inside that, the driver's own cost, from taking
 //!   the command off its channel to the P2OS bytes written (validation, encoding, the
 //!   write), measured by the driver (`LoopStats::arrival_to_wire`; the last 512 commands);
+//!   and inside it the link's send alone (`LoopStats::link_write`: encoding and the
+//!   `write(2)`, clock read before and after it), the kernel's share. A pty's write wakes
+//!   the tty's buffer worker (a kernel thread), which, woken on the writer's core, runs
+//!   as the write returns and before the driver reads its clock: on a spinning core
+//!   that is most writes, so the spinning stage counts the kernel's pty work too;
 //! * `reply read → client sees the state`: acquisition stamp to the client's receipt
 //!   (driver publish, notify, client wake-up);
 //! * the total, client send → client receipt.
+//!
+//! With the spinning variant comes its floor, `loop.spin.pty_write`: a bare `write(2)` of
+//! an ARM_POS command's 9 bytes on a pty whose other end a blocked thread reads (as the
+//! emulator does), from a thread that spins between writes (on the driver's core when
+//! pinned), clock read before and after: what the kernel takes for the driver's send.
 //!
 //! Run twice when both strategies are enabled: with the event-driven driver (ids
 //! `loop.*`), and with the busy-polling driver (`limber pioneer --spin`; ids `loop.spin.*`,
 //! labels ending `[driver spinning]`), whose `driver` stage is the driver's own cost when
 //! it is awake. The client waits on events in both, so the emulator thread keeps a core.
+//! With `--pin`, the driver runs on the child's core and the emulator thread on the
+//! client's (see `RunCtx::client_cpu`), so the emulator never takes the driver's core.
 
 use std::time::{Duration, Instant};
 
@@ -58,10 +70,103 @@ impl Scenario for Loop {
         }
         if ctx.spin_enabled() {
             run_variant(ctx, Variant::DriverSpin)?;
+            pty_write_floor(ctx)?;
         }
         Ok(())
     }
 }
+
+/// `loop.spin.pty_write`: the floor of the spinning driver's send (see the module doc).
+fn pty_write_floor(ctx: &mut RunCtx) -> Result<(), BenchError> {
+    use serialport::SerialPort;
+    use std::io::{Read, Write};
+    use std::os::unix::fs::OpenOptionsExt;
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicBool, Ordering};
+
+    let (warm, n) = (ctx.count(50, 20), ctx.count(1_000, 200));
+    let pty = |e: serialport::Error| err("pty", e.to_string());
+    let (mut master, slave) = serialport::TTYPort::pair().map_err(pty)?;
+    let path = slave
+        .name()
+        .ok_or_else(|| err("pty", "the pty has no name".into()))?;
+    // Writes go straight to write(2): no poll first, no buffering.
+    let mut writer = std::fs::OpenOptions::new()
+        .write(true)
+        .custom_flags(rustix::fs::OFlags::NOCTTY.bits() as i32)
+        .open(&path)
+        .map_err(|e| BenchError::io(path.clone(), e))?;
+    master
+        .set_timeout(Duration::from_millis(100))
+        .map_err(pty)?;
+    let stop = Arc::new(AtomicBool::new(false));
+    let (reader_cpu, writer_cpu) = (ctx.client_cpu(), ctx.child_cpu());
+    let stop2 = Arc::clone(&stop);
+    let reader = std::thread::spawn(move || {
+        if let Some(cpu) = reader_cpu {
+            crate::roles::pin_to(cpu);
+        }
+        let mut buf = [0u8; 512];
+        let mut bytes = 0u64;
+        while !stop2.load(Ordering::Relaxed) {
+            match master.read(&mut buf) {
+                Ok(k) => bytes += k as u64,
+                // The read's own timeout: look at the stop flag again.
+                Err(e) if e.kind() == std::io::ErrorKind::TimedOut => {}
+                Err(e) => return Err(e),
+            }
+        }
+        Ok(bytes)
+    });
+    let progress = Progress::new(ctx.progress, "bare pty write (floor)", warm + n);
+    let writing = std::thread::spawn(move || {
+        if let Some(cpu) = writer_cpu {
+            crate::roles::pin_to(cpu);
+        }
+        let mut h = new_histogram()?;
+        for i in 1..=warm + n {
+            // Spin between writes, as the spinning driver does between commands.
+            let until = Instant::now() + Duration::from_micros(50);
+            while Instant::now() < until {
+                std::hint::spin_loop();
+            }
+            let t0 = monotonic_ns();
+            writer
+                .write_all(&ARM_POS_FRAME)
+                .map_err(|e| BenchError::io("pty write", e))?;
+            let t1 = monotonic_ns();
+            if i > warm {
+                h.saturating_record(t1.saturating_sub(t0));
+            }
+            progress.tick(i);
+        }
+        progress.finish();
+        Ok::<_, BenchError>(h)
+    });
+    let written = writing
+        .join()
+        .map_err(|_| err("pty write", "the writer thread panicked".into()));
+    stop.store(true, Ordering::Relaxed);
+    let read = reader
+        .join()
+        .map_err(|_| err("pty read", "the reader thread panicked".into()))?
+        .map_err(|e| BenchError::io("pty read", e))?;
+    let hist = written??;
+    tracing::debug!("pty floor: {read} bytes read");
+    ctx.push(Measurement {
+        scenario: "loop",
+        id: "loop.spin.pty_write".into(),
+        label: "  floor: bare write(2) of the same bytes on a pty, spinning writer".into(),
+        strategy: Strategy::Spin,
+        metric: Metric::OneWay,
+        bytes: None,
+        hist,
+    });
+    Ok(())
+}
+
+/// An ARM_POS command as the loop sends it (ARM_POS 77, joint 1, tick 120), 9 bytes.
+const ARM_POS_FRAME: [u8; 9] = [0xFA, 0xFB, 0x06, 0x4D, 0x3B, 0x78, 0x01, 0xC5, 0x3C];
 
 /// How the driver child waits; the client always waits on events (its spin budget
 /// included), so the emulator thread keeps a core when the driver spins on the other.
@@ -99,6 +204,10 @@ fn run_variant(ctx: &mut RunCtx, variant: Variant) -> Result<(), BenchError> {
         domain: Some(domain.name().to_string()),
         out: Some(out.clone()),
         cpu: ctx.child_cpu(),
+        // Pinned, the emulator thread runs on the client's core, not on the driver's:
+        // the client waits on events, the driver may spin (and a reader woken on the
+        // writer's core preempts it as its write returns, before its clock read).
+        emulator_cpu: ctx.client_cpu(),
         deadline: ctx.deadline_for(warm + n, Duration::from_millis(20)),
         ..Default::default()
     })?;
@@ -147,6 +256,7 @@ fn run_variant(ctx: &mut RunCtx, variant: Variant) -> Result<(), BenchError> {
     }
     child.finish(Duration::from_secs(10))?;
     let driver = read_histogram(&out)?;
+    let send = read_histogram(&super::request::link_write_path(&out))?;
     let bytes = Some((
         core::mem::size_of::<ActArrayCmdMsg>(),
         core::mem::size_of::<ActArrayData>(),
@@ -165,6 +275,13 @@ fn run_variant(ctx: &mut RunCtx, variant: Variant) -> Result<(), BenchError> {
             driver_strategy,
             Metric::OneWay,
             driver,
+        ),
+        (
+            "driver_send",
+            "  of which the link's send (encoding, write(2) on the pty)",
+            driver_strategy,
+            Metric::OneWay,
+            send,
         ),
         (
             "to_client",

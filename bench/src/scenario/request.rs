@@ -55,6 +55,7 @@ impl Scenario for Request {
             role: "pioneer-driver".into(),
             domain: Some(domain.name().to_string()),
             cpu: ctx.child_cpu(),
+            emulator_cpu: ctx.client_cpu(),
             deadline: ctx.deadline_for(warm + n, Duration::from_micros(500)),
             ..Default::default()
         })?;
@@ -109,8 +110,18 @@ pub fn driver_role(args: &BenchArgs, mode: LoopMode) -> Result<(), BenchError> {
         .map_err(|e| err("driver context", e.to_string()))?;
     // Fast mode: the emulator answers at once instead of at its 100 ms cycle boundary,
     // so the scenarios measure limber, not the controller's cycle (the labels say so).
-    let emu =
-        Emulator::start_pty(EmulatorConfig::fast()).map_err(|e| err("emulator", e.to_string()))?;
+    // A thread starts with its creator's affinity: pinned, the emulator's thread is
+    // created on its own core, then this thread goes back to the driver's.
+    if let Some(cpu) = args.emulator_cpu {
+        roles::pin_to(cpu);
+    }
+    let emu = Emulator::start_pty(EmulatorConfig::fast());
+    match (args.emulator_cpu, args.cpu) {
+        (None, _) => {}
+        (Some(_), Some(cpu)) => roles::pin_to(cpu),
+        (Some(_), None) => roles::unpin(),
+    }
+    let emu = emu.map_err(|e| err("emulator", e.to_string()))?;
     let mut driver = PioneerDriver::start(&ctx, PioneerConfig::default(), emu.link_target())
         .map_err(|e| err("pioneer driver", e.to_string()))?;
     if !driver.hardware().arm {
@@ -129,14 +140,19 @@ pub fn driver_role(args: &BenchArgs, mode: LoopMode) -> Result<(), BenchError> {
             _ => Instant::now() > deadline,
         }
     });
-    // The driver's own cost per command (arrival → bytes on the pty), for `loop`.
+    // The driver's own cost per command (arrival → bytes on the pty) and, inside it, the
+    // link's send alone, for `loop`.
     let written = match &args.out {
         Some(_) => {
-            let mut h = new_histogram()?;
-            for ns in driver.loop_stats().arrival_to_wire.samples() {
-                h.saturating_record(*ns);
+            let stats = driver.loop_stats();
+            let (mut own, mut send) = (new_histogram()?, new_histogram()?);
+            for ns in stats.arrival_to_wire.samples() {
+                own.saturating_record(*ns);
             }
-            Some(h)
+            for ns in stats.link_write.samples() {
+                send.saturating_record(*ns);
+            }
+            Some((own, send))
         }
         None => None,
     };
@@ -146,8 +162,16 @@ pub fn driver_role(args: &BenchArgs, mode: LoopMode) -> Result<(), BenchError> {
     }
     r.map(|_| ())
         .map_err(|e| err("pioneer driver loop", e.to_string()))?;
-    match written {
-        Some(h) => roles::write_histogram(args, &h),
-        None => Ok(()),
+    match (written, &args.out) {
+        (Some((own, send)), Some(out)) => {
+            roles::write_histogram_to(&link_write_path(out), &send)?;
+            roles::write_histogram(args, &own)
+        }
+        _ => Ok(()),
     }
+}
+
+/// Where the Pioneer driver child writes the histogram of its link sends, beside `out`.
+pub fn link_write_path(out: &std::path::Path) -> std::path::PathBuf {
+    out.with_extension("send.hdr")
 }

@@ -102,6 +102,10 @@ pub struct Faults {
     /// Never answer CONFIG (18), like a controller or simulator that does not implement
     /// it: the CONFIGpacs are dropped ([`EmulatorStats::config_dropped`]).
     pub no_config: bool,
+    /// Stop reading the wire, still talking (a controller whose input hangs): what the
+    /// client sends stays in the pty or socket until its buffer is full. A new TCP
+    /// client is not accepted meanwhile.
+    pub deaf: bool,
 }
 
 /// Configuration of an emulator.

@@ -120,8 +120,17 @@ enum Input {
     Gone,
 }
 
-fn wait_input(ep: &mut Endpoint, buf: &mut [u8], timeout: Duration) -> io::Result<Input> {
+fn wait_input(
+    ep: &mut Endpoint,
+    buf: &mut [u8],
+    timeout: Duration,
+    deaf: bool,
+) -> io::Result<Input> {
     match ep {
+        _ if deaf => {
+            std::thread::sleep(timeout);
+            Ok(Input::Nothing)
+        }
         Endpoint::Pty { master: None, .. } => {
             std::thread::sleep(timeout);
             Ok(Input::Nothing)
@@ -321,7 +330,12 @@ pub(super) fn run(
             wake = wake.min(t);
         }
         let mut close_after_send = false;
-        let input = wait_input(&mut ep, &mut buf, wake.saturating_duration_since(now))?;
+        let input = wait_input(
+            &mut ep,
+            &mut buf,
+            wake.saturating_duration_since(now),
+            faults.deaf,
+        )?;
         let now = Instant::now();
         match input {
             Input::Nothing => {}

@@ -3,11 +3,11 @@
 use super::codec::{Decoder, DecoderStats, EncodeError, Frame};
 use super::command::Command;
 use super::packet::RobotPacket;
-use super::sys::wait_readable;
+use super::sys::{wait_readable, wait_writable};
 use serialport::{ClearBuffer, SerialPort, TTYPort};
 use std::io::{self, Read, Write};
 use std::net::{SocketAddr, TcpStream, ToSocketAddrs};
-use std::os::fd::{AsRawFd, RawFd};
+use std::os::fd::{AsRawFd, BorrowedFd, RawFd};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 use thiserror::Error;
@@ -64,6 +64,10 @@ pub enum OpenError {
         /// The last cause.
         source: io::Error,
     },
+    /// The descriptor could not be made non-blocking (the link writes and reads without
+    /// waiting, and waits with its timeout only when the device is full or empty).
+    #[error("cannot make the link non-blocking: {0}")]
+    NonBlocking(#[source] io::Error),
 }
 
 /// Why a send or receive failed.
@@ -107,9 +111,40 @@ enum Transport {
     Tcp(TcpStream),
 }
 
+/// The serial port's descriptor, for `read(2)` / `write(2)` straight on it: the port's
+/// own `Read` / `Write` poll before every call (one more system call per packet).
+fn port_fd(p: &TTYPort) -> BorrowedFd<'_> {
+    // SAFETY: the TTYPort owns its descriptor and keeps it open until it is dropped; the
+    // borrow is tied to `p`, so it cannot outlive the port.
+    unsafe { BorrowedFd::borrow_raw(p.as_raw_fd()) }
+}
+
+/// `read(2)` / `write(2)` on a borrowed descriptor, with `std::io` errors.
+struct FdIo<'a>(BorrowedFd<'a>);
+
+impl Read for FdIo<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        Ok(rustix::io::read(self.0, buf)?)
+    }
+}
+
+impl Write for FdIo<'_> {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        Ok(rustix::io::write(self.0, buf)?)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        Ok(())
+    }
+}
+
 /// A P2OS link. Reading goes through an internal [`Decoder`]; the raw fd is
 /// exposed ([`AsRawFd`]) so an event loop can register it with epoll and call
 /// [`Link::poll_payload`] / [`Link::poll_packet`] when it becomes readable.
+///
+/// The descriptor is non-blocking: a send is one `write(2)` while the device has room,
+/// and waits for room (up to the write timeout, [`Link::set_write_timeout`]) only when
+/// it has none; a receive reads first and waits only when nothing is there.
 pub struct Link {
     io: Transport,
     decoder: Decoder,
@@ -133,8 +168,13 @@ impl std::fmt::Debug for Link {
 const DEFAULT_WRITE_TIMEOUT: Duration = Duration::from_millis(500);
 
 impl Link {
-    fn from_transport(io: Transport) -> Link {
-        Link {
+    fn from_transport(io: Transport) -> Result<Link, OpenError> {
+        let nonblocking = match &io {
+            Transport::Serial(p) => rustix::io::ioctl_fionbio(port_fd(p), true).map_err(Into::into),
+            Transport::Tcp(s) => s.set_nonblocking(true),
+        };
+        nonblocking.map_err(OpenError::NonBlocking)?;
+        Ok(Link {
             io,
             decoder: Decoder::new(),
             bytes_out: 0,
@@ -143,7 +183,7 @@ impl Link {
             last_send: None,
             last_receive: None,
             write_timeout: DEFAULT_WRITE_TIMEOUT,
-        }
+        })
     }
 
     /// Opens a serial device (or pty) raw 8N1 at `baud`.
@@ -154,7 +194,6 @@ impl Link {
             source,
         };
         let port = serialport::new(path.to_string_lossy(), baud)
-            .timeout(DEFAULT_WRITE_TIMEOUT)
             .open_native()
             .map_err(err)?;
         // Stale bytes from before we opened are of no use; flush_input drains them too
@@ -162,11 +201,12 @@ impl Link {
         if let Err(e) = port.clear(ClearBuffer::Input) {
             tracing::debug!("cannot clear the input buffer of {}: {e}", path.display());
         }
-        Ok(Link::from_transport(Transport::Serial(port)))
+        Link::from_transport(Transport::Serial(port))
     }
 
-    /// Wraps an already open serial port (e.g. one end of `TTYPort::pair()`).
-    pub fn from_serial_port(port: TTYPort) -> Link {
+    /// Wraps an already open serial port (e.g. one end of `TTYPort::pair()`) and makes
+    /// it non-blocking.
+    pub fn from_serial_port(port: TTYPort) -> Result<Link, OpenError> {
         Link::from_transport(Transport::Serial(port))
     }
 
@@ -179,7 +219,7 @@ impl Link {
         let mut last = io::Error::new(io::ErrorKind::NotFound, "no address");
         for a in &addrs {
             match TcpStream::connect_timeout(a, timeout) {
-                Ok(s) => return Ok(Link::from_tcp_stream(s)),
+                Ok(s) => return Link::from_tcp_stream(s),
                 Err(e) => last = e,
             }
         }
@@ -192,13 +232,10 @@ impl Link {
         })
     }
 
-    /// Wraps a connected TCP stream.
-    pub fn from_tcp_stream(s: TcpStream) -> Link {
+    /// Wraps a connected TCP stream and makes it non-blocking.
+    pub fn from_tcp_stream(s: TcpStream) -> Result<Link, OpenError> {
         if let Err(e) = s.set_nodelay(true) {
             tracing::warn!("TCP_NODELAY not set (commands may be delayed): {e}");
-        }
-        if let Err(e) = s.set_write_timeout(Some(DEFAULT_WRITE_TIMEOUT)) {
-            tracing::warn!("no write timeout on the TCP link (a stuck peer may block): {e}");
         }
         Link::from_transport(Transport::Tcp(s))
     }
@@ -233,21 +270,16 @@ impl Link {
         }
     }
 
-    /// How long a write may wait for the device.
+    /// How long a send may wait for the device to take its bytes (500 ms by default).
+    /// A send that cannot finish in that time fails with [`LinkError::Io`] of kind
+    /// [`io::ErrorKind::TimedOut`].
     pub fn set_write_timeout(&mut self, t: Duration) {
         self.write_timeout = t;
-        match &mut self.io {
-            Transport::Serial(p) => {
-                if let Err(e) = p.set_timeout(t) {
-                    tracing::warn!("cannot set the serial write timeout to {t:?}: {e}");
-                }
-            }
-            Transport::Tcp(s) => {
-                if let Err(e) = s.set_write_timeout(Some(t.max(Duration::from_millis(1)))) {
-                    tracing::warn!("cannot set the TCP write timeout to {t:?}: {e}");
-                }
-            }
-        }
+    }
+
+    /// How long a send may wait for the device to take its bytes.
+    pub fn write_timeout(&self) -> Duration {
+        self.write_timeout
     }
 
     /// Sends a command.
@@ -263,19 +295,53 @@ impl Link {
         Ok(())
     }
 
-    /// Sends raw bytes (no framing).
+    /// Sends raw bytes (no framing): `write(2)` at once; only when the device is full
+    /// (or took part of the bytes) does it wait for room, at most the write timeout in
+    /// all ([`LinkError::Io`] of kind [`io::ErrorKind::TimedOut`] then).
     pub fn send_bytes(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
-        let r = match &mut self.io {
-            Transport::Serial(p) => p.write_all(bytes),
-            Transport::Tcp(s) => s.write_all(bytes),
-        };
-        match r {
-            Ok(()) => {}
-            Err(e) if is_closed(&e) => return Err(LinkError::Closed),
-            Err(e) => return Err(LinkError::Io(e)),
-        }
-        self.bytes_out += bytes.len() as u64;
+        let r = self.write_all(bytes);
         self.last_send = Some(Instant::now());
+        r
+    }
+
+    fn write_all(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        let mut rest = bytes;
+        // Read from the clock only when the device is full.
+        let mut deadline = None;
+        while !rest.is_empty() {
+            let r = match &mut self.io {
+                Transport::Serial(p) => FdIo(port_fd(p)).write(rest),
+                Transport::Tcp(s) => s.write(rest),
+            };
+            match r {
+                Ok(0) => return Err(LinkError::Io(io::ErrorKind::WriteZero.into())),
+                Ok(n) => {
+                    rest = &rest[n..];
+                    self.bytes_out += n as u64;
+                }
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+                Err(e) if e.kind() == io::ErrorKind::WouldBlock => {
+                    let deadline =
+                        *deadline.get_or_insert_with(|| crate::sys::deadline(self.write_timeout));
+                    let left = deadline.saturating_duration_since(Instant::now());
+                    if left.is_zero() {
+                        return Err(LinkError::Io(io::Error::new(
+                            io::ErrorKind::TimedOut,
+                            format!(
+                                "the link took no more bytes within {:?} ({} of {} sent)",
+                                self.write_timeout,
+                                bytes.len() - rest.len(),
+                                bytes.len()
+                            ),
+                        )));
+                    }
+                    // Room, a hang-up, the timeout or a signal: the next write tells.
+                    wait_writable(self.as_raw_fd(), left)?;
+                }
+                Err(e) if is_closed(&e) => return Err(LinkError::Closed),
+                Err(e) => return Err(LinkError::Io(e)),
+            }
+        }
         Ok(())
     }
 
@@ -316,14 +382,15 @@ impl Link {
         let mut scratch = [0u8; 256];
         // Bounded: a robot that streams faster than we drain cannot hold us.
         for _ in 0..64 {
-            if wait_readable(&[self.as_raw_fd()], Duration::ZERO)? == 0 {
-                break;
-            }
-            match self.raw_read(&mut scratch) {
+            let r = match &mut self.io {
+                Transport::Serial(p) => FdIo(port_fd(p)).read(&mut scratch),
+                Transport::Tcp(s) => s.read(&mut scratch),
+            };
+            match r {
                 Ok(0) => return Err(LinkError::Closed),
                 Ok(_) => {}
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
                 Err(e) if e.kind() == io::ErrorKind::WouldBlock => break,
-                Err(e) if e.kind() == io::ErrorKind::TimedOut => break,
                 Err(e) if is_closed(&e) => return Err(LinkError::Closed),
                 Err(e) => return Err(LinkError::Io(e)),
             }
@@ -332,21 +399,22 @@ impl Link {
         Ok(())
     }
 
-    fn raw_read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-        match &mut self.io {
-            Transport::Serial(p) => p.read(buf),
-            Transport::Tcp(s) => s.read(buf),
-        }
-    }
-
-    /// Reads once into the decoder if the fd is readable within `timeout`.
-    /// Returns whether bytes arrived.
+    /// Reads once into the decoder; if nothing was there, waits up to `timeout` for
+    /// the fd to become readable and reads once more. Returns whether bytes arrived.
     fn fill(&mut self, timeout: Duration) -> Result<bool, LinkError> {
-        if wait_readable(&[self.as_raw_fd()], timeout)? == 0 {
+        if self.read_once()? {
+            return Ok(true);
+        }
+        if timeout.is_zero() || wait_readable(&[self.as_raw_fd()], timeout)? == 0 {
             return Ok(false);
         }
+        self.read_once()
+    }
+
+    /// One non-blocking read into the decoder. Returns whether bytes arrived.
+    fn read_once(&mut self) -> Result<bool, LinkError> {
         let r = match &mut self.io {
-            Transport::Serial(p) => self.decoder.read_from(p),
+            Transport::Serial(p) => self.decoder.read_from(&mut FdIo(port_fd(p))),
             Transport::Tcp(s) => self.decoder.read_from(s),
         };
         match r {

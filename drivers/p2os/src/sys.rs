@@ -1,5 +1,5 @@
-//! Small OS helpers shared by the link and the emulator: waiting for readability with
-//! `poll(2)` (through rustix) and saturating deadlines.
+//! Small OS helpers shared by the link and the emulator: waiting for readability or
+//! writability with `poll(2)` (through rustix) and saturating deadlines.
 
 use std::io;
 use std::os::fd::{BorrowedFd, RawFd};
@@ -15,6 +15,18 @@ use rustix::event::{PollFd, PollFlags, Timespec};
 /// Every non-negative descriptor must stay open for the duration of the call (the
 /// callers pass descriptors of objects they hold borrowed).
 pub fn wait_readable(fds: &[RawFd], timeout: Duration) -> io::Result<u8> {
+    wait(fds, PollFlags::IN, timeout)
+}
+
+/// Waits until `fd` can take bytes (or is hung up / in error, which the next write
+/// reports), at most `timeout`. Returns whether it is ready; false on timeout or on an
+/// interrupted wait. `fd` must stay open for the duration of the call.
+pub fn wait_writable(fd: RawFd, timeout: Duration) -> io::Result<bool> {
+    Ok(wait(&[fd], PollFlags::OUT, timeout)? != 0)
+}
+
+/// [`wait_readable`] for `events`.
+fn wait(fds: &[RawFd], events: PollFlags, timeout: Duration) -> io::Result<u8> {
     // The positions in `fds` of the descriptors that are polled.
     let mut index = [0usize; 8];
     let mut n = 0;
@@ -28,12 +40,12 @@ pub fn wait_readable(fds: &[RawFd], timeout: Duration) -> io::Result<u8> {
         // Slots past `n` are never passed to poll(2); they hold descriptor 0 as a
         // placeholder value only.
         let (fd, events) = if k < n {
-            (fds[index[k]], PollFlags::IN)
+            (fds[index[k]], events)
         } else {
             (0, PollFlags::empty())
         };
-        // SAFETY: `fd` is non-negative and, per this function's contract, open for the
-        // whole call (placeholders are never used); the borrow does not outlive it.
+        // SAFETY: `fd` is non-negative and, per the public functions' contract, open for
+        // the whole call (placeholders are never used); the borrow does not outlive it.
         PollFd::from_borrowed_fd(unsafe { BorrowedFd::borrow_raw(fd) }, events)
     });
     // Round up so a sub-millisecond timeout does not become a busy loop.

@@ -43,7 +43,7 @@ fn decoding_and_receiving_do_not_allocate() {
 
     // The link's receive path over a pty.
     let (mut master, slave) = TTYPort::pair().unwrap();
-    let mut link = Link::from_serial_port(slave);
+    let mut link = Link::from_serial_port(slave).unwrap();
     let frames: Vec<u8> = [arm.as_bytes(), sip.as_bytes()].concat();
     let mut got = 0;
     let before = allocations();

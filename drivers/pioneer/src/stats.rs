@@ -69,6 +69,11 @@ pub struct LoopStats {
     /// Command taken from the channel → bytes on the wire: the driver's own cost
     /// (validation, IK, encoding, the write), without the way from the client.
     pub arrival_to_wire: Ring,
+    /// Inside `arrival_to_wire`, the link's send alone (encoding and `write(2)`): what
+    /// the kernel takes. On a busy core it includes what the kernel runs as the write
+    /// returns (a pty's write wakes the tty's buffer worker, which may take the core
+    /// before the driver reads its clock).
+    pub link_write: Ring,
     last_tick: Option<Instant>,
     /// SIPs counted in the current second.
     pub sips_this_second: u64,

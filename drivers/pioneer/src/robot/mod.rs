@@ -357,12 +357,19 @@ impl RobotModel {
             return Err(Status::LinkDown);
         }
         let conn = self.conn.as_mut().ok_or(Status::LinkDown)?;
-        match conn.send(cmd) {
+        let before = if from.received_ns != 0 {
+            monotonic_ns()
+        } else {
+            0
+        };
+        let sent = conn.send(cmd);
+        // Read right after the write: the stages end when the bytes are on the wire.
+        let now = monotonic_ns();
+        match sent {
             Ok(()) => {
                 if let Command::ArmPower(on) = *cmd {
                     self.arm.power_commanded(on);
                 }
-                let now = monotonic_ns();
                 if from.sent_ns != 0 {
                     self.stats
                         .cmd_to_wire
@@ -372,11 +379,13 @@ impl RobotModel {
                     self.stats
                         .arrival_to_wire
                         .push(now.saturating_sub(from.received_ns));
+                    self.stats.link_write.push(now.saturating_sub(before));
                 }
                 Ok(())
             }
-            Err(_) => {
+            Err(e) => {
                 // The loop notices the dead link (read error or silence) and reconnects.
+                tracing::warn!("cannot send {cmd:?} to the robot: {e}");
                 Err(Status::LinkDown)
             }
         }
