@@ -4,6 +4,7 @@
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use limber_kinematics::Pose;
+use limber_kinematics::chain::DeterministicRng;
 use limber_kinematics::pioneer::*;
 use nalgebra::{Rotation3, Vector3};
 use proptest::prelude::*;
@@ -690,4 +691,143 @@ fn setpose_nearest_honours_its_tolerances() {
         .solve_setpose_nearest(&p, &a, &o, &[0.0; 5], &tight)
         .unwrap_err();
     assert!(matches!(e, PioneerIkError::OutOfReach { .. }), "{e:?}");
+}
+
+/// Steps 1 and 2 of SETPOSITION as they were written before the search tested the
+/// closed form without the FK (issue 16): every approach scored by the FK and the
+/// selection, the plane scanned outward in `approach_search_step`, the first feasible
+/// elevation refined by bisection towards the preferred one to 1e-9 rad. `None` when
+/// no in-plane approach reaches the target (the later steps then decide).
+fn reference_in_plane(
+    g: &PioneerGeometry,
+    p: &Vector3<f64>,
+    preferred: &Vector3<f64>,
+    current: &Theta,
+    o: &PioneerIkOptions,
+) -> Option<Theta> {
+    let strict = PioneerIkOptions {
+        position_tolerance: EXACT_POSITION,
+        orientation_tolerance: EXACT_ORIENTATION,
+        ..*o
+    };
+    let attempt = |a: &Vector3<f64>| {
+        g.approach_candidates(p, a, current, &strict)
+            .ok()?
+            .select(current, &strict)
+            .ok()
+            .map(|c| c.theta)
+    };
+    if let Some(t) = attempt(preferred) {
+        return Some(t);
+    }
+    let h = p.x.hypot(p.y);
+    let yaw = if h > 1e-12 {
+        p.y.atan2(p.x)
+    } else {
+        current[0]
+    };
+    let radial = Vector3::new(yaw.cos(), yaw.sin(), 0.0);
+    let in_plane = |phi: f64| radial * phi.cos() + Vector3::z() * phi.sin();
+    let phi0 = preferred.z.atan2(preferred.dot(&radial));
+    let step = o.approach_search_step;
+    let steps = (PI / step).ceil() as usize;
+    for k in 0..=steps {
+        for sign in [1.0, -1.0] {
+            let phi = phi0 + sign * (k as f64 * step).min(PI);
+            if let Some(found) = attempt(&in_plane(phi)) {
+                if k == 0 {
+                    return Some(found);
+                }
+                let mut good = (phi, found);
+                let mut bad = phi0 + sign * ((k - 1) as f64 * step);
+                while (good.0 - bad).abs() > 1e-9 {
+                    let mid = 0.5 * (good.0 + bad);
+                    match attempt(&in_plane(mid)) {
+                        Some(t) => good = (mid, t),
+                        None => bad = mid,
+                    }
+                }
+                return Some(good.1);
+            }
+            if k == 0 {
+                break;
+            }
+        }
+    }
+    None
+}
+
+/// Issue 16: the SETPOSITION search that tests each approach by the closed form alone
+/// and scores only the one it keeps finds the same joints as the search that scored
+/// every approach, on a grid of reachable positions (FK of a grid of joint angles),
+/// and of random ones, with the default limits and with wide ones (where the base can
+/// turn round), for
+/// several current configurations and preferences; where no in-plane approach
+/// reaches, its answer still reaches the position inside the limits.
+#[test]
+fn setposition_finds_what_the_scored_scan_found() {
+    let wide = PioneerGeometry {
+        limits: [
+            JointLimit::new(-2.6, 2.6),
+            JointLimit::new(-1.2, 2.0),
+            JointLimit::new(-2.6, 2.6),
+            JointLimit::new(-3.0, 3.0),
+            JointLimit::new(-1.8, 1.8),
+        ],
+        ..geom()
+    };
+    let o = opts();
+    let (mut same, mut later) = (0, 0);
+    for g in [geom(), wide] {
+        let frac = [0.07, 0.36, 0.64, 0.93];
+        let at = |i: usize, f: f64| g.limits[i].min + f * (g.limits[i].max - g.limits[i].min);
+        let currents = [
+            [0.0; 5],
+            [at(0, 0.8), at(1, 0.3), at(2, 0.6), 0.0, at(4, 0.2)],
+        ];
+        let grid = frac
+            .iter()
+            .flat_map(|a| frac.iter().map(move |b| (*a, *b)))
+            .flat_map(|(a, b)| frac.iter().map(move |c| (a, b, *c)))
+            .flat_map(|(a, b, c)| [0.2, 0.85].map(|d| [a, b, c, 0.5, d]));
+        // And random ones, where some positions have no in-plane approach.
+        let mut rng = DeterministicRng::new(0xB0A7_5EED);
+        let random: Vec<[f64; 5]> = (0..250)
+            .map(|_| std::array::from_fn(|_| rng.next_f64()))
+            .collect();
+        for (n, f) in grid.chain(random).enumerate() {
+            let theta: Theta = std::array::from_fn(|i| at(i, f[i]));
+            let p = g.fk(&theta).unwrap().position;
+            let current = currents[n % 2];
+            let preferences = [
+                (
+                    ApproachPreference::Current,
+                    g.fk(&current).unwrap().approach(),
+                ),
+                (ApproachPreference::Down, -Vector3::z()),
+            ];
+            for (preference, preferred) in preferences {
+                let got = g.solve_position(&p, preference, &current, &o);
+                match reference_in_plane(&g, &p, &preferred, &current, &o) {
+                    Some(want) => {
+                        let got = got.unwrap().theta;
+                        let d = got.iter().zip(&want).map(|(a, b)| (a - b).abs());
+                        assert!(d.fold(0.0, f64::max) < 1e-6, "{p:?}: {got:?} vs {want:?}");
+                        same += 1;
+                    }
+                    None => {
+                        let got = got.unwrap().theta;
+                        assert!(g.within_limits(&got));
+                        assert!((g.fk(&got).unwrap().position - p).norm() <= 1e-6);
+                        later += 1;
+                    }
+                }
+            }
+        }
+    }
+    // Both kinds of target are on the grid.
+    assert!(
+        same > 300 && later > 10,
+        "{same} in the plane, {later} later"
+    );
 }

@@ -3,11 +3,12 @@
 //! deterministically, preferring the caller's approach, then the arm's vertical plane,
 //! then θ1 held on a yaw limit, then cones around the preferred approach.
 
+use std::cell::Cell;
 use std::f64::consts::{PI, TAU};
 
 use nalgebra::Vector3;
 
-use super::ik::WristGoal;
+use super::ik::{Reach, WristGoal};
 use super::{
     EXACT_ORIENTATION, EXACT_POSITION, IkCandidate, LIMIT_TOLERANCE, PioneerGeometry,
     PioneerIkError, PioneerIkOptions, Theta, joint_distance,
@@ -43,6 +44,11 @@ impl PioneerGeometry {
     /// 4. failing that, approaches out of the plane, on cones around the preferred one
     ///    five search steps apart, and finally the direction from the shoulder circle to
     ///    the target (the only approach at full stretch).
+    ///
+    /// The search tests each approach by the closed form alone, without scoring
+    /// its candidates by the FK and without an inverse trigonometric function (the
+    /// limits are tested on sines and cosines); the approach it keeps is scored and
+    /// checked by the FK like any other answer.
     ///
     /// For the chosen approach the in-limit solution nearest to `current` wins. The
     /// result's `orientation_error` is the error to the chosen approach. Fails with
@@ -85,7 +91,10 @@ impl PioneerGeometry {
                 max,
             });
         }
-        let mut any_exact = false;
+        // Whether an exact solution outside the limits has been seen: then only the
+        // in-limit candidates can change the answer, and once every approach has
+        // failed the cause is the limits, not the reach.
+        let any_exact = Cell::new(false);
         // The search accepts only exact solutions (round-off), so that the bisection
         // cannot settle on a reach boundary blurred by the tolerance; the last resort
         // (full stretch) accepts the tolerances.
@@ -94,30 +103,52 @@ impl PioneerGeometry {
             orientation_tolerance: EXACT_ORIENTATION,
             ..*options
         };
-        // An approach is taken only for an in-limit candidate; the others matter only
-        // to tell "outside the limits" from "out of reach" at the end, so once an
-        // exact solution outside the limits has been seen they are no longer scored
-        // (the answer is the same, and each attempt costs a fraction).
-        let mut attempt_with = |a: &Vector3<f64>, opts: &PioneerIkOptions| {
+        // The candidates for approach `a`, scored by the FK, and the selection.
+        let attempt_with = |a: &Vector3<f64>, opts: &PioneerIkOptions| {
             let cands = self
                 .candidates(
                     position,
                     WristGoal::Approach(a),
                     current,
                     opts.position_tolerance,
-                    any_exact,
+                    any_exact.get(),
                 )
                 .ok()?;
             match cands.select(current, opts) {
                 Ok(c) => Some(c),
                 Err(PioneerIkError::OutsideJointLimits) => {
-                    any_exact = true;
+                    any_exact.set(true);
                     None
                 }
                 Err(_) => None,
             }
         };
-        let mut attempt = |a: &Vector3<f64>| attempt_with(a, &strict);
+        // The closed form without the FK scoring (a fraction of the cost): whether an
+        // in-limit solution attains approach `a`. The search tests every approach this
+        // way first and scores only those that pass.
+        let arcs = self.limit_arcs();
+        let reaches = |a: &Vector3<f64>| match self.reach_with_approach(
+            position,
+            a,
+            current,
+            EXACT_POSITION,
+            any_exact.get(),
+            &arcs,
+        ) {
+            Reach::Within => true,
+            Reach::Outside => {
+                any_exact.set(true);
+                false
+            }
+            Reach::None => false,
+        };
+        let attempt = |a: &Vector3<f64>| {
+            if reaches(a) {
+                attempt_with(a, &strict)
+            } else {
+                None
+            }
+        };
         // 1. The preferred approach.
         if let Some(c) = attempt(&preferred) {
             return Ok(c);
@@ -133,29 +164,26 @@ impl PioneerGeometry {
         let phi0 = preferred.z.atan2(preferred.dot(&radial));
         let step = options.approach_search_step;
         let steps = (PI / step).ceil() as usize;
-        for k in 0..=steps {
+        if let Some(c) = attempt(&in_plane(phi0)) {
+            return Ok(c);
+        }
+        for k in 1..=steps {
             for sign in [1.0, -1.0] {
                 let phi = phi0 + sign * (k as f64 * step).min(PI);
-                if let Some(found) = attempt(&in_plane(phi)) {
-                    if k == 0 {
-                        return Ok(found);
-                    }
-                    let mut good = (phi, found);
-                    let mut bad = phi0 + sign * ((k - 1) as f64 * step);
-                    for _ in 0..64 {
-                        if (good.0 - bad).abs() <= 1e-9 {
-                            break;
-                        }
-                        let mid = 0.5 * (good.0 + bad);
-                        match attempt(&in_plane(mid)) {
-                            Some(c) => good = (mid, c),
-                            None => bad = mid,
-                        }
-                    }
-                    return Ok(good.1);
+                if !reaches(&in_plane(phi)) {
+                    continue;
                 }
-                if k == 0 {
-                    break;
+                let bad = phi0 + sign * ((k - 1) as f64 * step);
+                // The boundary by the closed form alone, then the FK check there; if
+                // round-off makes the two disagree, the bisection again with the check
+                // at every step.
+                let (edge, ()) = bisect((phi, ()), bad, |m| reaches(&in_plane(m)).then_some(()));
+                if let Some(c) = attempt_with(&in_plane(edge), &strict) {
+                    return Ok(c);
+                }
+                if let Some(found) = attempt_with(&in_plane(phi), &strict) {
+                    let (_, c) = bisect((phi, found), bad, |m| attempt_with(&in_plane(m), &strict));
+                    return Ok(c);
                 }
             }
         }
@@ -264,7 +292,7 @@ impl PioneerGeometry {
                 return Ok(c);
             }
         }
-        if any_exact {
+        if any_exact.get() {
             Err(PioneerIkError::OutsideJointLimits)
         } else {
             Err(PioneerIkError::OutOfReach {
@@ -280,6 +308,23 @@ impl PioneerGeometry {
 /// before trying them (both circles; 720 at the default 1° step). A finer step scans
 /// in angle order instead, keeping the best.
 const CIRCLE_SCAN_CAPACITY: usize = 1024;
+
+/// Bisection between an elevation `good` that passes `test` (with what it returned)
+/// and one `bad` that does not, until they are 1e-9 rad apart: the last elevation
+/// that passed, and what `test` returned there.
+fn bisect<T>(mut good: (f64, T), mut bad: f64, mut test: impl FnMut(f64) -> Option<T>) -> (f64, T) {
+    for _ in 0..64 {
+        if (good.0 - bad).abs() <= 1e-9 {
+            break;
+        }
+        let mid = 0.5 * (good.0 + bad);
+        match test(mid) {
+            Some(t) => good = (mid, t),
+            None => bad = mid,
+        }
+    }
+    good
+}
 
 /// Two unit vectors that complete `a` (a unit vector) to an orthonormal basis.
 fn perpendicular_basis(a: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
