@@ -36,8 +36,8 @@ impl Chain {
     /// the chain's atlas (256 drawn at load) whose tool poses are nearest the target,
     /// the others at deterministic random configurations. Each
     /// attempt is Levenberg–Marquardt on the damped least-squares step
-    /// `Δq = Jᵀ(JJᵀ + λI)⁻¹e` with λ adapted to the cost, the step limited to 0.5 rad
-    /// (or m) per joint, joints pushing against a limit frozen for that step, and the
+    /// `Δq = Jᵀ(JJᵀ + λI)⁻¹e` with λ adapted to the cost (from [`INITIAL_DAMPING`]),
+    /// the step limited to [`MAX_STEP`] rad (or m) per joint, joints pushing against a limit frozen for that step, and the
     /// result clamped into the limits. An attempt has stalled when the cost falls by
     /// less than half in 10 iterations, or by less than a fifth in 3 while a joint
     /// sits on a limit. The first time it stalls, rotary joints on a limit whose
@@ -144,7 +144,7 @@ impl Chain {
             let mut pose = self.fk_jacobian(&q, w, &mut jac);
             let mut e = residual(&pose);
             let mut cost = e.norm_squared();
-            let mut lambda = 1e-3;
+            let mut lambda = INITIAL_DAMPING;
             let mut checkpoint = cost;
             let mut recent = cost;
             let mut crossed = false;
@@ -174,7 +174,9 @@ impl Chain {
                     pose = self.fk_jacobian(&q, w, &mut jac);
                     e = residual(&pose);
                     cost = e.norm_squared();
-                    lambda = 1e-3;
+                    // Small: the crossed joint is near its goal more often than not
+                    // (INITIAL_DAMPING here cost more restarts).
+                    lambda = CROSSED_DAMPING;
                     checkpoint = cost;
                     recent = cost;
                 }
@@ -233,7 +235,11 @@ impl Chain {
                     }
                 }
                 let biggest = dq.iter().take(n).fold(0.0_f64, |m, v| m.max(v.abs()));
-                let scale = if biggest > 0.5 { 0.5 / biggest } else { 1.0 };
+                let scale = if biggest > MAX_STEP {
+                    MAX_STEP / biggest
+                } else {
+                    1.0
+                };
                 let mut q_new = q;
                 for (i, v) in q_new.iter_mut().enumerate() {
                     *v += dq[i] * scale;
@@ -279,6 +285,18 @@ impl Chain {
         })
     }
 }
+
+/// λ at the start of an attempt of [`Chain::ik`]. Against 1e-3 before (issue 16):
+/// more first attempts succeed (6-joint pose 86 % instead of 78 % of the bench's
+/// targets from home), in fewer iterations (p99 89 instead of 107).
+const INITIAL_DAMPING: f64 = 0.3;
+
+/// λ after joints crossed their gaps in [`Chain::ik`].
+const CROSSED_DAMPING: f64 = 1e-3;
+
+/// Largest change of one joint in a step of [`Chain::ik`], rad or m (0.5 before issue
+/// 16: with [`INITIAL_DAMPING`] this takes fewer iterations and no more restarts).
+const MAX_STEP: f64 = 0.7;
 
 /// Configurations in a chain's atlas of restart seeds.
 const ATLAS_SIZE: usize = 256;
