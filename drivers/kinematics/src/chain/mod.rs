@@ -303,7 +303,7 @@ pub struct ChainSolution {
     pub orientation_error: f64,
     /// Iterations used in total.
     pub iterations: u32,
-    /// Random restarts used.
+    /// Restarts used (atlas or random).
     pub restarts: u32,
 }
 
