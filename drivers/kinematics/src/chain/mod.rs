@@ -38,7 +38,8 @@
 //!
 //! # Allocation
 //!
-//! Loading allocates (names, the joint list). FK, the Jacobian and [`Chain::ik`] do
+//! Loading allocates (names, the joint list, the atlas of restart seeds). FK, the
+//! Jacobian and [`Chain::ik`] do
 //! not: they work on fixed-size stack arrays of [`MAX_JOINTS`] entries.
 
 use std::ops::{Deref, DerefMut};
