@@ -206,10 +206,10 @@ impl PioneerGeometry {
                     (position - normal * off, Vector3::new(c1, s1, 0.0), r)
                 })
             });
-            let approach_at = |circle: usize, j: usize| {
+            // The approach with the wrist centre at angle ψ (cosine, sine) on a circle.
+            let approach_on = |circle: usize, (c, s): (f64, f64)| {
                 circles[circle].map(|(centre, e1, r)| {
-                    let psi = j as f64 * step;
-                    let w = centre + (e1 * psi.cos() + Vector3::z() * psi.sin()) * r;
+                    let w = centre + (e1 * c + Vector3::z() * s) * r;
                     (position - w) / self.l5
                 })
             };
@@ -218,30 +218,47 @@ impl PioneerGeometry {
                 // Every approach on both circles, scored, then tried best first: the
                 // first feasible one is the one a full scan keeps (smallest score, ties
                 // to the earlier circle and angle), after a fraction of the attempts.
+                // The cosines and sines are shared by the circles and the two passes;
+                // the order is made a chunk at a time (most targets need the first).
+                let mut trig = [(0.0f64, 0.0f64); CIRCLE_SCAN_CAPACITY / 2];
+                for (j, t) in trig.iter_mut().enumerate().take(per_circle) {
+                    let psi = j as f64 * step;
+                    *t = (psi.cos(), psi.sin());
+                }
                 let mut order = [(0.0f64, 0u16); CIRCLE_SCAN_CAPACITY];
                 let mut len = 0;
                 for circle in 0..2 {
-                    for j in 0..per_circle {
-                        if let Some(a) = approach_at(circle, j) {
+                    for (j, t) in trig.iter().enumerate().take(per_circle) {
+                        if let Some(a) = approach_on(circle, *t) {
                             order[len] = (-a.dot(&preferred), (circle * per_circle + j) as u16);
                             len += 1;
                         }
                     }
                 }
-                let order = &mut order[..len];
-                order.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-                for &(_, index) in order.iter() {
-                    let index = usize::from(index);
-                    let a = approach_at(index / per_circle, index % per_circle);
-                    if let Some(c) = a.and_then(|a| attempt(&a)) {
-                        return Ok(c);
+                let by = |x: &(f64, u16), y: &(f64, u16)| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1));
+                let mut rest = &mut order[..len];
+                while !rest.is_empty() {
+                    let chunk = CIRCLE_CHUNK.min(rest.len());
+                    if chunk < rest.len() {
+                        rest.select_nth_unstable_by(chunk - 1, by);
                     }
+                    let (first, others) = rest.split_at_mut(chunk);
+                    first.sort_unstable_by(by);
+                    for &(_, index) in first.iter() {
+                        let index = usize::from(index);
+                        let a = approach_on(index / per_circle, trig[index % per_circle]);
+                        if let Some(c) = a.and_then(|a| attempt(&a)) {
+                            return Ok(c);
+                        }
+                    }
+                    rest = others;
                 }
             } else {
                 let mut best: Option<(f64, IkCandidate)> = None;
                 for circle in 0..2 {
                     for j in 0..per_circle {
-                        let Some(a) = approach_at(circle, j) else {
+                        let psi = j as f64 * step;
+                        let Some(a) = approach_on(circle, (psi.cos(), psi.sin())) else {
                             break;
                         };
                         if let Some(c) = attempt(&a) {
@@ -325,6 +342,10 @@ fn bisect<T>(mut good: (f64, T), mut bad: f64, mut test: impl FnMut(f64) -> Opti
     }
     good
 }
+
+/// Approaches of the yaw-limit scan ordered at a time: the best this many, then the
+/// next, ... (the order is that of a full sort).
+const CIRCLE_CHUNK: usize = 48;
 
 /// Two unit vectors that complete `a` (a unit vector) to an orthonormal basis.
 fn perpendicular_basis(a: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
