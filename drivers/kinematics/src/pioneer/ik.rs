@@ -441,14 +441,15 @@ impl PioneerGeometry {
         let (dmin, dmax) = self.wrist_reach();
         let mut reach = Reach::None;
         for (s1, c1) in [(sy, cy), (-sy, -cy)] {
+            // The yaw first: it is cheaper than the reach.
+            let in1 = arcs.contains(0, s1, c1);
+            if in_limits_only && !in1 {
+                continue;
+            }
             let r = c1 * w.x + s1 * w.y - self.l1;
             let z = w.z;
             let d = hyp(r, z);
             if d > dmax + tol || d < dmin - tol {
-                continue;
-            }
-            let in1 = arcs.contains(0, s1, c1);
-            if in_limits_only && !in1 {
                 continue;
             }
             let (_, (sg, cg)) = self.elbow_half_angle(d);
