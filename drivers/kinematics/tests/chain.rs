@@ -1,6 +1,8 @@
 //! Generic chains: loading, FK (cross-checked against the Pioneer closed form), numeric
 //! IK success rates on 5-, 6- and 7-joint arms, reach and limit failures, bad input.
 
+use std::f64::consts::FRAC_PI_2;
+
 use limber_kinematics::Pose;
 use limber_kinematics::chain::*;
 use limber_kinematics::pioneer::{PioneerGeometry, Theta};
@@ -174,6 +176,69 @@ fn a_joint_stalled_on_a_limit_crosses_its_gap() {
     let got = c.fk(&s.q).unwrap();
     assert!(got.position_error(&target) <= 1e-6);
     assert!(got.orientation_error(&target) <= 1e-6);
+}
+
+/// Issue 16: targets at the hard places of the workspace still solve, pose and
+/// position, from home and from a far seed, each answer inside the limits and checked
+/// by the FK: the 6-joint arm's wrist singularity (wrist_2 = 0, wrist_1 and wrist_3
+/// aligned), its straight and folded elbow, and the 7-joint arm with joints on their
+/// limits (j2 at ±101°, j4 at −4° next to the straight elbow, j6 at both ends) or
+/// next to its wrist singularity.
+#[test]
+fn hard_targets_near_singularities_and_limits_solve() {
+    let c6 = Chain::default_6dof();
+    let c7 = Chain::default_7dof();
+    let cases: [(&Chain, &[f64]); 10] = [
+        (&c6, &[0.3, -1.2, 1.1, -0.5, 0.0, 0.2]),
+        (&c6, &[-2.0, -0.7, 0.0, 1.0, 0.9, -0.4]),
+        (&c6, &[1.1, -2.2, 3.1, -1.7, 1e-7, 2.5]),
+        (&c6, &[0.0, -FRAC_PI_2, 0.0, -FRAC_PI_2, 0.0, 0.0]),
+        (&c7, &[0.3, 1.7628, -0.4, -0.0698, 0.2, 1.9, 0.4]),
+        (&c7, &[-1.0, -1.7628, 0.8, -1.5, -0.5, -0.0175, 1.2]),
+        (&c7, &[2.0, 0.4, -2.8973, -0.0698, 2.8973, 3.7525, -2.8973]),
+        (&c7, &[0.0, 0.0, 0.0, -0.0698, 0.0, -0.0175, 0.0]),
+        (&c7, &[-2.8973, 1.2, 0.0, -3.0718, 0.0, 3.7525, 2.8973]),
+        // Next to the wrist singularity (j5 ≈ 0): the attempt used to be stopped as
+        // stalled 2e-6 from the target.
+        (
+            &c7,
+            &[
+                -1.3534127530408548,
+                -0.32881995226685845,
+                2.7381185873814045,
+                -0.4651073065845237,
+                0.00020768662511949643,
+                1.6807073861199362,
+                -0.18333754869551777,
+            ],
+        ),
+    ];
+    let o = NumericIkOptions::default();
+    for (chain, q) in cases {
+        let target = chain.fk(q).unwrap();
+        let mut far = chain.home();
+        for (v, j) in far.iter_mut().zip(chain.joints()) {
+            *v = 0.8 * j.max + 0.2 * j.min;
+        }
+        for seed in [chain.home(), far] {
+            for pose in [true, false] {
+                let goal = if pose {
+                    IkTarget::Pose(target)
+                } else {
+                    IkTarget::Position(target.position)
+                };
+                let s = chain
+                    .ik(&goal, &seed, &o)
+                    .unwrap_or_else(|e| panic!("{} {q:?} pose {pose}: {e:?}", chain.name()));
+                assert!(chain.within_limits(&s.q));
+                let got = chain.fk(&s.q).unwrap();
+                assert!(got.position_error(&target) <= o.position_tolerance);
+                if pose {
+                    assert!(got.orientation_error(&target) <= o.orientation_tolerance);
+                }
+            }
+        }
+    }
 }
 
 #[test]

@@ -3,8 +3,9 @@
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use limber_kinematics::Pose;
+use limber_kinematics::chain::DeterministicRng;
 use limber_kinematics::pioneer::*;
+use limber_kinematics::{Pose, fit_angle_to_limits};
 use nalgebra::{Rotation3, Vector3};
 use proptest::prelude::*;
 
@@ -690,4 +691,173 @@ fn setpose_nearest_honours_its_tolerances() {
         .solve_setpose_nearest(&p, &a, &o, &[0.0; 5], &tight)
         .unwrap_err();
     assert!(matches!(e, PioneerIkError::OutOfReach { .. }), "{e:?}");
+}
+
+/// Steps 1 to 3 of SETPOSITION as they were written before the search tested the
+/// closed form without the FK (issue 16): every approach scored by the FK and the
+/// selection, the plane scanned outward in `approach_search_step`, the first feasible
+/// elevation refined by bisection towards the preferred one to 1e-9 rad, then the
+/// yaw-limit circles in a full sort. `None` when none of these reaches the target
+/// (the cones of step 4 then decide).
+fn reference_search(
+    g: &PioneerGeometry,
+    p: &Vector3<f64>,
+    preferred: &Vector3<f64>,
+    current: &Theta,
+    o: &PioneerIkOptions,
+) -> Option<(Theta, u8)> {
+    let strict = PioneerIkOptions {
+        position_tolerance: EXACT_POSITION,
+        orientation_tolerance: EXACT_ORIENTATION,
+        ..*o
+    };
+    let attempt = |a: &Vector3<f64>| {
+        g.approach_candidates(p, a, current, &strict)
+            .ok()?
+            .select(current, &strict)
+            .ok()
+            .map(|c| c.theta)
+    };
+    if let Some(t) = attempt(preferred) {
+        return Some((t, 1));
+    }
+    let h = p.x.hypot(p.y);
+    let yaw = if h > 1e-12 {
+        p.y.atan2(p.x)
+    } else {
+        current[0]
+    };
+    let radial = Vector3::new(yaw.cos(), yaw.sin(), 0.0);
+    let in_plane = |phi: f64| radial * phi.cos() + Vector3::z() * phi.sin();
+    let phi0 = preferred.z.atan2(preferred.dot(&radial));
+    let step = o.approach_search_step;
+    let steps = (PI / step).ceil() as usize;
+    for k in 0..=steps {
+        for sign in [1.0, -1.0] {
+            let phi = phi0 + sign * (k as f64 * step).min(PI);
+            if let Some(found) = attempt(&in_plane(phi)) {
+                if k == 0 {
+                    return Some((found, 2));
+                }
+                let mut good = (phi, found);
+                let mut bad = phi0 + sign * ((k - 1) as f64 * step);
+                while (good.0 - bad).abs() > 1e-9 {
+                    let mid = 0.5 * (good.0 + bad);
+                    match attempt(&in_plane(mid)) {
+                        Some(t) => good = (mid, t),
+                        None => bad = mid,
+                    }
+                }
+                return Some((good.1, 2));
+            }
+            if k == 0 {
+                break;
+            }
+        }
+    }
+    // 3. θ1 held on a yaw limit (when the plane, or its opposite, is beyond the
+    //    limits): every approach on both circles, scored, fully sorted, the first that
+    //    an exact in-limit solution attains.
+    let l = g.limits[0];
+    let yaw_ok =
+        |y: f64| fit_angle_to_limits(y, l.min, l.max, current[0], LIMIT_TOLERANCE).is_some();
+    if yaw_ok(yaw) && yaw_ok(yaw + PI) {
+        return None;
+    }
+    let per_circle = 2 * steps;
+    let mut scored = vec![];
+    for (circle, t1) in [l.min, l.max].into_iter().enumerate() {
+        let normal = Vector3::new(-t1.sin(), t1.cos(), 0.0);
+        let off = p.dot(&normal);
+        if off.abs() >= g.l5 {
+            continue;
+        }
+        let r = (g.l5 * g.l5 - off * off).sqrt();
+        let centre = p - normal * off;
+        let e1 = Vector3::new(t1.cos(), t1.sin(), 0.0);
+        for j in 0..per_circle {
+            let psi = j as f64 * step;
+            let w = centre + (e1 * psi.cos() + Vector3::z() * psi.sin()) * r;
+            let a = (p - w) / g.l5;
+            scored.push((-a.dot(preferred), circle * per_circle + j, a));
+        }
+    }
+    scored.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    scored
+        .iter()
+        .find_map(|(_, _, a)| attempt(a))
+        .map(|t| (t, 3))
+}
+
+/// Issue 16: the SETPOSITION search that tests each approach by the closed form alone
+/// and scores only the one it keeps finds the same joints as the search that scored
+/// every approach, on a grid of reachable positions (FK of a grid of joint angles),
+/// and of random ones, with the default limits and with wide ones (where the base can
+/// turn round), for
+/// several current configurations and preferences; where neither the plane nor the
+/// yaw limits do, its answer still reaches the position inside the limits.
+#[test]
+fn setposition_finds_what_the_scored_scan_found() {
+    let wide = PioneerGeometry {
+        limits: [
+            JointLimit::new(-2.6, 2.6),
+            JointLimit::new(-1.2, 2.0),
+            JointLimit::new(-2.6, 2.6),
+            JointLimit::new(-3.0, 3.0),
+            JointLimit::new(-1.8, 1.8),
+        ],
+        ..geom()
+    };
+    let o = opts();
+    let mut by_step = [0usize; 4];
+    for g in [geom(), wide] {
+        let frac = [0.07, 0.36, 0.64, 0.93];
+        let at = |i: usize, f: f64| g.limits[i].min + f * (g.limits[i].max - g.limits[i].min);
+        let currents = [
+            [0.0; 5],
+            [at(0, 0.8), at(1, 0.3), at(2, 0.6), 0.0, at(4, 0.2)],
+        ];
+        let grid = frac
+            .iter()
+            .flat_map(|a| frac.iter().map(move |b| (*a, *b)))
+            .flat_map(|(a, b)| frac.iter().map(move |c| (a, b, *c)))
+            .flat_map(|(a, b, c)| [0.2, 0.85].map(|d| [a, b, c, 0.5, d]));
+        // And random ones, where some positions have no in-plane approach.
+        let mut rng = DeterministicRng::new(0xB0A7_5EED);
+        let random: Vec<[f64; 5]> = (0..250)
+            .map(|_| std::array::from_fn(|_| rng.next_f64()))
+            .collect();
+        for (n, f) in grid.chain(random).enumerate() {
+            let theta: Theta = std::array::from_fn(|i| at(i, f[i]));
+            let p = g.fk(&theta).unwrap().position;
+            let current = currents[n % 2];
+            let preferences = [
+                (
+                    ApproachPreference::Current,
+                    g.fk(&current).unwrap().approach(),
+                ),
+                (ApproachPreference::Down, -Vector3::z()),
+            ];
+            for (preference, preferred) in preferences {
+                let got = g.solve_position(&p, preference, &current, &o);
+                match reference_search(&g, &p, &preferred, &current, &o) {
+                    Some((want, step)) => {
+                        let got = got.unwrap().theta;
+                        let d = got.iter().zip(&want).map(|(a, b)| (a - b).abs());
+                        assert!(d.fold(0.0, f64::max) < 1e-6, "{p:?}: {got:?} vs {want:?}");
+                        by_step[usize::from(step) - 1] += 1;
+                    }
+                    None => {
+                        let got = got.unwrap().theta;
+                        assert!(g.within_limits(&got));
+                        assert!((g.fk(&got).unwrap().position - p).norm() <= 1e-6);
+                        by_step[3] += 1;
+                    }
+                }
+            }
+        }
+    }
+    // The preferred approach, the plane and the yaw limits each answer some targets.
+    println!("answered by step 1, 2, 3, later: {by_step:?}");
+    assert!(by_step[..3].iter().all(|n| *n > 10), "{by_step:?}");
 }

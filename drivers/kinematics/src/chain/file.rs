@@ -145,7 +145,7 @@ impl Chain {
             .iter()
             .map(|j| (Turn::of(&j.rest), Axis::of(&j.axis)))
             .collect();
-        Ok(Chain {
+        let mut chain = Chain {
             name: file.name,
             description: file.description,
             base,
@@ -154,7 +154,10 @@ impl Chain {
             gripper,
             reach,
             turns,
-        })
+            atlas: Vec::new(),
+        };
+        chain.atlas = chain.make_atlas();
+        Ok(chain)
     }
 
     /// Reads, parses and validates a chain file.

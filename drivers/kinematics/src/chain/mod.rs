@@ -2,7 +2,8 @@
 //! geometry describes it (type, origin offset, rest orientation, axis, limits, speed),
 //! loaded from TOML, with forward kinematics and a numeric inverse
 //! (Levenberg–Marquardt on the damped least-squares step, joint limits by projection
-//! and an active set, deterministic random restarts).
+//! and an active set, restarts from the nearest of a set of configurations made at
+//! load, then deterministic random ones).
 //!
 //! # Chain file format (TOML)
 //!
@@ -37,7 +38,8 @@
 //!
 //! # Allocation
 //!
-//! Loading allocates (names, the joint list). FK, the Jacobian and [`Chain::ik`] do
+//! Loading allocates (names, the joint list, the atlas of restart seeds). FK, the
+//! Jacobian and [`Chain::ik`] do
 //! not: they work on fixed-size stack arrays of [`MAX_JOINTS`] entries.
 
 use std::ops::{Deref, DerefMut};
@@ -108,6 +110,9 @@ pub struct Chain {
     reach: f64,
     /// Per joint: its rest orientation and axis in their cheapest form, for the walk.
     turns: Vec<(Turn, Axis)>,
+    /// Restart seeds of [`Chain::ik`]: deterministic configurations and their tool
+    /// poses, made at load.
+    atlas: Vec<(JointVec, Pose)>,
 }
 
 /// Why a chain could not be loaded.
@@ -268,7 +273,8 @@ pub struct NumericIkOptions {
     pub orientation_weight: f64,
     /// Iterations per attempt (100).
     pub max_iterations: u32,
-    /// Random restarts after the attempt from the seed (40).
+    /// Restarts after the attempt from the seed (40): atlas seeds near the target
+    /// first, then random configurations (see [`Chain::ik`]).
     pub max_restarts: u32,
     /// Seed of the deterministic restart generator (same inputs, same answer).
     pub seed: u64,
@@ -298,7 +304,7 @@ pub struct ChainSolution {
     pub orientation_error: f64,
     /// Iterations used in total.
     pub iterations: u32,
-    /// Random restarts used.
+    /// Restarts used (atlas or random).
     pub restarts: u32,
 }
 

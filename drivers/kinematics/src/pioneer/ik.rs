@@ -5,7 +5,8 @@
 //! candidate is scored by the FK error and marked for the limits; [`IkCandidates::select`]
 //! picks among them deterministically.
 
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
+use std::ops::ControlFlow;
 
 use nalgebra::Vector3;
 
@@ -224,6 +225,59 @@ pub(super) fn unit(y: f64, x: f64) -> (f64, f64) {
     if h > 0.0 { (y / h, x / h) } else { (0.0, 1.0) }
 }
 
+/// One closed-form solution before the FK scores it.
+pub(super) struct Solution {
+    theta: Theta,
+    branch: Branch,
+    within_limits: bool,
+    trig: Trig,
+}
+
+/// What [`PioneerGeometry::reach_with_approach`] found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Reach {
+    /// A solution inside the limits.
+    Within,
+    /// Solutions, all outside the limits.
+    Outside,
+    /// No solution (the wrist centre is outside its annulus).
+    None,
+}
+
+/// One joint's limits (widened by [`LIMIT_TOLERANCE`]) as an arc of the circle.
+#[derive(Clone, Copy, Debug)]
+struct LimitArc {
+    sin_lo: f64,
+    cos_lo: f64,
+    cos_len: f64,
+    len: f64,
+}
+
+/// The joint limits as arcs: an angle given by its sine and cosine is tested without
+/// an inverse trigonometric function, modulo 2π like [`fit_angle_to_limits`].
+#[derive(Clone, Copy, Debug)]
+pub(super) struct LimitArcs([LimitArc; PIONEER_DOF]);
+
+impl LimitArcs {
+    /// Whether the angle of joint `i` with sine `s` and cosine `c` lies on its arc.
+    fn contains(&self, i: usize, s: f64, c: f64) -> bool {
+        let arc = &self.0[i];
+        if arc.len >= TAU {
+            return true;
+        }
+        // The angle from the arc's start, δ in [0, 2π): its sine and cosine.
+        let sd = s * arc.cos_lo - c * arc.sin_lo;
+        let cd = c * arc.cos_lo + s * arc.sin_lo;
+        if sd >= 0.0 {
+            // δ in [0, π], where the cosine falls.
+            arc.len >= PI || cd >= arc.cos_len
+        } else {
+            // δ in (π, 2π), where it rises.
+            arc.len > PI && cd <= arc.cos_len
+        }
+    }
+}
+
 /// Which wrist solution to compute.
 #[derive(Clone, Copy)]
 pub(super) enum WristGoal<'a> {
@@ -331,11 +385,8 @@ impl PioneerGeometry {
             .select(current, options)
     }
 
-    /// Closed-form candidates. `tol` widens the reachable annulus of the wrist centre.
-    /// With `in_limits_only`, candidates with an angle outside its limit are dropped as
-    /// soon as that angle is known (before the FK check that scores them): the
-    /// SETPOSITION search uses it once it knows that exact solutions exist, when only
-    /// the in-limit candidates can change its answer.
+    /// Closed-form candidates, each scored by the FK. `tol` widens the reachable
+    /// annulus of the wrist centre. With `in_limits_only`, see [`Self::solutions`].
     pub(super) fn candidates(
         &self,
         p: &Vector3<f64>,
@@ -344,6 +395,160 @@ impl PioneerGeometry {
         tol: f64,
         in_limits_only: bool,
     ) -> Result<IkCandidates, PioneerIkError> {
+        let mut out = IkCandidates::new();
+        self.solutions(p, goal, current, tol, in_limits_only, |s| {
+            let fk = self.fk_trig(&s.trig);
+            let position_error = (fk.position - p).norm();
+            let orientation_error = match goal {
+                WristGoal::Frame(pose) => fk.orientation_error(pose),
+                WristGoal::Approach(a) => vector_angle(&fk.approach(), a),
+            };
+            let ok = |v: f64| if v.is_finite() { v } else { f64::INFINITY };
+            out.push(IkCandidate {
+                theta: s.theta,
+                branch: s.branch,
+                within_limits: s.within_limits,
+                position_error: ok(position_error),
+                orientation_error: ok(orientation_error),
+            });
+            ControlFlow::Continue(())
+        })?;
+        Ok(out)
+    }
+
+    /// Whether an approach vector `a` (unit) attains the position `p` in closed form,
+    /// like [`Self::candidates`] but without scoring the candidates by the FK (the
+    /// closed form is exact to round-off wherever the wrist centre lies within `tol`
+    /// of its annulus) and without an inverse trigonometric function: the limits are
+    /// tested on the sines and cosines ([`LimitArcs`]). `Within` as soon as one
+    /// candidate lies inside the limits; with `in_limits_only`, `Within` or `None`.
+    pub(super) fn reach_with_approach(
+        &self,
+        p: &Vector3<f64>,
+        a: &Vector3<f64>,
+        current: &Theta,
+        tol: f64,
+        in_limits_only: bool,
+        arcs: &LimitArcs,
+    ) -> Reach {
+        let w = p - a * self.l5;
+        let h = hyp(w.x, w.y);
+        let (sy, cy) = if h < 1e-12 {
+            current[0].sin_cos()
+        } else {
+            (w.y / h, w.x / h)
+        };
+        let (dmin, dmax) = self.wrist_reach();
+        let mut reach = Reach::None;
+        for (s1, c1) in [(sy, cy), (-sy, -cy)] {
+            // The yaw first: it is cheaper than the reach.
+            let in1 = arcs.contains(0, s1, c1);
+            if in_limits_only && !in1 {
+                continue;
+            }
+            let r = c1 * w.x + s1 * w.y - self.l1;
+            let z = w.z;
+            let d = hyp(r, z);
+            if d > dmax + tol || d < dmin - tol {
+                continue;
+            }
+            let (_, (sg, cg)) = self.elbow_half_angle(d);
+            let (sa, ca) = unit(z, r);
+            for (s3, c3) in [(sg, cg), (-sg, cg)] {
+                let (s2, c2) = self.shoulder_pitch((sa, ca), s3, c3);
+                let in123 = in1 && arcs.contains(1, s2, c2) && arcs.contains(2, s3, c3);
+                if in_limits_only && !in123 {
+                    continue;
+                }
+                let (s23, c23) = (s2 * c3 + c2 * s3, c2 * c3 - s2 * s3);
+                // The approach in the forearm frame (see `solutions`).
+                let al = Vector3::new(
+                    c23 * (c1 * a.x + s1 * a.y) + s23 * a.z,
+                    -s1 * a.x + c1 * a.y,
+                    -s23 * (c1 * a.x + s1 * a.y) + c23 * a.z,
+                );
+                let s5 = hyp(al.y, al.z);
+                let (s4, c4) = if s5 < 1e-12 {
+                    current[3].sin_cos()
+                } else {
+                    (-al.y / s5, al.z / s5)
+                };
+                let (ss5, cs5) = unit(s5, al.x);
+                for (s4, c4, s5, c5) in [(s4, c4, ss5, cs5), (-s4, -c4, -ss5, cs5)] {
+                    if in123 && arcs.contains(3, s4, c4) && arcs.contains(4, s5, c5) {
+                        return Reach::Within;
+                    }
+                    if !in_limits_only {
+                        reach = Reach::Outside;
+                    }
+                }
+            }
+        }
+        reach
+    }
+
+    /// The limits as arcs, for [`Self::reach_with_approach`].
+    pub(super) fn limit_arcs(&self) -> LimitArcs {
+        LimitArcs(self.limits.map(|l| {
+            let lo = l.min - LIMIT_TOLERANCE;
+            let len = (l.max - l.min) + 2.0 * LIMIT_TOLERANCE;
+            let (s, c) = lo.sin_cos();
+            LimitArc {
+                sin_lo: s,
+                cos_lo: c,
+                cos_len: len.cos(),
+                len,
+            }
+        }))
+    }
+
+    /// The elbow for a wrist centre at distance `d` from the shoulder: two numbers
+    /// whose ratio is tan(|θ3|/2) (|θ3| = 2·atan2 of them), and the sine and cosine
+    /// of |θ3|. By the half-angle formula, tan²(θ3/2) = (1 − c3)/(1 + c3) with
+    /// 1 − c3 = ((L2+L4)² − d²)/(2·L2·L4) and 1 + c3 = (d² − (L2−L4)²)/(2·L2·L4),
+    /// each factored so that it keeps its precision near the straight (and the
+    /// folded) elbow, where acos(c3) would lose half the digits; the sine and cosine
+    /// come from the same quantities (no transcendental function).
+    fn elbow_half_angle(&self, d: f64) -> ((f64, f64), (f64, f64)) {
+        let (dmin, dmax) = self.wrist_reach();
+        let one_minus = (dmax - d).max(0.0) * (dmax + d);
+        let one_plus = (d - dmin).max(0.0) * (d + dmin);
+        let pm = one_plus + one_minus;
+        let trig = if pm > 0.0 {
+            (
+                2.0 * (one_minus * one_plus).sqrt() / pm,
+                (one_plus - one_minus) / pm,
+            )
+        } else {
+            (0.0, 1.0)
+        };
+        ((one_minus.sqrt(), one_plus.sqrt()), trig)
+    }
+
+    /// Sine and cosine of θ2 for the elbow (`s3`, `c3`) and the direction (`sa`, `ca`)
+    /// of the wrist centre from the shoulder: θ2 = atan2(z, r) − atan2(L4·s3,
+    /// L2 + L4·c3), by the difference formulas.
+    fn shoulder_pitch(&self, (sa, ca): (f64, f64), s3: f64, c3: f64) -> (f64, f64) {
+        let (sb, cb) = unit(self.l4 * s3, self.l2 + self.l4 * c3);
+        (sa * cb - ca * sb, ca * cb + sa * sb)
+    }
+
+    /// The closed-form solutions for a wrist centre, each handed to `visit` (which may
+    /// stop the walk) with the sines and cosines the FK needs. Fails with
+    /// [`PioneerIkError::OutOfReach`] when none was visited. With `in_limits_only`,
+    /// solutions with an angle outside its limit are dropped as soon as that angle is
+    /// known (before the FK check that scores them): the SETPOSITION search uses it
+    /// once it knows that exact solutions exist, when only the in-limit candidates
+    /// can change its answer.
+    fn solutions(
+        &self,
+        p: &Vector3<f64>,
+        goal: WristGoal<'_>,
+        current: &Theta,
+        tol: f64,
+        in_limits_only: bool,
+        mut visit: impl FnMut(&Solution) -> ControlFlow<()>,
+    ) -> Result<(), PioneerIkError> {
         let a = match goal {
             WristGoal::Frame(pose) => pose.approach(),
             WristGoal::Approach(a) => *a,
@@ -356,13 +561,13 @@ impl PioneerGeometry {
             w.y.atan2(w.x)
         };
         let (dmin, dmax) = self.wrist_reach();
-        let mut out = IkCandidates::new();
+        let mut visited = 0usize;
         let mut front_distance = f64::NAN;
         let in_limit = |i: usize, v: f64| {
             let l = self.limits[i];
             fit_angle_to_limits(v, l.min, l.max, current[i], LIMIT_TOLERANCE).is_some()
         };
-        for (shoulder, t1) in [(Shoulder::Front, yaw), (Shoulder::Back, wrap_pi(yaw + PI))] {
+        'walk: for (shoulder, t1) in [(Shoulder::Front, yaw), (Shoulder::Back, wrap_pi(yaw + PI))] {
             let (s1, c1) = t1.sin_cos();
             let r = c1 * w.x + s1 * w.y - self.l1;
             let z = w.z;
@@ -376,30 +581,13 @@ impl PioneerGeometry {
             if in_limits_only && !in_limit(0, t1) {
                 continue;
             }
-            // |θ3| by the half-angle formula, tan²(θ3/2) = (1 − c3)/(1 + c3) with
-            // 1 − c3 = ((L2+L4)² − d²)/(2·L2·L4) and 1 + c3 = (d² − (L2−L4)²)/(2·L2·L4),
-            // each factored so that it keeps its precision near the straight (and the
-            // folded) elbow, where acos(c3) would lose half the digits.
-            let one_minus = (dmax - d).max(0.0) * (dmax + d);
-            let one_plus = (d - dmin).max(0.0) * (d + dmin);
-            let g = 2.0 * one_minus.sqrt().atan2(one_plus.sqrt());
-            // sin and cos of g from the same half-angle quantities (no transcendental).
-            let pm = one_plus + one_minus;
-            let (sg, cg) = if pm > 0.0 {
-                (
-                    2.0 * (one_minus * one_plus).sqrt() / pm,
-                    (one_plus - one_minus) / pm,
-                )
-            } else {
-                g.sin_cos()
-            };
+            let ((root_minus, root_plus), (sg, cg)) = self.elbow_half_angle(d);
+            let g = 2.0 * root_minus.atan2(root_plus);
             let (sa, ca) = unit(z, r);
             let mut arms = [Arm::default(); 4];
             let mut n_arms = 0;
             for (elbow, t3, s3, c3) in [(Elbow::Down, g, sg, cg), (Elbow::Up, -g, -sg, cg)] {
-                // θ2 = atan2(z, r) − atan2(L4·s3, L2 + L4·c3), by the difference formulas.
-                let (sb, cb) = unit(self.l4 * s3, self.l2 + self.l4 * c3);
-                let (s2, c2) = (sa * cb - ca * sb, ca * cb + sa * sb);
+                let (s2, c2) = self.shoulder_pitch((sa, ca), s3, c3);
                 let t2 = s2.atan2(c2);
                 arms[n_arms] = Arm {
                     elbow,
@@ -476,27 +664,10 @@ impl PioneerGeometry {
                             }
                         }
                         if in_limits_only && !within {
-                            return;
+                            return ControlFlow::Continue(());
                         }
-                        let fk = self.fk_trig(&Trig {
-                            s1,
-                            c1,
-                            s2,
-                            c2,
-                            s23,
-                            c23,
-                            s4,
-                            c4,
-                            s5,
-                            c5,
-                        });
-                        let position_error = (fk.position - p).norm();
-                        let orientation_error = match goal {
-                            WristGoal::Frame(pose) => fk.orientation_error(pose),
-                            WristGoal::Approach(a) => vector_angle(&fk.approach(), a),
-                        };
-                        let ok = |v: f64| if v.is_finite() { v } else { f64::INFINITY };
-                        out.push(IkCandidate {
+                        visited += 1;
+                        visit(&Solution {
                             theta,
                             branch: Branch {
                                 shoulder,
@@ -504,9 +675,19 @@ impl PioneerGeometry {
                                 wrist,
                             },
                             within_limits: within,
-                            position_error: ok(position_error),
-                            orientation_error: ok(orientation_error),
-                        });
+                            trig: Trig {
+                                s1,
+                                c1,
+                                s2,
+                                c2,
+                                s23,
+                                c23,
+                                s4,
+                                c4,
+                                s5,
+                                c5,
+                            },
+                        })
                     };
                 match goal {
                     WristGoal::Frame(pose) => {
@@ -516,7 +697,10 @@ impl PioneerGeometry {
                         // v = Rx(θ4)ᵀ·a_local = (c5, 0, s5) for a consistent frame.
                         let vx = al.x;
                         let vz = -s4 * al.y + c4 * al.z;
-                        push(t4, (s4, c4), vz.atan2(vx), unit(vz, vx), Wrist::Normal);
+                        if push(t4, (s4, c4), vz.atan2(vx), unit(vz, vx), Wrist::Normal).is_break()
+                        {
+                            break 'walk;
+                        }
                     }
                     WristGoal::Approach(_) => {
                         let s5 = hyp(al.y, al.z);
@@ -527,19 +711,142 @@ impl PioneerGeometry {
                             ((-al.y).atan2(al.z), (-al.y / s5, al.z / s5))
                         };
                         let (ss5, cs5) = unit(s5, al.x);
-                        push(t4, (s4, c4), t5, (ss5, cs5), Wrist::Normal);
-                        push(t4 + PI, (-s4, -c4), -t5, (-ss5, cs5), Wrist::Flipped);
+                        if push(t4, (s4, c4), t5, (ss5, cs5), Wrist::Normal).is_break()
+                            || push(t4 + PI, (-s4, -c4), -t5, (-ss5, cs5), Wrist::Flipped)
+                                .is_break()
+                        {
+                            break 'walk;
+                        }
                     }
                 }
             }
         }
-        if out.is_empty() {
+        if visited == 0 {
             return Err(PioneerIkError::OutOfReach {
                 distance: front_distance,
                 min: dmin,
                 max: dmax,
             });
         }
-        Ok(out)
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::chain::DeterministicRng;
+    use crate::pioneer::JointLimit;
+
+    fn limit_sets() -> [[JointLimit; PIONEER_DOF]; 3] {
+        let l = JointLimit::new;
+        [
+            PioneerGeometry::default().limits,
+            [
+                l(-2.6, 2.6),
+                l(-1.2, 2.0),
+                l(-2.6, 2.6),
+                l(-3.0, 3.0),
+                l(-1.8, 1.8),
+            ],
+            // Narrow, one-sided, beyond ±π, and a full turn and more.
+            [
+                l(0.3, 0.9),
+                l(-3.5, -2.9),
+                l(2.0, 4.0),
+                l(-7.0, 7.0),
+                l(-0.2, 4.5),
+            ],
+        ]
+    }
+
+    /// The arcs accept the angles `fit_angle_to_limits` fits, and only those, away
+    /// from round-off at the ends.
+    #[test]
+    fn limit_arcs_agree_with_fit_angle_to_limits() {
+        for limits in limit_sets() {
+            let g = PioneerGeometry {
+                limits,
+                ..PioneerGeometry::default()
+            };
+            let arcs = g.limit_arcs();
+            for (i, l) in limits.iter().enumerate() {
+                for k in -2000..=2000 {
+                    let angle = k as f64 * 0.005 + 0.0001;
+                    let ends = [l.min, l.max];
+                    let near_an_end = ends.iter().any(|e| {
+                        let d = wrap_pi(angle - e);
+                        d.abs() < 1e-7
+                    });
+                    if near_an_end {
+                        continue;
+                    }
+                    let (s, c) = angle.sin_cos();
+                    let want =
+                        fit_angle_to_limits(angle, l.min, l.max, 0.0, LIMIT_TOLERANCE).is_some();
+                    assert_eq!(
+                        arcs.contains(i, s, c),
+                        want,
+                        "joint {i} {l:?} angle {angle}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// `reach_with_approach` says what the scored candidates and the exact selection
+    /// say: `Within` when an exact in-limit candidate exists, `Outside` when exact
+    /// ones exist outside the limits only, `None` when there is none; with
+    /// `in_limits_only`, `Within` or `None`.
+    #[test]
+    fn reach_with_approach_agrees_with_the_scored_candidates() {
+        let mut rng = DeterministicRng::new(0x16);
+        let strict = PioneerIkOptions {
+            position_tolerance: EXACT_POSITION,
+            orientation_tolerance: EXACT_ORIENTATION,
+            ..PioneerIkOptions::default()
+        };
+        let mut seen = [0usize; 3];
+        for limits in limit_sets() {
+            let g = PioneerGeometry {
+                limits,
+                ..PioneerGeometry::default()
+            };
+            let arcs = g.limit_arcs();
+            for _ in 0..3000 {
+                let p = Vector3::new(
+                    rng.uniform(-0.45, 0.45),
+                    rng.uniform(-0.45, 0.45),
+                    rng.uniform(-0.45, 0.45),
+                );
+                let a = Vector3::new(
+                    rng.uniform(-1.0, 1.0),
+                    rng.uniform(-1.0, 1.0),
+                    rng.uniform(-1.0, 1.0),
+                )
+                .normalize();
+                let current: Theta = std::array::from_fn(|_| rng.uniform(-1.0, 1.0));
+                let want = match g
+                    .candidates(&p, WristGoal::Approach(&a), &current, EXACT_POSITION, false)
+                    .and_then(|c| c.select(&current, &strict))
+                {
+                    Ok(_) => Reach::Within,
+                    Err(PioneerIkError::OutsideJointLimits) => Reach::Outside,
+                    Err(_) => Reach::None,
+                };
+                let got = g.reach_with_approach(&p, &a, &current, EXACT_POSITION, false, &arcs);
+                assert_eq!(got, want, "{p:?} {a:?} {limits:?}");
+                let pruned = g.reach_with_approach(&p, &a, &current, EXACT_POSITION, true, &arcs);
+                let want_pruned = if want == Reach::Within {
+                    Reach::Within
+                } else {
+                    Reach::None
+                };
+                assert_eq!(pruned, want_pruned);
+                seen[want as usize] += 1;
+            }
+        }
+        // Every answer occurs.
+        assert!(seen.iter().all(|n| *n > 100), "{seen:?}");
     }
 }

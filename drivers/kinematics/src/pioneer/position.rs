@@ -3,11 +3,12 @@
 //! deterministically, preferring the caller's approach, then the arm's vertical plane,
 //! then θ1 held on a yaw limit, then cones around the preferred approach.
 
+use std::cell::Cell;
 use std::f64::consts::{PI, TAU};
 
 use nalgebra::Vector3;
 
-use super::ik::WristGoal;
+use super::ik::{Reach, WristGoal};
 use super::{
     EXACT_ORIENTATION, EXACT_POSITION, IkCandidate, LIMIT_TOLERANCE, PioneerGeometry,
     PioneerIkError, PioneerIkOptions, Theta, joint_distance,
@@ -43,6 +44,11 @@ impl PioneerGeometry {
     /// 4. failing that, approaches out of the plane, on cones around the preferred one
     ///    five search steps apart, and finally the direction from the shoulder circle to
     ///    the target (the only approach at full stretch).
+    ///
+    /// The search tests each approach by the closed form alone, without scoring
+    /// its candidates by the FK and without an inverse trigonometric function (the
+    /// limits are tested on sines and cosines); the approach it keeps is scored and
+    /// checked by the FK like any other answer.
     ///
     /// For the chosen approach the in-limit solution nearest to `current` wins. The
     /// result's `orientation_error` is the error to the chosen approach. Fails with
@@ -85,7 +91,10 @@ impl PioneerGeometry {
                 max,
             });
         }
-        let mut any_exact = false;
+        // Whether an exact solution outside the limits has been seen: then only the
+        // in-limit candidates can change the answer, and once every approach has
+        // failed the cause is the limits, not the reach.
+        let any_exact = Cell::new(false);
         // The search accepts only exact solutions (round-off), so that the bisection
         // cannot settle on a reach boundary blurred by the tolerance; the last resort
         // (full stretch) accepts the tolerances.
@@ -94,30 +103,52 @@ impl PioneerGeometry {
             orientation_tolerance: EXACT_ORIENTATION,
             ..*options
         };
-        // An approach is taken only for an in-limit candidate; the others matter only
-        // to tell "outside the limits" from "out of reach" at the end, so once an
-        // exact solution outside the limits has been seen they are no longer scored
-        // (the answer is the same, and each attempt costs a fraction).
-        let mut attempt_with = |a: &Vector3<f64>, opts: &PioneerIkOptions| {
+        // The candidates for approach `a`, scored by the FK, and the selection.
+        let attempt_with = |a: &Vector3<f64>, opts: &PioneerIkOptions| {
             let cands = self
                 .candidates(
                     position,
                     WristGoal::Approach(a),
                     current,
                     opts.position_tolerance,
-                    any_exact,
+                    any_exact.get(),
                 )
                 .ok()?;
             match cands.select(current, opts) {
                 Ok(c) => Some(c),
                 Err(PioneerIkError::OutsideJointLimits) => {
-                    any_exact = true;
+                    any_exact.set(true);
                     None
                 }
                 Err(_) => None,
             }
         };
-        let mut attempt = |a: &Vector3<f64>| attempt_with(a, &strict);
+        // The closed form without the FK scoring (a fraction of the cost): whether an
+        // in-limit solution attains approach `a`. The search tests every approach this
+        // way first and scores only those that pass.
+        let arcs = self.limit_arcs();
+        let reaches = |a: &Vector3<f64>| match self.reach_with_approach(
+            position,
+            a,
+            current,
+            EXACT_POSITION,
+            any_exact.get(),
+            &arcs,
+        ) {
+            Reach::Within => true,
+            Reach::Outside => {
+                any_exact.set(true);
+                false
+            }
+            Reach::None => false,
+        };
+        let attempt = |a: &Vector3<f64>| {
+            if reaches(a) {
+                attempt_with(a, &strict)
+            } else {
+                None
+            }
+        };
         // 1. The preferred approach.
         if let Some(c) = attempt(&preferred) {
             return Ok(c);
@@ -133,29 +164,26 @@ impl PioneerGeometry {
         let phi0 = preferred.z.atan2(preferred.dot(&radial));
         let step = options.approach_search_step;
         let steps = (PI / step).ceil() as usize;
-        for k in 0..=steps {
+        if let Some(c) = attempt(&in_plane(phi0)) {
+            return Ok(c);
+        }
+        for k in 1..=steps {
             for sign in [1.0, -1.0] {
                 let phi = phi0 + sign * (k as f64 * step).min(PI);
-                if let Some(found) = attempt(&in_plane(phi)) {
-                    if k == 0 {
-                        return Ok(found);
-                    }
-                    let mut good = (phi, found);
-                    let mut bad = phi0 + sign * ((k - 1) as f64 * step);
-                    for _ in 0..64 {
-                        if (good.0 - bad).abs() <= 1e-9 {
-                            break;
-                        }
-                        let mid = 0.5 * (good.0 + bad);
-                        match attempt(&in_plane(mid)) {
-                            Some(c) => good = (mid, c),
-                            None => bad = mid,
-                        }
-                    }
-                    return Ok(good.1);
+                if !reaches(&in_plane(phi)) {
+                    continue;
                 }
-                if k == 0 {
-                    break;
+                let bad = phi0 + sign * ((k - 1) as f64 * step);
+                // The boundary by the closed form alone, then the FK check there; if
+                // round-off makes the two disagree, the bisection again with the check
+                // at every step.
+                let (edge, ()) = bisect((phi, ()), bad, |m| reaches(&in_plane(m)).then_some(()));
+                if let Some(c) = attempt_with(&in_plane(edge), &strict) {
+                    return Ok(c);
+                }
+                if let Some(found) = attempt_with(&in_plane(phi), &strict) {
+                    let (_, c) = bisect((phi, found), bad, |m| attempt_with(&in_plane(m), &strict));
+                    return Ok(c);
                 }
             }
         }
@@ -178,10 +206,10 @@ impl PioneerGeometry {
                     (position - normal * off, Vector3::new(c1, s1, 0.0), r)
                 })
             });
-            let approach_at = |circle: usize, j: usize| {
+            // The approach with the wrist centre at angle ψ (cosine, sine) on a circle.
+            let approach_on = |circle: usize, (c, s): (f64, f64)| {
                 circles[circle].map(|(centre, e1, r)| {
-                    let psi = j as f64 * step;
-                    let w = centre + (e1 * psi.cos() + Vector3::z() * psi.sin()) * r;
+                    let w = centre + (e1 * c + Vector3::z() * s) * r;
                     (position - w) / self.l5
                 })
             };
@@ -190,30 +218,47 @@ impl PioneerGeometry {
                 // Every approach on both circles, scored, then tried best first: the
                 // first feasible one is the one a full scan keeps (smallest score, ties
                 // to the earlier circle and angle), after a fraction of the attempts.
+                // The cosines and sines are shared by the circles and the two passes;
+                // the order is made a chunk at a time (most targets need the first).
+                let mut trig = [(0.0f64, 0.0f64); CIRCLE_SCAN_CAPACITY / 2];
+                for (j, t) in trig.iter_mut().enumerate().take(per_circle) {
+                    let psi = j as f64 * step;
+                    *t = (psi.cos(), psi.sin());
+                }
                 let mut order = [(0.0f64, 0u16); CIRCLE_SCAN_CAPACITY];
                 let mut len = 0;
                 for circle in 0..2 {
-                    for j in 0..per_circle {
-                        if let Some(a) = approach_at(circle, j) {
+                    for (j, t) in trig.iter().enumerate().take(per_circle) {
+                        if let Some(a) = approach_on(circle, *t) {
                             order[len] = (-a.dot(&preferred), (circle * per_circle + j) as u16);
                             len += 1;
                         }
                     }
                 }
-                let order = &mut order[..len];
-                order.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-                for &(_, index) in order.iter() {
-                    let index = usize::from(index);
-                    let a = approach_at(index / per_circle, index % per_circle);
-                    if let Some(c) = a.and_then(|a| attempt(&a)) {
-                        return Ok(c);
+                let by = |x: &(f64, u16), y: &(f64, u16)| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1));
+                let mut rest = &mut order[..len];
+                while !rest.is_empty() {
+                    let chunk = CIRCLE_CHUNK.min(rest.len());
+                    if chunk < rest.len() {
+                        rest.select_nth_unstable_by(chunk - 1, by);
                     }
+                    let (first, others) = rest.split_at_mut(chunk);
+                    first.sort_unstable_by(by);
+                    for &(_, index) in first.iter() {
+                        let index = usize::from(index);
+                        let a = approach_on(index / per_circle, trig[index % per_circle]);
+                        if let Some(c) = a.and_then(|a| attempt(&a)) {
+                            return Ok(c);
+                        }
+                    }
+                    rest = others;
                 }
             } else {
                 let mut best: Option<(f64, IkCandidate)> = None;
                 for circle in 0..2 {
                     for j in 0..per_circle {
-                        let Some(a) = approach_at(circle, j) else {
+                        let psi = j as f64 * step;
+                        let Some(a) = approach_on(circle, (psi.cos(), psi.sin())) else {
                             break;
                         };
                         if let Some(c) = attempt(&a) {
@@ -264,7 +309,7 @@ impl PioneerGeometry {
                 return Ok(c);
             }
         }
-        if any_exact {
+        if any_exact.get() {
             Err(PioneerIkError::OutsideJointLimits)
         } else {
             Err(PioneerIkError::OutOfReach {
@@ -280,6 +325,27 @@ impl PioneerGeometry {
 /// before trying them (both circles; 720 at the default 1° step). A finer step scans
 /// in angle order instead, keeping the best.
 const CIRCLE_SCAN_CAPACITY: usize = 1024;
+
+/// Bisection between an elevation `good` that passes `test` (with what it returned)
+/// and one `bad` that does not, until they are 1e-9 rad apart: the last elevation
+/// that passed, and what `test` returned there.
+fn bisect<T>(mut good: (f64, T), mut bad: f64, mut test: impl FnMut(f64) -> Option<T>) -> (f64, T) {
+    for _ in 0..64 {
+        if (good.0 - bad).abs() <= 1e-9 {
+            break;
+        }
+        let mid = 0.5 * (good.0 + bad);
+        match test(mid) {
+            Some(t) => good = (mid, t),
+            None => bad = mid,
+        }
+    }
+    good
+}
+
+/// Approaches of the yaw-limit scan ordered at a time: the best this many, then the
+/// next, ... (the order is that of a full sort).
+const CIRCLE_CHUNK: usize = 48;
 
 /// Two unit vectors that complete `a` (a unit vector) to an orthonormal basis.
 fn perpendicular_basis(a: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
