@@ -248,7 +248,85 @@ pub const RATIOS: &[RatioDef] = &[
         pct: Pct::P50,
         goal: None,
     },
+    RatioDef {
+        label: "spinning driver's cost (arrival → bytes on the pty) / bare pty write(2)",
+        num: "loop.spin.driver",
+        den: "loop.spin.pty_write",
+        pct: Pct::P50,
+        goal: None,
+    },
 ];
+
+/// A goal in time on one series of a run (issue 16's absolute goals): unlike the ratios they
+/// depend on the machine, and on this VM its compute speed varies (up to 1.8x between runs).
+#[derive(Debug, Clone, Copy)]
+pub struct TimeGoalDef {
+    /// What it says.
+    pub label: &'static str,
+    /// The measurement id.
+    pub id: &'static str,
+    /// The percentile.
+    pub pct: Pct,
+    /// The most it may be, ns.
+    pub at_most_ns: u64,
+}
+
+/// The goals in time reported.
+pub const TIME_GOALS: &[TimeGoalDef] = &[
+    TimeGoalDef {
+        label: "Pioneer GET_GEOM request round trip",
+        id: "request.pioneer.rtt",
+        pct: Pct::P50,
+        at_most_ns: 16_000,
+    },
+    TimeGoalDef {
+        label: "spinning driver, command arrival → bytes on the pty",
+        id: "loop.spin.driver",
+        pct: Pct::P50,
+        at_most_ns: 2_000,
+    },
+    TimeGoalDef {
+        label: "Pioneer SETPOSITION",
+        id: "ik.pioneer.position",
+        pct: Pct::P99,
+        at_most_ns: 100_000,
+    },
+    TimeGoalDef {
+        label: "numeric IK, 6 joints, pose",
+        id: "ik.chain6.pose",
+        pct: Pct::P50,
+        at_most_ns: 10_000,
+    },
+    TimeGoalDef {
+        label: "numeric IK, 6 joints, pose",
+        id: "ik.chain6.pose",
+        pct: Pct::P99,
+        at_most_ns: 100_000,
+    },
+    TimeGoalDef {
+        label: "numeric IK, 7 joints, pose",
+        id: "ik.chain7.pose",
+        pct: Pct::P99,
+        at_most_ns: 100_000,
+    },
+];
+
+/// A goal in time, as measured.
+#[derive(Debug, Clone, Serialize)]
+pub struct TimeGoal {
+    /// What it says, with the percentile.
+    pub label: String,
+    /// The measurement id.
+    pub id: &'static str,
+    /// The percentile.
+    pub pct: Pct,
+    /// The value measured, ns.
+    pub ns: u64,
+    /// The most it may be, ns.
+    pub at_most_ns: u64,
+    /// Whether the goal was met.
+    pub met: bool,
+}
 
 /// One point of a percentile curve.
 #[derive(Debug, Clone, Copy, Serialize, PartialEq)]
@@ -325,6 +403,8 @@ pub struct Report {
     pub measurements: Vec<Row>,
     /// Ratios against the floor and the peers, with goals.
     pub ratios: Vec<Ratio>,
+    /// Goals in time on single series.
+    pub time_goals: Vec<TimeGoal>,
 }
 
 /// The floor of `m` of one kind: `(spin, blocking)` name the floor's series for each
@@ -461,12 +541,32 @@ impl Report {
                 })
             })
             .collect();
+        let time_goals = TIME_GOALS
+            .iter()
+            .filter_map(|g| {
+                let m = find(g.id)?;
+                let sm = Summary::of(&m.hist);
+                if sm.count == 0 {
+                    return None;
+                }
+                let ns = g.pct.of(&sm);
+                Some(TimeGoal {
+                    label: format!("{} ({})", g.label, g.pct.name()),
+                    id: g.id,
+                    pct: g.pct,
+                    ns,
+                    at_most_ns: g.at_most_ns,
+                    met: ns <= g.at_most_ns,
+                })
+            })
+            .collect();
         Report {
             machine,
             jitter_definition: JITTER,
             scenarios,
             measurements: rows,
             ratios,
+            time_goals,
         }
     }
 
@@ -563,6 +663,19 @@ impl Report {
                     format!("{:.2}", r.value)
                 };
                 let _ = writeln!(t, "  {:<72} {:<15} {value:>8}  {goal}", r.label, r.strategy);
+            }
+        }
+        if !self.time_goals.is_empty() {
+            let _ = writeln!(t, "\ngoals in time (this machine, this run):");
+            for g in &self.time_goals {
+                let met = if g.met { "met" } else { "NOT met" };
+                let _ = writeln!(
+                    t,
+                    "  {:<72} {:>24}  goal <= {}: {met}",
+                    g.label,
+                    fmt_ns(g.ns),
+                    fmt_ns(g.at_most_ns)
+                );
             }
         }
         t

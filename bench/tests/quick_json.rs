@@ -102,6 +102,24 @@ fn quick_run_writes_a_well_formed_report() {
             .any(|r| r["num"] == "floor.event.rtt")
     );
 
+    // The goals in time: each with the value of its series in this run and a verdict.
+    let goals = v["time_goals"].as_array().unwrap();
+    let six = goals
+        .iter()
+        .find(|g| g["id"] == "ik.chain6.pose" && g["pct"] == "p50")
+        .expect("the 6-joint pose goal");
+    assert_eq!(
+        six["ns"].as_u64().unwrap(),
+        ms.iter().find(|m| m["id"] == "ik.chain6.pose").unwrap()["summary"]["p50_ns"]
+            .as_u64()
+            .unwrap()
+    );
+    assert_eq!(six["at_most_ns"], 10_000);
+    assert_eq!(
+        six["met"].as_bool().unwrap(),
+        six["ns"].as_u64().unwrap() <= 10_000
+    );
+
     // Blocking rows are compared with the futex floor, spinning rows with the cache line.
     let row = |id: &str| ms.iter().find(|m| m["id"] == id).unwrap();
     assert_eq!(row("floor.event.rtt")["phys_id"], "floor.futex.rtt");
