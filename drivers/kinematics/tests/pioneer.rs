@@ -794,7 +794,8 @@ fn reference_search(
 /// every approach, on a grid of reachable positions (FK of a grid of joint angles),
 /// and of random ones, with the default limits and with wide ones (where the base can
 /// turn round), for
-/// several current configurations and preferences; where neither the plane nor the
+/// several current configurations and preferences, at the default search step and a
+/// coarser one; where neither the plane nor the
 /// yaw limits do, its answer still reaches the position inside the limits.
 #[test]
 fn setposition_finds_what_the_scored_scan_found() {
@@ -808,9 +809,19 @@ fn setposition_finds_what_the_scored_scan_found() {
         ],
         ..geom()
     };
-    let o = opts();
+    // The default step (its cosines and sines made once per process) and a coarser
+    // one (made on the stack by each search).
+    let coarse = PioneerIkOptions {
+        approach_search_step: 3f64.to_radians(),
+        ..opts()
+    };
     let mut by_step = [0usize; 4];
-    for g in [geom(), wide] {
+    for (g, o) in [
+        (geom(), opts()),
+        (wide, opts()),
+        (geom(), coarse),
+        (wide, coarse),
+    ] {
         let frac = [0.07, 0.36, 0.64, 0.93];
         let at = |i: usize, f: f64| g.limits[i].min + f * (g.limits[i].max - g.limits[i].min);
         let currents = [

@@ -5,6 +5,7 @@
 
 use std::cell::Cell;
 use std::f64::consts::{PI, TAU};
+use std::sync::OnceLock;
 
 use nalgebra::Vector3;
 
@@ -164,13 +165,36 @@ impl PioneerGeometry {
         let phi0 = preferred.z.atan2(preferred.dot(&radial));
         let step = options.approach_search_step;
         let steps = (PI / step).ceil() as usize;
+        let per_circle = steps * 2;
+        // The cosines and sines of j·step (j < per_circle) for both scans: the
+        // default step's are made once per process, another step's on the stack.
+        let made: [(f64, f64); CIRCLE_SCAN_CAPACITY / 2];
+        let trig: &[(f64, f64)] = if per_circle > CIRCLE_SCAN_CAPACITY / 2 {
+            &[]
+        } else if let Some(t) = default_step_trig(step) {
+            &t[..per_circle]
+        } else {
+            made = step_trig(step, per_circle);
+            &made[..per_circle]
+        };
         if let Some(c) = attempt(&in_plane(phi0)) {
             return Ok(c);
         }
+        let (s0, c0) = phi0.sin_cos();
         for k in 1..=steps {
             for sign in [1.0, -1.0] {
                 let phi = phi0 + sign * (k as f64 * step).min(PI);
-                if !reaches(&in_plane(phi)) {
+                // The scan tests φ0 ± k·step by the sum formulas on the shared
+                // cosines and sines (within an ulp or two of `in_plane(phi)`); what
+                // it keeps is computed from φ itself.
+                let a = match trig.get(k) {
+                    Some(&(ck, sk)) if k as f64 * step <= PI => {
+                        let sk = sign * sk;
+                        radial * (c0 * ck - s0 * sk) + Vector3::z() * (s0 * ck + c0 * sk)
+                    }
+                    _ => in_plane(phi),
+                };
+                if !reaches(&a) {
                     continue;
                 }
                 let bad = phi0 + sign * ((k - 1) as f64 * step);
@@ -213,22 +237,16 @@ impl PioneerGeometry {
                     (position - w) / self.l5
                 })
             };
-            let per_circle = steps * 2;
             if 2 * per_circle <= CIRCLE_SCAN_CAPACITY {
                 // Every approach on both circles, scored, then tried best first: the
                 // first feasible one is the one a full scan keeps (smallest score, ties
                 // to the earlier circle and angle), after a fraction of the attempts.
                 // The cosines and sines are shared by the circles and the two passes;
                 // the order is made a chunk at a time (most targets need the first).
-                let mut trig = [(0.0f64, 0.0f64); CIRCLE_SCAN_CAPACITY / 2];
-                for (j, t) in trig.iter_mut().enumerate().take(per_circle) {
-                    let psi = j as f64 * step;
-                    *t = (psi.cos(), psi.sin());
-                }
                 let mut order = [(0.0f64, 0u16); CIRCLE_SCAN_CAPACITY];
                 let mut len = 0;
                 for circle in 0..2 {
-                    for (j, t) in trig.iter().enumerate().take(per_circle) {
+                    for (j, t) in trig.iter().enumerate() {
                         if let Some(a) = approach_on(circle, *t) {
                             order[len] = (-a.dot(&preferred), (circle * per_circle + j) as u16);
                             len += 1;
@@ -326,6 +344,26 @@ impl PioneerGeometry {
 /// in angle order instead, keeping the best.
 const CIRCLE_SCAN_CAPACITY: usize = 1024;
 
+/// The cosines and sines of j·`step` for j < `len` (at most half of
+/// [`CIRCLE_SCAN_CAPACITY`]), as `(cos, sin)`.
+fn step_trig(step: f64, len: usize) -> [(f64, f64); CIRCLE_SCAN_CAPACITY / 2] {
+    let mut t = [(0.0, 0.0); CIRCLE_SCAN_CAPACITY / 2];
+    for (j, t) in t.iter_mut().enumerate().take(len) {
+        let psi = j as f64 * step;
+        *t = (psi.cos(), psi.sin());
+    }
+    t
+}
+
+/// [`step_trig`] of the default search step for the whole table, made once per
+/// process; `None` for any other step.
+fn default_step_trig(step: f64) -> Option<&'static [(f64, f64); CIRCLE_SCAN_CAPACITY / 2]> {
+    static TABLE: OnceLock<[(f64, f64); CIRCLE_SCAN_CAPACITY / 2]> = OnceLock::new();
+    let default = PioneerIkOptions::default().approach_search_step;
+    (step.to_bits() == default.to_bits())
+        .then(|| TABLE.get_or_init(|| step_trig(default, CIRCLE_SCAN_CAPACITY / 2)))
+}
+
 /// Bisection between an elevation `good` that passes `test` (with what it returned)
 /// and one `bad` that does not, until they are 1e-9 rad apart: the last elevation
 /// that passed, and what `test` returned there.
@@ -357,4 +395,28 @@ fn perpendicular_basis(a: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
     let u = a.cross(&helper).normalize();
     let v = a.cross(&u);
     (u, v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The table shared by the searches at the default step is that step's cosines
+    /// and sines, bit for bit (the yaw-limit scan then orders the approaches a full
+    /// scan would); another step gets none.
+    #[test]
+    fn the_default_step_table_is_that_steps_trigonometry() {
+        let step = PioneerIkOptions::default().approach_search_step;
+        let table = default_step_trig(step).expect("the default step has a table");
+        for (j, &(c, s)) in table.iter().enumerate() {
+            let psi = j as f64 * step;
+            assert_eq!(c.to_bits(), psi.cos().to_bits(), "cos at {j}");
+            assert_eq!(s.to_bits(), psi.sin().to_bits(), "sin at {j}");
+        }
+        assert!(default_step_trig(step * 0.5).is_none());
+        assert!(default_step_trig(f64::from_bits(step.to_bits() + 1)).is_none());
+        let half = step_trig(step * 0.5, 3);
+        assert_eq!(half[2], (step.cos(), step.sin()));
+        assert_eq!(half[3], (0.0, 0.0));
+    }
 }
