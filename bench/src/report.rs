@@ -666,16 +666,15 @@ impl Report {
             }
         }
         if !self.time_goals.is_empty() {
-            let _ = writeln!(t, "\ngoals in time (this machine, this run):");
+            t.push_str("\ngoals in time (this machine, this run):\n");
             for g in &self.time_goals {
                 let met = if g.met { "met" } else { "NOT met" };
-                let _ = writeln!(
-                    t,
-                    "  {:<72} {:>24}  goal <= {}: {met}",
+                t.push_str(&format!(
+                    "  {:<72} {:>24}  goal <= {}: {met}\n",
                     g.label,
                     fmt_ns(g.ns),
                     fmt_ns(g.at_most_ns)
-                );
+                ));
             }
         }
         t

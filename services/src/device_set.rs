@@ -250,11 +250,17 @@ impl core::fmt::Debug for DeviceSet {
     }
 }
 
-/// Which way [`DeviceSet::process_with`] drains a host.
-#[derive(Clone, Copy)]
-enum Drain {
+/// How [`DeviceSet::process_as`] polls each device.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Drain {
+    /// Everything pending ([`DeviceHost::process`]): after a wake-up.
     All,
+    /// Commands on every call, requests on every 16th ([`DeviceHost::process_spin`]): a
+    /// busy-polling loop, where commands are the hot path.
     Spin,
+    /// Commands and requests on every call ([`DeviceHost::process_linger`]): the linger
+    /// of an event-driven loop after activity, where a client's next request must not
+    /// wait 16 polls.
     Linger,
 }
 
@@ -408,7 +414,7 @@ impl DeviceSet {
         &mut self,
         handler: &mut H,
     ) -> Result<Activity, DeviceError<ProcessError>> {
-        self.process_with(handler, Drain::All)
+        self.process_as(handler, Drain::All)
     }
 
     /// For the linger of an event-driven loop after activity: [`DeviceHost::process_linger`]
@@ -417,7 +423,7 @@ impl DeviceSet {
         &mut self,
         handler: &mut H,
     ) -> Result<Activity, DeviceError<ProcessError>> {
-        self.process_with(handler, Drain::Linger)
+        self.process_as(handler, Drain::Linger)
     }
 
     /// For a busy-polling loop: [`DeviceHost::process_spin`] on every device.
@@ -425,10 +431,12 @@ impl DeviceSet {
         &mut self,
         handler: &mut H,
     ) -> Result<Activity, DeviceError<ProcessError>> {
-        self.process_with(handler, Drain::Spin)
+        self.process_as(handler, Drain::Spin)
     }
 
-    fn process_with<H: DeviceSetHandler + ?Sized>(
+    /// Polls every device the way `drain` says; never blocks. Every device is processed
+    /// even if one fails; the first failure is returned.
+    pub fn process_as<H: DeviceSetHandler + ?Sized>(
         &mut self,
         handler: &mut H,
         drain: Drain,

@@ -90,7 +90,7 @@ pub use client::{
     WaitMode,
 };
 pub use context::{Context, ContextError, Role, monotonic_ns};
-pub use device_set::{DeviceError, DeviceSet, DeviceSetHandler};
+pub use device_set::{DeviceError, DeviceSet, DeviceSetHandler, Drain};
 pub use discovery::{DeviceInfo, ListError, list_devices};
 pub use domain_dir::DomainError;
 pub use error::Iox2Error;

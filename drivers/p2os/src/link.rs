@@ -119,18 +119,25 @@ fn port_fd(p: &TTYPort) -> BorrowedFd<'_> {
     unsafe { BorrowedFd::borrow_raw(p.as_raw_fd()) }
 }
 
-/// `read(2)` / `write(2)` on a borrowed descriptor, with `std::io` errors.
-struct FdIo<'a>(BorrowedFd<'a>);
-
-impl Read for FdIo<'_> {
+/// One read of the link's non-blocking descriptor: `read(2)` straight on the serial
+/// port's, the TCP stream's own read.
+impl Read for Transport {
     fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-        Ok(rustix::io::read(self.0, buf)?)
+        match self {
+            Transport::Serial(p) => Ok(rustix::io::read(port_fd(p), buf)?),
+            Transport::Tcp(s) => s.read(buf),
+        }
     }
 }
 
-impl Write for FdIo<'_> {
+/// One write to the link's non-blocking descriptor: `write(2)` straight on the serial
+/// port's, the TCP stream's own write (a `send` that raises no SIGPIPE).
+impl Write for Transport {
     fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-        Ok(rustix::io::write(self.0, buf)?)
+        match self {
+            Transport::Serial(p) => Ok(rustix::io::write(port_fd(p), buf)?),
+            Transport::Tcp(s) => s.write(buf),
+        }
     }
 
     fn flush(&mut self) -> io::Result<()> {
@@ -309,10 +316,7 @@ impl Link {
         // Read from the clock only when the device is full.
         let mut deadline = None;
         while !rest.is_empty() {
-            let r = match &mut self.io {
-                Transport::Serial(p) => FdIo(port_fd(p)).write(rest),
-                Transport::Tcp(s) => s.write(rest),
-            };
+            let r = self.io.write(rest);
             match r {
                 Ok(0) => return Err(LinkError::Io(io::ErrorKind::WriteZero.into())),
                 Ok(n) => {
@@ -382,10 +386,7 @@ impl Link {
         let mut scratch = [0u8; 256];
         // Bounded: a robot that streams faster than we drain cannot hold us.
         for _ in 0..64 {
-            let r = match &mut self.io {
-                Transport::Serial(p) => FdIo(port_fd(p)).read(&mut scratch),
-                Transport::Tcp(s) => s.read(&mut scratch),
-            };
+            let r = self.io.read(&mut scratch);
             match r {
                 Ok(0) => return Err(LinkError::Closed),
                 Ok(_) => {}
@@ -413,10 +414,7 @@ impl Link {
 
     /// One non-blocking read into the decoder. Returns whether bytes arrived.
     fn read_once(&mut self) -> Result<bool, LinkError> {
-        let r = match &mut self.io {
-            Transport::Serial(p) => self.decoder.read_from(&mut FdIo(port_fd(p))),
-            Transport::Tcp(s) => self.decoder.read_from(s),
-        };
+        let r = self.decoder.read_from(&mut self.io);
         match r {
             Ok(0) => Err(LinkError::Closed),
             Ok(_) => {

@@ -10,7 +10,7 @@ use limber_interfaces::prelude::*;
 use limber_services::diagnostics::StatsPublisher;
 use limber_services::event_loop::{self, FdSource, LoopExit, Wake};
 use limber_services::{
-    Context, DeviceSet, DeviceSetHandler, HostError, Motion, Origin, monotonic_ns,
+    Context, DeviceSet, DeviceSetHandler, Drain, HostError, Motion, Origin, monotonic_ns,
 };
 use thiserror::Error;
 
@@ -386,19 +386,6 @@ impl core::fmt::Debug for PioneerDriver {
 // The handler of every device: borrows the robot model for the duration of a `process`
 // call. `actarray/0` is the arm, `actarray/1` the lift, `gripper/0` the body gripper and
 // `gripper/1` the arm gripper.
-/// How [`PioneerDriver::process_clients`] polls the devices.
-#[derive(Clone, Copy)]
-enum Drain {
-    /// Everything pending ([`DeviceSet::process`]): after a wake-up.
-    All,
-    /// Commands on every call, requests on every 16th ([`DeviceSet::process_spin`]): the
-    /// spinning loop and the tick.
-    Spin,
-    /// Commands and requests on every call ([`DeviceSet::process_linger`]): the linger
-    /// after activity, where a client's next request must not wait 16 polls.
-    Linger,
-}
-
 struct Serve<'a>(&'a mut RobotModel);
 
 impl DeviceSetHandler for Serve<'_> {
@@ -914,11 +901,7 @@ impl PioneerDriver {
     /// returns whether there was any.
     fn process_clients(&mut self, how: Drain) -> bool {
         let mut handler = Serve(&mut self.robot);
-        let r = match how {
-            Drain::All => self.hosts.process(&mut handler),
-            Drain::Spin => self.hosts.process_spin(&mut handler),
-            Drain::Linger => self.hosts.process_linger(&mut handler),
-        };
+        let r = self.hosts.process_as(&mut handler, how);
         match r {
             Ok(a) => a.commands + a.requests > 0,
             Err(e) => {
