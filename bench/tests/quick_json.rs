@@ -70,6 +70,11 @@ fn quick_run_writes_a_well_formed_report() {
         "ik.chain6.pose",
         "loop.to_robot",
         "loop.driver",
+        "loop.driver_send",
+        "loop.driver_work",
+        "loop.spin.driver",
+        "loop.spin.driver_work",
+        "loop.spin.pty_write",
         "loop.to_client",
         "loop.total",
     ] {
@@ -115,6 +120,21 @@ fn quick_run_writes_a_well_formed_report() {
             .unwrap()
     );
     assert_eq!(six["at_most_ns"], 10_000);
+    assert!(six["floor"].is_null());
+    // The spinning driver's goal names its floor, the bare pty write, as measured.
+    let driver = goals
+        .iter()
+        .find(|g| g["id"] == "loop.spin.driver")
+        .expect("the spinning driver's goal");
+    assert_eq!(driver["floor"]["id"], "loop.spin.pty_write");
+    assert_eq!(
+        driver["floor"]["ns"].as_u64().unwrap(),
+        ms.iter()
+            .find(|m| m["id"] == "loop.spin.pty_write")
+            .unwrap()["summary"]["p50_ns"]
+            .as_u64()
+            .unwrap()
+    );
     assert_eq!(
         six["met"].as_bool().unwrap(),
         six["ns"].as_u64().unwrap() <= 10_000

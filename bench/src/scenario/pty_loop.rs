@@ -13,7 +13,9 @@
 //!   the command off its channel to the P2OS bytes written (validation, encoding, the
 //!   write), measured by the driver (`LoopStats::arrival_to_wire`; the last 512 commands);
 //!   and inside it the link's send alone (`LoopStats::link_write`: encoding and the
-//!   `write(2)`, clock read before and after it), the kernel's share. A pty's write wakes
+//!   `write(2)`, clock read before and after it), the kernel's share, and what comes
+//!   before that send (`LoopStats::arrival_to_send`: taking the command, validation, the
+//!   handler), the driver's work without the kernel's. A pty's write wakes
 //!   the tty's buffer worker (a kernel thread), which, woken on the writer's core, runs
 //!   as the write returns and before the driver reads its clock: on a spinning core
 //!   that is most writes, so the spinning stage counts the kernel's pty work too;
@@ -257,6 +259,7 @@ fn run_variant(ctx: &mut RunCtx, variant: Variant) -> Result<(), BenchError> {
     child.finish(Duration::from_secs(10))?;
     let driver = read_histogram(&out)?;
     let send = read_histogram(&super::request::link_write_path(&out))?;
+    let work = read_histogram(&super::request::driver_work_path(&out))?;
     let bytes = Some((
         core::mem::size_of::<ActArrayCmdMsg>(),
         core::mem::size_of::<ActArrayData>(),
@@ -282,6 +285,13 @@ fn run_variant(ctx: &mut RunCtx, variant: Variant) -> Result<(), BenchError> {
             driver_strategy,
             Metric::OneWay,
             send,
+        ),
+        (
+            "driver_work",
+            "  and before it, the driver's work (validation, the handler)",
+            driver_strategy,
+            Metric::OneWay,
+            work,
         ),
         (
             "to_client",

@@ -141,18 +141,22 @@ pub fn driver_role(args: &BenchArgs, mode: LoopMode) -> Result<(), BenchError> {
         }
     });
     // The driver's own cost per command (arrival → bytes on the pty) and, inside it, the
-    // link's send alone, for `loop`.
+    // link's send alone and the work before it, for `loop`.
     let written = match &args.out {
         Some(_) => {
             let stats = driver.loop_stats();
-            let (mut own, mut send) = (new_histogram()?, new_histogram()?);
-            for ns in stats.arrival_to_wire.samples() {
-                own.saturating_record(*ns);
+            let (mut own, mut send, mut work) =
+                (new_histogram()?, new_histogram()?, new_histogram()?);
+            for (ring, hist) in [
+                (&stats.arrival_to_wire, &mut own),
+                (&stats.link_write, &mut send),
+                (&stats.arrival_to_send, &mut work),
+            ] {
+                for ns in ring.samples() {
+                    hist.saturating_record(*ns);
+                }
             }
-            for ns in stats.link_write.samples() {
-                send.saturating_record(*ns);
-            }
-            Some((own, send))
+            Some((own, send, work))
         }
         None => None,
     };
@@ -163,8 +167,9 @@ pub fn driver_role(args: &BenchArgs, mode: LoopMode) -> Result<(), BenchError> {
     r.map(|_| ())
         .map_err(|e| err("pioneer driver loop", e.to_string()))?;
     match (written, &args.out) {
-        (Some((own, send)), Some(out)) => {
+        (Some((own, send, work)), Some(out)) => {
             roles::write_histogram_to(&link_write_path(out), &send)?;
+            roles::write_histogram_to(&driver_work_path(out), &work)?;
             roles::write_histogram(args, &own)
         }
         _ => Ok(()),
@@ -174,4 +179,10 @@ pub fn driver_role(args: &BenchArgs, mode: LoopMode) -> Result<(), BenchError> {
 /// Where the Pioneer driver child writes the histogram of its link sends, beside `out`.
 pub fn link_write_path(out: &std::path::Path) -> std::path::PathBuf {
     out.with_extension("send.hdr")
+}
+
+/// Where the Pioneer driver child writes the histogram of its own work before each send
+/// (arrival → the send begins), beside `out`.
+pub fn driver_work_path(out: &std::path::Path) -> std::path::PathBuf {
+    out.with_extension("work.hdr")
 }

@@ -74,6 +74,9 @@ pub struct LoopStats {
     /// returns (a pty's write wakes the tty's buffer worker, which may take the core
     /// before the driver reads its clock).
     pub link_write: Ring,
+    /// Inside `arrival_to_wire`, what comes before the link's send: the driver's own work
+    /// (taking the command, validation, IK, the handler), without encoding and `write(2)`.
+    pub arrival_to_send: Ring,
     last_tick: Option<Instant>,
     /// SIPs counted in the current second.
     pub sips_this_second: u64,

@@ -380,6 +380,9 @@ impl RobotModel {
                         .arrival_to_wire
                         .push(now.saturating_sub(from.received_ns));
                     self.stats.link_write.push(now.saturating_sub(before));
+                    self.stats
+                        .arrival_to_send
+                        .push(before.saturating_sub(from.received_ns));
                 }
                 Ok(())
             }
