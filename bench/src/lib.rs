@@ -231,6 +231,19 @@ impl BenchArgs {
     }
 }
 
+/// Fails when `path` (the file of `flag`) cannot be written: its directory is missing or
+/// not writable, or it is a directory. An existing file is left as it is until the report
+/// replaces it; a new one is created empty.
+fn check_writable(flag: &str, path: &std::path::Path) -> Result<(), BenchError> {
+    std::fs::OpenOptions::new()
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(path)
+        .map(drop)
+        .map_err(|e| BenchError::io(format!("{flag} {}: cannot write it", path.display()), e))
+}
+
 /// Runs `limber bench` with parsed arguments: the selected scenarios, then the table,
 /// the JSON file and the plot. With the hidden `--role`, runs as a child process instead.
 ///
@@ -255,6 +268,13 @@ pub fn run_cli(args: BenchArgs) -> Result<(), BenchError> {
             "--scale must be a positive number, got {}",
             args.scale
         )));
+    }
+    // A run takes seconds to minutes: an output that cannot be written is said before it,
+    // not after.
+    for (flag, path) in [("--json", &args.json), ("--plot", &args.plot)] {
+        if let Some(path) = path {
+            check_writable(flag, path)?;
+        }
     }
     let mut ctx = RunCtx::new(&args)?;
     let mut outcomes = Vec::new();

@@ -175,6 +175,33 @@ fn unknown_scenario_is_an_error_not_a_panic() {
     assert!(!err.contains("panicked"), "{err}");
 }
 
+#[test]
+fn an_output_that_cannot_be_written_is_refused_before_the_run() {
+    let dir = std::env::temp_dir().join(format!("limber-bench-out-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let missing = dir.join("no-such-dir").join("x.json");
+    for (flag, path) in [("--json", &missing), ("--plot", &dir)] {
+        let out = limber_bounded_run::output_within(
+            Command::new(env!("CARGO_BIN_EXE_limber-bench"))
+                .args(["--only", "floor", "--quick", "--no-progress", flag])
+                .arg(path),
+            Duration::from_secs(60),
+        );
+        assert!(!out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(&format!("{flag} {}", path.display())), "{err}");
+        assert!(err.contains("cannot write it"), "{err}");
+        // Refused before the run: no table was printed.
+        assert!(
+            out.stdout.is_empty(),
+            "{}",
+            String::from_utf8_lossy(&out.stdout)
+        );
+    }
+    assert!(!missing.exists());
+    std::fs::remove_dir_all(&dir).expect("remove the test's directory");
+}
+
 /// `--only lang`: the Rust, C and Python clients' state reads and command round trips; a
 /// language that cannot run here is skipped with the reason (in CI, `CI=true`, with the
 /// venv of `.ci/run` in `LIMBER_PYTHON`, all three must run). And without a Python, the
