@@ -7,6 +7,7 @@ use limber_emulator::{Emulator, EmulatorConfig};
 use limber_p2os::LinkTarget;
 use limber_pioneer::{
     ConfigError, DriverError, LoopMode, PioneerConfig, PioneerDriver, RunOptions, apply_realtime,
+    check_cpu,
 };
 use limber_services::{Context, Role};
 
@@ -22,7 +23,8 @@ pub struct PioneerArgs {
     /// The link: a serial device (/dev/ttyS0), a pty, or tcp://host:port (simulator: 8101).
     #[arg(long)]
     pub port: Option<String>,
-    /// Serial baud rate (default: try 9600, 38400, 19200, 115200, 57600).
+    /// Serial baud rate: 9600, 19200, 38400, 57600 or 115200 (default: try 9600, 38400,
+    /// 19200, 115200, 57600).
     #[arg(long)]
     pub baud: Option<u32>,
     /// Robot name in the device names (default "pioneer").
@@ -34,7 +36,8 @@ pub struct PioneerArgs {
     /// Busy-poll instead of waiting on events (lowest latency; takes a whole core).
     #[arg(long)]
     pub spin: bool,
-    /// Pin the driver thread to this CPU core.
+    /// Pin the driver thread to this CPU core (one this process may use: refused
+    /// otherwise).
     #[arg(long, value_name = "N")]
     pub cpu: Option<usize>,
     /// Real-time: SCHED_FIFO priority 80 and locked memory (needs CAP_SYS_NICE /
@@ -61,6 +64,9 @@ pub enum PioneerCliError {
     /// The driver failed.
     #[error(transparent)]
     Driver(#[from] DriverError),
+    /// `--cpu` names a core this process may not use.
+    #[error(transparent)]
+    Cpu(#[from] limber_pioneer::CpuError),
 }
 
 /// The configuration from `--config` and the flags.
@@ -86,7 +92,7 @@ pub fn config_from(args: &PioneerArgs) -> Result<PioneerConfig, PioneerCliError>
 pub fn run(args: PioneerArgs) -> Result<(), CliError> {
     let to_cli = |e: PioneerCliError| {
         let code = match e {
-            PioneerCliError::Config(_) => exit::USAGE,
+            PioneerCliError::Config(_) | PioneerCliError::Cpu(_) => exit::USAGE,
             _ => exit::FAILURE,
         };
         CliError::new(code, e.to_string())
@@ -101,6 +107,9 @@ pub fn run(args: PioneerArgs) -> Result<(), CliError> {
 
 fn serve(args: PioneerArgs, domain: &limber_services::Domain) -> Result<(), PioneerCliError> {
     let cfg = config_from(&args)?;
+    if let Some(n) = args.cpu {
+        check_cpu(n)?;
+    }
     let ctx = Context::new(domain, Role::Driver, "pioneer").map_err(|e| {
         PioneerCliError::Setup(format!("cannot join domain {}: {e}", domain.name()))
     })?;

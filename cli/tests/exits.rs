@@ -97,6 +97,23 @@ fn bad_values_and_verbs_of_the_wrong_interface_exit_2() {
     );
     std::fs::write(&cfg, "tick_ms = 0\n").unwrap();
     usage(&["pioneer", "--config", cfg.to_str().unwrap()], "tick_ms");
+    // A baud rate P2OS does not speak (0 would hang up a real serial line), from the
+    // flag or the file, is refused before any port is opened.
+    for b in ["0", "12345"] {
+        let says = format!("baud {b} is not a rate a P2OS controller speaks");
+        usage(&["pioneer", "--emulated", "--baud", b], &says);
+        usage(&["pioneer", "--baud", b, "--print-config"], &says);
+    }
+    std::fs::write(&cfg, "baud = 4800\n").unwrap();
+    usage(
+        &["pioneer", "--config", cfg.to_str().unwrap()],
+        "baud 4800 is not a rate",
+    );
+    // A core this process may not use is refused, not a warning and an unpinned driver.
+    usage(
+        &["pioneer", "--emulated", "--cpu", "4096"],
+        "--cpu 4096: no such core among those this process may use",
+    );
     std::fs::remove_file(&cfg).unwrap();
     // An empty domain is an error with a sentence, not silently "limber".
     usage(&["list", "--domain", ""], "the domain name is empty");

@@ -46,7 +46,8 @@ pub struct PioneerConfig {
     /// The link: a serial device (`/dev/ttyS0`), a pty, or `tcp://host:port` (a
     /// simulator or an ethernet-serial bridge; 8101 is the simulator port).
     pub port: String,
-    /// Serial baud rate; unset: try 9600, 38400, 19200, 115200, 57600 in turn.
+    /// Serial baud rate, one of the P2OS rates (9600, 19200, 38400, 57600, 115200); unset:
+    /// try 9600, 38400, 19200, 115200, 57600 in turn.
     pub baud: Option<u32>,
     /// The robot name in device names (`<robot>/actarray/0`, ...).
     pub robot: String,
@@ -324,6 +325,13 @@ impl PioneerConfig {
             && self.setpose_approach_tolerance_deg <= 10.0)
         {
             return bad("setpose_approach_tolerance_deg must be in (0, 10] degrees");
+        }
+        if let Some(b) = self.baud
+            && !limber_p2os::BAUD_RATES.contains(&b)
+        {
+            return Err(ConfigError::Invalid(format!(
+                "baud {b} is not a rate a P2OS controller speaks: one of 9600, 19200, 38400, 57600, 115200, or unset to try them all"
+            )));
         }
         if self.tick_ms == 0 || self.tick_ms > 1000 {
             return bad("tick_ms must be 1..=1000");

@@ -28,5 +28,5 @@ mod stats;
 
 pub use config::{BodyGripper, ConfigError, GripperGeometry, PioneerConfig};
 pub use driver::{DriverError, Hardware, LoopMode, PioneerDriver, RunOptions, gripper_decision};
-pub use realtime::{RealtimeWarning, apply_realtime};
+pub use realtime::{CpuError, RealtimeWarning, apply_realtime, check_cpu};
 pub use stats::{LoopStats, Ring};

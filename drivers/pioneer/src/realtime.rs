@@ -12,6 +12,29 @@ impl fmt::Display for RealtimeWarning {
     }
 }
 
+/// `--cpu N` names a core this process may not run on (none such, or outside its
+/// affinity mask, as `taskset` or a cgroup set it).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("--cpu {cpu}: no such core among those this process may use ({usable:?})")]
+pub struct CpuError {
+    /// The core asked for.
+    pub cpu: usize,
+    /// The cores this process may use.
+    pub usable: Vec<usize>,
+}
+
+/// Checks that this process may run on core `cpu`, before anything starts. When the
+/// affinity mask cannot be read it passes, and [`apply_realtime`] warns if pinning fails.
+pub fn check_cpu(cpu: usize) -> Result<(), CpuError> {
+    match core_affinity::get_core_ids() {
+        Some(ids) if !ids.iter().any(|c| c.id == cpu) => Err(CpuError {
+            cpu,
+            usable: ids.into_iter().map(|c| c.id).collect(),
+        }),
+        _ => Ok(()),
+    }
+}
+
 /// Pins the calling thread to CPU `cpu` (if given) and, with `rt`, gives it SCHED_FIFO
 /// priority 80 and locks the process's memory. Returns a warning for each part that was
 /// not permitted (each is also logged).
