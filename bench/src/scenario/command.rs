@@ -16,7 +16,9 @@
 //!
 //! Round trip: client clock before `move_to` to after `wait_outcome`. One-way
 //! client→driver: `MsgMeta.stamp_ns` (set in `Client::send`) against the driver's clock
-//! at the top of the handler. One-way driver→client: the outcome's stamp
+//! on receipt (`Origin::received_ns`, read by the host as `receive` returns the sample),
+//! where the floor's echo reads its clock too; the host's work before the handler
+//! (releasing the sample, decoding, the lease check) is in the round trip. One-way driver→client: the outcome's stamp
 //! (`Outcome::stamp_ns`, taken when the driver publishes it) against the client's clock
 //! when `wait_outcome_detail` returned. (The state sample that follows the outcome is not
 //! what the client waits for: its stamp may belong to the previous command.)
@@ -285,12 +287,11 @@ impl DeviceHandler<ActArray> for BenchArm {
         from: &Origin,
         state: &mut ActArrayData,
     ) -> Status {
-        let now = monotonic_ns();
         let status = match *cmd {
             ActArrayCommand::Position { joint, position } => {
                 if from.seq > self.warmup {
                     self.oneway
-                        .saturating_record(now.saturating_sub(from.sent_ns));
+                        .saturating_record(from.received_ns.saturating_sub(from.sent_ns));
                 }
                 match state.actuators.get_mut(joint as usize) {
                     Some(a) => {
