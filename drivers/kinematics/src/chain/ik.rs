@@ -11,9 +11,11 @@ impl Chain {
     pub(super) fn fk_jacobian(&self, q: &[f64], w: f64, jac: &mut Jacobian) -> Pose {
         // During the walk each column holds its joint's origin (rows 0-2) and axis
         // (rows 3-5) in the world frame; the tip then turns them into velocities.
-        let tip = self.walk_axes(q, |i, before, _, axis| {
-            jac.fixed_view_mut::<3, 1>(0, i).copy_from(&before.position);
-            jac.fixed_view_mut::<3, 1>(3, i).copy_from(axis);
+        // (A joint's own motion moves neither its origin nor its axis.)
+        let tip = self.walk(q, |i, p, r| {
+            jac.fixed_view_mut::<3, 1>(0, i).copy_from(p);
+            jac.fixed_view_mut::<3, 1>(3, i)
+                .copy_from(&self.turns[i].1.in_frame(r));
         });
         for (i, j) in self.joints.iter().enumerate() {
             let z: Vector3<f64> = jac.fixed_view::<3, 1>(3, i).into_owned();
