@@ -127,8 +127,10 @@ impl Chain {
             got: seed.len(),
         })?;
         self.clamp_to_limits(&mut q);
-        let mut jac = Jacobian::zeros();
-        let mut jac_new = Jacobian::zeros();
+        // The current Jacobian and the trial's; `flipped` when the second is current
+        // (an accepted trial flips it instead of copying 768 bytes).
+        let mut jacs = (Jacobian::zeros(), Jacobian::zeros());
+        let mut flipped = false;
         let mut best_q = q;
         let mut best_cost = f64::INFINITY;
         let mut iterations = 0u32;
@@ -143,7 +145,10 @@ impl Chain {
                     _ => self.random_configuration(&mut rng),
                 };
             }
-            let mut pose = self.fk_jacobian(&q, w, &mut jac);
+            let jac = if flipped { &mut jacs.1 } else { &mut jacs.0 };
+            let mut pose = self.fk_jacobian(&q, w, jac);
+            // JJᵀ, for every λ tried on this Jacobian.
+            let mut gram = Gram::of(jac, n);
             let mut e = residual(&pose);
             let mut cost = e.norm_squared();
             let mut lambda = INITIAL_DAMPING;
@@ -151,6 +156,11 @@ impl Chain {
             let mut recent = cost;
             let mut crossed = false;
             for it in 0..=options.max_iterations {
+                let (jac, jac_new) = if flipped {
+                    (&mut jacs.1, &mut jacs.0)
+                } else {
+                    (&mut jacs.0, &mut jacs.1)
+                };
                 // Stalled: less than half the cost gone in 10 iterations, or less than a
                 // fifth in 3 while a joint sits on a limit (a minimum on the boundary).
                 let mut stalled = false;
@@ -175,7 +185,8 @@ impl Chain {
                         break;
                     }
                     crossed = true;
-                    pose = self.fk_jacobian(&q, w, &mut jac);
+                    pose = self.fk_jacobian(&q, w, jac);
+                    gram = Gram::of(jac, n);
                     e = residual(&pose);
                     cost = e.norm_squared();
                     // Small: the crossed joint is near its goal more often than not
@@ -209,7 +220,7 @@ impl Chain {
                     break;
                 }
                 iterations += 1;
-                let Some(mut dq) = dls_step(&jac, &e, lambda, n) else {
+                let Some(mut dq) = gram.step(jac, &e, lambda, n) else {
                     lambda *= 10.0;
                     continue;
                 };
@@ -224,13 +235,13 @@ impl Chain {
                     .any(|(i, j)| pushed_out(i, j))
                 {
                     // Only then copy the Jacobian (6 × MAX_JOINTS) to zero columns.
-                    let mut jf = jac;
+                    let mut jf = *jac;
                     for (i, j) in self.joints.iter().enumerate() {
                         if pushed_out(i, j) {
                             jf.column_mut(i).fill(0.0);
                         }
                     }
-                    match dls_step(&jf, &e, lambda, n) {
+                    match Gram::of(&jf, n).step(&jf, &e, lambda, n) {
                         Some(d) => dq = d,
                         None => {
                             lambda *= 10.0;
@@ -249,7 +260,7 @@ impl Chain {
                     *v += dq[i] * scale;
                 }
                 self.clamp_to_limits(&mut q_new);
-                let pose_new = self.fk_jacobian(&q_new, w, &mut jac_new);
+                let pose_new = self.fk_jacobian(&q_new, w, jac_new);
                 let e_new = residual(&pose_new);
                 let cost_new = e_new.norm_squared();
                 if cost_new < cost {
@@ -257,7 +268,8 @@ impl Chain {
                     pose = pose_new;
                     e = e_new;
                     cost = cost_new;
-                    std::mem::swap(&mut jac, &mut jac_new);
+                    gram = Gram::of(jac_new, n);
+                    flipped = !flipped;
                     lambda = (lambda * 0.3).max(1e-12);
                 } else {
                     lambda *= 5.0;
@@ -409,78 +421,6 @@ impl Chain {
         }
         moved
     }
-}
-
-/// `Jᵀ (J Jᵀ + λ I)⁻¹ e` over the first `n` columns, `None` if the 6×6 system is not
-/// positive definite. Plain loops and a hand-written Cholesky: small, allocation-free
-/// and fast even in unoptimised builds.
-#[allow(clippy::needless_range_loop)]
-pub(super) fn dls_step(
-    jac: &Jacobian,
-    e: &Vector6<f64>,
-    lambda: f64,
-    n: usize,
-) -> Option<SMatrix<f64, MAX_JOINTS, 1>> {
-    // The columns, 6 values each (column-major storage): fixed-length slices, so
-    // that the loops below need no index checks.
-    let columns = || jac.as_slice().chunks_exact(6).take(n);
-    let mut a = [[0.0f64; 6]; 6];
-    for col in columns() {
-        for (r, row) in a.iter_mut().enumerate() {
-            for (c, cell) in row.iter_mut().enumerate().take(r + 1) {
-                *cell += col[r] * col[c];
-            }
-        }
-    }
-    for (r, row) in a.iter_mut().enumerate() {
-        row[r] += lambda;
-    }
-    // Cholesky A = L·Lᵀ in place (lower triangle), with the reciprocals of the
-    // diagonal (six divisions instead of 27).
-    let mut inv = [0.0f64; 6];
-    for j in 0..6 {
-        let mut d = a[j][j];
-        for k in 0..j {
-            d -= a[j][k] * a[j][k];
-        }
-        if !(d > 0.0 && d.is_finite()) {
-            return None;
-        }
-        let d = d.sqrt();
-        a[j][j] = d;
-        inv[j] = 1.0 / d;
-        for i in j + 1..6 {
-            let mut v = a[i][j];
-            for k in 0..j {
-                v -= a[i][k] * a[j][k];
-            }
-            a[i][j] = v * inv[j];
-        }
-    }
-    let mut y = [0.0f64; 6];
-    for i in 0..6 {
-        let mut v = e[i];
-        for k in 0..i {
-            v -= a[i][k] * y[k];
-        }
-        y[i] = v * inv[i];
-    }
-    for i in (0..6).rev() {
-        let mut v = y[i];
-        for k in i + 1..6 {
-            v -= a[k][i] * y[k];
-        }
-        y[i] = v * inv[i];
-    }
-    let mut dq = SMatrix::<f64, MAX_JOINTS, 1>::zeros();
-    for (d, col) in dq.iter_mut().zip(columns()) {
-        let mut v = 0.0;
-        for (c, yr) in col.iter().zip(&y) {
-            v += c * yr;
-        }
-        *d = v;
-    }
-    dq.iter().all(|v| v.is_finite()).then_some(dq)
 }
 
 pub(super) fn sample_range(j: &JointSpec) -> (f64, f64) {

@@ -334,6 +334,8 @@ impl DeterministicRng {
         lo + (hi - lo) * self.next_f64()
     }
 }
+mod dls;
+use dls::Gram;
 mod file;
 use file::{ARM6_TOML, ARM7_TOML, PIONEER5_TOML};
 mod ik;
