@@ -20,9 +20,16 @@ impl Gram {
     /// `JJᵀ` over the first `n` columns of `jac`.
     #[inline]
     pub(super) fn of(jac: &Jacobian, n: usize) -> Gram {
+        Self::without(jac, n, 0)
+    }
+
+    /// `JJᵀ` over the first `n` columns of `jac` but those whose bits are set in
+    /// `frozen` (as if they were zero).
+    #[inline]
+    pub(super) fn without(jac: &Jacobian, n: usize, frozen: u32) -> Gram {
         let mut a = [[0.0f64; 6]; 6];
         // Column-major storage: each chunk is one column of six values.
-        for col in jac.as_slice().chunks_exact(6).take(n) {
+        for (_, col) in columns(jac, n, frozen) {
             for (row, x) in a.iter_mut().zip(col) {
                 for (cell, y) in row.iter_mut().zip(col) {
                     *cell += x * y;
@@ -32,9 +39,10 @@ impl Gram {
         Gram(a)
     }
 
-    /// `Jᵀ (JJᵀ + λI)⁻¹ e` over the first `n` columns of `jac` (the Jacobian this is
-    /// the Gram matrix of), `None` if `JJᵀ + λI` is not positive definite (to
-    /// round-off) or the step is not finite.
+    /// `Jᵀ (JJᵀ + λI)⁻¹ e` over the first `n` columns of `jac` but the `frozen` ones
+    /// (the Jacobian and columns this is the Gram matrix of; the frozen joints' steps
+    /// are 0), `None` if `JJᵀ + λI` is not positive definite (to round-off) or the
+    /// step is not finite.
     #[inline]
     pub(super) fn step(
         &self,
@@ -42,6 +50,7 @@ impl Gram {
         e: &Vector6<f64>,
         lambda: f64,
         n: usize,
+        frozen: u32,
     ) -> Option<Step> {
         let mut f = Ldl {
             w: self.0,
@@ -61,11 +70,21 @@ impl Gram {
         }
         let x = f.solve(e);
         let mut dq = Step::zeros();
-        for (d, col) in dq.iter_mut().zip(jac.as_slice().chunks_exact(6).take(n)) {
-            *d = col.iter().zip(&x).map(|(c, x)| c * x).sum();
+        for (i, col) in columns(jac, n, frozen) {
+            dq[i] = col.iter().zip(&x).map(|(c, x)| c * x).sum();
         }
         dq.iter().all(|v| v.is_finite()).then_some(dq)
     }
+}
+
+/// The first `n` columns of `jac` but the `frozen` ones, with their indices.
+#[inline(always)]
+fn columns(jac: &Jacobian, n: usize, frozen: u32) -> impl Iterator<Item = (usize, &[f64])> {
+    jac.as_slice()
+        .chunks_exact(6)
+        .take(n)
+        .enumerate()
+        .filter(move |(i, _)| frozen & (1 << i) == 0)
 }
 
 /// `JJᵀ + λI` being factorised as `L·D·Lᵀ` in place: below the diagonal of `w`, row
@@ -138,8 +157,9 @@ mod tests {
     use crate::chain::DeterministicRng;
 
     /// The step equals the textbook formula computed with nalgebra's dynamic
-    /// matrices and LU, for ranks from 1 to 6, several λ and column counts; a
-    /// matrix that is not positive definite gives `None`.
+    /// matrices and LU, for ranks from 1 to 6, several λ and column counts; frozen
+    /// columns count as zero columns; a matrix that is not positive definite gives
+    /// `None`.
     #[test]
     fn step_equals_the_formula() {
         let mut rng = DeterministicRng::new(3);
@@ -157,7 +177,7 @@ mod tests {
                         jac.column_mut(n).fill(7.0);
                     }
                     let e = Vector6::from_fn(|_, _| rng.uniform(-1.0, 1.0));
-                    let dq = Gram::of(&jac, n).step(&jac, &e, lambda, n).unwrap();
+                    let dq = Gram::of(&jac, n).step(&jac, &e, lambda, n, 0).unwrap();
                     let a = &j * j.transpose() + DMatrix::identity(6, 6) * lambda;
                     let y = a
                         .lu()
@@ -175,14 +195,24 @@ mod tests {
                         );
                     }
                     assert!(dq.iter().skip(n).all(|v| *v == 0.0));
+                    // Frozen columns count as zero columns, to the bit.
+                    let frozen = 0b101u32 & ((1 << n) - 1);
+                    let mut zeroed = jac;
+                    for i in (0..n).filter(|i| frozen & (1 << i) != 0) {
+                        zeroed.column_mut(i).fill(0.0);
+                    }
+                    assert_eq!(
+                        Gram::without(&jac, n, frozen).step(&jac, &e, lambda, n, frozen),
+                        Gram::of(&zeroed, n).step(&zeroed, &e, lambda, n, 0)
+                    );
                 }
             }
         }
         let jac = Jacobian::zeros();
         let e = Vector6::repeat(1.0);
-        assert!(Gram::of(&jac, 6).step(&jac, &e, 0.0, 6).is_none());
-        assert!(Gram::of(&jac, 6).step(&jac, &e, -1.0, 6).is_none());
-        assert!(Gram::of(&jac, 6).step(&jac, &e, f64::NAN, 6).is_none());
-        assert!(Gram::of(&jac, 6).step(&jac, &e, 1.0, 6).is_some());
+        assert!(Gram::of(&jac, 6).step(&jac, &e, 0.0, 6, 0).is_none());
+        assert!(Gram::of(&jac, 6).step(&jac, &e, -1.0, 6, 0).is_none());
+        assert!(Gram::of(&jac, 6).step(&jac, &e, f64::NAN, 6, 0).is_none());
+        assert!(Gram::of(&jac, 6).step(&jac, &e, 1.0, 6, 0).is_some());
     }
 }

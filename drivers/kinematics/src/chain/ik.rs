@@ -155,6 +155,7 @@ impl Chain {
             let mut checkpoint = cost;
             let mut recent = cost;
             let mut crossed = false;
+            let mut q_new = q;
             for it in 0..=options.max_iterations {
                 let (jac, jac_new) = if flipped {
                     (&mut jacs.1, &mut jacs.0)
@@ -198,10 +199,8 @@ impl Chain {
                 if !cost.is_finite() {
                     break;
                 }
-                if cost < best_cost {
-                    best_cost = cost;
-                    best_q = q;
-                }
+                // (The best configuration is kept when the attempt ends or crosses a
+                // gap: in between, only a lower cost moves q.)
                 // The residual bounds both errors (‖e‖² = pe² + (w·oe)²), so the exact
                 // errors are worth computing only once it is small.
                 if cost <= near_cost {
@@ -220,7 +219,7 @@ impl Chain {
                     break;
                 }
                 iterations += 1;
-                let Some(mut dq) = gram.step(jac, &e, lambda, n) else {
+                let Some(mut dq) = gram.step(jac, &e, lambda, n, 0) else {
                     lambda *= 10.0;
                     continue;
                 };
@@ -228,20 +227,15 @@ impl Chain {
                 let pushed_out = |i: usize, j: &JointSpec| {
                     (q[i] <= j.min && dq[i] < 0.0) || (q[i] >= j.max && dq[i] > 0.0)
                 };
-                if self
+                let frozen = self
                     .joints
                     .iter()
                     .enumerate()
-                    .any(|(i, j)| pushed_out(i, j))
-                {
-                    // Only then copy the Jacobian (6 × MAX_JOINTS) to zero columns.
-                    let mut jf = *jac;
-                    for (i, j) in self.joints.iter().enumerate() {
-                        if pushed_out(i, j) {
-                            jf.column_mut(i).fill(0.0);
-                        }
-                    }
-                    match Gram::of(&jf, n).step(&jf, &e, lambda, n) {
+                    .filter(|(i, j)| pushed_out(*i, j))
+                    .fold(0u32, |m, (i, _)| m | 1 << i);
+                if frozen != 0 {
+                    // Their columns of the Jacobian count as zero.
+                    match Gram::without(jac, n, frozen).step(jac, &e, lambda, n, frozen) {
                         Some(d) => dq = d,
                         None => {
                             lambda *= 10.0;
@@ -255,16 +249,15 @@ impl Chain {
                 } else {
                     1.0
                 };
-                let mut q_new = q;
-                for (i, v) in q_new.iter_mut().enumerate() {
-                    *v += dq[i] * scale;
+                for (i, (v, j)) in q_new.iter_mut().zip(&self.joints).enumerate() {
+                    *v = (q[i] + dq[i] * scale).clamp(j.min, j.max);
                 }
-                self.clamp_to_limits(&mut q_new);
                 let pose_new = self.fk_jacobian(&q_new, w, jac_new);
                 let e_new = residual(&pose_new);
                 let cost_new = e_new.norm_squared();
                 if cost_new < cost {
-                    q = q_new;
+                    // The values only (a fixed-size copy, inlined).
+                    q.values = q_new.values;
                     pose = pose_new;
                     e = e_new;
                     cost = cost_new;

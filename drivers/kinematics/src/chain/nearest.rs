@@ -188,7 +188,7 @@ impl Chain {
                 }
                 checkpoint = cost;
             }
-            let Some(dq) = Gram::of(&jac, n).step(&jac, &e, lambda, n) else {
+            let Some(dq) = Gram::of(&jac, n).step(&jac, &e, lambda, n, 0) else {
                 lambda *= 10.0;
                 continue;
             };
