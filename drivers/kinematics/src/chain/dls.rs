@@ -20,7 +20,12 @@ impl Gram {
     /// `JJᵀ` over the first `n` columns of `jac`.
     #[inline]
     pub(super) fn of(jac: &Jacobian, n: usize) -> Gram {
-        Self::without(jac, n, 0)
+        let mut a = [[0.0f64; 6]; 6];
+        // Column-major storage: each chunk is one column of six values.
+        for col in jac.as_slice().chunks_exact(6).take(n) {
+            add_outer(&mut a, col);
+        }
+        Gram(a)
     }
 
     /// `JJᵀ` over the first `n` columns of `jac` but those whose bits are set in
@@ -28,13 +33,8 @@ impl Gram {
     #[inline]
     pub(super) fn without(jac: &Jacobian, n: usize, frozen: u32) -> Gram {
         let mut a = [[0.0f64; 6]; 6];
-        // Column-major storage: each chunk is one column of six values.
         for (_, col) in columns(jac, n, frozen) {
-            for (row, x) in a.iter_mut().zip(col) {
-                for (cell, y) in row.iter_mut().zip(col) {
-                    *cell += x * y;
-                }
-            }
+            add_outer(&mut a, col);
         }
         Gram(a)
     }
@@ -74,6 +74,16 @@ impl Gram {
             dq[i] = col.iter().zip(&x).map(|(c, x)| c * x).sum();
         }
         dq.iter().all(|v| v.is_finite()).then_some(dq)
+    }
+}
+
+/// `a ← a + col·colᵀ`.
+#[inline(always)]
+fn add_outer(a: &mut [[f64; 6]; 6], col: &[f64]) {
+    for (row, x) in a.iter_mut().zip(col) {
+        for (cell, y) in row.iter_mut().zip(col) {
+            *cell += x * y;
+        }
     }
 }
 
