@@ -25,6 +25,38 @@ const LIMIT: f64 = 1.0e5;
 /// 1.5·2^52: adding and subtracting it rounds a value below 2^51 to an integer.
 const ROUND: f64 = 6_755_399_441_055_744.0;
 
+/// sin r = r − r³/3! + r⁵/5! − … + r¹⁷/17!: the coefficients of (sin r − r)/r³ in
+/// powers of r².
+const SIN: [f64; 8] = [
+    -1.0 / 6.0,
+    1.0 / 120.0,
+    -1.0 / 5_040.0,
+    1.0 / 362_880.0,
+    -1.0 / 39_916_800.0,
+    1.0 / 6_227_020_800.0,
+    -1.0 / 1_307_674_368_000.0,
+    1.0 / 355_687_428_096_000.0,
+];
+
+/// cos r = 1 − r²/2! + r⁴/4! − … + r¹⁶/16!: the coefficients of (cos r − 1)/r² in
+/// powers of r².
+const COS: [f64; 8] = [
+    -0.5,
+    1.0 / 24.0,
+    -1.0 / 720.0,
+    1.0 / 40_320.0,
+    -1.0 / 3_628_800.0,
+    1.0 / 479_001_600.0,
+    -1.0 / 87_178_291_200.0,
+    1.0 / 20_922_789_888_000.0,
+];
+
+/// The polynomial with coefficients `c` (lowest power first) at `z`, by Horner.
+#[inline(always)]
+fn horner(c: &[f64; 8], z: f64) -> f64 {
+    c.iter().rev().fold(0.0, |acc, c| acc * z + c)
+}
+
 /// (sin, cos) of every value of `q` into `s` and `c` (entries beyond `q.len()` are
 /// left alone).
 pub(super) fn sin_cos_all(q: &[f64], s: &mut [f64; MAX_JOINTS], c: &mut [f64; MAX_JOINTS]) {
@@ -48,25 +80,8 @@ fn sin_cos(x: f64) -> (f64, f64) {
     // each other, or k is 0), the products with HI and MID are exact.
     let r = ((x - k * PIO2_HI) - k * PIO2_MID) - k * PIO2_LO;
     let z = r * r;
-    // sin r = r − r³/3! + r⁵/5! − … + r¹⁷/17!, cos r = 1 − r²/2! + … + r¹⁶/16!.
-    let ps = z
-        * (-1.0 / 6.0
-            + z * (1.0 / 120.0
-                + z * (-1.0 / 5_040.0
-                    + z * (1.0 / 362_880.0
-                        + z * (-1.0 / 39_916_800.0
-                            + z * (1.0 / 6_227_020_800.0
-                                + z * (-1.0 / 1_307_674_368_000.0
-                                    + z * (1.0 / 355_687_428_096_000.0))))))));
-    let pc = z
-        * (-0.5
-            + z * (1.0 / 24.0
-                + z * (-1.0 / 720.0
-                    + z * (1.0 / 40_320.0
-                        + z * (-1.0 / 3_628_800.0
-                            + z * (1.0 / 479_001_600.0
-                                + z * (-1.0 / 87_178_291_200.0
-                                    + z * (1.0 / 20_922_789_888_000.0))))))));
+    // sin r = r + r·z·SIN(z), cos r = 1 + z·COS(z).
+    let (ps, pc) = (z * horner(&SIN, z), z * horner(&COS, z));
     let (sr, cr) = (r + r * ps, 1.0 + pc);
     // The quadrant: sin(r + π/2) = cos r, cos(r + π/2) = −sin r; a half turn negates
     // both.
