@@ -11,7 +11,9 @@ impl Chain {
     pub(super) fn fk_jacobian(&self, q: &[f64], w: f64, jac: &mut Jacobian) -> Pose {
         // During the walk each column holds its joint's origin (rows 0-2) and axis
         // (rows 3-5) in the world frame; the tip then turns them into velocities.
-        // (A joint's own motion moves neither its origin nor its axis.)
+        // The walk gives each frame after its joint's motion: a rotary joint's motion
+        // moves neither its origin nor its axis, a linear joint's moves only its origin,
+        // which its column does not use.
         let tip = self.walk(q, |i, p, r| {
             jac.fixed_view_mut::<3, 1>(0, i).copy_from(p);
             jac.fixed_view_mut::<3, 1>(3, i)
