@@ -11,9 +11,13 @@ impl Chain {
     pub(super) fn fk_jacobian(&self, q: &[f64], w: f64, jac: &mut Jacobian) -> Pose {
         // During the walk each column holds its joint's origin (rows 0-2) and axis
         // (rows 3-5) in the world frame; the tip then turns them into velocities.
-        let tip = self.walk_axes(q, |i, before, _, axis| {
-            jac.fixed_view_mut::<3, 1>(0, i).copy_from(&before.position);
-            jac.fixed_view_mut::<3, 1>(3, i).copy_from(axis);
+        // The walk gives each frame after its joint's motion: a rotary joint's motion
+        // moves neither its origin nor its axis, a linear joint's moves only its origin,
+        // which its column does not use.
+        let tip = self.walk(q, |i, p, r| {
+            jac.fixed_view_mut::<3, 1>(0, i).copy_from(p);
+            jac.fixed_view_mut::<3, 1>(3, i)
+                .copy_from(&self.turns[i].1.in_frame(r));
         });
         for (i, j) in self.joints.iter().enumerate() {
             let z: Vector3<f64> = jac.fixed_view::<3, 1>(3, i).into_owned();
@@ -125,8 +129,10 @@ impl Chain {
             got: seed.len(),
         })?;
         self.clamp_to_limits(&mut q);
-        let mut jac = Jacobian::zeros();
-        let mut jac_new = Jacobian::zeros();
+        // The current Jacobian and the trial's; `flipped` when the second is current
+        // (an accepted trial flips it instead of copying 768 bytes).
+        let mut jacs = (Jacobian::zeros(), Jacobian::zeros());
+        let mut flipped = false;
         let mut best_q = q;
         let mut best_cost = f64::INFINITY;
         let mut iterations = 0u32;
@@ -141,14 +147,23 @@ impl Chain {
                     _ => self.random_configuration(&mut rng),
                 };
             }
-            let mut pose = self.fk_jacobian(&q, w, &mut jac);
+            let jac = if flipped { &mut jacs.1 } else { &mut jacs.0 };
+            let mut pose = self.fk_jacobian(&q, w, jac);
+            // JJᵀ, for every λ tried on this Jacobian.
+            let mut gram = Gram::of(jac, n);
             let mut e = residual(&pose);
             let mut cost = e.norm_squared();
             let mut lambda = INITIAL_DAMPING;
             let mut checkpoint = cost;
             let mut recent = cost;
             let mut crossed = false;
+            let mut q_new = q;
             for it in 0..=options.max_iterations {
+                let (jac, jac_new) = if flipped {
+                    (&mut jacs.1, &mut jacs.0)
+                } else {
+                    (&mut jacs.0, &mut jacs.1)
+                };
                 // Stalled: less than half the cost gone in 10 iterations, or less than a
                 // fifth in 3 while a joint sits on a limit (a minimum on the boundary).
                 let mut stalled = false;
@@ -173,7 +188,8 @@ impl Chain {
                         break;
                     }
                     crossed = true;
-                    pose = self.fk_jacobian(&q, w, &mut jac);
+                    pose = self.fk_jacobian(&q, w, jac);
+                    gram = Gram::of(jac, n);
                     e = residual(&pose);
                     cost = e.norm_squared();
                     // Small: the crossed joint is near its goal more often than not
@@ -185,10 +201,8 @@ impl Chain {
                 if !cost.is_finite() {
                     break;
                 }
-                if cost < best_cost {
-                    best_cost = cost;
-                    best_q = q;
-                }
+                // (The best configuration is kept when the attempt ends or crosses a
+                // gap: in between, only a lower cost moves q.)
                 // The residual bounds both errors (‖e‖² = pe² + (w·oe)²), so the exact
                 // errors are worth computing only once it is small.
                 if cost <= near_cost {
@@ -207,7 +221,7 @@ impl Chain {
                     break;
                 }
                 iterations += 1;
-                let Some(mut dq) = dls_step(&jac, &e, lambda, n) else {
+                let Some(mut dq) = gram.step(jac, &e, lambda, n, 0) else {
                     lambda *= 10.0;
                     continue;
                 };
@@ -215,20 +229,15 @@ impl Chain {
                 let pushed_out = |i: usize, j: &JointSpec| {
                     (q[i] <= j.min && dq[i] < 0.0) || (q[i] >= j.max && dq[i] > 0.0)
                 };
-                if self
+                let frozen = self
                     .joints
                     .iter()
                     .enumerate()
-                    .any(|(i, j)| pushed_out(i, j))
-                {
-                    // Only then copy the Jacobian (6 × MAX_JOINTS) to zero columns.
-                    let mut jf = jac;
-                    for (i, j) in self.joints.iter().enumerate() {
-                        if pushed_out(i, j) {
-                            jf.column_mut(i).fill(0.0);
-                        }
-                    }
-                    match dls_step(&jf, &e, lambda, n) {
+                    .filter(|(i, j)| pushed_out(*i, j))
+                    .fold(0u32, |m, (i, _)| m | 1 << i);
+                if frozen != 0 {
+                    // Their columns of the Jacobian count as zero.
+                    match Gram::without(jac, n, frozen).step(jac, &e, lambda, n, frozen) {
                         Some(d) => dq = d,
                         None => {
                             lambda *= 10.0;
@@ -242,20 +251,20 @@ impl Chain {
                 } else {
                     1.0
                 };
-                let mut q_new = q;
-                for (i, v) in q_new.iter_mut().enumerate() {
-                    *v += dq[i] * scale;
+                for (i, (v, j)) in q_new.iter_mut().zip(&self.joints).enumerate() {
+                    *v = (q[i] + dq[i] * scale).clamp(j.min, j.max);
                 }
-                self.clamp_to_limits(&mut q_new);
-                let pose_new = self.fk_jacobian(&q_new, w, &mut jac_new);
+                let pose_new = self.fk_jacobian(&q_new, w, jac_new);
                 let e_new = residual(&pose_new);
                 let cost_new = e_new.norm_squared();
                 if cost_new < cost {
-                    q = q_new;
+                    // The values only (a fixed-size copy, inlined).
+                    q.values = q_new.values;
                     pose = pose_new;
                     e = e_new;
                     cost = cost_new;
-                    std::mem::swap(&mut jac, &mut jac_new);
+                    gram = Gram::of(jac_new, n);
+                    flipped = !flipped;
                     lambda = (lambda * 0.3).max(1e-12);
                 } else {
                     lambda *= 5.0;
@@ -409,78 +418,6 @@ impl Chain {
     }
 }
 
-/// `Jᵀ (J Jᵀ + λ I)⁻¹ e` over the first `n` columns, `None` if the 6×6 system is not
-/// positive definite. Plain loops and a hand-written Cholesky: small, allocation-free
-/// and fast even in unoptimised builds.
-#[allow(clippy::needless_range_loop)]
-pub(super) fn dls_step(
-    jac: &Jacobian,
-    e: &Vector6<f64>,
-    lambda: f64,
-    n: usize,
-) -> Option<SMatrix<f64, MAX_JOINTS, 1>> {
-    // The columns, 6 values each (column-major storage): fixed-length slices, so
-    // that the loops below need no index checks.
-    let columns = || jac.as_slice().chunks_exact(6).take(n);
-    let mut a = [[0.0f64; 6]; 6];
-    for col in columns() {
-        for (r, row) in a.iter_mut().enumerate() {
-            for (c, cell) in row.iter_mut().enumerate().take(r + 1) {
-                *cell += col[r] * col[c];
-            }
-        }
-    }
-    for (r, row) in a.iter_mut().enumerate() {
-        row[r] += lambda;
-    }
-    // Cholesky A = L·Lᵀ in place (lower triangle), with the reciprocals of the
-    // diagonal (six divisions instead of 27).
-    let mut inv = [0.0f64; 6];
-    for j in 0..6 {
-        let mut d = a[j][j];
-        for k in 0..j {
-            d -= a[j][k] * a[j][k];
-        }
-        if !(d > 0.0 && d.is_finite()) {
-            return None;
-        }
-        let d = d.sqrt();
-        a[j][j] = d;
-        inv[j] = 1.0 / d;
-        for i in j + 1..6 {
-            let mut v = a[i][j];
-            for k in 0..j {
-                v -= a[i][k] * a[j][k];
-            }
-            a[i][j] = v * inv[j];
-        }
-    }
-    let mut y = [0.0f64; 6];
-    for i in 0..6 {
-        let mut v = e[i];
-        for k in 0..i {
-            v -= a[i][k] * y[k];
-        }
-        y[i] = v * inv[i];
-    }
-    for i in (0..6).rev() {
-        let mut v = y[i];
-        for k in i + 1..6 {
-            v -= a[k][i] * y[k];
-        }
-        y[i] = v * inv[i];
-    }
-    let mut dq = SMatrix::<f64, MAX_JOINTS, 1>::zeros();
-    for (d, col) in dq.iter_mut().zip(columns()) {
-        let mut v = 0.0;
-        for (c, yr) in col.iter().zip(&y) {
-            v += c * yr;
-        }
-        *d = v;
-    }
-    dq.iter().all(|v| v.is_finite()).then_some(dq)
-}
-
 pub(super) fn sample_range(j: &JointSpec) -> (f64, f64) {
     use std::f64::consts::PI;
     if j.kind == JointKind::Rotary {
@@ -496,6 +433,97 @@ pub(super) fn sample_range(j: &JointSpec) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A chain with every kind of joint and rotation the walk tells apart: a rotated
+    /// base, a general (tilted) axis, a linear joint, a general rest orientation.
+    const MIXED: &str = r#"
+name = "mixed"
+[base]
+xyz = [0.1, -0.2, 0.3]
+rpy = [0.2, -0.1, 0.4]
+[[joints]]
+name = "a"
+type = "rotary"
+axis = [0.0, 0.0, 1.0]
+min = -3.0
+max = 3.0
+max_speed = 1.0
+[[joints]]
+name = "b"
+type = "rotary"
+xyz = [0.0, 0.05, 0.2]
+rpy = [0.0, 1.5707963267948966, 0.0]
+axis = [0.3, -0.5, 0.8]
+min = -3.0
+max = 3.0
+max_speed = 1.0
+[[joints]]
+name = "c"
+type = "linear"
+xyz = [0.3, 0.0, 0.0]
+rpy = [0.1, 0.2, 0.3]
+axis = [0.0, 1.0, 0.0]
+min = -0.2
+max = 0.4
+max_speed = 1.0
+[[joints]]
+name = "d"
+type = "rotary"
+xyz = [0.0, 0.0, 0.25]
+axis = [-1.0, 0.0, 0.0]
+min = -3.0
+max = 3.0
+max_speed = 1.0
+[tool]
+xyz = [0.05, 0.02, 0.1]
+rpy = [0.3, 0.0, -0.2]
+"#;
+
+    /// The one-walk Jacobian (linear rows, then angular rows scaled by w) equals
+    /// central differences of FK, and its pose is FK's.
+    #[test]
+    fn fk_jacobian_equals_finite_differences() {
+        let mixed = Chain::from_toml_str(MIXED).unwrap();
+        let chains = [
+            Chain::default_6dof(),
+            Chain::default_7dof(),
+            Chain::pioneer5(),
+            mixed,
+        ];
+        let mut rng = DeterministicRng::new(7);
+        let w = 0.5;
+        let h = 1e-5;
+        for chain in &chains {
+            for _ in 0..20 {
+                let q = chain.random_configuration(&mut rng);
+                let mut jac = Jacobian::zeros();
+                let pose = chain.fk_jacobian(&q, w, &mut jac);
+                assert_eq!(pose, chain.fk(&q).unwrap());
+                for i in 0..chain.dof() {
+                    let (mut plus, mut minus) = (q, q);
+                    plus[i] += h;
+                    minus[i] -= h;
+                    let (a, b) = (chain.fk(&plus).unwrap(), chain.fk(&minus).unwrap());
+                    let lin = (a.position - b.position) / (2.0 * h);
+                    // sin(angle)·axis from the skew part of the relative rotation (its
+                    // scaled_axis takes the angle from acos, 1e-7 off at 2e-5 rad).
+                    let d = (a.rotation * b.rotation.inverse()).into_inner();
+                    let skew = Vector3::new(d.m32 - d.m23, d.m13 - d.m31, d.m21 - d.m12) / 2.0;
+                    let ang = skew * (w / (2.0 * h));
+                    let col = jac.column(i);
+                    for r in 0..3 {
+                        assert!((col[r] - lin[r]).abs() < 1e-7, "{} {i}", chain.name());
+                        assert!((col[r + 3] - ang[r]).abs() < 1e-7, "{} {i}", chain.name());
+                    }
+                }
+                assert!(
+                    jac.columns(chain.dof(), MAX_JOINTS - chain.dof())
+                        .iter()
+                        .all(|v| *v == 0.0)
+                );
+            }
+        }
+    }
 
     /// The restart seeds are the atlas entries nearest the target, nearest first: a
     /// target at an entry's pose puts that entry first, and the distances rise.

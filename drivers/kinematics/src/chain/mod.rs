@@ -44,7 +44,7 @@
 
 use std::ops::{Deref, DerefMut};
 
-use nalgebra::{Rotation3, SMatrix, Unit, Vector3};
+use nalgebra::{Matrix3, Rotation3, SMatrix, Unit, Vector3};
 use rand::rngs::SmallRng;
 use rand::{Rng as _, RngCore as _, SeedableRng};
 use serde::Deserialize;
@@ -334,12 +334,15 @@ impl DeterministicRng {
         lo + (hi - lo) * self.next_f64()
     }
 }
+mod dls;
+use dls::Gram;
 mod file;
 use file::{ARM6_TOML, ARM7_TOML, PIONEER5_TOML};
 mod ik;
 use ik::sample_range;
 mod nearest;
 pub use nearest::{NearestOptions, NearestSolution};
+mod trig;
 mod turn;
 use turn::{Axis, Turn};
 
@@ -484,37 +487,27 @@ impl Chain {
                 got: frames.len(),
             });
         }
-        Ok(self.walk(q, |i, _, after| frames[i] = *after))
+        Ok(self.walk(q, |i, p, r| {
+            frames[i] = Pose::new(*p, Rotation3::from_matrix_unchecked(*r));
+        }))
     }
 
-    /// Walks the chain; `visit(i, joint_frame_before_motion, frame_after_motion)`.
-    fn walk(&self, q: &[f64], mut visit: impl FnMut(usize, &Pose, &Pose)) -> Pose {
-        self.walk_axes(q, |i, before, after, _| visit(i, before, after))
-    }
-
-    /// [`Chain::walk`], also giving `visit` the joint's axis in the world frame.
-    fn walk_axes(
-        &self,
-        q: &[f64],
-        mut visit: impl FnMut(usize, &Pose, &Pose, &Vector3<f64>),
-    ) -> Pose {
+    /// Walks the chain; `visit(i, position, rotation)` with joint i's frame after its
+    /// motion. Returns the tool pose.
+    #[inline]
+    fn walk(&self, q: &[f64], mut visit: impl FnMut(usize, &Vector3<f64>, &Matrix3<f64>)) -> Pose {
+        let (mut sin, mut cos) = ([0.0; MAX_JOINTS], [1.0; MAX_JOINTS]);
+        trig::sin_cos_all(q, &mut sin, &mut cos);
         let mut r = *self.base.rotation.matrix();
         let mut p = self.base.position;
         for (i, ((j, (rest, axis)), v)) in self.joints.iter().zip(&self.turns).zip(q).enumerate() {
             p += r * j.origin;
             rest.apply(&mut r);
-            let before = Pose::new(p, Rotation3::from_matrix_unchecked(r));
-            let world_axis = axis.in_frame(&r);
             match j.kind {
-                JointKind::Rotary => axis.turn(&mut r, *v),
-                JointKind::Linear => p += world_axis * *v,
+                JointKind::Rotary => axis.turn(&mut r, sin[i], cos[i]),
+                JointKind::Linear => p += axis.in_frame(&r) * *v,
             }
-            visit(
-                i,
-                &before,
-                &Pose::new(p, Rotation3::from_matrix_unchecked(r)),
-                &world_axis,
-            );
+            visit(i, &p, &r);
         }
         p += r * self.tool.position;
         r *= self.tool.rotation.matrix();

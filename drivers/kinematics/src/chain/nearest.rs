@@ -15,7 +15,6 @@
 
 use nalgebra::{Matrix3, Vector3, Vector6};
 
-use super::ik::dls_step;
 use super::*;
 use crate::pose::angle_between_rotations;
 
@@ -189,7 +188,7 @@ impl Chain {
                 }
                 checkpoint = cost;
             }
-            let Some(dq) = dls_step(&jac, &e, lambda, n) else {
+            let Some(dq) = Gram::of(&jac, n).step(&jac, &e, lambda, n, 0) else {
                 lambda *= 10.0;
                 continue;
             };

@@ -84,15 +84,18 @@ impl Axis {
         Axis::General(*axis)
     }
 
-    /// `r ← r·Rot(axis, angle)`.
+    /// `r ← r·Rot(axis, angle)`, given the angle's sine `s` and cosine `c`.
     #[inline]
-    pub(super) fn turn(&self, r: &mut Matrix3<f64>, angle: f64) {
+    pub(super) fn turn(&self, r: &mut Matrix3<f64>, s: f64, c: f64) {
         match *self {
-            Axis::Coordinate { a, b, sign, .. } => {
-                let (s, c) = (sign * angle).sin_cos();
-                mix(r, a, b, c, s);
+            Axis::Coordinate { a, b, sign, .. } => mix(r, a, b, c, sign * s),
+            Axis::General(axis) => {
+                // Rodrigues: c·I + s·[u]ₓ + (1 − c)·u·uᵀ.
+                let u = axis.into_inner();
+                let m =
+                    Matrix3::identity() * c + u.cross_matrix() * s + u * u.transpose() * (1.0 - c);
+                *r *= m;
             }
-            Axis::General(axis) => *r *= Rotation3::from_axis_angle(&axis, angle).matrix(),
         }
     }
 
@@ -159,7 +162,8 @@ mod tests {
         ] {
             let axis = Unit::new_normalize(v);
             let mut m = *r.matrix();
-            Axis::of(&axis).turn(&mut m, 0.83);
+            let (s, c) = 0.83f64.sin_cos();
+            Axis::of(&axis).turn(&mut m, s, c);
             let want = r * Rotation3::from_axis_angle(&axis, 0.83);
             assert!(close(&m, want.matrix()), "{v:?}");
             let d = Axis::of(&axis).in_frame(r.matrix()) - r * axis.into_inner();
