@@ -695,6 +695,14 @@ impl<I: Interface> DeviceHost<I> {
     /// Publishes the current state (with a new sequence number, the last command's outcome,
     /// the flags and the overflow count) and notifies waiting clients.
     pub fn publish(&mut self) -> Result<(), PublishError> {
+        self.send_state()?;
+        self.state_sent();
+        Ok(())
+    }
+
+    /// The sending half of [`DeviceHost::publish`]: the header filled in and the sample
+    /// sent, without notifying clients or loaning the next sample.
+    fn send_state(&mut self) -> Result<(), PublishError> {
         self.seq += 1;
         let h = self.state.header_mut();
         h.seq = self.seq;
@@ -709,12 +717,19 @@ impl<I: Interface> DeviceHost<I> {
                 0
             };
         h.cmd_overflows = self.stats.overflows.min(u32::MAX as u64) as u32;
-        self.publish_verbatim()
+        self.send_verbatim()
     }
 
     /// Publishes the state as it is, header included (a relayed device's), and notifies;
     /// then loans the sample of the next publication, off the clients' path.
     pub(crate) fn publish_verbatim(&mut self) -> Result<(), PublishError> {
+        self.send_verbatim()?;
+        self.state_sent();
+        Ok(())
+    }
+
+    /// Sends the state as it is.
+    fn send_verbatim(&mut self) -> Result<(), PublishError> {
         let sample = match self.state_loan.take() {
             Some(s) => s,
             None => self.publisher.loan_uninit().map_err(PublishError::Loan)?,
@@ -724,10 +739,15 @@ impl<I: Interface> DeviceHost<I> {
             .send()
             .map_err(PublishError::Send)?;
         self.stats.published += 1;
+        Ok(())
+    }
+
+    /// After a state was sent (and the outcome or reply it goes with): notifies waiting
+    /// clients, then loans the sample of the next publication, off the clients' path.
+    fn state_sent(&mut self) {
         // A client that waits with a timeout re-checks anyway: counted, not fatal.
         self.notify_clients(qos::EVENT_STATE);
         self.state_loan = loan_ahead(&self.publisher, &self.device, "state");
-        Ok(())
     }
 
     pub(crate) fn commands_port(&self) -> &Subscriber<ipc::Service, I::CmdMsg, ()> {
@@ -863,6 +883,16 @@ impl<I: Interface> DeviceHost<I> {
                 }
                 Err(e) => e.status(),
             };
+            self.outcome = CmdOutcome {
+                client_id: meta.client_id,
+                cmd_seq: meta.seq,
+                kind: meta.kind,
+                status: status.code(),
+            };
+            // The state that shows the command goes out before its outcome: a client that
+            // has seen the outcome and then takes the state sees the command's effect.
+            // (Clients are notified after both.)
+            let state_sent = self.publish_each_outcome.then(|| self.send_state());
             match (status, holder) {
                 (Status::Leased, Some(h)) => self.publish_outcome(
                     (meta.client_id, meta.seq, meta.kind),
@@ -876,15 +906,10 @@ impl<I: Interface> DeviceHost<I> {
             if !status.is_carried_out() {
                 self.stats.refused += 1;
             }
-            self.outcome = CmdOutcome {
-                client_id: meta.client_id,
-                cmd_seq: meta.seq,
-                kind: meta.kind,
-                status: status.code(),
-            };
             n += 1;
-            if self.publish_each_outcome {
-                self.publish()?;
+            if let Some(sent) = state_sent {
+                sent?;
+                self.state_sent();
             }
             // The next command's outcome sample, loaned now rather than on its path.
             if self.outcome_loan.is_none() {
@@ -1139,6 +1164,7 @@ impl<I: Interface> DeviceHost<I> {
         handler: &mut H,
     ) -> Result<usize, ProcessError> {
         let mut n = 0;
+        let mut state_result: Option<Result<(), PublishError>> = None;
         loop {
             let active: ActiveRequest<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()> =
                 match self.server.receive() {
@@ -1155,7 +1181,9 @@ impl<I: Interface> DeviceHost<I> {
                 received_ns: monotonic_ns(),
             };
             let holder = self.lease.filter(|l| l.client_id != meta.client_id);
-            let reply = match I::Request::read(raw) {
+            let parsed = I::Request::read(raw);
+            let mutating = !matches!(&parsed, Ok(r) if r.is_read_only());
+            let reply = match parsed {
                 Ok(req) if holder.is_some() && !req.is_read_only() => {
                     self.stats.leased_refusals += 1;
                     Err(Status::Leased)
@@ -1163,6 +1191,14 @@ impl<I: Interface> DeviceHost<I> {
                 Ok(req) => handler.request(&req, &origin, &mut self.state),
                 Err(e) => Err(e.status()),
             };
+            // What a request that may change the device (power, brakes, ...) did is in
+            // the state sent before its reply, as for commands (the first failure kept).
+            if mutating && self.publish_each_outcome {
+                let sent = self.send_state();
+                if !matches!(state_result, Some(Err(_))) {
+                    state_result = Some(sent);
+                }
+            }
             let sent = match active.loan_uninit() {
                 Ok(loan) => {
                     let mut resp = loan.write_payload(I::ReplyMsg::default());
@@ -1192,9 +1228,14 @@ impl<I: Interface> DeviceHost<I> {
             n += 1;
             self.notify_clients(qos::EVENT_REPLY);
         }
-        // What a request changed (power, ...) is visible in the state at once.
-        if n > 0 && self.publish_each_outcome {
-            self.publish()?;
+        match state_result {
+            Some(sent) => {
+                sent?;
+                self.state_sent();
+            }
+            // A read-only request's state, as before: the latest, published at once.
+            None if n > 0 && self.publish_each_outcome => self.publish()?,
+            None => {}
         }
         Ok(n)
     }

@@ -26,7 +26,8 @@ pub struct Outcome {
     /// ([`Status::Preempted`]) or the one holding the device ([`Status::Leased`]); 0 if
     /// none.
     pub other_client: u64,
-    /// When the driver published it (`CLOCK_MONOTONIC` ns; 0 for none yet).
+    /// When the driver published it (`CLOCK_MONOTONIC` ns; 0 for none yet); taken from
+    /// the state that showed the command, that state's acquisition stamp.
     pub stamp_ns: u64,
     other_name: [u8; 32],
 }
@@ -39,6 +40,17 @@ impl Outcome {
         stamp_ns: 0,
         other_name: [0; 32],
     };
+
+    /// An outcome as a state showed it (`StateHeader::last_cmd`): no other client, the
+    /// state's acquisition stamp.
+    pub(super) fn shown(seq: u64, status: Status, stamp_ns: u64) -> Self {
+        Outcome {
+            seq,
+            status,
+            stamp_ns,
+            ..Outcome::NONE
+        }
+    }
 
     pub(super) fn from_msg(m: &OutcomeMsg) -> Self {
         Outcome {

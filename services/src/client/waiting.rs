@@ -51,19 +51,51 @@ impl<I: Interface> Client<I> {
 
     /// Takes every state sample that arrived; returns true if there was a new one.
     pub fn refresh(&mut self) -> Result<bool, WaitError> {
+        // Outcomes first: a driver sends the state that shows a command before the
+        // command's outcome, so the states taken after an outcome include that one.
+        self.take_outcomes()?;
+        self.take_states()
+    }
+
+    /// Takes every state sample that arrived; returns true if there was a new one. A
+    /// state that shows one of this client's commands (`last_cmd`) gives that command's
+    /// outcome: a limber driver sends it before the outcome message, which follows with
+    /// the details (the holder of a lease, when refused as [`Status::Leased`]: waited for).
+    fn take_states(&mut self) -> Result<bool, WaitError> {
         let mut got = false;
         loop {
             match self.states.receive() {
                 Ok(Some(s)) => {
+                    let data: &I::Data = &s;
+                    let h = data.header();
+                    let (last, stamp_ns) = (h.last_cmd, h.stamp_ns);
                     self.latest = Some(s);
                     got = true;
+                    if last.client_id == self.client_id && last.cmd_seq != 0 {
+                        self.outcome_shown(last, stamp_ns);
+                    }
                 }
                 Ok(None) => break,
                 Err(e) => return Err(WaitError::Transport(e.into())),
             }
         }
-        self.take_outcomes()?;
         Ok(got)
+    }
+
+    /// Records the outcome of this client's command `last` as a state showed it, unless
+    /// it is known already or needs the outcome message's details.
+    fn outcome_shown(&mut self, last: CmdOutcome, stamp_ns: u64) {
+        let slot = (last.cmd_seq as usize) % OUTCOME_SLOTS;
+        if self.outcomes[slot].seq == last.cmd_seq {
+            return;
+        }
+        match Status::try_from(last.status) {
+            Ok(Status::Leased) | Err(_) => {}
+            Ok(status) => {
+                self.outcomes[slot] = Outcome::shown(last.cmd_seq, status, stamp_ns);
+                self.max_seen_seq = self.max_seen_seq.max(last.cmd_seq);
+            }
+        }
     }
 
     /// Takes the outcomes that arrived, keeping this client's own.
@@ -88,6 +120,14 @@ impl<I: Interface> Client<I> {
                 Err(e) => return Err(WaitError::Transport(e.into())),
             }
         }
+    }
+
+    /// Whether the latest state shows this client's command `seq` (or a later one of its).
+    fn latest_shows(&self, seq: u64) -> bool {
+        self.latest.as_deref().is_some_and(|d| {
+            let l = d.header().last_cmd;
+            l.client_id == self.client_id && l.cmd_seq >= seq
+        })
     }
 
     /// Whether the motion that the command of `ticket` started was cut short by another
@@ -177,6 +217,9 @@ impl<I: Interface> Client<I> {
     }
 
     /// Waits for the outcome of the command of `ticket`, as published by the driver.
+    /// When it returns, the latest state ([`Client::last_state`], [`Client::state`])
+    /// shows the command: a limber driver sends that state before the outcome message,
+    /// and the outcome is taken from whichever comes first.
     pub fn wait_outcome(&mut self, ticket: Ticket, timeout: Duration) -> Result<Status, WaitError> {
         self.wait_outcome_detail(ticket, timeout).map(|o| o.status)
     }
@@ -193,9 +236,20 @@ impl<I: Interface> Client<I> {
         let mut next_check = start + LIVENESS_PERIOD;
         let mut polls = 0u32;
         loop {
-            self.refresh()?;
-            let o = self.outcomes[(ticket.seq as usize) % OUTCOME_SLOTS];
+            // The state that shows the command comes first, then the outcome message.
+            let seen = self.take_states()?;
+            let slot = (ticket.seq as usize) % OUTCOME_SLOTS;
+            if self.outcomes[slot].seq == ticket.seq {
+                return Ok(self.outcomes[slot]);
+            }
+            self.take_outcomes()?;
+            let o = self.outcomes[slot];
             if o.seq == ticket.seq {
+                // Known from the message alone (a state overwritten before it was taken,
+                // or sent after it by a driver that is not limber's): the states again.
+                if !seen && !self.latest_shows(ticket.seq) {
+                    self.take_states()?;
+                }
                 return Ok(o);
             }
             // Commands of one client are applied in order: an outcome of a later one
