@@ -12,8 +12,8 @@ use std::io;
 use std::os::unix::fs::MetadataExt;
 use std::time::{Duration, Instant};
 
-use iceoryx2::prelude::{CallbackProgression, Node, NodeState, ipc};
 use iceoryx2::node::{NodeListFailure, NodeView};
+use iceoryx2::prelude::{CallbackProgression, Node, NodeState, ipc};
 use thiserror::Error;
 
 use crate::domain_dir::{self, DomainError};
@@ -160,7 +160,10 @@ mod tests {
         assert!(in_use.iter().all(|p| p.exists()), "all kept: {in_use:?}");
         drop(ctx);
         assert!(remove_domain_files(&domain).unwrap() > 0);
-        assert_eq!(domain_dir::files_of(domain.name(), &files), Vec::<std::path::PathBuf>::new());
+        assert_eq!(
+            domain_dir::files_of(domain.name(), &files),
+            Vec::<std::path::PathBuf>::new()
+        );
         assert!(in_use.iter().all(|p| !p.exists()), "all gone: {in_use:?}");
     }
 }

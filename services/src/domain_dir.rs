@@ -534,7 +534,11 @@ pub fn files_of(domain: &str, files: &DomainFiles) -> Vec<PathBuf> {
     out.extend(with_prefix(&files.root));
     out.extend(with_prefix(&files.root.join("services")));
     let nodes = files.root.join("nodes");
-    for node in fs::read_dir(&nodes).into_iter().flatten().filter_map(Result::ok) {
+    for node in fs::read_dir(&nodes)
+        .into_iter()
+        .flatten()
+        .filter_map(Result::ok)
+    {
         if node.file_type().is_ok_and(|t| t.is_dir()) {
             let ours = with_prefix(&node.path());
             if !ours.is_empty() {

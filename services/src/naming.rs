@@ -120,9 +120,16 @@ impl Domain {
             .duration_since(std::time::UNIX_EPOCH)
             .map_or(0, |d| d.subsec_nanos());
         let name = format!("limber_t{}_{}_{nanos:x}", std::process::id(), n);
-        let mut domain = Domain::new(&name).expect("generated test domain names are valid");
-        domain.remove_on_drop = Some(Arc::new(RemoveOnDrop(name)));
-        domain
+        Domain::for_test(&name).expect("generated test domain names are valid")
+    }
+
+    /// A test's domain of a name the test chose (one made from a [`Domain::unique_for_test`]
+    /// name, for a test that needs several domains): it cleans up after itself as that one
+    /// does.
+    pub fn for_test(name: &str) -> Result<Self, NameError> {
+        let mut domain = Domain::new(name)?;
+        domain.remove_on_drop = Some(Arc::new(RemoveOnDrop(name.to_string())));
+        Ok(domain)
     }
 
     /// The name.

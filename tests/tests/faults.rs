@@ -317,7 +317,11 @@ fn a_driver_killed_in_the_middle_of_a_request_is_reported_and_new_clients_find_i
 /// Every path under `dir` (recursively) whose name contains `token`.
 fn named_with(dir: &std::path::Path, token: &str) -> Vec<PathBuf> {
     let mut out = Vec::new();
-    for e in std::fs::read_dir(dir).into_iter().flatten().filter_map(Result::ok) {
+    for e in std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .filter_map(Result::ok)
+    {
         if e.file_name().to_string_lossy().contains(token) {
             out.push(e.path());
         }
