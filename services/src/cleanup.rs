@@ -3,7 +3,7 @@
 //! A process that ends normally removes its own iceoryx2 files; one that is killed leaves
 //! them, and they stay until a process of the same domain cleans up after it. A test's
 //! domain ([`Domain::unique_for_test`]) is never joined again, so each one removes its
-//! files when its last handle is dropped ([`remove_when_idle`]): the files of the processes
+//! files when its last handle is dropped ([`remove_domain_files`]): the files of the processes
 //! the test killed, the node counter iceoryx2 leaves in `/dev/shm`, and the domain's token.
 //! A test run thus leaves nothing in the runtime directory or in `/dev/shm`.
 
