@@ -290,7 +290,7 @@ mod tests {
     fn a_pause_whose_end_has_come_returns_at_once() {
         let (tx, rx) = std::sync::mpsc::channel();
         // Its own thread: a pause that blocks for good fails the test instead of hanging it.
-        std::thread::spawn(move || {
+        let t = std::thread::spawn(move || {
             let domain = Domain::unique_for_test();
             let ctx = Context::new(&domain, Role::Driver, "pause").unwrap();
             let _driver = TestDriver::new(&ctx, "pause", 2).unwrap();
@@ -306,5 +306,7 @@ mod tests {
         });
         rx.recv_timeout(Duration::from_secs(30))
             .expect("a pause ending now returned");
+        // The thread's domain removes its files as the thread ends: before this process does.
+        t.join().unwrap();
     }
 }
