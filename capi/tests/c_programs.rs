@@ -737,6 +737,8 @@ fn a_handle_sees_its_driver_go() {
         assert_eq!(limber_actarray_liveness(h, 5000, &mut live), LimberCode::Ok);
     }
     assert_eq!(live, LimberLiveness::Alive);
+    // The domain outlives the driver: its files go once the handle is disconnected too.
+    let _domain = p.domain.clone();
     drop(p);
     // SAFETY: as above; the handle is live until disconnected.
     unsafe {

@@ -306,8 +306,11 @@ fn verb(args: &[String]) -> (Option<&str>, Option<&str>) {
 
 /// A shell session: a domain of its own and the background jobs.
 struct Session {
-    domain: Domain,
+    /// First: the jobs end before the domains, which then remove their files.
     jobs: Vec<Job>,
+    domain: Domain,
+    /// The domains of `--domain NAME`.
+    named: Vec<Domain>,
     pioneer: bool,
     simarm: bool,
 }
@@ -315,8 +318,9 @@ struct Session {
 impl Session {
     fn new() -> Session {
         Session {
-            domain: Domain::unique_for_test(),
             jobs: Vec::new(),
+            domain: Domain::unique_for_test(),
+            named: Vec::new(),
             pioneer: false,
             simarm: false,
         }
@@ -344,18 +348,26 @@ impl Session {
     }
 
     /// `--domain NAME` becomes a domain of this session's own.
-    fn own_domains(&self, args: Vec<String>) -> Vec<String> {
+    fn own_domains(&mut self, args: Vec<String>) -> Vec<String> {
         let mut out = Vec::with_capacity(args.len());
         let mut it = args.into_iter();
         while let Some(a) = it.next() {
-            let own = |n: &str| format!("{}_{n}", self.domain.name());
+            let mut own = |n: &str| {
+                let name = format!("{}_{n}", self.domain.name());
+                if !self.named.iter().any(|d| d.name() == name) {
+                    // A bad name stays as it is: the command reports it.
+                    self.named.extend(Domain::for_test(&name).ok());
+                }
+                name
+            };
             if a == "--domain" {
                 out.push(a);
                 if let Some(n) = it.next() {
                     out.push(own(&n));
                 }
             } else if let Some(n) = a.strip_prefix("--domain=") {
-                out.push(format!("--domain={}", own(n)));
+                let n = own(n);
+                out.push(format!("--domain={n}"));
             } else {
                 out.push(a);
             }

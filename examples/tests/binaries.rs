@@ -19,8 +19,11 @@ const RUN_TIMEOUT: Duration = Duration::from_secs(60);
 fn driver(domain: &Domain) -> mpsc::Sender<()> {
     let (tx, rx) = mpsc::channel::<()>();
     let (ready_tx, ready_rx) = mpsc::channel();
-    let domain = domain.clone();
+    // A handle of its own: the test's, dropped last, then removes the domain's files once
+    // this thread's driver is gone.
+    let name = domain.name().to_string();
     std::thread::spawn(move || {
+        let domain = Domain::new(&name).unwrap();
         let ctx = Context::new(&domain, Role::Driver, "testdriver").unwrap();
         let mut d = TestDriver::new(&ctx, "ex", 6).unwrap();
         ready_tx.send(()).unwrap();

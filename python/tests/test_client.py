@@ -75,30 +75,38 @@ _used_domains = []
 
 
 def unique_domain() -> str:
-    # `limber_t*`, like the Rust tests' domains (.ci/run removes their leftovers).
+    # `limber_t*`, like the Rust tests' domains; their files go at the end of the run
+    # (conftest.py, remove_domain_files).
     d = f"limber_tpy{os.getpid()}_{next(_domains)}"
     _used_domains.append(d)
     return d
 
 
-def remove_global_mgmt(domain):
-    """iceoryx2 leaves one 16-byte global_mgmt object per domain in /dev/shm: remove it once
-    no node of the domain is left."""
-    try:
-        prefix = limber.Domain(domain).prefix
-        for f in os.listdir("/dev/shm"):
-            if f.startswith(prefix) and f.endswith("global_mgmt"):
-                os.unlink(os.path.join("/dev/shm", f))
-    except OSError:
-        pass
+def remove_domain_files(domain):
+    """Every file of a test's domain once no process runs in it, as the Rust tests' domains
+    do (limber_services::cleanup, TESTING.md): the files of the drivers a test killed, the
+    node counter iceoryx2 leaves in /dev/shm, the token. A domain with a live node, or
+    without a token (it has no files), is left as it is."""
+    root = limber.Domain(domain).root_path
+    token = os.path.join(os.path.dirname(root.rstrip("/")), f"{domain}.token")
+    if not os.path.exists(token) or any(s == "Alive" for s, _ in node_states(domain)):
+        return
+    prefix = limber.Domain(domain).prefix
+    nodes = os.path.join(root, "nodes")
 
+    def remove_ours(d):
+        for f in os.listdir(d) if os.path.isdir(d) else []:
+            if f.startswith(prefix):
+                os.unlink(os.path.join(d, f))
 
-@pytest.fixture(scope="module", autouse=True)
-def _clean_shm():
-    yield
-    for d in _used_domains:
-        if not node_states(d):
-            remove_global_mgmt(d)
+    for n in os.listdir(nodes) if os.path.isdir(nodes) else []:
+        node = os.path.join(nodes, n)
+        if os.path.isdir(node) and any(f.startswith(prefix) for f in os.listdir(node)):
+            remove_ours(node)
+            os.rmdir(node)
+    for d in ["/dev/shm", root, os.path.join(root, "services"), nodes]:
+        remove_ours(d)
+    os.unlink(token)
 
 
 def state_where(client, pred, timeout=T):
@@ -469,11 +477,12 @@ def test_another_layout_version_or_type_is_incompatible(driver, monkeypatch):
 def test_domain_from_env(monkeypatch):
     monkeypatch.delenv("LIMBER_DOMAIN", raising=False)
     assert limber.Domain().name == "limber"
-    monkeypatch.setenv("LIMBER_DOMAIN", "robot_7")
-    assert limber.Domain().name == "robot_7"
+    robot, other = unique_domain(), unique_domain()
+    monkeypatch.setenv("LIMBER_DOMAIN", robot)
+    assert limber.Domain().name == robot
     assert re.fullmatch(r"limber_[0-9a-f]{16}_", limber.Domain().prefix)
-    assert limber.Domain().prefix == limber.Domain("robot_7").prefix != limber.Domain("x").prefix
-    assert limber.Domain("x").name == "x"
+    assert limber.Domain().prefix == limber.Domain(robot).prefix != limber.Domain(other).prefix
+    assert limber.Domain(other).name == other
 
 
 def test_driver_stopped(own_driver):

@@ -5,7 +5,6 @@ client (iceoryx2) in another domain commands the arm through `limber bridge mirr
 Every wait has a timeout.
 """
 
-import itertools
 import os
 import queue
 import signal
@@ -17,10 +16,11 @@ import time
 
 import pytest
 
+from test_client import unique_domain
+
 REPO = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 EXAMPLE = os.path.join(REPO, "python", "examples", "zenoh_remote.py")
 T = 30.0  # generous: a slow machine only makes the test slower
-_n = itertools.count()
 
 
 def _need(ok, msg):
@@ -93,13 +93,13 @@ def bridge():
         import zenoh  # noqa: F401
     except ImportError:
         _need(False, "eclipse-zenoh is not installed (pip install eclipse-zenoh==1.10.2)")
-    domain = f"limber_tpyz{os.getpid()}_{next(_n)}"
+    domain = unique_domain()
     endpoint = f"tcp/127.0.0.1:{free_port()}"
     driver = Job(domain, "pioneer", "--emulated")
     driver.wait_line(lambda l: l.endswith("ready"))
     expose = Job(domain, "bridge", "expose", "--listen", endpoint)
     expose.wait_line(lambda l: l == "exposed pioneer/actarray/0")
-    mirror_domain = f"limber_tpyz{os.getpid()}_{next(_n)}"
+    mirror_domain = unique_domain()
     mirror = Job(mirror_domain, "bridge", "mirror", "--connect", endpoint)
     mirror.wait_line(lambda l: l == "mirrored pioneer/actarray/0 as pioneer/actarray/0")
     yield endpoint, mirror_domain

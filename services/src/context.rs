@@ -85,8 +85,10 @@ pub enum ContextError {
 }
 
 pub(crate) struct Inner {
-    pub(crate) domain: Domain,
     pub(crate) node: Node<ipc::Service>,
+    /// After the node: dropped last, so a test's domain, whose files go when its last
+    /// handle does ([`Domain::unique_for_test`]), finds this process's node gone.
+    pub(crate) domain: Domain,
     pub(crate) role: Role,
     pub(crate) name: String,
 }

@@ -436,6 +436,12 @@ fn token(dir: &Path, domain: &str, group: Option<&Group>) -> Result<String, Doma
             Err(e) => return Err(io_err("create", &path)(e)),
         }
     }
+    read_token(path, group)
+}
+
+/// The token in the token file `path`, refused when it is not a file of ours (or, in group
+/// mode, of the group's) holding a token.
+fn read_token(path: PathBuf, group: Option<&Group>) -> Result<String, DomainError> {
     let md = fs::symlink_metadata(&path).map_err(io_err("inspect", &path))?;
     if !md.file_type().is_file() {
         return Err(DomainError::BadToken(path));
@@ -484,6 +490,71 @@ pub fn prepare(domain: &str) -> Result<DomainFiles, DomainError> {
         prefix,
         group,
     })
+}
+
+/// Where the files of `domain` are, when it has any: like [`prepare`], but creates nothing
+/// (None: the domain has no token, so no file of it exists).
+pub fn existing(domain: &str) -> Result<Option<DomainFiles>, DomainError> {
+    let group = group_from_env()?;
+    let dir = runtime_dir_for(group.as_ref());
+    let path = dir.join(format!("{domain}.token"));
+    if fs::symlink_metadata(&path).is_err() {
+        return Ok(None);
+    }
+    let token = read_token(path, group.as_ref())?;
+    let mut root = dir.join("iceoryx2").into_os_string();
+    root.push("/");
+    Ok(Some(DomainFiles {
+        root: PathBuf::from(root),
+        prefix: format!("limber_{token}_"),
+        group,
+    }))
+}
+
+/// Every file of the domain named `domain` whose files are `files`, as found now: its
+/// segments in `/dev/shm`, its event sockets under the iceoryx2 root, its static service
+/// configurations under `services/`, the files of its nodes under `nodes/<id>/` and those
+/// directories themselves (listed after their files), the nodes' monitors in `nodes/`, and
+/// its token last. Only names with
+/// the domain's prefix are listed (a node directory, named by the node's id, when the
+/// files in it have the prefix), so no other domain's file is ever among them.
+pub fn files_of(domain: &str, files: &DomainFiles) -> Vec<PathBuf> {
+    let prefix = files.prefix.as_str();
+    let with_prefix = |dir: &Path| -> Vec<PathBuf> {
+        fs::read_dir(dir)
+            .map(|rd| {
+                rd.filter_map(Result::ok)
+                    .filter(|e| e.file_name().to_string_lossy().starts_with(prefix))
+                    .map(|e| e.path())
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let mut out = with_prefix(Path::new(SHM_DIR));
+    out.extend(with_prefix(&files.root));
+    out.extend(with_prefix(&files.root.join("services")));
+    let nodes = files.root.join("nodes");
+    for node in fs::read_dir(&nodes)
+        .into_iter()
+        .flatten()
+        .filter_map(Result::ok)
+    {
+        if node.file_type().is_ok_and(|t| t.is_dir()) {
+            let ours = with_prefix(&node.path());
+            if !ours.is_empty() {
+                out.extend(ours);
+                out.push(node.path());
+            }
+        }
+    }
+    // The nodes' monitors, after their directories.
+    out.extend(with_prefix(&nodes));
+    let token = files
+        .root
+        .parent()
+        .map(|rt| rt.join(format!("{domain}.token")));
+    out.extend(token.filter(|t| fs::symlink_metadata(t).is_ok()));
+    out
 }
 
 /// The `global_mgmt` files of the domain with `prefix` in `/dev/shm`.

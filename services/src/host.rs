@@ -362,8 +362,6 @@ pub(crate) fn loan_ahead<T: core::fmt::Debug + ZeroCopySend>(
 /// in place, commands and requests are read in place.
 pub struct DeviceHost<I: Interface> {
     device: DeviceName,
-    /// The domain (group mode decides whose dead processes this host may clean up).
-    domain: crate::naming::Domain,
     data_svc:
         iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, I::Data, ()>,
     publisher: Publisher<ipc::Service, I::Data, ()>,
@@ -398,6 +396,9 @@ pub struct DeviceHost<I: Interface> {
     /// An outcome sample loaned ahead, for the next command's outcome.
     outcome_loan: Option<SampleMutUninit<ipc::Service, MaybeUninit<OutcomeMsg>, ()>>,
     _i: PhantomData<I>,
+    /// The domain (group mode decides whose dead processes this host may clean up). Last:
+    /// dropped after the ports, so a test's domain whose last handle this is finds them gone.
+    domain: crate::naming::Domain,
 }
 
 impl<I: Interface> core::fmt::Debug for DeviceHost<I> {

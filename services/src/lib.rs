@@ -68,6 +68,7 @@
 
 #![warn(missing_docs)]
 
+pub mod cleanup;
 pub mod client;
 pub mod context;
 pub mod device_set;

@@ -58,6 +58,19 @@ pub struct Domain {
     name: String,
     /// The iceoryx2 configuration, made on first use (it needs the domain's files).
     config: Arc<OnceLock<Resolved>>,
+    /// A test's domain ([`Domain::unique_for_test`]): removes the domain's files when the
+    /// last clone is dropped.
+    remove_on_drop: Option<Arc<RemoveOnDrop>>,
+}
+
+/// Removes the files of a test's domain when dropped ([`crate::cleanup`]).
+#[derive(Debug)]
+struct RemoveOnDrop(String);
+
+impl Drop for RemoveOnDrop {
+    fn drop(&mut self) {
+        crate::cleanup::remove_when_idle(&self.0, crate::cleanup::IDLE_WAIT);
+    }
 }
 
 /// A domain's iceoryx2 configuration, prefix and group, made once.
@@ -78,6 +91,7 @@ impl Domain {
         Ok(Domain {
             name: name.to_string(),
             config: Arc::new(OnceLock::new()),
+            remove_on_drop: None,
         })
     }
 
@@ -89,8 +103,13 @@ impl Domain {
         }
     }
 
-    /// A fresh domain for one test: `limber_t<pid>_<n>`, unique on this machine while this
-    /// process lives.
+    /// A fresh domain for one test: `limber_t<pid>_<n>_<nanos>`, unique on this machine.
+    ///
+    /// It cleans up after itself: when its last clone is dropped, once no process runs in it
+    /// any more (waiting a few seconds at most for processes just killed or told to stop),
+    /// every file of the domain is removed, those of processes the test killed included
+    /// ([`crate::cleanup::remove_domain_files`]). Keep it alive for as long as the test uses
+    /// the domain, also when only its name is handed to other processes.
     pub fn unique_for_test() -> Self {
         static N: AtomicU32 = AtomicU32::new(0);
         let n = N.fetch_add(1, Ordering::Relaxed);
@@ -101,7 +120,16 @@ impl Domain {
             .duration_since(std::time::UNIX_EPOCH)
             .map_or(0, |d| d.subsec_nanos());
         let name = format!("limber_t{}_{}_{nanos:x}", std::process::id(), n);
-        Domain::new(&name).expect("generated test domain names are valid")
+        Domain::for_test(&name).expect("generated test domain names are valid")
+    }
+
+    /// A test's domain of a name the test chose (one made from a [`Domain::unique_for_test`]
+    /// name, for a test that needs several domains): it cleans up after itself as that one
+    /// does.
+    pub fn for_test(name: &str) -> Result<Self, NameError> {
+        let mut domain = Domain::new(name)?;
+        domain.remove_on_drop = Some(Arc::new(RemoveOnDrop(name.to_string())));
+        Ok(domain)
     }
 
     /// The name.

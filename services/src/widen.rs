@@ -377,7 +377,7 @@ pub fn remove_orphans(prefix: &str, root: &Path) -> usize {
 }
 
 /// Whether the node directory of node `id` under `root` belongs to this process's user.
-fn node_is_mine(root: &Path, id: u128) -> bool {
+pub(crate) fn node_is_mine(root: &Path, id: u128) -> bool {
     fs::symlink_metadata(root.join("nodes").join(id.to_string())).is_ok_and(|md| md.uid() == euid())
 }
 

@@ -24,13 +24,14 @@ fn free_port() -> u16 {
         .expect("a free loopback port")
 }
 
+/// The processes first: they end before the domains, which then remove their files.
 struct Setup {
-    a: Domain,
-    b: Domain,
-    endpoint: String,
     driver: Proc,
     expose: Proc,
     mirror: Proc,
+    a: Domain,
+    b: Domain,
+    endpoint: String,
 }
 
 fn start_driver(a: &Domain) -> Proc {
@@ -74,12 +75,12 @@ fn setup() -> Setup {
     let expose = start_expose(&a, &endpoint);
     let mirror = start_mirror(&b, &endpoint);
     Setup {
-        a,
-        b,
-        endpoint,
         driver,
         expose,
         mirror,
+        a,
+        b,
+        endpoint,
     }
 }
 

@@ -313,3 +313,70 @@ fn a_driver_killed_in_the_middle_of_a_request_is_reported_and_new_clients_find_i
     assert_eq!(c.wait_timeout(LIMIT), Some(0));
     assert!(c.rest_of_stdout().contains("ok"));
 }
+
+/// Every path under `dir` (recursively) whose name contains `token`.
+fn named_with(dir: &std::path::Path, token: &str) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .filter_map(Result::ok)
+    {
+        if e.file_name().to_string_lossy().contains(token) {
+            out.push(e.path());
+        }
+        if e.file_type().is_ok_and(|t| t.is_dir()) {
+            out.extend(named_with(&e.path(), token));
+        }
+    }
+    out
+}
+
+#[test]
+fn a_test_domain_removes_the_files_of_the_processes_its_test_killed() {
+    let domain = Domain::unique_for_test();
+    let name = domain.name().to_string();
+    let mut driver = start_driver(&domain, &[]);
+    let mut holder = Proc::spawn(CLIENT, &name, &["hold-samples"]);
+    assert!(holder.read_until(|l| l.starts_with("holding ")).is_some());
+    commands_work(&domain, 0.1);
+    for p in [&mut holder, &mut driver] {
+        p.signal(libc::SIGKILL);
+        assert_eq!(p.wait_timeout(T), None);
+    }
+    // The token is the domain's part of every name: in the runtime directory (the token
+    // file, the iceoryx2 files of the domain's processes) and in /dev/shm.
+    let token = domain.prefix().unwrap().trim_end_matches('_').to_string();
+    let runtime = limber_services::domain_dir::runtime_dir();
+    let everywhere = || {
+        let mut v = named_with(&runtime, &token);
+        v.extend(named_with(std::path::Path::new("/dev/shm"), &token));
+        v.extend(named_with(&runtime, &name));
+        v
+    };
+    let before = everywhere();
+    let nodes = runtime.join("iceoryx2").join("nodes");
+    assert!(
+        before.iter().any(|p| p.starts_with(&nodes)),
+        "the killed processes leave their nodes: {before:?}"
+    );
+    assert!(
+        before
+            .iter()
+            .any(|p| p.starts_with("/dev/shm") && !p.to_string_lossy().ends_with(".global_mgmt")),
+        "and their segments: {before:?}"
+    );
+    // The node directories (named by the node's id) of the domain.
+    let node_dirs: std::collections::BTreeSet<PathBuf> = before
+        .iter()
+        .filter_map(|p| p.parent())
+        .filter(|d| d.parent() == Some(nodes.as_path()))
+        .map(PathBuf::from)
+        .collect();
+    assert!(!node_dirs.is_empty(), "{before:?}");
+    drop((holder, driver));
+    drop(domain);
+    assert_eq!(everywhere(), Vec::<PathBuf>::new(), "left behind");
+    let dirs_left: Vec<_> = node_dirs.iter().filter(|d| d.exists()).collect();
+    assert!(dirs_left.is_empty(), "node directories left: {dirs_left:?}");
+}

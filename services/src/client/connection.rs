@@ -51,7 +51,6 @@ type DataSvc<I> = iceoryx2::service::port_factory::publish_subscribe::PortFactor
 /// Reading the state and sending a command allocate nothing; requests allocate nothing
 /// either. Not `Send`: create it on the thread that uses it.
 pub struct Client<I: Interface> {
-    pub(super) ctx: Context,
     pub(crate) device: DeviceName,
     pub(super) client_id: u64,
     pub(crate) data_svc: DataSvc<I>,
@@ -84,6 +83,9 @@ pub struct Client<I: Interface> {
     /// The next command's sample, loaned right after the previous command was sent
     /// (`crate::host::loan_ahead`).
     pub(super) cmd_loan: Option<CmdLoan<I>>,
+    /// Last: dropped after the ports, so a test's domain whose last handle this is finds
+    /// them gone ([`crate::Domain::unique_for_test`]).
+    pub(super) ctx: Context,
 }
 
 /// A command sample loaned ahead of its command.

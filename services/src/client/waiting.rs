@@ -318,11 +318,49 @@ impl<I: Interface> Client<I> {
                     return Ok(());
                 }
                 let left = until.saturating_duration_since(Instant::now());
+                // iceoryx2 waits on a socket with SO_RCVTIMEO, in whole microseconds: less
+                // than one is a timeout of zero, which blocks without end.
+                if left < Duration::from_micros(1) {
+                    return Ok(());
+                }
                 if let Some(l) = &self.notify {
                     l.timed_wait(|_| {}, left)?;
                 }
                 Ok(())
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use core::time::Duration;
+    use std::time::Instant;
+
+    use crate::testing::TestDriver;
+    use crate::{ActArrayClient, Context, Domain, Role};
+
+    #[test]
+    fn a_pause_whose_end_has_come_returns_at_once() {
+        let (tx, rx) = std::sync::mpsc::channel();
+        // Its own thread: a pause that blocks for good fails the test instead of hanging it.
+        let t = std::thread::spawn(move || {
+            let domain = Domain::unique_for_test();
+            let ctx = Context::new(&domain, Role::Driver, "pause").unwrap();
+            let _driver = TestDriver::new(&ctx, "pause", 2).unwrap();
+            let mut arm =
+                ActArrayClient::connect_timeout(&ctx, "pause/actarray/0", Duration::from_secs(5))
+                    .unwrap();
+            arm.spin_until = None;
+            for _ in 0..3 {
+                // The first one makes the listener; the others wait on it.
+                arm.pause(Instant::now()).unwrap();
+            }
+            tx.send(()).unwrap();
+        });
+        rx.recv_timeout(Duration::from_secs(30))
+            .expect("a pause ending now returned");
+        // The thread's domain removes its files as the thread ends: before this process does.
+        t.join().unwrap();
     }
 }

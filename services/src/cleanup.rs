@@ -1,0 +1,169 @@
+//! Removing a domain's files once nothing runs in it.
+//!
+//! A process that ends normally removes its own iceoryx2 files; one that is killed leaves
+//! them, and they stay until a process of the same domain cleans up after it. A test's
+//! domain ([`Domain::unique_for_test`]) is never joined again, so each one removes its
+//! files when its last handle is dropped ([`remove_domain_files`]): the files of the processes
+//! the test killed, the node counter iceoryx2 leaves in `/dev/shm`, and the domain's token.
+//! A test run thus leaves nothing in the runtime directory or in `/dev/shm`.
+
+use std::fs;
+use std::io;
+use std::os::unix::fs::MetadataExt;
+use std::time::{Duration, Instant};
+
+use iceoryx2::node::{NodeListFailure, NodeView};
+use iceoryx2::prelude::{CallbackProgression, Node, NodeState, ipc};
+use thiserror::Error;
+
+use crate::domain_dir::{self, DomainError};
+use crate::naming::Domain;
+
+/// The files of a domain could not be removed.
+#[derive(Debug, Error)]
+pub enum RemoveError {
+    /// The domain's files could not be found, or are not this user's.
+    #[error(transparent)]
+    Domain(#[from] DomainError),
+    /// iceoryx2 could not list the processes of the domain.
+    #[error("cannot list the processes of domain {domain}: {source}")]
+    List {
+        /// The domain.
+        domain: String,
+        /// iceoryx2's error.
+        #[source]
+        source: NodeListFailure,
+    },
+    /// Processes still run in the domain: its files are theirs.
+    #[error("{alive} process(es) still run in domain {domain}: stop them first")]
+    Alive {
+        /// The domain.
+        domain: String,
+        /// How many of its iceoryx2 nodes are alive.
+        alive: usize,
+    },
+}
+
+/// Removes every file of `domain` when no process runs in it: first the resources of its
+/// dead processes, as iceoryx2 removes them, then what is left of the domain
+/// ([`domain_dir::files_of`]: the node counter in `/dev/shm`, the files of processes
+/// iceoryx2 could not clean up, the token). Only this user's files are removed (in group
+/// mode the other members' stay theirs). Returns how many files and directories were
+/// removed; a domain without files (no token) is left as it is, and nothing is created.
+pub fn remove_domain_files(domain: &Domain) -> Result<usize, RemoveError> {
+    let Some(files) = domain_dir::existing(domain.name())? else {
+        return Ok(0);
+    };
+    // The token exists: this reads it, it does not make one.
+    let config = domain.config()?;
+    let mut alive = 0;
+    let mut dead = Vec::new();
+    Node::<ipc::Service>::list(config, |n| {
+        match n {
+            NodeState::Alive(_) => alive += 1,
+            NodeState::Dead(v) if crate::widen::node_is_mine(&files.root, v.id().value()) => {
+                dead.push(v);
+            }
+            _ => {}
+        }
+        CallbackProgression::Continue
+    })
+    .map_err(|source| RemoveError::List {
+        domain: domain.name().to_string(),
+        source,
+    })?;
+    for v in dead {
+        if let Err(e) = v.blocking_remove_stale_resources(Duration::ZERO) {
+            tracing::debug!(error = ?e, "cannot clean up after a dead process of the domain");
+        }
+    }
+    if alive > 0 {
+        return Err(RemoveError::Alive {
+            domain: domain.name().to_string(),
+            alive,
+        });
+    }
+    let me = domain_dir::euid();
+    let mut removed = 0;
+    for path in domain_dir::files_of(domain.name(), &files) {
+        let Ok(md) = fs::symlink_metadata(&path) else {
+            continue;
+        };
+        if md.uid() != me {
+            continue;
+        }
+        let r = if md.is_dir() {
+            fs::remove_dir(&path)
+        } else {
+            fs::remove_file(&path)
+        };
+        match r {
+            Ok(()) => removed += 1,
+            Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+            Err(e) => {
+                tracing::warn!(path = %path.display(), error = %e, "cannot remove a file of the domain");
+            }
+        }
+    }
+    Ok(removed)
+}
+
+/// How long a test's domain, when its last handle is dropped, waits for the processes
+/// still in it to end (a child just killed, a driver thread just told to stop) before it
+/// leaves their files.
+pub(crate) const IDLE_WAIT: Duration = Duration::from_secs(5);
+
+/// Removes the files of the domain `name` ([`remove_domain_files`]) as soon as no process
+/// runs in it, waiting at most `wait` for that; logs what it cannot remove.
+pub(crate) fn remove_when_idle(name: &str, wait: Duration) {
+    let Ok(domain) = Domain::new(name) else {
+        return;
+    };
+    let deadline = Instant::now() + wait;
+    loop {
+        match remove_domain_files(&domain) {
+            Ok(_) => return,
+            Err(RemoveError::Alive { .. }) if Instant::now() < deadline => {
+                std::thread::sleep(Duration::from_millis(10));
+            }
+            Err(e) => {
+                tracing::warn!(domain = name, error = %e, "a test's domain keeps its files");
+                return;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Context, Role};
+
+    #[test]
+    fn a_domain_in_use_keeps_its_files_and_an_idle_one_loses_them_all() {
+        let domain = Domain::new(&format!("limber_cleanup{}", std::process::id())).unwrap();
+        assert_eq!(remove_domain_files(&domain).unwrap(), 0, "no token yet");
+        assert!(
+            domain_dir::existing(domain.name()).unwrap().is_none(),
+            "nothing was made"
+        );
+        let ctx = Context::new(&domain, Role::Client, "cleanup").unwrap();
+        let files = domain_dir::existing(domain.name()).unwrap().unwrap();
+        let in_use = domain_dir::files_of(domain.name(), &files);
+        assert!(
+            matches!(
+                remove_domain_files(&domain),
+                Err(RemoveError::Alive { alive: 1, .. })
+            ),
+            "a process runs in it"
+        );
+        assert!(in_use.iter().all(|p| p.exists()), "all kept: {in_use:?}");
+        drop(ctx);
+        assert!(remove_domain_files(&domain).unwrap() > 0);
+        assert_eq!(
+            domain_dir::files_of(domain.name(), &files),
+            Vec::<std::path::PathBuf>::new()
+        );
+        assert!(in_use.iter().all(|p| !p.exists()), "all gone: {in_use:?}");
+    }
+}
