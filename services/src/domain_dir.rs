@@ -521,24 +521,17 @@ pub fn existing(domain: &str) -> Result<Option<DomainFiles>, DomainError> {
 pub fn files_of(domain: &str, files: &DomainFiles) -> Vec<PathBuf> {
     let prefix = files.prefix.as_str();
     let with_prefix = |dir: &Path| -> Vec<PathBuf> {
-        fs::read_dir(dir)
-            .map(|rd| {
-                rd.filter_map(Result::ok)
-                    .filter(|e| e.file_name().to_string_lossy().starts_with(prefix))
-                    .map(|e| e.path())
-                    .collect()
-            })
-            .unwrap_or_default()
+        entries(dir)
+            .into_iter()
+            .filter(|e| e.file_name().to_string_lossy().starts_with(prefix))
+            .map(|e| e.path())
+            .collect()
     };
     let mut out = with_prefix(Path::new(SHM_DIR));
     out.extend(with_prefix(&files.root));
     out.extend(with_prefix(&files.root.join("services")));
     let nodes = files.root.join("nodes");
-    for node in fs::read_dir(&nodes)
-        .into_iter()
-        .flatten()
-        .filter_map(Result::ok)
-    {
+    for node in entries(&nodes) {
         if node.file_type().is_ok_and(|t| t.is_dir()) {
             let ours = with_prefix(&node.path());
             if !ours.is_empty() {
@@ -555,6 +548,26 @@ pub fn files_of(domain: &str, files: &DomainFiles) -> Vec<PathBuf> {
         .map(|rt| rt.join(format!("{domain}.token")));
     out.extend(token.filter(|t| fs::symlink_metadata(t).is_ok()));
     out
+}
+
+/// The entries of `dir`: none when it does not exist; one that cannot be read is logged
+/// and left out (its files stay behind rather than the cleanup failing).
+fn entries(dir: &Path) -> Vec<fs::DirEntry> {
+    let rd = match fs::read_dir(dir) {
+        Ok(rd) => rd,
+        Err(e) if e.kind() == io::ErrorKind::NotFound => return Vec::new(),
+        Err(e) => {
+            tracing::warn!(dir = %dir.display(), error = %e, "cannot list a directory of the domain's files");
+            return Vec::new();
+        }
+    };
+    rd.filter_map(|e| {
+        e.inspect_err(|e| {
+            tracing::warn!(dir = %dir.display(), error = %e, "cannot read an entry of a directory of the domain's files");
+        })
+        .ok()
+    })
+    .collect()
 }
 
 /// The `global_mgmt` files of the domain with `prefix` in `/dev/shm`.

@@ -237,7 +237,7 @@ impl<I: Interface> Client<I> {
         let mut polls = 0u32;
         loop {
             // The state that shows the command comes first, then the outcome message.
-            let seen = self.take_states()?;
+            self.take_states()?;
             let slot = (ticket.seq as usize) % OUTCOME_SLOTS;
             if self.outcomes[slot].seq == ticket.seq {
                 return Ok(self.outcomes[slot]);
@@ -247,7 +247,7 @@ impl<I: Interface> Client<I> {
             if o.seq == ticket.seq {
                 // Known from the message alone (a state overwritten before it was taken,
                 // or sent after it by a driver that is not limber's): the states again.
-                if !seen && !self.latest_shows(ticket.seq) {
+                if !self.latest_shows(ticket.seq) {
                     self.take_states()?;
                 }
                 return Ok(o);
