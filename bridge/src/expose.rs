@@ -430,6 +430,22 @@ impl<I: Interface> Exposed<I> {
     }
 }
 
+/// [`expose_device`] for a device of any interface.
+struct Expose<'a> {
+    allow: &'a Allow,
+    ctx: &'a Context,
+    session: &'a Session,
+    device: &'a DeviceName,
+    tx: &'a Sender<Event>,
+}
+
+impl InterfaceVisitor for Expose<'_> {
+    type Output = Result<Box<dyn ExposedDevice>, String>;
+    fn visit<I: Interface>(self) -> Self::Output {
+        expose_device::<I>(self.allow, self.ctx, self.session, self.device, self.tx)
+    }
+}
+
 fn expose_device<I: Interface>(
     allow: &Allow,
     ctx: &Context,
@@ -734,17 +750,13 @@ impl Exposer<'_> {
                 continue;
             }
             let (ctx, session, tx) = (&self.ctx, self.session, &self.tx);
-            let made = match info.interface() {
-                InterfaceKind::ActArray => {
-                    expose_device::<ActArray>(&config.allow, ctx, session, &info.name, tx)
-                }
-                InterfaceKind::Limb => {
-                    expose_device::<Limb>(&config.allow, ctx, session, &info.name, tx)
-                }
-                InterfaceKind::Gripper => {
-                    expose_device::<Gripper>(&config.allow, ctx, session, &info.name, tx)
-                }
-            };
+            let made = info.interface().visit(Expose {
+                allow: &config.allow,
+                ctx,
+                session,
+                device: &info.name,
+                tx,
+            });
             match made {
                 Ok(d) => {
                     tracing::info!(device = %info.name, "exposed");

@@ -723,18 +723,22 @@ fn a_handle_sees_its_driver_go() {
     let mut data = ActArrayData::default();
     // SAFETY: valid strings, and pointers to locals that outlive the calls.
     unsafe {
-        let c = limber_actarray_connect_checked(
+        let c = limber_device_connect_checked(
             c"pioneer/actarray/0".as_ptr(),
             domain.as_ptr(),
             5000,
             limber_interfaces::LAYOUT_VERSION,
+            LimberInterface::Actarray as i32,
             size_of::<ActArrayData>(),
             size_of::<limber_interfaces::prelude::ActArrayGeom>(),
             &mut h,
         );
         assert_eq!(c, LimberCode::Ok);
-        assert_eq!(limber_actarray_state(h, 5000, &mut data), LimberCode::Ok);
-        assert_eq!(limber_actarray_liveness(h, 5000, &mut live), LimberCode::Ok);
+        assert_eq!(
+            limber_device_state(h, 5000, (&raw mut data).cast(), size_of::<ActArrayData>()),
+            LimberCode::Ok
+        );
+        assert_eq!(limber_device_liveness(h, 5000, &mut live), LimberCode::Ok);
     }
     assert_eq!(live, LimberLiveness::Alive);
     // The domain outlives the driver: its files go once the handle is disconnected too.
@@ -745,20 +749,22 @@ fn a_handle_sees_its_driver_go() {
         // The states published as it stopped, then the news that it is gone.
         let mut c = LimberCode::Ok;
         for _ in 0..100 {
-            c = limber_actarray_wait_state(h, 10_000, &mut data);
+            c = limber_device_wait_state(
+                h,
+                10_000,
+                (&raw mut data).cast(),
+                size_of::<ActArrayData>(),
+            );
             if c != LimberCode::Ok {
                 break;
             }
         }
         assert_eq!(c, LimberCode::DriverGone);
-        assert_eq!(limber_actarray_liveness(h, 0, &mut live), LimberCode::Ok);
+        assert_eq!(limber_device_liveness(h, 0, &mut live), LimberCode::Ok);
         let mut status = LimberDriverStatus::Alive;
-        assert_eq!(
-            limber_actarray_driver_status(h, &mut status),
-            LimberCode::Ok
-        );
+        assert_eq!(limber_device_driver_status(h, &mut status), LimberCode::Ok);
         assert_ne!(status, LimberDriverStatus::Alive);
-        limber_actarray_disconnect(h);
+        limber_device_disconnect(h);
     }
     assert_eq!(live, LimberLiveness::Gone);
 }

@@ -86,9 +86,9 @@ pub mod testing;
 pub mod widen;
 
 pub use client::{
-    ActArrayClient, Client, CommandError, ConnectError, DriverStatus, Freshness, GripperClient,
-    Incompatibility, LeaseError, LeaseHolder, LimbClient, Outcome, RequestError, Ticket, WaitError,
-    WaitMode,
+    ActArrayClient, AnyGeom, Client, CommandError, ConnectError, DeviceClient, DriverStatus,
+    Freshness, GripperClient, Incompatibility, LeaseError, LeaseHolder, LimbClient, Outcome,
+    RequestError, Ticket, WaitError, WaitMode, connect_device,
 };
 pub use context::{Context, ContextError, Role, monotonic_ns};
 pub use device_set::{DeviceError, DeviceSet, DeviceSetHandler, Drain};
@@ -105,8 +105,8 @@ pub use relay::{AnswerError, PendingLease, PendingRelay, RelayedLease, RelayedRe
 /// Everything a driver or client author needs, in one `use`.
 pub mod prelude {
     pub use crate::client::{
-        ActArrayClient, Client, CommandError, ConnectError, DriverStatus, Freshness, GripperClient,
-        LimbClient, RequestError, Ticket, WaitError, WaitMode,
+        ActArrayClient, Client, CommandError, ConnectError, DeviceClient, DriverStatus, Freshness,
+        GripperClient, LimbClient, RequestError, Ticket, WaitError, WaitMode, connect_device,
     };
     pub use crate::context::{Context, Role, monotonic_ns};
     pub use crate::device_set::{DeviceSet, DeviceSetHandler};
