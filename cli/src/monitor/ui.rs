@@ -39,18 +39,19 @@ fn device_lines(d: &Device) -> u16 {
     let Ok(c) = &d.conn else {
         return 1;
     };
-    match c.client.kind() {
-        InterfaceKind::ActArray => {
-            let n = c
-                .state::<ActArray>()
-                .map(|s| s.actuators().len())
-                .filter(|&n| n > 0)
-                .or_else(|| c.geometry::<ActArray>().map(|g| g.actuators().len()))
-                .unwrap_or(0);
-            1 + n.max(1) as u16
-        }
-        InterfaceKind::Limb => 3,
-        InterfaceKind::Gripper => 1,
+    if c.client.kind() == InterfaceKind::ActArray {
+        let n = c
+            .state::<ActArray>()
+            .map(|s| s.actuators().len())
+            .filter(|&n| n > 0)
+            .or_else(|| c.geometry::<ActArray>().map(|g| g.actuators().len()))
+            .unwrap_or(0);
+        1 + n.max(1) as u16
+    } else if c.client.kind() == InterfaceKind::Limb {
+        3
+    } else {
+        // A gripper, and any interface without a panel of its own: one line.
+        1
     }
 }
 
