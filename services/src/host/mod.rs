@@ -24,7 +24,8 @@ use iceoryx2::sample_mut_uninit::SampleMutUninit;
 use limber_interfaces::prelude::*;
 
 use crate::context::monotonic_ns;
-use crate::naming::{DeviceName, Domain};
+use crate::domain::Domain;
+use crate::naming::DeviceName;
 use crate::qos;
 
 mod arbiter;
@@ -353,7 +354,7 @@ impl<I: Interface> DeviceHost<I> {
     /// services (in group mode, of this user's processes only: README, Security). Cheap
     /// enough for a 1 Hz housekeeping tick, not for every cycle.
     pub fn cleanup_dead(&self) {
-        crate::widen::cleanup_dead_nodes(&self.data_svc, &self.domain);
-        crate::widen::cleanup_dead_nodes(&self.lease_svc, &self.domain);
+        self.domain.cleanup_dead_nodes(&self.data_svc);
+        self.domain.cleanup_dead_nodes(&self.lease_svc);
     }
 }

@@ -2,7 +2,6 @@
 
 use core::marker::PhantomData;
 
-use iceoryx2::node::NodeView;
 use iceoryx2::prelude::*;
 use iceoryx2::service::attribute::{AttributeKey, AttributeValue};
 use limber_interfaces::prelude::*;
@@ -83,9 +82,9 @@ impl<I: Interface> DeviceHost<I> {
             .map_err(|e| transport("data", e.into()))?;
         // A live driver already publishing this device: refuse to serve it twice.
         if data_svc.dynamic_config().number_of_publishers() > 0 {
-            crate::widen::cleanup_dead_nodes(&data_svc, ctx.domain());
+            ctx.domain().cleanup_dead_nodes(&data_svc);
             if data_svc.dynamic_config().number_of_publishers() > 0 {
-                if let Some(owner) = dead_node_of_another_user(&data_svc, ctx) {
+                if let Some(owner) = ctx.domain().dead_node_of_another_user(&data_svc) {
                     return Err(HostError::DeadDriverOfAnotherMember { device: dev, owner });
                 }
                 return Err(HostError::AlreadyServed { device: dev });
@@ -218,30 +217,4 @@ impl<I: Interface> DeviceHost<I> {
             _i: PhantomData,
         })
     }
-}
-
-/// In group mode, the user of a dead node of `svc` that belongs to another user (its node
-/// directory is theirs: only they may clean it up), as `user NAME (uid N)`.
-fn dead_node_of_another_user<
-    P: iceoryx2::service::port_factory::PortFactory<Service = ipc::Service>,
->(
-    svc: &P,
-    ctx: &Context,
-) -> Option<String> {
-    use std::os::unix::fs::MetadataExt;
-    ctx.domain().group().ok().flatten()?;
-    let nodes = ctx.domain().root().ok()?.join("nodes");
-    let mut owner = None;
-    if let Err(e) = svc.nodes(|n| {
-        if let NodeState::Dead(v) = &n
-            && let Ok(md) = std::fs::symlink_metadata(nodes.join(v.id().value().to_string()))
-            && md.uid() != crate::domain_dir::euid()
-        {
-            owner = Some(crate::domain_dir::describe_user(md.uid()));
-        }
-        CallbackProgression::Continue
-    }) {
-        tracing::warn!(error = %e, "cannot list the nodes of a device");
-    }
-    owner
 }
