@@ -41,6 +41,7 @@ pub fn run(args: CleanArgs) -> Result<(), CliError> {
     for d in &domains {
         match d.remove_files() {
             Ok(0) => outln!("domain {}: no files", d.name())?,
+            Ok(1) => outln!("domain {}: removed 1 file", d.name())?,
             Ok(n) => outln!("domain {}: removed {n} files", d.name())?,
             Err(e @ RemoveError::Alive { .. }) => {
                 tracing::debug!(domain = d.name(), error = %e, "domain kept");

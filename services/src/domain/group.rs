@@ -271,7 +271,7 @@ pub(crate) fn start(prefix: &str, root: &Path, group: &Group) {
 }
 
 /// Widens, once, every file of the domain with `prefix` (iceoryx2 root `root`) that this
-/// process's user owns (what [`start`]'s thread does as files appear).
+/// process's user owns (what the thread of `start` does as files appear).
 pub fn sweep(prefix: &str, root: &Path, group: &Group) {
     let watch = Watch {
         prefix: prefix.to_string(),
