@@ -40,9 +40,17 @@ pub fn run(args: CleanArgs) -> Result<(), CliError> {
     let mut in_use = Vec::new();
     for d in &domains {
         match d.remove_files() {
-            Ok(0) => outln!("domain {}: no files", d.name())?,
-            Ok(1) => outln!("domain {}: removed 1 file", d.name())?,
-            Ok(n) => outln!("domain {}: removed {n} files", d.name())?,
+            Ok(r) if r.is_nothing() => outln!("domain {}: no files", d.name())?,
+            Ok(r) if r.dead_processes == 0 => {
+                outln!("domain {}: removed {}", d.name(), files(r.files))?;
+            }
+            Ok(r) => outln!(
+                "domain {}: removed the files of {} dead process{}, then {}",
+                d.name(),
+                r.dead_processes,
+                if r.dead_processes == 1 { "" } else { "es" },
+                files(r.files)
+            )?,
             Err(e @ RemoveError::Alive { .. }) => {
                 tracing::debug!(domain = d.name(), error = %e, "domain kept");
                 in_use.push(e.to_string());
@@ -65,4 +73,13 @@ pub fn run(args: CleanArgs) -> Result<(), CliError> {
             in_use.join("; ")
         ),
     ))
+}
+
+/// `1 file`, `N files`.
+fn files(n: usize) -> String {
+    if n == 1 {
+        "1 file".to_string()
+    } else {
+        format!("{n} files")
+    }
 }

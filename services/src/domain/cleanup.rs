@@ -49,6 +49,24 @@ pub enum RemoveError {
     },
 }
 
+/// What [`remove`] removed.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Removed {
+    /// Dead processes of the domain whose resources iceoryx2 removed (their segments,
+    /// ports and node directories).
+    pub dead_processes: usize,
+    /// The files and directories removed after that ([`dir::files_of`]: the node counter,
+    /// what iceoryx2 could not clean up, the token).
+    pub files: usize,
+}
+
+impl Removed {
+    /// Nothing was there.
+    pub fn is_nothing(&self) -> bool {
+        self.dead_processes == 0 && self.files == 0
+    }
+}
+
 /// Removes every file of `domain` when no process runs in it: first the resources of its
 /// dead processes, as iceoryx2 removes them, then what is left of the domain
 /// ([`dir::files_of`]: the node counter in `/dev/shm`, the files of processes
@@ -56,8 +74,13 @@ pub enum RemoveError {
 /// mode the other members' stay theirs). Returns how many files and directories were
 /// removed; a domain without files (no token) is left as it is, and nothing is created.
 pub fn remove_domain_files(domain: &Domain) -> Result<usize, RemoveError> {
+    remove(domain).map(|r| r.files)
+}
+
+/// [`remove_domain_files`], saying also how many dead processes were cleaned up after.
+pub fn remove(domain: &Domain) -> Result<Removed, RemoveError> {
     let Some(files) = dir::existing(domain.name())? else {
-        return Ok(0);
+        return Ok(Removed::default());
     };
     // The token exists: this reads it, it does not make one.
     let config = domain.config()?;
@@ -77,9 +100,13 @@ pub fn remove_domain_files(domain: &Domain) -> Result<usize, RemoveError> {
         domain: domain.name().to_string(),
         source,
     })?;
+    let mut dead_processes = 0;
     for v in dead {
-        if let Err(e) = v.blocking_remove_stale_resources(Duration::ZERO) {
-            tracing::debug!(error = ?e, "cannot clean up after a dead process of the domain");
+        match v.blocking_remove_stale_resources(Duration::ZERO) {
+            Ok(_) => dead_processes += 1,
+            Err(e) => {
+                tracing::debug!(error = ?e, "cannot clean up after a dead process of the domain");
+            }
         }
     }
     if !processes.is_empty() {
@@ -111,7 +138,10 @@ pub fn remove_domain_files(domain: &Domain) -> Result<usize, RemoveError> {
             }
         }
     }
-    Ok(removed)
+    Ok(Removed {
+        dead_processes,
+        files: removed,
+    })
 }
 
 /// `NODE (pid N)` for a live node (`a process` when its details cannot be read).

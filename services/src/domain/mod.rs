@@ -28,7 +28,7 @@ pub mod cleanup;
 pub mod dir;
 pub mod group;
 
-pub use cleanup::RemoveError;
+pub use cleanup::{RemoveError, Removed};
 pub use dir::{DomainError, DomainFiles, Group};
 
 /// A domain: the set of devices and clients that can see each other.
@@ -248,9 +248,9 @@ impl Domain {
     }
 
     /// Removes every file of the domain when no process runs in it (`limber clean`): see
-    /// [`cleanup::remove_domain_files`]. Returns how many files and directories went.
-    pub fn remove_files(&self) -> Result<usize, RemoveError> {
-        cleanup::remove_domain_files(self)
+    /// [`cleanup::remove_domain_files`].
+    pub fn remove_files(&self) -> Result<Removed, RemoveError> {
+        cleanup::remove(self)
     }
 }
 
