@@ -1,7 +1,7 @@
 //! Every documented command runs as a test (issue 13 item 7), like rustdoc's doctests:
 //! each shell command in a fenced `sh` block of README.md, examples/**/README.md,
-//! python/README.md and TESTING.md, and the example of each verb's `--help`, runs as written against the
-//! emulated Pioneer or simarm, in a domain of its own, with a bounded time.
+//! python/README.md and TESTING.md, and the example of each verb's `--help`, runs as written
+//! against the emulated Pioneer or simarm, in a domain of its own, with a bounded time.
 //!
 //! How a command is run:
 //!

@@ -7,7 +7,8 @@ use thiserror::Error;
 use crate::error::Iox2Error;
 use crate::naming::NameError;
 
-/// Offering a device failed ([`DeviceHost::new`](super::DeviceHost::new), [`crate::DeviceSet::new`]).
+/// Offering a device failed ([`DeviceHost::new`](super::DeviceHost::new),
+/// [`crate::DeviceSet::new`]).
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
 pub enum HostError {
     /// The device name is invalid (a robot name made of other characters, ...).
@@ -74,7 +75,8 @@ pub enum PublishError {
     Send(#[source] SendError),
 }
 
-/// Receiving commands or requests failed ([`DeviceHost::process`](super::DeviceHost::process) and its variants).
+/// Receiving commands or requests failed
+/// ([`DeviceHost::process`](super::DeviceHost::process) and its variants).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
 pub enum ProcessError {
     /// Receiving from shared memory failed.

@@ -8,7 +8,8 @@ pub struct HostStats {
     /// Commands refused (any status but ok and clamped: see `Status::is_carried_out`).
     pub refused: u64,
     /// Commands lost before the driver saw them: gaps in the sequence numbers of one of
-    /// the [`CLIENT_SLOTS`](super::CLIENT_SLOTS) most recently active clients (only gaps that can be proven).
+    /// the [`CLIENT_SLOTS`](super::CLIENT_SLOTS) most recently active clients (only gaps
+    /// that can be proven).
     pub overflows: u64,
     /// Requests answered.
     pub requests: u64,
@@ -70,7 +71,8 @@ impl Activity {
     }
 }
 
-/// How many commands and requests one call of [`DeviceHost::process`](super::DeviceHost::process) handled.
+/// How many commands and requests one call of
+/// [`DeviceHost::process`](super::DeviceHost::process) handled.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Activity {
     /// Commands handled.
