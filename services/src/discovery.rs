@@ -40,7 +40,7 @@ pub enum ListError {
         domain: String,
         /// Why.
         #[source]
-        source: Box<crate::domain_dir::DomainError>,
+        source: Box<crate::domain::DomainError>,
     },
     /// iceoryx2 could not read the service directory (permissions?).
     #[error("cannot list the services of domain {domain}: {source}")]
