@@ -265,8 +265,10 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
             return;
         };
         let remote = req.meta().client_id;
-        if self.allow.read_only && !I::Request::read(&req).is_ok_and(|r| r.is_read_only()) {
-            tracing::warn!(device = %self.device, origin, "a request that changes the device: refused (read-only bridge)");
+        let read_only = I::Request::read(&req).is_ok_and(|r| r.is_read_only());
+        if !self.allow.request(I::KIND, req.meta().kind, read_only) {
+            tracing::warn!(device = %self.device, origin, kind = req.meta().kind,
+                "a request that changes the device: refused (not let through by this bridge)");
             let out = keys::nack::<I>(&req, Status::Unsupported);
             if let Err(e) = query
                 .reply(query.key_expr().clone(), out.as_bytes().to_vec())
@@ -300,7 +302,7 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
             refuse(&query, Status::InvalidArgument);
             return;
         };
-        if self.allow.read_only || self.allow.commands.is_some() {
+        if self.allow.read_only || self.allow.filtered() {
             // A lease would let a remote client refuse the robot's own clients: only a
             // bridge that lets every command through carries leases.
             refuse(&query, Status::Unsupported);

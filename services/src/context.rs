@@ -8,7 +8,8 @@ use iceoryx2::node::NodeCreationFailure;
 use iceoryx2::prelude::*;
 use thiserror::Error;
 
-use crate::naming::{CLIENT_NODE_PREFIX, DRIVER_NODE_PREFIX, Domain};
+use crate::domain::Domain;
+use crate::naming::{CLIENT_NODE_PREFIX, DRIVER_NODE_PREFIX};
 
 /// The monotonic clock in ns (`CLOCK_MONOTONIC`), the time base of every stamp.
 pub fn monotonic_ns() -> u64 {

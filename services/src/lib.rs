@@ -89,8 +89,6 @@ pub mod testing;
 pub use domain::cleanup;
 /// The old path of [`domain::dir`] (other crates use it).
 pub use domain::dir as domain_dir;
-/// The old path of [`domain::group`], for the crate's clients.
-pub(crate) use domain::group as widen;
 
 pub use client::{
     ActArrayClient, AnyGeom, Client, CommandError, ConnectError, DeviceClient, DriverStatus,
@@ -100,13 +98,14 @@ pub use client::{
 pub use context::{Context, ContextError, Role, monotonic_ns};
 pub use device_set::{DeviceError, DeviceSet, DeviceSetHandler, Drain};
 pub use discovery::{DeviceInfo, ListError, list_devices};
+pub use domain::Domain;
 pub use domain::DomainError;
 pub use error::Iox2Error;
 pub use host::{
     Activity, CLIENT_SLOTS, DeviceHandler, DeviceHost, Holder, HostError, HostStats, Motion,
     Origin, ProcessError, PublishError,
 };
-pub use naming::{Channel, DeviceName, Domain, NameError};
+pub use naming::{Channel, DeviceName, NameError};
 pub use relay::{AnswerError, PendingLease, PendingRelay, RelayedLease, RelayedRequest};
 
 /// Everything a driver or client author needs, in one `use`.
@@ -118,7 +117,8 @@ pub mod prelude {
     pub use crate::context::{Context, Role, monotonic_ns};
     pub use crate::device_set::{DeviceSet, DeviceSetHandler};
     pub use crate::discovery::{DeviceInfo, list_devices};
+    pub use crate::domain::Domain;
     pub use crate::host::{DeviceHandler, DeviceHost, Motion, Origin};
-    pub use crate::naming::{DeviceName, Domain};
+    pub use crate::naming::DeviceName;
     pub use limber_interfaces::prelude::*;
 }

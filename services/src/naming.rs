@@ -8,9 +8,8 @@
 //! path of its owner's (see [`crate::domain`]), so robots and tests on one PC never
 //! meet and no other user can read, command or deny a domain.
 //!
-//! Names only: no file is touched here. [`Domain`] lives in [`crate::domain`] and is
-//! re-exported here for its old path (`naming::Domain`); the domain module uses the names
-//! of this one, never the other way round.
+//! Names only: no file is touched here, and nothing of [`crate::domain`] is used (the
+//! domain module uses the names of this one, never the other way round).
 
 use core::fmt;
 use std::str::FromStr;
@@ -18,8 +17,6 @@ use std::str::FromStr;
 use iceoryx2::prelude::ServiceName;
 use limber_interfaces::InterfaceKind;
 use thiserror::Error;
-
-pub use crate::domain::Domain;
 
 /// The environment variable that selects the domain.
 pub const DOMAIN_ENV: &str = "LIMBER_DOMAIN";

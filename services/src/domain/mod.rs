@@ -12,8 +12,8 @@
 //!   and each member's cleanup after its own dead processes.
 //! * [`cleanup`]: removing a domain's files once nothing runs in it.
 //!
-//! This module uses [`crate::naming`] (domain names, [`NameError`]); naming calls nothing of
-//! this one (it only re-exports [`Domain`] for its old path, `naming::Domain`).
+//! This module uses [`crate::naming`] (domain names, [`NameError`]); naming uses nothing of
+//! this one: no import cycle.
 
 use core::fmt;
 use std::sync::atomic::{AtomicU32, Ordering};
