@@ -131,10 +131,15 @@ impl Arbiter {
         self.lease.as_ref()
     }
 
-    /// The holder of the lease when it is not `client_id`: that client's commands, and its
-    /// requests that may change the device, are refused ([`Status::Leased`]).
-    pub(crate) fn refusing(&self, client_id: u64) -> Option<&Holder> {
-        self.lease.as_ref().filter(|l| l.client_id != client_id)
+    /// The holder of the lease when the sender is not it: the sender's commands, and its
+    /// requests that may change the device, are refused ([`Status::Leased`]). The sender is
+    /// the client id its message carries *and* the node the transport says sent it
+    /// (`node`, from iceoryx2's registry of the service's ports): a client that writes the
+    /// holder's id into its messages from another process is not the holder.
+    pub(crate) fn refusing(&self, client_id: u64, node: u128) -> Option<&Holder> {
+        self.lease
+            .as_ref()
+            .filter(|l| l.client_id != client_id || l.node_id != node)
     }
 
     /// A command arrived: returns how many earlier commands of its client provably went
@@ -145,8 +150,8 @@ impl Arbiter {
 
     /// What the sender of `cmd` is told when its command ended with `status`: a command
     /// refused because another client holds the device names that holder.
-    pub(crate) fn outcome(&self, cmd: CmdRef, status: Status) -> Told {
-        match self.refusing(cmd.client_id) {
+    pub(crate) fn outcome(&self, cmd: CmdRef, node: u128, status: Status) -> Told {
+        match self.refusing(cmd.client_id, node) {
             Some(h) if status == Status::Leased => Told {
                 cmd,
                 status,
@@ -194,10 +199,12 @@ impl Arbiter {
         }
     }
 
-    /// Applies one lease request (acquire, renew, release, query) at `now_ns`.
-    pub(crate) fn lease_request(&mut self, req: &LeaseReq, now_ns: u64) -> LeaseAnswer {
+    /// Applies one lease request (acquire, renew, release, query) at `now_ns`, sent from
+    /// node `node` as the transport says (0: not known; never the node id the request
+    /// carries, which the client writes itself).
+    pub(crate) fn lease_request(&mut self, req: &LeaseReq, node: u128, now_ns: u64) -> LeaseAnswer {
         let before = self.lease.map(|l| l.client_id);
-        let (status, event) = self.lease_op(req, now_ns);
+        let (status, event) = self.lease_op(req, node, now_ns);
         LeaseAnswer {
             status,
             holder_changed: before != self.lease.map(|l| l.client_id),
@@ -205,15 +212,20 @@ impl Arbiter {
         }
     }
 
-    fn lease_op(&mut self, req: &LeaseReq, now_ns: u64) -> (Status, Option<LeaseEvent>) {
-        let other = self.refusing(req.client_id).is_some();
+    fn lease_op(
+        &mut self,
+        req: &LeaseReq,
+        node: u128,
+        now_ns: u64,
+    ) -> (Status, Option<LeaseEvent>) {
+        let other = self.refusing(req.client_id, node).is_some();
         match req.op {
             lease_op::ACQUIRE => {
                 if other {
                     return (Status::Leased, None);
                 }
                 if req.client_id == 0
-                    || req.node_id() == 0
+                    || node == 0
                     || !(MIN_LEASE_TIMEOUT_NS..=MAX_LEASE_TIMEOUT_NS).contains(&req.timeout_ns)
                     || get_name(&req.name).is_err()
                 {
@@ -223,7 +235,7 @@ impl Arbiter {
                 put_name(&mut name, get_name(&req.name).unwrap_or(""));
                 self.lease = Some(Holder {
                     client_id: req.client_id,
-                    node_id: req.node_id(),
+                    node_id: node,
                     timeout_ns: req.timeout_ns,
                     last_renewal_ns: now_ns,
                     name,
@@ -324,7 +336,13 @@ mod tests {
     }
 
     fn acquire(a: &mut Arbiter, client: u64, timeout_ns: u64, now: u64) -> LeaseAnswer {
-        a.lease_request(&lease(lease_op::ACQUIRE, client, timeout_ns, "holder"), now)
+        let req = lease(lease_op::ACQUIRE, client, timeout_ns, "holder");
+        a.lease_request(&req, req.node_id(), now)
+    }
+
+    /// The node of a client in these tests (as `lease` puts it in the request).
+    fn node(client_id: u64) -> u128 {
+        u128::from(client_id) << 64 | 7
     }
 
     fn cmd(client_id: u64, seq: u64) -> CmdRef {
@@ -366,7 +384,7 @@ mod tests {
         let mut a = Arbiter::new();
         acquire(&mut a, HOLDER, 100 * MS, 0);
         let req = lease(lease_op::ACQUIRE, OTHER, 100 * MS, "other");
-        let ans = a.lease_request(&req, 1);
+        let ans = a.lease_request(&req, req.node_id(), 1);
         assert_eq!(ans.status, Status::Leased);
         assert!(!ans.holder_changed);
         assert_eq!(ans.event, None);
@@ -399,15 +417,21 @@ mod tests {
         );
         let mut no_node = lease(lease_op::ACQUIRE, HOLDER, 100 * MS, "x");
         no_node.set_node_id(0);
-        assert_eq!(a.lease_request(&no_node, 0).status, Status::InvalidArgument);
+        assert_eq!(
+            a.lease_request(&no_node, no_node.node_id(), 0).status,
+            Status::InvalidArgument
+        );
         let mut bad_name = lease(lease_op::ACQUIRE, HOLDER, 100 * MS, "x");
         bad_name.name = [0xff; 32];
         assert_eq!(
-            a.lease_request(&bad_name, 0).status,
+            a.lease_request(&bad_name, bad_name.node_id(), 0).status,
             Status::InvalidArgument
         );
         let unknown = lease(99, HOLDER, 100 * MS, "x");
-        assert_eq!(a.lease_request(&unknown, 0).status, Status::InvalidArgument);
+        assert_eq!(
+            a.lease_request(&unknown, unknown.node_id(), 0).status,
+            Status::InvalidArgument
+        );
         assert!(a.holder().is_none());
         // The bounds themselves are accepted.
         assert_eq!(
@@ -447,7 +471,7 @@ mod tests {
             let now = t * 80 * MS;
             assert!(!matches!(a.deadman(now), Deadman::Expired(_)), "at {now}");
             let renew = lease(lease_op::RENEW, HOLDER, 100 * MS, "");
-            let ans = a.lease_request(&renew, now);
+            let ans = a.lease_request(&renew, renew.node_id(), now);
             assert_eq!((ans.status, ans.holder_changed), (Status::Ok, false));
         }
         assert_eq!(a.holder().unwrap().last_renewal_ns, 800 * MS);
@@ -459,7 +483,10 @@ mod tests {
         let mut a = Arbiter::new();
         acquire(&mut a, HOLDER, 100 * MS, 0);
         let renew = lease(lease_op::RENEW, OTHER, 100 * MS, "");
-        assert_eq!(a.lease_request(&renew, 90 * MS).status, Status::Leased);
+        assert_eq!(
+            a.lease_request(&renew, renew.node_id(), 90 * MS).status,
+            Status::Leased
+        );
         assert!(matches!(a.deadman(101 * MS), Deadman::Expired(_)));
     }
 
@@ -467,7 +494,7 @@ mod tests {
     fn renewing_a_lease_nobody_holds_is_ok_and_takes_nothing() {
         let mut a = Arbiter::new();
         let renew = lease(lease_op::RENEW, HOLDER, 100 * MS, "");
-        let ans = a.lease_request(&renew, 0);
+        let ans = a.lease_request(&renew, renew.node_id(), 0);
         assert_eq!((ans.status, ans.holder_changed), (Status::Ok, false));
         assert!(a.holder().is_none());
         assert_eq!(a.lease_reply(&renew, ans.status).holder_client, 0);
@@ -503,15 +530,18 @@ mod tests {
         let mut a = Arbiter::new();
         acquire(&mut a, HOLDER, 100 * MS, 0);
         let by_other = lease(lease_op::RELEASE, OTHER, 0, "");
-        assert_eq!(a.lease_request(&by_other, 1).status, Status::Leased);
+        assert_eq!(
+            a.lease_request(&by_other, by_other.node_id(), 1).status,
+            Status::Leased
+        );
         assert!(a.holder().is_some());
         let by_holder = lease(lease_op::RELEASE, HOLDER, 0, "");
-        let ans = a.lease_request(&by_holder, 2);
+        let ans = a.lease_request(&by_holder, by_holder.node_id(), 2);
         assert_eq!(ans.status, Status::Ok);
         assert!(ans.holder_changed);
         assert_eq!(ans.event, Some(LeaseEvent::Released));
         // Released twice: ok, nothing to log.
-        let again = a.lease_request(&by_holder, 3);
+        let again = a.lease_request(&by_holder, by_holder.node_id(), 3);
         assert_eq!((again.status, again.event), (Status::Ok, None));
         assert_eq!(
             a.deadman(10_000 * MS),
@@ -525,7 +555,7 @@ mod tests {
         let mut a = Arbiter::new();
         acquire(&mut a, HOLDER, 100 * MS, 0);
         let q = lease(lease_op::QUERY, OTHER, 0, "");
-        let ans = a.lease_request(&q, 50 * MS);
+        let ans = a.lease_request(&q, q.node_id(), 50 * MS);
         assert_eq!(
             (ans.status, ans.holder_changed, ans.event),
             (Status::Ok, false, None)
@@ -536,11 +566,17 @@ mod tests {
     #[test]
     fn a_held_device_refuses_others_naming_the_holder_and_admits_the_holder() {
         let mut a = Arbiter::new();
-        assert!(a.refusing(OTHER).is_none(), "no lease: last writer wins");
+        assert!(
+            a.refusing(OTHER, node(OTHER)).is_none(),
+            "no lease: last writer wins"
+        );
         acquire(&mut a, HOLDER, 100 * MS, 0);
-        assert!(a.refusing(HOLDER).is_none());
-        assert_eq!(a.refusing(OTHER).map(|h| h.client_id), Some(HOLDER));
-        let told = a.outcome(cmd(OTHER, 3), Status::Leased);
+        assert!(a.refusing(HOLDER, node(HOLDER)).is_none());
+        assert_eq!(
+            a.refusing(OTHER, node(OTHER)).map(|h| h.client_id),
+            Some(HOLDER)
+        );
+        let told = a.outcome(cmd(OTHER, 3), node(OTHER), Status::Leased);
         assert_eq!(told.status, Status::Leased);
         assert_eq!(told.other_client, HOLDER);
         assert_eq!(get_name(&told.other_name.unwrap()).unwrap(), "holder");
@@ -552,11 +588,11 @@ mod tests {
         let mut a = Arbiter::new();
         acquire(&mut a, HOLDER, 100 * MS, 0);
         for status in [Status::Ok, Status::BeyondLimits, Status::Unsupported] {
-            let told = a.outcome(cmd(HOLDER, 1), status);
+            let told = a.outcome(cmd(HOLDER, 1), node(HOLDER), status);
             assert_eq!((told.other_client, told.other_name), (0, None), "{status}");
         }
         // The holder's own command is never refused by its lease.
-        let told = a.outcome(cmd(HOLDER, 2), Status::Leased);
+        let told = a.outcome(cmd(HOLDER, 2), node(HOLDER), Status::Leased);
         assert_eq!(told.other_client, 0);
     }
 
@@ -651,5 +687,38 @@ mod tests {
         assert_eq!(a.arrived(cmd(1, 4)), 2);
         assert_eq!(a.arrived(cmd(2, 2)), 0);
         assert_eq!(a.arrived(cmd(2, 10)), 7);
+    }
+
+    #[test]
+    fn the_holders_id_written_by_another_process_is_not_the_holder() {
+        let mut a = Arbiter::new();
+        acquire(&mut a, HOLDER, 100 * MS, 0);
+        let forger = node(OTHER);
+        // A command carrying the holder's client id, from another node: refused, naming the
+        // holder.
+        assert_eq!(
+            a.refusing(HOLDER, forger).map(|h| h.client_id),
+            Some(HOLDER)
+        );
+        let told = a.outcome(cmd(HOLDER, 9), forger, Status::Leased);
+        assert_eq!(told.other_client, HOLDER);
+        // Its RELEASE and RENEW as the holder are refused and the lease stays.
+        for op in [lease_op::RELEASE, lease_op::RENEW] {
+            let req = lease(op, HOLDER, 100 * MS, "holder");
+            let ans = a.lease_request(&req, forger, 1);
+            assert_eq!(ans.status, Status::Leased, "op {op}");
+        }
+        assert_eq!(a.holder().map(|h| h.node_id), Some(node(HOLDER)));
+        // An ACQUIRE whose request carries the holder's node but comes from the forger's.
+        let mut req = lease(lease_op::ACQUIRE, OTHER, 100 * MS, "mallory");
+        req.set_node_id(node(HOLDER));
+        assert_eq!(a.lease_request(&req, forger, 2).status, Status::Leased);
+        // Nobody holds: the lease is bound to the node the transport names, not the one the
+        // request carries.
+        let mut b = Arbiter::new();
+        let mut req = lease(lease_op::ACQUIRE, OTHER, 100 * MS, "mallory");
+        req.set_node_id(node(HOLDER));
+        assert_eq!(b.lease_request(&req, forger, 0).status, Status::Ok);
+        assert_eq!(b.holder().map(|h| h.node_id), Some(forger));
     }
 }

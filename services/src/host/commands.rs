@@ -31,6 +31,10 @@ impl<I: Interface> DeviceHost<I> {
             };
             let raw: &I::CmdMsg = &sample;
             let meta = *raw.meta();
+            // Who sent it, as the transport says: the node of its publisher.
+            let node = self
+                .cmd_senders
+                .publisher(sample.header().publisher_id().value(), &self.cmd_svc);
             let origin = Origin {
                 client_id: meta.client_id,
                 seq: meta.seq,
@@ -46,7 +50,7 @@ impl<I: Interface> DeviceHost<I> {
             let status = match I::Command::read(raw) {
                 Ok(decoded) => {
                     drop(sample);
-                    if self.arbiter.refusing(cmd.client_id).is_some() {
+                    if self.arbiter.refusing(cmd.client_id, node).is_some() {
                         self.stats.leased_refusals += 1;
                         Status::Leased
                     } else {
@@ -65,7 +69,7 @@ impl<I: Interface> DeviceHost<I> {
             // has seen the outcome and then takes the state sees the command's effect.
             // (Clients are notified after both.)
             let state_sent = self.publish_each_outcome.then(|| self.send_state());
-            let told = self.arbiter.outcome(cmd, status);
+            let told = self.arbiter.outcome(cmd, node, status);
             publish_outcome(
                 &self.outcomes,
                 &mut self.outcome_loan,

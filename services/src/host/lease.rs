@@ -76,7 +76,11 @@ impl<I: Interface> DeviceHost<I> {
                 Err(e) => return Err(ProcessError::Receive(e)),
             };
             let req: LeaseReq = *active.payload();
-            let answer = self.arbiter.lease_request(&req, monotonic_ns());
+            // The holder is the node the transport names, not the one the request carries.
+            let node = self
+                .lease_senders
+                .client(active.header().client_id().value(), &self.lease_svc);
+            let answer = self.arbiter.lease_request(&req, node, monotonic_ns());
             changed |= answer.holder_changed;
             match answer.event {
                 Some(LeaseEvent::Acquired) => {

@@ -36,6 +36,7 @@ pub mod handler;
 mod lease;
 mod open;
 mod requests;
+mod senders;
 pub mod stats;
 
 use arbiter::Arbiter;
@@ -78,6 +79,24 @@ pub struct DeviceHost<I: Interface> {
         iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, I::Data, ()>,
     publisher: Publisher<ipc::Service, I::Data, ()>,
     commands: Subscriber<ipc::Service, I::CmdMsg, ()>,
+    /// The `cmd` service, whose registry says which node each command's publisher is.
+    cmd_svc: iceoryx2::service::port_factory::publish_subscribe::PortFactory<
+        ipc::Service,
+        I::CmdMsg,
+        (),
+    >,
+    /// The `req` service, whose registry says which node each request's client is.
+    req_svc: iceoryx2::service::port_factory::request_response::PortFactory<
+        ipc::Service,
+        I::ReqMsg,
+        (),
+        I::ReplyMsg,
+        (),
+    >,
+    /// Who sent each command, request and lease request (see `senders.rs`).
+    cmd_senders: senders::PortNodes,
+    req_senders: senders::PortNodes,
+    lease_senders: senders::PortNodes,
     server: Server<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()>,
     wake: Option<Listener<ipc::Service>>,
     notify: Notifier<ipc::Service>,

@@ -35,7 +35,11 @@ impl<I: Interface> DeviceHost<I> {
                 sent_ns: meta.stamp_ns,
                 received_ns: monotonic_ns(),
             };
-            let leased = self.arbiter.refusing(meta.client_id).is_some();
+            // Who sent it, as the transport says: the node of its client port.
+            let node = self
+                .req_senders
+                .client(active.header().client_id().value(), &self.req_svc);
+            let leased = self.arbiter.refusing(meta.client_id, node).is_some();
             let parsed = I::Request::read(raw);
             let mutating = !matches!(&parsed, Ok(r) if r.is_read_only());
             let reply = match parsed {

@@ -1,0 +1,114 @@
+//! Who sent a message, as the transport knows it: the node (process) that owns the port it
+//! came from, from iceoryx2's registry of the service's ports (the publishers of `cmd`, the
+//! clients of `req` and `lease`), never from the bytes a client writes into the message.
+//! The arbiter binds a lease to that node, so a client that writes the holder's client id
+//! into its commands from another process is not the holder.
+//!
+//! A fixed table per channel, no allocation: a port seen before is found in it; a new one
+//! refills the table from the registry (once per new port).
+
+use iceoryx2::prelude::*;
+use iceoryx2::service::port_factory::{publish_subscribe, request_response};
+
+/// Entries kept per channel: every port the service admits ([`crate::qos::MAX_CLIENTS`]
+/// clients, and room for the dead ones not yet cleaned up).
+const PORTS: usize = 2 * crate::qos::MAX_CLIENTS;
+
+/// Port id → node id of one channel.
+#[derive(Debug, Clone)]
+pub(crate) struct PortNodes {
+    entries: [(u128, u128); PORTS],
+    len: usize,
+}
+
+impl PortNodes {
+    pub(crate) const fn new() -> Self {
+        PortNodes {
+            entries: [(0, 0); PORTS],
+            len: 0,
+        }
+    }
+
+    fn find(&self, port: u128) -> Option<u128> {
+        self.entries[..self.len]
+            .iter()
+            .find(|(p, _)| *p == port)
+            .map(|(_, n)| *n)
+    }
+
+    /// The node of `port`; on a miss, `fill` lists the registry's (port, node) pairs again.
+    /// 0 when the registry does not know the port (it left meanwhile).
+    fn node_of(&mut self, port: u128, fill: impl FnOnce(&mut dyn FnMut(u128, u128))) -> u128 {
+        if let Some(n) = self.find(port) {
+            return n;
+        }
+        self.len = 0;
+        let (entries, len) = (&mut self.entries, &mut self.len);
+        fill(&mut |p, n| {
+            if *len < PORTS {
+                entries[*len] = (p, n);
+                *len += 1;
+            }
+        });
+        self.find(port).unwrap_or(0)
+    }
+
+    /// The node of the publisher `port` of the pub/sub service `svc`.
+    pub(crate) fn publisher<P: core::fmt::Debug + ZeroCopySend>(
+        &mut self,
+        port: u128,
+        svc: &publish_subscribe::PortFactory<ipc::Service, P, ()>,
+    ) -> u128 {
+        self.node_of(port, |add| {
+            svc.dynamic_config().list_publishers(|d| {
+                add(d.publisher_id.value(), d.node_id.value());
+                CallbackProgression::Continue
+            });
+        })
+    }
+
+    /// The node of the client `port` of the request-response service `svc`.
+    pub(crate) fn client<Req, Res>(
+        &mut self,
+        port: u128,
+        svc: &request_response::PortFactory<ipc::Service, Req, (), Res, ()>,
+    ) -> u128
+    where
+        Req: core::fmt::Debug + ZeroCopySend,
+        Res: core::fmt::Debug + ZeroCopySend,
+    {
+        self.node_of(port, |add| {
+            svc.dynamic_config().list_clients(|d| {
+                add(d.client_id.value(), d.node_id.value());
+                CallbackProgression::Continue
+            });
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_known_port_is_found_and_a_new_one_refills_the_table() {
+        let mut t = PortNodes::new();
+        let mut fills = 0;
+        let mut registry = vec![(1u128, 10u128), (2, 20)];
+        let look = |t: &mut PortNodes, port: u128, registry: &[(u128, u128)], fills: &mut u32| {
+            t.node_of(port, |add| {
+                *fills += 1;
+                for (p, n) in registry {
+                    add(*p, *n);
+                }
+            })
+        };
+        assert_eq!(look(&mut t, 2, &registry, &mut fills), 20);
+        assert_eq!(look(&mut t, 1, &registry, &mut fills), 10);
+        assert_eq!(fills, 1, "the second port was in the first fill");
+        registry.push((3, 30));
+        assert_eq!(look(&mut t, 3, &registry, &mut fills), 30);
+        assert_eq!(look(&mut t, 9, &registry, &mut fills), 0, "unknown port");
+        assert_eq!(fills, 3);
+    }
+}
