@@ -202,14 +202,11 @@ impl RobotModel {
 
     /// The arm geometry from the calibration.
     pub fn arm_geometry(&self) -> Result<ActArrayGeom, Status> {
-        let cal = self
-            .cal
-            .as_ref()
-            .ok_or(if self.has_arm || self.conn.is_none() {
-                Status::NotCalibrated
-            } else {
-                Status::Unsupported
-            })?;
+        let cal = self.cal.as_ref().ok_or(if self.has_arm || !self.link.up {
+            Status::NotCalibrated
+        } else {
+            Status::Unsupported
+        })?;
         let mut g = ActArrayGeom {
             actuators_count: cal.num_joints().min(ARM_JOINTS) as u32,
             base_pos: Vec3::from(self.cfg.arm_base),

@@ -1,20 +1,27 @@
 //! The driver's model of the robot and its command handling: what every device does with a
 //! command or request, validated before anything is written to the link.
 //!
-//! [`RobotModel`] holds the link, the calibration and what was commanded; its methods are
-//! split by device: [`arm`] (the arm actarray), [`limb`] (the end effector and its IK),
-//! [`grippers`] (the arm gripper and the body gripper) and [`lift`].
+//! [`RobotModel`] holds the calibration, what the robot last said and what was commanded;
+//! it has no link. It takes the robot's packets ([`RobotModel::on_packet`]) and the link's
+//! comings and goings ([`RobotModel::link_up`], [`RobotModel::link_down`]), and every
+//! command it accepts leaves P2OS [`Command`]s in its [`Outbox`], which the driver writes
+//! to the link. Its methods are split by device: [`arm`] (the arm actarray), [`limb`] (the
+//! end effector and its IK), [`grippers`] (the arm gripper and the body gripper) and
+//! [`lift`].
 
 mod arm;
 mod grippers;
 mod lift;
 mod limb;
 mod motion;
+mod outbox;
 
 pub use lift::LiftModel;
+pub use outbox::{OUTBOX_CAPACITY, Outbox, OutboxFull, Queued};
 
 use std::time::{Duration, Instant};
 
+use limber_interfaces::limb_outcome::LimbOutcome;
 use limber_interfaces::prelude::*;
 use limber_services::Origin;
 use limber_services::monotonic_ns;
@@ -24,10 +31,18 @@ use limber_kinematics::FrameError;
 use limber_kinematics::pioneer::{
     DriverAngleMap, PIONEER_DOF, PioneerGeometry, PioneerIkError, PioneerIkOptions, Theta,
 };
-use limber_p2os::{ArmCalibration, ArmJoint, ArmPacket, ArmpacLayout, Command, Connection, Sip};
+use limber_p2os::{ArmCalibration, ArmJoint, ArmPacket, ArmpacLayout, Command, RobotPacket, Sip};
 
 use crate::config::PioneerConfig;
-use crate::stats::LoopStats;
+
+/// The driver itself as the origin of a command (its own power, autopark and stream
+/// commands, VECMOVE waypoints, the deadman's stops): never refused as stale.
+pub const INTERNAL: Origin = Origin {
+    client_id: 0,
+    seq: 0,
+    sent_ns: 0,
+    received_ns: 0,
+};
 
 /// Joints of the arm actarray: 5 arm joints and the gripper.
 pub const ARM_JOINTS: usize = 6;
@@ -196,56 +211,74 @@ pub struct VecMovePlan {
     next: usize,
 }
 
-/// The driver's state and the link.
+/// The link as the model sees it: up or down, since when, and when the robot last spoke.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LinkState {
+    /// The link is up: commands are accepted.
+    pub(crate) up: bool,
+    /// When the link came up (`CLOCK_MONOTONIC` ns; commands sent earlier are refused:
+    /// never replayed).
+    pub(crate) up_since_ns: u64,
+    /// When the last packet arrived.
+    pub(crate) last_rx: Instant,
+}
+
+/// What a packet changed that the driver acts on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PacketEffect {
+    /// Nothing beyond the model's state.
+    None,
+    /// A SIP arrived (the driver counts them).
+    Sip,
+    /// An ARMINFOpac arrived: the calibration is (re)set.
+    ArmInfo,
+}
+
+/// The driver's model of the robot: calibration, what the robot last said, what was
+/// commanded, and the commands waiting for the link. No link inside.
 pub struct RobotModel {
     /// The configuration.
-    pub cfg: PioneerConfig,
-    /// The connection while the link is up.
-    pub conn: Option<Connection>,
-    /// When the link came up (commands sent earlier are refused: never replayed).
-    pub link_up_since_ns: u64,
-    /// When the last packet arrived.
-    pub last_rx: Instant,
+    pub(crate) cfg: PioneerConfig,
+    /// The link's state.
+    pub(crate) link: LinkState,
+    /// Commands accepted and not yet written to the link.
+    pub(crate) outbox: Outbox,
     /// Calibration from ARMINFO.
-    pub cal: Option<ArmCalibration>,
+    pub(crate) cal: Option<ArmCalibration>,
     /// The robot answered ARM_INFO.
-    pub has_arm: bool,
+    pub(crate) has_arm: bool,
     /// Arm kinematics.
-    pub geom: PioneerGeometry,
+    pub(crate) geom: PioneerGeometry,
     /// Driver ↔ kinematic angles.
-    pub map: DriverAngleMap,
+    pub(crate) map: DriverAngleMap,
     /// IK options.
-    pub ik: PioneerIkOptions,
+    pub(crate) ik: PioneerIkOptions,
     /// The arm.
-    pub arm: ArmModel,
-    /// The last limb target was out of reach (cleared by the next valid limb command).
-    pub limb_oor: bool,
-    /// How much the last SETPOSE adjusted the orientation, rad (0 after any other limb
-    /// command).
-    pub limb_adjustment: f64,
+    pub(crate) arm: ArmModel,
+    /// OUT_OF_REACH and the orientation adjustment of the last limb command.
+    pub(crate) limb: LimbOutcome,
     /// A VECMOVE being streamed.
-    pub vecmove: Option<Box<VecMovePlan>>,
+    pub(crate) vecmove: Option<Box<VecMovePlan>>,
     /// End-effector speed for limb motions, m/s.
-    pub limb_speed: f64,
+    pub(crate) limb_speed: f64,
     /// The lift.
-    pub lift: LiftModel,
+    pub(crate) lift: LiftModel,
     /// The latest SIP.
-    pub sip: Option<Sip>,
+    pub(crate) sip: Option<Sip>,
     /// The last body-gripper command (OPEN/CLOSE/STOP).
-    pub gripper_cmd: Option<GripperCommand>,
+    pub(crate) gripper_cmd: Option<GripperCommand>,
     /// The last arm-gripper command.
-    pub armgrip_cmd: Option<GripperCommand>,
+    pub(crate) armgrip_cmd: Option<GripperCommand>,
     /// What changed on the link since the last publish.
-    pub dirty: Dirty,
-    /// Loop statistics.
-    pub stats: LoopStats,
+    pub(crate) dirty: Dirty,
 }
 
 impl core::fmt::Debug for RobotModel {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.debug_struct("RobotModel")
-            .field("link_up", &self.conn.is_some())
+            .field("link_up", &self.link.up)
             .field("has_arm", &self.has_arm)
+            .field("outbox", &self.outbox.len())
             .finish()
     }
 }
@@ -267,15 +300,6 @@ pub(crate) fn ik_status(e: &PioneerIkError) -> Status {
     }
 }
 
-/// True for the statuses that mean "the limb cannot get there" (the limb's OUT_OF_REACH
-/// state): beyond its reach, an orientation its joints cannot hold, or a joint limit.
-pub(crate) fn cannot_get_there(s: Status) -> bool {
-    matches!(
-        s,
-        Status::OutOfReach | Status::UnreachableOrientation | Status::BeyondLimits
-    )
-}
-
 impl RobotModel {
     /// The model for `cfg`, link down.
     pub fn new(cfg: PioneerConfig) -> Self {
@@ -293,9 +317,12 @@ impl RobotModel {
         let limb_speed = cfg.limb_speed;
         RobotModel {
             cfg,
-            conn: None,
-            link_up_since_ns: 0,
-            last_rx: Instant::now(),
+            link: LinkState {
+                up: false,
+                up_since_ns: 0,
+                last_rx: Instant::now(),
+            },
+            outbox: Outbox::default(),
             cal: None,
             has_arm: false,
             geom,
@@ -308,8 +335,7 @@ impl RobotModel {
                 ..PioneerIkOptions::default()
             },
             arm: ArmModel::default(),
-            limb_oor: false,
-            limb_adjustment: 0.0,
+            limb: LimbOutcome::default(),
             vecmove: None,
             limb_speed,
             lift,
@@ -317,7 +343,6 @@ impl RobotModel {
             gripper_cmd: None,
             armgrip_cmd: None,
             dirty: Dirty::default(),
-            stats: LoopStats::default(),
         }
     }
 
@@ -350,47 +375,134 @@ impl RobotModel {
         self.dirty.arm = true;
     }
 
-    /// Writes a command to the link. Refused (LinkDown) when the link is down, or when
+    /// Queues a command for the link. Refused (LinkDown) when the link is down, or when
     /// the client sent it before the link came up (never replayed after a fault).
-    pub fn send(&mut self, cmd: &Command, from: &Origin) -> Result<(), Status> {
-        if from.sent_ns != 0 && from.sent_ns < self.link_up_since_ns {
+    pub(crate) fn send(&mut self, cmd: &Command, from: &Origin) -> Result<(), Status> {
+        if !self.link.up || (from.sent_ns != 0 && from.sent_ns < self.link.up_since_ns) {
             return Err(Status::LinkDown);
         }
-        let conn = self.conn.as_mut().ok_or(Status::LinkDown)?;
-        let before = if from.received_ns != 0 {
-            monotonic_ns()
-        } else {
-            0
+        if let Err(e) = self.outbox.push(Queued {
+            cmd: *cmd,
+            from: *from,
+        }) {
+            // The driver drains the outbox after every call: a bug, never the client's.
+            tracing::error!("cannot queue {cmd:?}: {e}");
+            return Err(Status::Busy);
+        }
+        if let Command::ArmPower(on) = *cmd {
+            self.arm.power_commanded(on);
+        }
+        Ok(())
+    }
+
+    /// Queues one of the driver's own commands (power, autopark, the ARMpac stream).
+    pub fn send_internal(&mut self, cmd: &Command) -> Result<(), Status> {
+        self.send(cmd, &INTERNAL)
+    }
+
+    /// The commands waiting for the link (the driver drains them after every call).
+    pub fn outbox_mut(&mut self) -> &mut Outbox {
+        &mut self.outbox
+    }
+
+    /// The commands waiting for the link.
+    pub fn outbox(&self) -> &Outbox {
+        &self.outbox
+    }
+
+    /// Writing `failed` to the link failed: it and everything queued after it are
+    /// dropped, and what they would have started is forgotten (the joints hold wherever
+    /// they are, a VECMOVE is abandoned, never resumed on a later link).
+    pub fn write_failed(&mut self, failed: &Queued) {
+        let dropped = self.outbox.clear();
+        tracing::debug!("dropped {dropped} queued commands after {:?}", failed.cmd);
+        if failed.cmd == Command::ArmPower(true) {
+            self.arm.power_on_pending = 0;
+        }
+        self.arm.target = [None; ARM_JOINTS];
+        self.vecmove = None;
+        self.dirty.arm = true;
+    }
+
+    /// The link came up at `now`: commands are accepted again, those sent before refused;
+    /// whatever was commanded before is void (the arm holds where it is).
+    pub fn link_up(&mut self, now: Instant) {
+        self.link = LinkState {
+            up: true,
+            up_since_ns: monotonic_ns(),
+            last_rx: now,
         };
-        let sent = conn.send(cmd);
-        // Read right after the write: the stages end when the bytes are on the wire.
-        let now = monotonic_ns();
-        match sent {
-            Ok(()) => {
-                if let Command::ArmPower(on) = *cmd {
-                    self.arm.power_commanded(on);
-                }
-                if from.sent_ns != 0 {
-                    self.stats
-                        .cmd_to_wire
-                        .push(now.saturating_sub(from.sent_ns));
-                }
-                if from.received_ns != 0 {
-                    self.stats
-                        .arrival_to_wire
-                        .push(now.saturating_sub(from.received_ns));
-                    self.stats.link_write.push(now.saturating_sub(before));
-                    self.stats
-                        .arrival_to_send
-                        .push(before.saturating_sub(from.received_ns));
-                }
-                Ok(())
+        self.arm.target = [None; ARM_JOINTS];
+        self.dirty.arm = true;
+        self.dirty.body = true;
+    }
+
+    /// The link went down: commands are refused (LinkDown), nothing queued is sent later,
+    /// a VECMOVE is abandoned. Returns how many queued commands were dropped.
+    pub fn link_down(&mut self) -> usize {
+        self.link.up = false;
+        self.vecmove = None;
+        self.dirty.arm = true;
+        self.dirty.body = true;
+        self.outbox.clear()
+    }
+
+    /// True while the link is up.
+    pub fn is_link_up(&self) -> bool {
+        self.link.up
+    }
+
+    /// When the robot last sent a packet.
+    pub fn last_rx(&self) -> Instant {
+        self.link.last_rx
+    }
+
+    /// True once the robot answered ARM_INFO with a calibration.
+    pub fn calibrated(&self) -> bool {
+        self.cal.is_some()
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &PioneerConfig {
+        &self.cfg
+    }
+
+    /// The arm as the last ARMpac described it, and what was commanded.
+    pub fn arm(&self) -> &ArmModel {
+        &self.arm
+    }
+
+    /// Takes a SIP that arrived outside the loop (the handshake's last).
+    pub fn set_sip(&mut self, sip: Sip) {
+        self.sip = Some(sip);
+        self.dirty.body = true;
+    }
+
+    /// Takes a packet from the robot at `now`: a SIP, an ARMpac (the next VECMOVE
+    /// waypoint is queued when the arm reached the current one) or an ARMINFOpac.
+    pub fn on_packet(&mut self, pkt: &RobotPacket<'_>, now: Instant) -> PacketEffect {
+        self.link.last_rx = now;
+        match pkt {
+            RobotPacket::Sip(s) => {
+                self.set_sip(*s);
+                PacketEffect::Sip
             }
-            Err(e) => {
-                // The loop notices the dead link (read error or silence) and reconnects.
-                tracing::warn!("cannot send {cmd:?} to the robot: {e}");
-                Err(Status::LinkDown)
+            RobotPacket::Arm(a) => {
+                self.arm.update(a, self.cfg.armpac_layout, now);
+                self.dirty.arm = true;
+                if let Err(status) = self.stream_vecmove(&INTERNAL) {
+                    // The next waypoint could not be queued (the link is down): the line
+                    // is abandoned, never resumed on a later link.
+                    tracing::warn!("VECMOVE abandoned: {status}");
+                    self.vecmove = None;
+                }
+                PacketEffect::None
             }
+            RobotPacket::ArmInfo(i) => {
+                self.set_calibration(ArmCalibration::from(*i));
+                PacketEffect::ArmInfo
+            }
+            _ => PacketEffect::None,
         }
     }
 
@@ -405,7 +517,7 @@ impl RobotModel {
     }
 
     pub(super) fn calibration(&self) -> Result<&ArmCalibration, Status> {
-        if self.conn.is_none() {
+        if !self.link.up {
             return Err(Status::LinkDown);
         }
         if !self.has_arm {
