@@ -327,3 +327,27 @@ fn sips_are_taken_and_the_silence_clock_follows_the_packets() {
     m.on_packet(&RobotPacket::Arm(arm_packet(true, 0, home_ticks())), later);
     assert_eq!(m.last_rx(), later);
 }
+
+#[test]
+fn a_client_command_is_refused_when_the_robot_has_been_silent_too_long() {
+    let (mut m, _) = ready();
+    let pos = ActArrayCommand::Position {
+        joint: 1,
+        position: 0.2,
+    };
+    let bound = m.config().command_silence();
+    // The last packet came longer ago than the bound: refused, nothing queued.
+    let then = Instant::now() - bound - Duration::from_millis(50);
+    m.on_packet(&RobotPacket::Arm(arm_packet(true, 0, home_ticks())), then);
+    assert_eq!(m.arm_command(&pos, &now_origin()), Status::LinkDown);
+    assert!(m.outbox().is_empty());
+    // The driver's own commands (a deadman's stop) still go out.
+    assert_eq!(m.limb_command(&LimbCommand::Stop, &INTERNAL), Status::Ok);
+    drain(&mut m);
+    // The robot speaks again: accepted.
+    m.on_packet(
+        &RobotPacket::Arm(arm_packet(true, 0, home_ticks())),
+        Instant::now(),
+    );
+    assert_eq!(m.arm_command(&pos, &now_origin()), Status::Ok);
+}

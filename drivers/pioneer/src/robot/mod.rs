@@ -375,11 +375,21 @@ impl RobotModel {
         self.dirty.arm = true;
     }
 
-    /// Queues a command for the link. Refused (LinkDown) when the link is down, or when
-    /// the client sent it before the link came up (never replayed after a fault).
+    /// Queues a command for the link. Refused (LinkDown) when the link is down, when the
+    /// client sent it before the link came up (never replayed after a fault), or when the
+    /// robot has been silent longer than [`PioneerConfig::command_silence`].
     pub(crate) fn send(&mut self, cmd: &Command, from: &Origin) -> Result<(), Status> {
         if !self.link.up || (from.sent_ns != 0 && from.sent_ns < self.link.up_since_ns) {
             return Err(Status::LinkDown);
+        }
+        // A robot silent for a while may be gone: a client's command written now could be
+        // carried out much later (from the link's buffers, after a reconnect), or never.
+        if from.sent_ns != 0 {
+            let silent = Instant::now().saturating_duration_since(self.link.last_rx);
+            if silent > self.cfg.command_silence() {
+                tracing::debug!(?silent, "{cmd:?} refused: the robot is silent");
+                return Err(Status::LinkDown);
+            }
         }
         if let Err(e) = self.outbox.push(Queued {
             cmd: *cmd,
