@@ -351,3 +351,42 @@ fn a_client_command_is_refused_when_the_robot_has_been_silent_too_long() {
     );
     assert_eq!(m.arm_command(&pos, &now_origin()), Status::Ok);
 }
+
+/// Issue "Nobody moves the arm who may not", item 9: an ARMINFOpac that cannot be a
+/// calibration (no joint; a joint with 0 ticks per 90°) is not taken: the arm is not
+/// calibrated (its state says so), and HOME is refused instead of answered "ok".
+#[test]
+fn an_arminfopac_that_cannot_be_a_calibration_is_not_taken() {
+    let good = limber_emulator::default_arm_info();
+    let mut zero_tp90 = good.joints;
+    zero_tp90[2].ticks_per_90 = 0;
+    for (what, info) in [
+        ("no joint", limber_p2os::ArmInfo::new("x", &[])),
+        (
+            "0 ticks per 90° on joint 3",
+            limber_p2os::ArmInfo::new("x", &zero_tp90),
+        ),
+    ] {
+        let mut m = RobotModel::new(PioneerConfig::default());
+        let t0 = Instant::now();
+        m.link_up(t0);
+        m.on_packet(&RobotPacket::ArmInfo(info), t0);
+        m.on_packet(&RobotPacket::Arm(arm_packet(true, 0, home_ticks())), t0);
+        assert!(!m.calibrated(), "{what}: taken as a calibration");
+        assert_eq!(m.malformed(), 1, "{what}: not counted");
+        assert_eq!(
+            m.arm_command(&ActArrayCommand::Home(JointSel::All), &now_origin()),
+            Status::NotCalibrated,
+            "{what}"
+        );
+        assert_eq!(
+            m.limb_command(&LimbCommand::Home, &now_origin()),
+            Status::NotCalibrated,
+            "{what}"
+        );
+        assert!(m.outbox().is_empty(), "{what}");
+        // A good one afterwards is taken.
+        m.on_packet(&RobotPacket::ArmInfo(good), t0);
+        assert!(m.calibrated(), "{what}");
+    }
+}

@@ -239,6 +239,17 @@ impl PioneerDriver {
                 PacketEffect::None => {}
             }
         }
+        // Packets that did not parse (a truncated ARMpac...): dropped by the link, counted
+        // and logged here.
+        if let Some(conn) = self.conn.as_ref() {
+            let malformed = conn.link().stats().malformed;
+            let new = malformed.saturating_sub(self.malformed_seen);
+            if new > 0 {
+                self.malformed_seen = malformed;
+                self.robot
+                    .note_malformed(new, &"packets that do not parse (dropped)");
+            }
+        }
         if let Err(status) = flush(&mut self.robot, self.conn.as_mut(), &mut self.timing) {
             // The next waypoint could not be written (the link is failing): the line is
             // abandoned (the model forgot it), never resumed on a later link.
@@ -325,10 +336,10 @@ impl PioneerDriver {
 
     /// Takes a connection the reconnection thread established.
     fn link_up_again(&mut self, conn: Connection) {
-        let answered = conn.arm_calibration().is_some();
-        if let Some(cal) = conn.arm_calibration() {
-            self.robot.set_calibration(*cal);
-        }
+        let answered = conn
+            .arm_calibration()
+            .is_some_and(|cal| self.robot.take_calibration(*cal));
+        self.malformed_seen = conn.link().stats().malformed;
         if let Some(sip) = conn.last_sip() {
             self.robot.set_sip(*sip);
         }

@@ -140,6 +140,8 @@ pub struct PioneerDriver {
     connecting: Option<Receiver<Result<Connection, ConnectError>>>,
     reconnect_log: ReconnectLog,
     devices_added: bool,
+    /// The link's count of packets that did not parse, as last seen.
+    malformed_seen: u64,
 }
 
 /// A failure the loop survives (it is retried on the next cycle or the next event).
@@ -215,9 +217,10 @@ impl PioneerDriver {
         } else {
             tracing::info!("{}", hardware.gripper_note);
         }
-        if let Some(cal) = conn.arm_calibration() {
-            model.set_calibration(*cal);
-        }
+        let malformed_seen = conn.link().stats().malformed;
+        let calibrated = conn
+            .arm_calibration()
+            .is_some_and(|cal| model.take_calibration(*cal));
         if let Some(sip) = conn.last_sip() {
             model.set_sip(*sip);
         }
@@ -265,7 +268,12 @@ impl PioneerDriver {
             connecting: None,
             reconnect_log: ReconnectLog::default(),
             devices_added: false,
+            malformed_seen,
         };
+        if d.hardware.arm && !calibrated {
+            // The ARMINFOpac was not a calibration (logged): ask again.
+            d.start_arm_probe(Instant::now());
+        }
         if !d.hardware.arm {
             tracing::warn!(
                 "no ARMINFOpac after {} ARM_INFO requests: serving no arm; asking again in the \

@@ -255,6 +255,8 @@ pub struct RobotModel {
     pub(crate) ik: PioneerIkOptions,
     /// The arm.
     pub(crate) arm: ArmModel,
+    /// Malformed input from the robot so far.
+    pub(crate) malformed: u64,
     /// OUT_OF_REACH and the orientation adjustment of the last limb command.
     pub(crate) limb: LimbOutcome,
     /// A VECMOVE being streamed.
@@ -281,6 +283,34 @@ impl core::fmt::Debug for RobotModel {
             .field("outbox", &self.outbox.len())
             .finish()
     }
+}
+
+/// Why an ARMINFOpac cannot be a calibration: no joint, or a joint without ticks per 90°
+/// (every angle would be infinite) or without a range.
+fn calibration_problem(cal: &ArmCalibration) -> Option<String> {
+    let n = cal.num_joints();
+    if n == 0 {
+        return Some("it has no joint".into());
+    }
+    for j in 0..n.min(ARM_JOINTS) {
+        let Ok(joint) = ArmJoint::from_index(j) else {
+            return Some(format!("joint index {j} is unknown"));
+        };
+        let Ok(c) = cal.joint(joint) else {
+            return Some(format!("joint {} has no calibration", joint.number()));
+        };
+        if c.ticks_per_90 == 0 {
+            return Some(format!("joint {} has 0 ticks per 90°", joint.number()));
+        }
+        if c.min == c.max {
+            return Some(format!(
+                "joint {} has no range (min = max = {})",
+                joint.number(),
+                c.min
+            ));
+        }
+    }
+    None
 }
 
 /// The cause of an IK failure, as the status a refused limb command carries.
@@ -335,6 +365,7 @@ impl RobotModel {
                 ..PioneerIkOptions::default()
             },
             arm: ArmModel::default(),
+            malformed: 0,
             limb: LimbOutcome::default(),
             vecmove: None,
             limb_speed,
@@ -467,6 +498,45 @@ impl RobotModel {
         self.link.last_rx
     }
 
+    /// Malformed input from the robot so far: packets that do not parse and ARMINFOpacs
+    /// that cannot be a calibration.
+    pub fn malformed(&self) -> u64 {
+        self.malformed
+    }
+
+    /// Counts malformed input from the robot and logs it: the first, then at powers of
+    /// two, so a robot that keeps sending it is visible without flooding the log.
+    pub fn note_malformed(&mut self, n: u64, what: &dyn core::fmt::Display) {
+        for _ in 0..n {
+            self.malformed += 1;
+            if self.malformed.is_power_of_two() {
+                tracing::warn!(
+                    "malformed input from the robot ({} so far): {what}",
+                    self.malformed
+                );
+            }
+        }
+    }
+
+    /// Takes an ARMINFOpac's calibration if it can be one (at least one joint, each
+    /// with ticks per 90° and a range); otherwise it is counted and logged as malformed
+    /// and the calibration held (if any) stays. Returns whether it was taken.
+    pub fn take_calibration(&mut self, cal: ArmCalibration) -> bool {
+        // The robot answered ARM_INFO: it has an arm, calibrated or not.
+        self.has_arm = true;
+        self.dirty.arm = true;
+        match calibration_problem(&cal) {
+            None => {
+                self.set_calibration(cal);
+                true
+            }
+            Some(problem) => {
+                self.note_malformed(1, &format_args!("ARMINFOpac not taken: {problem}"));
+                false
+            }
+        }
+    }
+
     /// True once the robot answered ARM_INFO with a calibration.
     pub fn calibrated(&self) -> bool {
         self.cal.is_some()
@@ -509,8 +579,11 @@ impl RobotModel {
                 PacketEffect::None
             }
             RobotPacket::ArmInfo(i) => {
-                self.set_calibration(ArmCalibration::from(*i));
-                PacketEffect::ArmInfo
+                if self.take_calibration(ArmCalibration::from(*i)) {
+                    PacketEffect::ArmInfo
+                } else {
+                    PacketEffect::None
+                }
             }
             _ => PacketEffect::None,
         }
