@@ -252,6 +252,64 @@ fn a_command_in_the_silence_before_a_link_loss_is_refused_and_never_carried_out(
     assert_eq!(emu.term(), Some(0));
 }
 
+/// Starts `limber emulator` on TCP port `port` (a robot that comes back where it was).
+fn emulator_at(domain: &Domain, port: &str, extra: &[&str]) -> Bg {
+    let mut args = vec!["emulator", "--tcp", port, "--ignore-stdin"];
+    args.extend_from_slice(extra);
+    let mut emu = Bg::spawn(domain.name(), &args);
+    emu.line(|l| !l.is_empty());
+    emu
+}
+
+/// Issue "Nobody moves the arm who may not", item 10: what the robot has is asked at every
+/// connection (CONFIG), not only the first: a robot that comes back without its body
+/// gripper has its gripper commands refused "unsupported", and one that comes back with it
+/// is served again.
+#[test]
+fn what_the_robot_has_is_asked_again_at_every_reconnect() {
+    let d = Domain::unique_for_test();
+    let (emu, addr) = emulator(&d, true, &[]);
+    let port = addr.rsplit(':').next().unwrap().to_string();
+    let cfg = config("reconfig");
+    let mut drv = pioneer(&d, &addr, cfg.to_str().unwrap(), &[]);
+    let ctx = Context::new(&d, Role::Client, "link-test").unwrap();
+    let mut arm = ActArrayClient::connect_timeout(&ctx, "pioneer/actarray/0", T).unwrap();
+    assert!(wait_link(&mut arm, true, T));
+    let open = || limber(d.name(), &["gripper", "pioneer/gripper/0", "open"]);
+    let o = open();
+    assert!(o.status.success(), "with its gripper: {}", stderr(&o));
+
+    let mut emu = emu;
+    for (extra, has) in [(&["--no-gripper"][..], false), (&[][..], true)] {
+        assert_eq!(emu.term(), Some(0));
+        assert!(
+            wait_link(&mut arm, false, T),
+            "the robot's end was not seen"
+        );
+        emu = emulator_at(&d, &port, extra);
+        assert!(
+            wait_link(&mut arm, true, Duration::from_secs(30)),
+            "the link did not come back ({extra:?})"
+        );
+        let o = open();
+        if has {
+            assert!(o.status.success(), "gripper back: {}", stderr(&o));
+        } else {
+            assert_eq!(
+                o.status.code(),
+                Some(5),
+                "gripper gone, answered {:?} {}: {}",
+                o.status.code(),
+                stdout(&o),
+                stderr(&o)
+            );
+            assert!(stderr(&o).contains("unsupported"), "{}", stderr(&o));
+        }
+    }
+    assert_eq!(drv.term(), Some(0));
+    assert_eq!(emu.term(), Some(0));
+}
+
 /// Issue 12 item 6: a second driver (another robot name) on a TCP endpoint that serves one
 /// client at a time is told the endpoint is held, and the first driver's link is left
 /// alone (no reconnect, no fault).

@@ -51,6 +51,7 @@ fn ready() -> (RobotModel, Instant) {
     let mut m = RobotModel::new(PioneerConfig::default());
     let t0 = Instant::now();
     m.link_up(t0);
+    m.set_body_gripper(true);
     let info = limber_emulator::default_arm_info();
     m.on_packet(&RobotPacket::ArmInfo(info), t0);
     m.on_packet(&RobotPacket::Arm(arm_packet(true, 0, home_ticks())), t0);
@@ -389,4 +390,50 @@ fn an_arminfopac_that_cannot_be_a_calibration_is_not_taken() {
         m.on_packet(&RobotPacket::ArmInfo(good), t0);
         assert!(m.calibrated(), "{what}");
     }
+}
+
+#[test]
+fn a_robot_without_its_body_gripper_has_gripper_and_lift_commands_refused() {
+    let (mut m, _) = ready();
+    assert_eq!(
+        m.gripper_command(&GripperCommand::Open, &now_origin()),
+        Status::Ok
+    );
+    assert_eq!(drain(&mut m).len(), 1);
+    m.set_body_gripper(false);
+    assert_eq!(
+        m.gripper_command(&GripperCommand::Open, &now_origin()),
+        Status::Unsupported
+    );
+    assert_eq!(
+        m.lift_command(&ActArrayCommand::Home(JointSel::All), &now_origin()),
+        Status::Unsupported
+    );
+    assert!(m.outbox().is_empty());
+}
+
+#[test]
+fn an_armpac_in_flight_when_the_power_off_left_does_not_power_the_arm_again() {
+    let (mut m, _) = ready();
+    assert!(matches!(
+        m.arm_request(&ActArrayRequest::Power(false), &now_origin()),
+        Ok(ActArrayReply::Done)
+    ));
+    drain(&mut m);
+    // An ARMpac the controller sent before it read the power-off.
+    m.on_packet(
+        &RobotPacket::Arm(arm_packet(true, 0, home_ticks())),
+        Instant::now(),
+    );
+    assert_eq!(
+        m.arm_command(
+            &ActArrayCommand::Position {
+                joint: 2,
+                position: 0.3
+            },
+            &now_origin()
+        ),
+        Status::PoweredOff
+    );
+    assert!(m.outbox().is_empty());
 }

@@ -89,6 +89,12 @@ pub(super) const ARM_DEVICES: [(InterfaceKind, u16); 3] = [
 
 /// [`DriverStats::hardware`]: what the robot has, and what the driver looked for and
 /// found missing (`NO_*`, shown by `limber list` and the CLI's "no driver" message).
+/// The devices of the body gripper: `gripper/0` and its lift `actarray/1`.
+pub(super) const BODY_DEVICES: [(InterfaceKind, u16); 2] =
+    [(InterfaceKind::Gripper, 0), (InterfaceKind::ActArray, 1)];
+
+/// [`DriverStats::hardware`](limber_interfaces::diagnostics::DriverStats::hardware): what
+/// the robot has, and what the driver looked for and found missing.
 pub(super) fn hardware_bits(hw: &Hardware) -> u32 {
     let arm = if hw.arm {
         hardware::ARM

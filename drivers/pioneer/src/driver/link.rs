@@ -6,11 +6,14 @@ use std::sync::mpsc::{self, TryRecvError};
 use std::time::{Duration, Instant};
 
 use limber_p2os::{
-    ArmStatusMode, Command, ConnectError, ConnectOptions, Connection, LinkError, LinkTarget,
+    ArmStatusMode, Command, ConfigProbe, ConnectError, ConnectOptions, Connection, LinkError,
+    LinkTarget,
 };
 
 use super::serve::flush;
-use super::{ARM_DEVICES, DRIVER, Failure, PioneerDriver, hardware_bits};
+use super::{
+    ARM_DEVICES, BODY_DEVICES, DRIVER, Failure, PioneerDriver, gripper_decision, hardware_bits,
+};
 use crate::config::{BodyGripper, PioneerConfig};
 use crate::robot::PacketEffect;
 
@@ -309,8 +312,10 @@ impl PioneerDriver {
         self.next_reconnect = now + Duration::from_millis(self.robot.cfg.reconnect_interval_ms);
         let mut opts = options(&self.robot.cfg, &self.target);
         opts.sync_attempts = 2;
-        // What the robot has was decided at start.
-        opts.config = false;
+        // What the robot has, asked again: a robot may come back without its gripper,
+        // or with one. Once: an unanswered CONFIG keeps the last decision.
+        opts.config = true;
+        opts.config_attempts = 1;
         opts.arm = self.hardware.arm;
         // One ARM_INFO in the handshake; if it goes unanswered, the loop asks again
         // without waiting (a bounded backoff), as after a start.
@@ -334,11 +339,45 @@ impl PioneerDriver {
         }
     }
 
+    /// What the robot has, asked again at a reconnection: a CONFIGpac decides again
+    /// whether the body gripper and lift are served (an unanswered or unreadable one
+    /// leaves the last decision). A gripper that appeared is offered (if it was not yet);
+    /// one that went has its commands refused UNSUPPORTED.
+    fn gripper_again(&mut self, probe: &ConfigProbe) {
+        if !matches!(probe, ConfigProbe::Answered(_)) {
+            return;
+        }
+        self.hardware.config = probe.clone();
+        let robot = self.robot.cfg.robot.clone();
+        let (served, note) = gripper_decision(self.robot.cfg.body_gripper, probe, &robot);
+        if served == self.hardware.gripper {
+            return;
+        }
+        if served && !self.gripper_offered {
+            if let Err(e) = self.hosts.add(&self.ctx, &robot, DRIVER, &BODY_DEVICES) {
+                tracing::error!("{note}, but the devices cannot be offered: {e}");
+                return;
+            }
+            self.devices_added = true;
+            self.gripper_offered = true;
+        }
+        self.hardware.gripper = served;
+        self.hardware.gripper_note = note;
+        self.stats.hardware = hardware_bits(&self.hardware);
+        self.robot.set_body_gripper(served);
+        tracing::warn!(
+            "what the robot has changed (reconnect #{}): {}",
+            self.reconnects,
+            self.hardware.gripper_note
+        );
+    }
+
     /// Takes a connection the reconnection thread established.
     fn link_up_again(&mut self, conn: Connection) {
         let answered = conn
             .arm_calibration()
             .is_some_and(|cal| self.robot.take_calibration(*cal));
+        let config = conn.config().clone();
         self.malformed_seen = conn.link().stats().malformed;
         if let Some(sip) = conn.last_sip() {
             self.robot.set_sip(*sip);
@@ -356,6 +395,7 @@ impl PioneerDriver {
             tracing::warn!("cannot power the arm after reconnecting: {status}");
         }
         self.reconnects += 1;
+        self.gripper_again(&config);
         tracing::info!("link up again (reconnect #{})", self.reconnects);
         if !answered {
             if self.hardware.arm {

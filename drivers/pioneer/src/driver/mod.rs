@@ -23,7 +23,7 @@ use thiserror::Error;
 
 use limber_p2os::{Command, ConfigProbe, ConnectError, Connection, LinkTarget};
 
-use hardware::{ARM_DEVICES, hardware_bits};
+use hardware::{ARM_DEVICES, BODY_DEVICES, hardware_bits};
 pub use hardware::{Hardware, gripper_decision};
 use link::{ArmProbe, ReconnectLog, options};
 use serve::Serve;
@@ -142,6 +142,9 @@ pub struct PioneerDriver {
     devices_added: bool,
     /// The link's count of packets that did not parse, as last seen.
     malformed_seen: u64,
+    /// The body gripper's devices are offered (they stay once offered; a robot that lost
+    /// its gripper has their commands refused).
+    gripper_offered: bool,
 }
 
 /// A failure the loop survives (it is retried on the next cycle or the next event).
@@ -232,8 +235,10 @@ impl PioneerDriver {
             serve.extend(ARM_DEVICES);
         }
         if hardware.gripper {
-            serve.extend([(InterfaceKind::Gripper, 0), (InterfaceKind::ActArray, 1)]);
+            serve.extend(BODY_DEVICES);
         }
+        model.set_body_gripper(hardware.gripper);
+        let gripper_offered = hardware.gripper;
         let hosts = DeviceSet::new(ctx, robot, DRIVER, &serve)?;
         let stats_pub = StatsPublisher::new(ctx, robot).map_err(DriverError::Stats)?;
         let mut stats = DriverStats::default();
@@ -269,6 +274,7 @@ impl PioneerDriver {
             reconnect_log: ReconnectLog::default(),
             devices_added: false,
             malformed_seen,
+            gripper_offered,
         };
         if d.hardware.arm && !calibrated {
             // The ARMINFOpac was not a calibration (logged): ask again.

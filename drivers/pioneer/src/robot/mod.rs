@@ -84,6 +84,9 @@ pub struct ArmModel {
     /// When the last power-on was written: "unpowered" reports before
     /// [`POWER_ON_SETTLE`] after it are not counted against the grace.
     pub power_on_sent: Option<Instant>,
+    /// When the last power-off was written: ARMpacs saying "powered" for
+    /// [`POWER_ON_SETTLE`] after it left the controller before it read the command.
+    pub power_off_sent: Option<Instant>,
     /// Commanded target tick per joint (None: hold wherever it is).
     pub target: [Option<u8>; ARM_JOINTS],
     /// Since when a joint has been still but short of its target.
@@ -104,6 +107,7 @@ impl Default for ArmModel {
             powered: false,
             power_on_pending: 0,
             power_on_sent: None,
+            power_off_sent: None,
             target: [None; ARM_JOINTS],
             short_since: [None; ARM_JOINTS],
             stamp_ns: 0,
@@ -149,7 +153,11 @@ impl ArmModel {
         let status = p.status(layout);
         self.ticks = p.ticks;
         self.moving = status.moving_mask();
-        self.powered = status.powered;
+        // "Powered" from a packet in flight when the power-off left is not believed.
+        self.powered = status.powered
+            && self
+                .power_off_sent
+                .is_none_or(|t| now.saturating_duration_since(t) >= POWER_ON_SETTLE);
         if self.powered {
             self.power_on_pending = 0;
         } else if self
@@ -181,10 +189,12 @@ impl ArmModel {
         if on {
             self.power_on_pending = POWER_ON_GRACE_PACKETS;
             self.power_on_sent = Some(Instant::now());
+            self.power_off_sent = None;
         } else {
             // Off at once: no motion command is accepted after it.
             self.power_on_pending = 0;
             self.powered = false;
+            self.power_off_sent = Some(Instant::now());
         }
     }
 
@@ -257,6 +267,9 @@ pub struct RobotModel {
     pub(crate) arm: ArmModel,
     /// Malformed input from the robot so far.
     pub(crate) malformed: u64,
+    /// The body gripper and lift are served (the robot's CONFIGpac or the configuration
+    /// says so); otherwise their commands are refused UNSUPPORTED.
+    pub(crate) body_gripper: bool,
     /// OUT_OF_REACH and the orientation adjustment of the last limb command.
     pub(crate) limb: LimbOutcome,
     /// A VECMOVE being streamed.
@@ -366,6 +379,7 @@ impl RobotModel {
             },
             arm: ArmModel::default(),
             malformed: 0,
+            body_gripper: false,
             limb: LimbOutcome::default(),
             vecmove: None,
             limb_speed,
@@ -535,6 +549,13 @@ impl RobotModel {
                 false
             }
         }
+    }
+
+    /// Whether the body gripper and lift are served: the robot has them now (asked at
+    /// every connection) or the configuration forces them.
+    pub fn set_body_gripper(&mut self, served: bool) {
+        self.body_gripper = served;
+        self.dirty.body = true;
     }
 
     /// True once the robot answered ARM_INFO with a calibration.
