@@ -475,6 +475,17 @@ impl PioneerDriver {
     /// Handles the pending commands and requests of every device, the way `how` says;
     /// returns whether there was any.
     fn process_clients(&mut self, how: Drain) -> bool {
+        // A robot that seems silent may only be unread (the loop was busy, e.g. in a write
+        // that waited for a full link): read what it sent before its silence is judged.
+        if self.conn.is_some() {
+            let now = Instant::now();
+            if now.saturating_duration_since(self.robot.last_rx())
+                > self.robot.cfg.command_silence() / 2
+                && !self.read_link(now)
+            {
+                self.link_failed("read failed");
+            }
+        }
         let mut handler = Serve {
             robot: &mut self.robot,
             conn: self.conn.as_mut(),

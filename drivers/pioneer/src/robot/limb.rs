@@ -244,9 +244,7 @@ impl RobotModel {
                 let reach = self.geom.l2 + self.geom.l4 + self.geom.l5;
                 for j in 0..PIONEER_DOF {
                     let joint = ArmJoint::from_index(j).map_err(|_| Status::UnknownJoint)?;
-                    let ms = cal
-                        .speed_to_ms_per_step(joint, v / reach)
-                        .map_err(|_| Status::InvalidArgument)?;
+                    let (ms, _) = super::arm::ms_per_step_within_limit(&cal, joint, v / reach)?;
                     self.send(
                         &Command::ArmSpeed {
                             joint,
