@@ -437,3 +437,41 @@ fn an_armpac_in_flight_when_the_power_off_left_does_not_power_the_arm_again() {
     );
     assert!(m.outbox().is_empty());
 }
+
+/// Issue "Nobody moves the arm who may not", item 9: ARMpacs that stop arriving (lost, or
+/// truncated and dropped) while SIPs keep the link up leave the arm's state stale: it is
+/// not reported as reporting, and its commands are refused LINK_DOWN, never carried out
+/// from a made-up position.
+#[test]
+fn an_arm_whose_armpacs_stop_is_stale_and_refuses_commands() {
+    let (mut m, _) = ready();
+    let timeout = Duration::from_millis(m.config().link_timeout_ms);
+    let long_ago = Instant::now() - timeout - Duration::from_millis(500);
+    m.link_up(long_ago);
+    m.on_packet(
+        &RobotPacket::Arm(arm_packet(true, 0, home_ticks())),
+        long_ago,
+    );
+    // SIPs keep coming.
+    m.on_packet(
+        &RobotPacket::Sip(limber_p2os::Sip::default()),
+        Instant::now(),
+    );
+    assert!(!m.arm_reporting(Instant::now()));
+    let pos = ActArrayCommand::Position {
+        joint: 2,
+        position: 0.3,
+    };
+    assert_eq!(m.arm_command(&pos, &now_origin()), Status::LinkDown);
+    assert_eq!(
+        m.limb_command(&LimbCommand::Home, &now_origin()),
+        Status::LinkDown
+    );
+    assert!(m.outbox().is_empty());
+    m.on_packet(
+        &RobotPacket::Arm(arm_packet(true, 0, home_ticks())),
+        Instant::now(),
+    );
+    assert!(m.arm_reporting(Instant::now()));
+    assert_eq!(m.arm_command(&pos, &now_origin()), Status::Ok);
+}

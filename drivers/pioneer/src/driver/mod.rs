@@ -378,25 +378,31 @@ impl PioneerDriver {
     /// Publishes the devices whose state changed, and the statistics once a second.
     fn publish_all(&mut self, now: Instant) {
         let flags = self.flags();
+        // The arm's devices say LINK_UP only while the arm reports (ARMpacs arrive).
+        let arm_flags = if self.robot.arm_reporting(now) {
+            flags
+        } else {
+            flags & !device_flag::LINK_UP
+        };
         let robot = &mut self.robot;
         let failures = &mut self.failures;
         if robot.dirty.arm {
             if let Some(h) = self.hosts.actarray_mut(0) {
-                h.set_flags(flags);
+                h.set_flags(arm_flags);
                 robot.arm_state(h.state_mut(), now);
                 if let Err(e) = h.publish() {
                     failures.note(Failure::Publish, &e);
                 }
             }
             if let Some(h) = self.hosts.limb_mut(0) {
-                h.set_flags(flags);
+                h.set_flags(arm_flags);
                 robot.limb_state(h.state_mut(), now);
                 if let Err(e) = h.publish() {
                     failures.note(Failure::Publish, &e);
                 }
             }
             if let Some(h) = self.hosts.gripper_mut(1) {
-                h.set_flags(flags);
+                h.set_flags(arm_flags);
                 robot.armgrip_state(h.state_mut(), now);
                 if let Err(e) = h.publish() {
                     failures.note(Failure::Publish, &e);

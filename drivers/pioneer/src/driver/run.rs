@@ -33,6 +33,7 @@ impl PioneerDriver {
         } else {
             self.try_reconnect();
         }
+        self.robot.check_arm_reporting(now);
         // Time-based lift estimate and stall detection move without packets.
         if self.robot.lift.moving.is_some() {
             self.robot.dirty.body = true;

@@ -93,6 +93,8 @@ pub struct ArmModel {
     pub short_since: [Option<Instant>; ARM_JOINTS],
     /// When the last ARMpac arrived (`CLOCK_MONOTONIC` ns).
     pub stamp_ns: u64,
+    /// When the last ARMpac arrived, on the model's clock.
+    pub last_packet: Option<Instant>,
     /// ARMpacs whose status bytes make sense only in the other layout than the
     /// configured `armpac_layout` (see [`ArmPacket::suggests_other_layout`]).
     pub layout_mismatches: u64,
@@ -111,6 +113,7 @@ impl Default for ArmModel {
             target: [None; ARM_JOINTS],
             short_since: [None; ARM_JOINTS],
             stamp_ns: 0,
+            last_packet: None,
             layout_mismatches: 0,
         }
     }
@@ -168,6 +171,7 @@ impl ArmModel {
         }
         self.seen = true;
         self.stamp_ns = monotonic_ns();
+        self.last_packet = Some(now);
         for j in 0..ARM_JOINTS {
             let short =
                 self.moving & (1 << j) == 0 && self.target[j].is_some_and(|t| t != self.ticks[j]);
@@ -231,6 +235,8 @@ pub(crate) struct LinkState {
     pub(crate) up_since_ns: u64,
     /// When the last packet arrived.
     pub(crate) last_rx: Instant,
+    /// When the link came up.
+    pub(crate) up_at: Instant,
 }
 
 /// What a packet changed that the driver acts on.
@@ -267,6 +273,8 @@ pub struct RobotModel {
     pub(crate) arm: ArmModel,
     /// Malformed input from the robot so far.
     pub(crate) malformed: u64,
+    /// The arm was reporting at the last [`RobotModel::check_arm_reporting`].
+    pub(crate) arm_reported: bool,
     /// The body gripper and lift are served (the robot's CONFIGpac or the configuration
     /// says so); otherwise their commands are refused UNSUPPORTED.
     pub(crate) body_gripper: bool,
@@ -364,7 +372,9 @@ impl RobotModel {
                 up: false,
                 up_since_ns: 0,
                 last_rx: Instant::now(),
+                up_at: Instant::now(),
             },
+            arm_reported: true,
             outbox: Outbox::default(),
             cal: None,
             has_arm: false,
@@ -486,6 +496,7 @@ impl RobotModel {
             up: true,
             up_since_ns: monotonic_ns(),
             last_rx: now,
+            up_at: now,
         };
         self.arm.target = [None; ARM_JOINTS];
         self.dirty.arm = true;
@@ -500,6 +511,42 @@ impl RobotModel {
         self.dirty.arm = true;
         self.dirty.body = true;
         self.outbox.clear()
+    }
+
+    /// True while the arm reports: the link is up and an ARMpac arrived within
+    /// `link_timeout_ms` (counted from the link's coming up before the first). Otherwise
+    /// what the model holds of the arm is stale: its state does not say LINK_UP and its
+    /// commands are refused LINK_DOWN (the ARMpacs may be lost, or arrive malformed,
+    /// while the SIPs keep the link up).
+    pub fn arm_reporting(&self, now: Instant) -> bool {
+        let since = self
+            .arm
+            .last_packet
+            .map_or(self.link.up_at, |t| t.max(self.link.up_at));
+        self.link.up
+            && now.saturating_duration_since(since)
+                <= Duration::from_millis(self.cfg.link_timeout_ms)
+    }
+
+    /// Notes whether the arm reports (the timer's work): a change is logged and makes the
+    /// arm's devices publish their state.
+    pub fn check_arm_reporting(&mut self, now: Instant) {
+        let reporting = !self.has_arm || self.arm_reporting(now);
+        if reporting == self.arm_reported {
+            return;
+        }
+        self.arm_reported = reporting;
+        self.dirty.arm = true;
+        if reporting {
+            tracing::info!("the arm reports again (ARMpacs arrive)");
+        } else if self.link.up {
+            tracing::warn!(
+                "no ARMpac for {} ms while the link is up: the arm's state is stale, its \
+                 commands are refused until ARMpacs arrive ({} malformed packets so far)",
+                self.cfg.link_timeout_ms,
+                self.malformed
+            );
+        }
     }
 
     /// True while the link is up.
@@ -626,6 +673,9 @@ impl RobotModel {
         }
         if !self.has_arm {
             return Err(Status::Unsupported);
+        }
+        if !self.arm_reporting(Instant::now()) {
+            return Err(Status::LinkDown);
         }
         self.cal.as_ref().ok_or(Status::NotCalibrated)
     }
