@@ -310,6 +310,48 @@ fn what_the_robot_has_is_asked_again_at_every_reconnect() {
     assert_eq!(emu.term(), Some(0));
 }
 
+/// Item 10, the other way: a driver started on a robot without its body gripper serves
+/// none; the robot comes back with one, and the gripper is served from then on.
+#[test]
+fn a_gripper_that_appears_at_a_reconnect_is_served() {
+    let d = Domain::unique_for_test();
+    let (mut emu, addr) = emulator(&d, true, &["--no-gripper"]);
+    let port = addr.rsplit(':').next().unwrap().to_string();
+    let cfg = config("gained");
+    let mut drv = pioneer(&d, &addr, cfg.to_str().unwrap(), &[]);
+    let ctx = Context::new(&d, Role::Client, "link-test").unwrap();
+    let mut arm = ActArrayClient::connect_timeout(&ctx, "pioneer/actarray/0", T).unwrap();
+    assert!(wait_link(&mut arm, true, T));
+    let open = || {
+        limber(
+            d.name(),
+            &["gripper", "pioneer/gripper/0", "open", "--timeout", "5"],
+        )
+    };
+    let o = open();
+    assert!(!o.status.success(), "no gripper, yet: {}", stdout(&o));
+
+    assert_eq!(emu.term(), Some(0));
+    assert!(
+        wait_link(&mut arm, false, T),
+        "the robot's end was not seen"
+    );
+    let mut emu = emulator_at(&d, &port, &[]);
+    assert!(
+        wait_link(&mut arm, true, Duration::from_secs(30)),
+        "the link did not come back"
+    );
+    let o = open();
+    assert!(
+        o.status.success(),
+        "the gripper that appeared is not served: {:?} {}",
+        o.status.code(),
+        stderr(&o)
+    );
+    assert_eq!(drv.term(), Some(0));
+    assert_eq!(emu.term(), Some(0));
+}
+
 /// Issue 12 item 6: a second driver (another robot name) on a TCP endpoint that serves one
 /// client at a time is told the endpoint is held, and the first driver's link is left
 /// alone (no reconnect, no fault).
