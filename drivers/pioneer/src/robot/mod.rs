@@ -413,7 +413,7 @@ impl RobotModel {
 
     /// Takes the calibration: sets the IK joint limits (in θ, from the driver-convention
     /// limits) and marks the arm present.
-    pub fn set_calibration(&mut self, cal: ArmCalibration) {
+    fn set_calibration(&mut self, cal: ArmCalibration) {
         let mut min = [0.0; PIONEER_DOF];
         let mut max = [0.0; PIONEER_DOF];
         for j in 0..PIONEER_DOF {
