@@ -399,6 +399,33 @@ fn done<I: Interface>(
     }
 }
 
+/// `speedcfg`: drivers set a speed beyond the joint's limit (the geometry's
+/// `config_speed`) to the limit, and a request's reply has no room to say so: said here,
+/// from the geometry.
+fn speedcfg(c: &mut Client<ActArray>, joint: usize, speed: f64) -> Result<(), CliError> {
+    match c.set_speed_config(joint, speed) {
+        Ok(()) => {
+            let limit = match c.geometry() {
+                Ok(g) => g
+                    .actuators()
+                    .get(joint)
+                    .map(|a| a.config_speed)
+                    .filter(|&l| l > 0.0 && speed > l),
+                Err(e) => {
+                    tracing::debug!(error = %e, "cannot read the geometry after speedcfg");
+                    None
+                }
+            };
+            match limit {
+                Some(l) => outln!("ok: clamped to {l} rad/s, the joint's limit")?,
+                None => outln!("ok")?,
+            }
+            Ok(())
+        }
+        Err(e) => done(c, |_| Err(e)),
+    }
+}
+
 /// Runs `limber actarray`.
 pub fn actarray(a: ActArrayArgs) -> Result<(), CliError> {
     let mut c = connect::<ActArray>(&a.device, &a.common)?;
@@ -412,9 +439,7 @@ pub fn actarray(a: ActArrayArgs) -> Result<(), CliError> {
         ActArrayVerb::Multicurrent { currents } => c.set_current_multi(&currents),
         ActArrayVerb::Power { value } => return done(&mut c, |c| c.power(value.on())),
         ActArrayVerb::Brakes { value } => return done(&mut c, |c| c.brakes(value.on())),
-        ActArrayVerb::Speedcfg { joint, speed } => {
-            return done(&mut c, |c| c.set_speed_config(joint, speed));
-        }
+        ActArrayVerb::Speedcfg { joint, speed } => return speedcfg(&mut c, joint, speed),
         ActArrayVerb::Accel { joint, accel } => {
             return done(&mut c, |c| c.set_accel_config(joint, accel));
         }

@@ -184,6 +184,174 @@ fn a_stopped_robot_over_tcp_does_not_freeze_the_driver() {
     a_stopped_robot_does_not_freeze_the_driver(true);
 }
 
+/// Issue "Nobody moves the arm who may not", item 7: the robot SIGSTOPped, a command
+/// 0.3 s into its silence (before the link is declared down, after the default 1 s) is not
+/// answered "ok" (the robot has been silent longer than `command_silence_ms`: "link
+/// down"), and once the robot continues and the link is back the arm has not moved to it:
+/// nothing queued before a link loss is sent after it.
+#[test]
+fn a_command_in_the_silence_before_a_link_loss_is_refused_and_never_carried_out() {
+    let d = Domain::unique_for_test();
+    let (mut emu, port) = emulator(&d, false, &[]);
+    // The default link timeout (1 s): the second before a silent robot is declared down.
+    let cfg = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("link-silent-second.toml");
+    std::fs::write(
+        &cfg,
+        "reconnect_interval_ms = 100\narm_info_timeout_ms = 500\n",
+    )
+    .unwrap();
+    let mut drv = pioneer(&d, &port, cfg.to_str().unwrap(), &[]);
+    let ctx = Context::new(&d, Role::Client, "link-test").unwrap();
+    let mut arm = ActArrayClient::connect_timeout(&ctx, "pioneer/actarray/0", T).unwrap();
+    assert!(wait_link(&mut arm, true, T));
+    let j2 = arm.wait_state(T).unwrap().actuators[2].position;
+    assert!((j2 - 0.3).abs() > 0.2, "joint 2 starts at {j2}");
+
+    emu.signal(libc::SIGSTOP);
+    // The scenario's 0.3 s of silence: time that has to pass, not a wait for evidence.
+    std::thread::sleep(Duration::from_millis(300));
+    let o = limber(
+        d.name(),
+        &["actarray", "pioneer/actarray/0", "pos", "2", "0.3"],
+    );
+    assert!(
+        wait_link(&mut arm, false, T),
+        "the silent robot was not detected"
+    );
+    emu.signal(libc::SIGCONT);
+    assert!(
+        wait_link(&mut arm, true, Duration::from_secs(30)),
+        "the link did not recover"
+    );
+    // The barrier: a later command on joint 1 that the robot carries out; a command left
+    // in the link's buffers would have been carried out before it.
+    let t = arm.move_to(1, 0.3).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
+    let (arrived, st) = wait_arm(&mut arm, T, |s| {
+        (s.actuators[1].position - 0.3).abs() < 0.02
+    });
+    assert!(arrived, "joint 1 never arrived: {:?}", st.actuators[1]);
+    assert!(
+        (st.actuators[2].position - j2).abs() < 0.05,
+        "the command of the silence was carried out after the reconnect: joint 2 at {} \
+         (was {j2}); its answer: {:?} {}",
+        st.actuators[2].position,
+        o.status.code(),
+        stdout(&o)
+    );
+    assert_eq!(
+        o.status.code(),
+        Some(5),
+        "answered {:?} {}: {}",
+        o.status.code(),
+        stdout(&o),
+        stderr(&o)
+    );
+    assert!(stderr(&o).contains("link"), "{}", stderr(&o));
+    assert_eq!(drv.term(), Some(0));
+    assert_eq!(emu.term(), Some(0));
+}
+
+/// Starts `limber emulator` on TCP port `port` (a robot that comes back where it was).
+fn emulator_at(domain: &Domain, port: &str, extra: &[&str]) -> Bg {
+    let mut args = vec!["emulator", "--tcp", port, "--ignore-stdin"];
+    args.extend_from_slice(extra);
+    let mut emu = Bg::spawn(domain.name(), &args);
+    emu.line(|l| !l.is_empty());
+    emu
+}
+
+/// Issue "Nobody moves the arm who may not", item 10: what the robot has is asked at every
+/// connection (CONFIG), not only the first: a robot that comes back without its body
+/// gripper has its gripper commands refused "unsupported", and one that comes back with it
+/// is served again.
+#[test]
+fn what_the_robot_has_is_asked_again_at_every_reconnect() {
+    let d = Domain::unique_for_test();
+    let (emu, addr) = emulator(&d, true, &[]);
+    let port = addr.rsplit(':').next().unwrap().to_string();
+    let cfg = config("reconfig");
+    let mut drv = pioneer(&d, &addr, cfg.to_str().unwrap(), &[]);
+    let ctx = Context::new(&d, Role::Client, "link-test").unwrap();
+    let mut arm = ActArrayClient::connect_timeout(&ctx, "pioneer/actarray/0", T).unwrap();
+    assert!(wait_link(&mut arm, true, T));
+    let open = || limber(d.name(), &["gripper", "pioneer/gripper/0", "open"]);
+    let o = open();
+    assert!(o.status.success(), "with its gripper: {}", stderr(&o));
+
+    let mut emu = emu;
+    for (extra, has) in [(&["--no-gripper"][..], false), (&[][..], true)] {
+        assert_eq!(emu.term(), Some(0));
+        assert!(
+            wait_link(&mut arm, false, T),
+            "the robot's end was not seen"
+        );
+        emu = emulator_at(&d, &port, extra);
+        assert!(
+            wait_link(&mut arm, true, Duration::from_secs(30)),
+            "the link did not come back ({extra:?})"
+        );
+        let o = open();
+        if has {
+            assert!(o.status.success(), "gripper back: {}", stderr(&o));
+        } else {
+            assert_eq!(
+                o.status.code(),
+                Some(5),
+                "gripper gone, answered {:?} {}: {}",
+                o.status.code(),
+                stdout(&o),
+                stderr(&o)
+            );
+            assert!(stderr(&o).contains("unsupported"), "{}", stderr(&o));
+        }
+    }
+    assert_eq!(drv.term(), Some(0));
+    assert_eq!(emu.term(), Some(0));
+}
+
+/// Item 10, the other way: a driver started on a robot without its body gripper serves
+/// none; the robot comes back with one, and the gripper is served from then on.
+#[test]
+fn a_gripper_that_appears_at_a_reconnect_is_served() {
+    let d = Domain::unique_for_test();
+    let (mut emu, addr) = emulator(&d, true, &["--no-gripper"]);
+    let port = addr.rsplit(':').next().unwrap().to_string();
+    let cfg = config("gained");
+    let mut drv = pioneer(&d, &addr, cfg.to_str().unwrap(), &[]);
+    let ctx = Context::new(&d, Role::Client, "link-test").unwrap();
+    let mut arm = ActArrayClient::connect_timeout(&ctx, "pioneer/actarray/0", T).unwrap();
+    assert!(wait_link(&mut arm, true, T));
+    let open = || {
+        limber(
+            d.name(),
+            &["gripper", "pioneer/gripper/0", "open", "--timeout", "5"],
+        )
+    };
+    let o = open();
+    assert!(!o.status.success(), "no gripper, yet: {}", stdout(&o));
+
+    assert_eq!(emu.term(), Some(0));
+    assert!(
+        wait_link(&mut arm, false, T),
+        "the robot's end was not seen"
+    );
+    let mut emu = emulator_at(&d, &port, &[]);
+    assert!(
+        wait_link(&mut arm, true, Duration::from_secs(30)),
+        "the link did not come back"
+    );
+    let o = open();
+    assert!(
+        o.status.success(),
+        "the gripper that appeared is not served: {:?} {}",
+        o.status.code(),
+        stderr(&o)
+    );
+    assert_eq!(drv.term(), Some(0));
+    assert_eq!(emu.term(), Some(0));
+}
+
 /// Issue 12 item 6: a second driver (another robot name) on a TCP endpoint that serves one
 /// client at a time is told the endpoint is held, and the first driver's link is left
 /// alone (no reconnect, no fault).

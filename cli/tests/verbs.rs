@@ -32,6 +32,10 @@ fn actarray_verbs() {
     assert!(ok(&["actarray", "cli/actarray/0", "home", "3"]).contains("ok"));
     assert!(ok(&["actarray", "cli/actarray/0", "power", "on"]).contains("ok"));
     assert!(ok(&["actarray", "cli/actarray/0", "speedcfg", "1", "0.5"]).contains("ok"));
+    // Issue "Nobody moves the arm who may not", item 8: beyond the joint's limit, clamped and
+    // said so.
+    let out = ok(&["actarray", "cli/actarray/0", "speedcfg", "1", "1e308"]);
+    assert!(out.contains("ok") && out.contains("clamped"), "{out}");
     assert!(ok(&["actarray", "cli/actarray/0", "pos", "1", "0.2", "--no-wait"]).contains("sent"));
     let geom = ok(&["actarray", "cli/actarray/0", "geom"]);
     assert_eq!(

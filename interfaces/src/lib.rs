@@ -45,6 +45,7 @@ pub mod error;
 pub mod gripper;
 pub mod interface;
 pub mod limb;
+pub mod limb_outcome;
 pub mod manifest;
 pub mod message;
 pub mod protocol;

@@ -258,3 +258,34 @@ fn limb_refusals_name_their_cause_and_a_huge_direction_moves() {
         s.orientation_adjustment
     );
 }
+
+/// Issue "Nobody moves the arm who may not", item 8: `speedcfg 2 1e308` answered a plain
+/// "ok" and set the servo to the controller's fastest step, so the next `pos 2 -1.5` moved
+/// 17 times faster than the geometry's `config_speed`. A speed request beyond the joint's
+/// limit now sets the limit (the joint's calibrated speed), like the SPEED command.
+#[test]
+fn a_speed_request_beyond_the_joint_limit_is_clamped_to_it() {
+    let domain = Domain::unique_for_test();
+    let emu = Emulator::start_pty(EmulatorConfig::default()).unwrap();
+    let _driver = start(&domain, &emu, "ok-speedcfg");
+    let c = ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
+    let j2 = ArmJoint::from_index(2).unwrap();
+    let limit_ms = cal().joint(j2).unwrap().speed;
+    let limit = arm.geometry().unwrap().actuators()[2].config_speed;
+    for speed in [1e308, 17.0 * limit] {
+        arm.set_speed_config(2, speed).unwrap();
+        let st = barrier(&mut arm, &emu, 0.3);
+        assert_eq!(
+            st.robot.ms_per_step[2], limit_ms,
+            "speedcfg 2 {speed}: the servo runs faster than its limit ({limit} rad/s)"
+        );
+    }
+    // Below the limit: as asked.
+    arm.set_speed_config(2, limit / 2.0).unwrap();
+    let st = barrier(&mut arm, &emu, 1.0);
+    assert_eq!(
+        st.robot.ms_per_step[2],
+        cal().speed_to_ms_per_step(j2, limit / 2.0).unwrap()
+    );
+}

@@ -71,6 +71,10 @@ pub struct PioneerConfig {
     pub tick_ms: u64,
     /// No packet from the robot for this long means the link is down, ms.
     pub link_timeout_ms: u64,
+    /// No packet from the robot for this long (or `link_timeout_ms`, if shorter) and a
+    /// client's command is refused "link down" instead of being written to a robot that
+    /// may carry it out late or never, ms. A robot sends a SIP every 100 ms.
+    pub command_silence_ms: u64,
     /// Pause between reconnection attempts, ms.
     pub reconnect_interval_ms: u64,
     /// How long each ARM_INFO may go unanswered, ms. The handshake asks 3 times before
@@ -224,6 +228,7 @@ impl Default for PioneerConfig {
             lift_speed: 0.02,
             tick_ms: 10,
             link_timeout_ms: 1000,
+            command_silence_ms: 250,
             reconnect_interval_ms: 500,
             arm_info_timeout_ms: 1000,
             pulse_interval_ms: 1000,
@@ -344,6 +349,9 @@ impl PioneerConfig {
         if self.linger_us > 10_000 {
             return bad("linger_us must be 0..=10000 (µs of polling after activity)");
         }
+        if self.command_silence_ms < 150 {
+            return bad("command_silence_ms must be >= 150 (a robot sends a SIP every 100 ms)");
+        }
         if self.link_timeout_ms < 200 {
             return bad("link_timeout_ms must be >= 200 (a robot sends a SIP every 100 ms)");
         }
@@ -356,6 +364,12 @@ impl PioneerConfig {
             return bad("robot must be [A-Za-z0-9_-]+");
         }
         Ok(())
+    }
+
+    /// How long the robot may have been silent when a client's command comes:
+    /// `command_silence_ms`, or `link_timeout_ms` if shorter.
+    pub fn command_silence(&self) -> Duration {
+        Duration::from_millis(self.command_silence_ms.min(self.link_timeout_ms))
     }
 
     /// The loop tick.

@@ -23,10 +23,11 @@
 mod config;
 mod driver;
 mod realtime;
-mod robot;
+pub mod robot;
 mod stats;
 
 pub use config::{BodyGripper, ConfigError, GripperGeometry, PioneerConfig};
 pub use driver::{DriverError, Hardware, LoopMode, PioneerDriver, RunOptions, gripper_decision};
 pub use realtime::{CpuError, RealtimeWarning, apply_realtime, check_cpu};
+pub use robot::{INTERNAL, Outbox, PacketEffect, Queued, RobotModel};
 pub use stats::{LoopStats, Ring};

@@ -9,6 +9,32 @@ use limber_p2os::{ArmJoint, Command, JointSelection};
 
 use super::*;
 
+/// The servo step (ms per tick) for `speed` rad/s, never faster than the joint's
+/// configured speed (its calibration; the geometry's `config_speed`): `Status::Clamped`
+/// when `speed` was beyond it.
+pub(super) fn ms_per_step_within_limit(
+    cal: &ArmCalibration,
+    joint: ArmJoint,
+    speed: f64,
+) -> Result<(u8, Status), Status> {
+    let ms = cal
+        .speed_to_ms_per_step(joint, speed)
+        .map_err(|_| Status::InvalidArgument)?;
+    // Fewer ms per step is faster.
+    let limit = cal.joint(joint).map_err(|_| Status::NotCalibrated)?.speed;
+    Ok(if limit > 0 && ms < limit {
+        tracing::debug!(
+            joint = joint.index(),
+            speed,
+            limit_ms_per_step = limit,
+            "speed clamped"
+        );
+        (limit, Status::Clamped)
+    } else {
+        (ms, Status::Ok)
+    })
+}
+
 impl RobotModel {
     /// An arm actarray command.
     /// A SPEED faster than the joint's configured speed (the geometry's `config_speed`,
@@ -98,17 +124,7 @@ impl RobotModel {
             return Ok(Status::Ok);
         }
         self.require_power()?;
-        let ms = cal
-            .speed_to_ms_per_step(joint, speed.abs())
-            .map_err(|_| Status::InvalidArgument)?;
-        // Fewer ms per step is faster: never faster than the joint's configured speed.
-        let limit = cal.joint(joint).map_err(|_| Status::NotCalibrated)?.speed;
-        let (ms, status) = if limit > 0 && ms < limit {
-            tracing::debug!(joint = j, speed, limit_ms_per_step = limit, "speed clamped");
-            (limit, Status::Clamped)
-        } else {
-            (ms, Status::Ok)
-        };
+        let (ms, status) = ms_per_step_within_limit(cal, joint, speed.abs())?;
         let [a, _, b, _] = cal
             .limits_radians(joint)
             .map_err(|_| Status::NotCalibrated)?;
@@ -182,11 +198,11 @@ impl RobotModel {
                         Status::NotFinite
                     });
                 }
-                // This joint's own calibration (Player used joint j+1's).
+                // This joint's own calibration (Player used joint j+1's); never faster
+                // than the joint's limit (a reply has no room for CLAMPED: the geometry's
+                // config_speed says what the limit is).
                 let aj = ArmJoint::from_index(j).map_err(|_| Status::UnknownJoint)?;
-                let ms = cal
-                    .speed_to_ms_per_step(aj, speed)
-                    .map_err(|_| Status::InvalidArgument)?;
+                let (ms, _) = ms_per_step_within_limit(cal, aj, speed)?;
                 self.send(
                     &Command::ArmSpeed {
                         joint: aj,
@@ -202,14 +218,11 @@ impl RobotModel {
 
     /// The arm geometry from the calibration.
     pub fn arm_geometry(&self) -> Result<ActArrayGeom, Status> {
-        let cal = self
-            .cal
-            .as_ref()
-            .ok_or(if self.has_arm || self.conn.is_none() {
-                Status::NotCalibrated
-            } else {
-                Status::Unsupported
-            })?;
+        let cal = self.cal.as_ref().ok_or(if self.has_arm || !self.link.up {
+            Status::NotCalibrated
+        } else {
+            Status::Unsupported
+        })?;
         let mut g = ActArrayGeom {
             actuators_count: cal.num_joints().min(ARM_JOINTS) as u32,
             base_pos: Vec3::from(self.cfg.arm_base),

@@ -75,6 +75,9 @@ impl RobotModel {
 
     /// A body-gripper command.
     pub fn gripper_command(&mut self, cmd: &GripperCommand, from: &Origin) -> Status {
+        if !self.body_gripper {
+            return Status::Unsupported;
+        }
         let p2 = match cmd {
             GripperCommand::Open => P2Gripper::Open,
             GripperCommand::Close => P2Gripper::Close,

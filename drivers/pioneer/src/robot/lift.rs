@@ -58,6 +58,9 @@ impl LiftModel {
 impl RobotModel {
     /// A lift command (one linear actuator, metres).
     pub fn lift_command(&mut self, cmd: &ActArrayCommand, from: &Origin) -> Status {
+        if !self.body_gripper {
+            return Status::Unsupported;
+        }
         let stroke = self.cfg.lift_stroke;
         let r = match *cmd {
             ActArrayCommand::Position { joint, position } => {

@@ -2,6 +2,7 @@
 
 use std::time::{Duration, Instant};
 
+use limber_interfaces::limb_outcome::adjustment_reported;
 use limber_interfaces::prelude::*;
 use limber_services::Origin;
 use nalgebra::Vector3;
@@ -53,24 +54,9 @@ impl RobotModel {
     /// A limb command. A SETPOSE whose orientation had to be turned to one the joints
     /// can hold is carried out as `Status::Adjusted`, the amount in the limb state.
     pub fn limb_command(&mut self, cmd: &LimbCommand, from: &Origin) -> Status {
-        self.limb_adjustment = 0.0;
+        self.limb.begin();
         let r = self.limb_command_inner(cmd, from);
-        match r {
-            Ok(()) => {
-                self.limb_oor = false;
-                if self.limb_adjustment > 0.0 {
-                    Status::Adjusted
-                } else {
-                    Status::Ok
-                }
-            }
-            Err(e) => {
-                if cannot_get_there(e) {
-                    self.limb_oor = true;
-                }
-                e
-            }
-        }
+        self.limb.settle(r)
     }
 
     pub(super) fn limb_command_inner(
@@ -103,9 +89,7 @@ impl RobotModel {
                 self.vecmove = None;
                 let s = self.solve_setpose(position, approach, orientation, &current)?;
                 self.send_theta(s.theta(), from)?;
-                if s.adjusted() {
-                    self.limb_adjustment = s.adjustment;
-                }
+                self.limb.adjusted_by(s.adjustment);
                 Ok(())
             }
             LimbCommand::SetPosition { position } => {
@@ -209,7 +193,7 @@ impl RobotModel {
             orientation_adjustment: s.adjustment,
             position_error: s.position_error,
             approach_error: s.approach_error,
-            adjusted: u32::from(s.adjusted()),
+            adjusted: u32::from(adjustment_reported(s.adjustment)),
             _pad: 0,
         })
     }
@@ -260,9 +244,7 @@ impl RobotModel {
                 let reach = self.geom.l2 + self.geom.l4 + self.geom.l5;
                 for j in 0..PIONEER_DOF {
                     let joint = ArmJoint::from_index(j).map_err(|_| Status::UnknownJoint)?;
-                    let ms = cal
-                        .speed_to_ms_per_step(joint, v / reach)
-                        .map_err(|_| Status::InvalidArgument)?;
+                    let (ms, _) = super::arm::ms_per_step_within_limit(&cal, joint, v / reach)?;
                     self.send(
                         &Command::ArmSpeed {
                             joint,
@@ -298,7 +280,7 @@ impl RobotModel {
         let stall = Duration::from_millis(self.cfg.stall_timeout_ms);
         let flags: [ActuatorFlags; PIONEER_DOF] =
             core::array::from_fn(|j| self.arm.flags(j, now, stall));
-        s.state = if self.limb_oor {
+        s.state = if self.limb.out_of_reach {
             LimbState::OutOfReach
         } else if flags.iter().any(|f| f.contains(ActuatorFlags::STALLED)) {
             LimbState::Collision
@@ -308,7 +290,7 @@ impl RobotModel {
         } else {
             LimbState::Idle
         } as u32;
-        s.orientation_adjustment = self.limb_adjustment;
+        s.orientation_adjustment = self.limb.adjustment;
         s.header.stamp_ns = self.arm.stamp_ns;
     }
 }

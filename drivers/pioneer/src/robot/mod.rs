@@ -1,20 +1,27 @@
 //! The driver's model of the robot and its command handling: what every device does with a
 //! command or request, validated before anything is written to the link.
 //!
-//! [`RobotModel`] holds the link, the calibration and what was commanded; its methods are
-//! split by device: [`arm`] (the arm actarray), [`limb`] (the end effector and its IK),
-//! [`grippers`] (the arm gripper and the body gripper) and [`lift`].
+//! [`RobotModel`] holds the calibration, what the robot last said and what was commanded;
+//! it has no link. It takes the robot's packets ([`RobotModel::on_packet`]) and the link's
+//! comings and goings ([`RobotModel::link_up`], [`RobotModel::link_down`]), and every
+//! command it accepts leaves P2OS [`Command`]s in its [`Outbox`], which the driver writes
+//! to the link. Its methods are split by device: [`arm`] (the arm actarray), [`limb`] (the
+//! end effector and its IK), [`grippers`] (the arm gripper and the body gripper) and
+//! [`lift`].
 
 mod arm;
 mod grippers;
 mod lift;
 mod limb;
 mod motion;
+mod outbox;
 
 pub use lift::LiftModel;
+pub use outbox::{OUTBOX_CAPACITY, Outbox, OutboxFull, Queued};
 
 use std::time::{Duration, Instant};
 
+use limber_interfaces::limb_outcome::LimbOutcome;
 use limber_interfaces::prelude::*;
 use limber_services::Origin;
 use limber_services::monotonic_ns;
@@ -24,10 +31,18 @@ use limber_kinematics::FrameError;
 use limber_kinematics::pioneer::{
     DriverAngleMap, PIONEER_DOF, PioneerGeometry, PioneerIkError, PioneerIkOptions, Theta,
 };
-use limber_p2os::{ArmCalibration, ArmJoint, ArmPacket, ArmpacLayout, Command, Connection, Sip};
+use limber_p2os::{ArmCalibration, ArmJoint, ArmPacket, ArmpacLayout, Command, RobotPacket, Sip};
 
 use crate::config::PioneerConfig;
-use crate::stats::LoopStats;
+
+/// The driver itself as the origin of a command (its own power, autopark and stream
+/// commands, VECMOVE waypoints, the deadman's stops): never refused as stale.
+pub const INTERNAL: Origin = Origin {
+    client_id: 0,
+    seq: 0,
+    sent_ns: 0,
+    received_ns: 0,
+};
 
 /// Joints of the arm actarray: 5 arm joints and the gripper.
 pub const ARM_JOINTS: usize = 6;
@@ -69,12 +84,17 @@ pub struct ArmModel {
     /// When the last power-on was written: "unpowered" reports before
     /// [`POWER_ON_SETTLE`] after it are not counted against the grace.
     pub power_on_sent: Option<Instant>,
+    /// When the last power-off was written: ARMpacs saying "powered" for
+    /// [`POWER_ON_SETTLE`] after it left the controller before it read the command.
+    pub power_off_sent: Option<Instant>,
     /// Commanded target tick per joint (None: hold wherever it is).
     pub target: [Option<u8>; ARM_JOINTS],
     /// Since when a joint has been still but short of its target.
     pub short_since: [Option<Instant>; ARM_JOINTS],
     /// When the last ARMpac arrived (`CLOCK_MONOTONIC` ns).
     pub stamp_ns: u64,
+    /// When the last ARMpac arrived, on the model's clock.
+    pub last_packet: Option<Instant>,
     /// ARMpacs whose status bytes make sense only in the other layout than the
     /// configured `armpac_layout` (see [`ArmPacket::suggests_other_layout`]).
     pub layout_mismatches: u64,
@@ -89,9 +109,11 @@ impl Default for ArmModel {
             powered: false,
             power_on_pending: 0,
             power_on_sent: None,
+            power_off_sent: None,
             target: [None; ARM_JOINTS],
             short_since: [None; ARM_JOINTS],
             stamp_ns: 0,
+            last_packet: None,
             layout_mismatches: 0,
         }
     }
@@ -134,7 +156,11 @@ impl ArmModel {
         let status = p.status(layout);
         self.ticks = p.ticks;
         self.moving = status.moving_mask();
-        self.powered = status.powered;
+        // "Powered" from a packet in flight when the power-off left is not believed.
+        self.powered = status.powered
+            && self
+                .power_off_sent
+                .is_none_or(|t| now.saturating_duration_since(t) >= POWER_ON_SETTLE);
         if self.powered {
             self.power_on_pending = 0;
         } else if self
@@ -145,6 +171,7 @@ impl ArmModel {
         }
         self.seen = true;
         self.stamp_ns = monotonic_ns();
+        self.last_packet = Some(now);
         for j in 0..ARM_JOINTS {
             let short =
                 self.moving & (1 << j) == 0 && self.target[j].is_some_and(|t| t != self.ticks[j]);
@@ -166,10 +193,12 @@ impl ArmModel {
         if on {
             self.power_on_pending = POWER_ON_GRACE_PACKETS;
             self.power_on_sent = Some(Instant::now());
+            self.power_off_sent = None;
         } else {
             // Off at once: no motion command is accepted after it.
             self.power_on_pending = 0;
             self.powered = false;
+            self.power_off_sent = Some(Instant::now());
         }
     }
 
@@ -196,58 +225,113 @@ pub struct VecMovePlan {
     next: usize,
 }
 
-/// The driver's state and the link.
+/// The link as the model sees it: up or down, since when, and when the robot last spoke.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LinkState {
+    /// The link is up: commands are accepted.
+    pub(crate) up: bool,
+    /// When the link came up (`CLOCK_MONOTONIC` ns; commands sent earlier are refused:
+    /// never replayed).
+    pub(crate) up_since_ns: u64,
+    /// When the last packet arrived.
+    pub(crate) last_rx: Instant,
+    /// When the link came up.
+    pub(crate) up_at: Instant,
+}
+
+/// What a packet changed that the driver acts on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PacketEffect {
+    /// Nothing beyond the model's state.
+    None,
+    /// A SIP arrived (the driver counts them).
+    Sip,
+    /// An ARMINFOpac arrived: the calibration is (re)set.
+    ArmInfo,
+}
+
+/// The driver's model of the robot: calibration, what the robot last said, what was
+/// commanded, and the commands waiting for the link. No link inside.
 pub struct RobotModel {
     /// The configuration.
-    pub cfg: PioneerConfig,
-    /// The connection while the link is up.
-    pub conn: Option<Connection>,
-    /// When the link came up (commands sent earlier are refused: never replayed).
-    pub link_up_since_ns: u64,
-    /// When the last packet arrived.
-    pub last_rx: Instant,
+    pub(crate) cfg: PioneerConfig,
+    /// The link's state.
+    pub(crate) link: LinkState,
+    /// Commands accepted and not yet written to the link.
+    pub(crate) outbox: Outbox,
     /// Calibration from ARMINFO.
-    pub cal: Option<ArmCalibration>,
+    pub(crate) cal: Option<ArmCalibration>,
     /// The robot answered ARM_INFO.
-    pub has_arm: bool,
+    pub(crate) has_arm: bool,
     /// Arm kinematics.
-    pub geom: PioneerGeometry,
+    pub(crate) geom: PioneerGeometry,
     /// Driver ↔ kinematic angles.
-    pub map: DriverAngleMap,
+    pub(crate) map: DriverAngleMap,
     /// IK options.
-    pub ik: PioneerIkOptions,
+    pub(crate) ik: PioneerIkOptions,
     /// The arm.
-    pub arm: ArmModel,
-    /// The last limb target was out of reach (cleared by the next valid limb command).
-    pub limb_oor: bool,
-    /// How much the last SETPOSE adjusted the orientation, rad (0 after any other limb
-    /// command).
-    pub limb_adjustment: f64,
+    pub(crate) arm: ArmModel,
+    /// Malformed input from the robot so far.
+    pub(crate) malformed: u64,
+    /// The arm was reporting at the last [`RobotModel::check_arm_reporting`].
+    pub(crate) arm_reported: bool,
+    /// The body gripper and lift are served (the robot's CONFIGpac or the configuration
+    /// says so); otherwise their commands are refused UNSUPPORTED.
+    pub(crate) body_gripper: bool,
+    /// OUT_OF_REACH and the orientation adjustment of the last limb command.
+    pub(crate) limb: LimbOutcome,
     /// A VECMOVE being streamed.
-    pub vecmove: Option<Box<VecMovePlan>>,
+    pub(crate) vecmove: Option<Box<VecMovePlan>>,
     /// End-effector speed for limb motions, m/s.
-    pub limb_speed: f64,
+    pub(crate) limb_speed: f64,
     /// The lift.
-    pub lift: LiftModel,
+    pub(crate) lift: LiftModel,
     /// The latest SIP.
-    pub sip: Option<Sip>,
+    pub(crate) sip: Option<Sip>,
     /// The last body-gripper command (OPEN/CLOSE/STOP).
-    pub gripper_cmd: Option<GripperCommand>,
+    pub(crate) gripper_cmd: Option<GripperCommand>,
     /// The last arm-gripper command.
-    pub armgrip_cmd: Option<GripperCommand>,
+    pub(crate) armgrip_cmd: Option<GripperCommand>,
     /// What changed on the link since the last publish.
-    pub dirty: Dirty,
-    /// Loop statistics.
-    pub stats: LoopStats,
+    pub(crate) dirty: Dirty,
 }
 
 impl core::fmt::Debug for RobotModel {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.debug_struct("RobotModel")
-            .field("link_up", &self.conn.is_some())
+            .field("link_up", &self.link.up)
             .field("has_arm", &self.has_arm)
+            .field("outbox", &self.outbox.len())
             .finish()
     }
+}
+
+/// Why an ARMINFOpac cannot be a calibration: no joint, or a joint without ticks per 90°
+/// (every angle would be infinite) or without a range.
+fn calibration_problem(cal: &ArmCalibration) -> Option<String> {
+    let n = cal.num_joints();
+    if n == 0 {
+        return Some("it has no joint".into());
+    }
+    for j in 0..n.min(ARM_JOINTS) {
+        let Ok(joint) = ArmJoint::from_index(j) else {
+            return Some(format!("joint index {j} is unknown"));
+        };
+        let Ok(c) = cal.joint(joint) else {
+            return Some(format!("joint {} has no calibration", joint.number()));
+        };
+        if c.ticks_per_90 == 0 {
+            return Some(format!("joint {} has 0 ticks per 90°", joint.number()));
+        }
+        if c.min == c.max {
+            return Some(format!(
+                "joint {} has no range (min = max = {})",
+                joint.number(),
+                c.min
+            ));
+        }
+    }
+    None
 }
 
 /// The cause of an IK failure, as the status a refused limb command carries.
@@ -267,15 +351,6 @@ pub(crate) fn ik_status(e: &PioneerIkError) -> Status {
     }
 }
 
-/// True for the statuses that mean "the limb cannot get there" (the limb's OUT_OF_REACH
-/// state): beyond its reach, an orientation its joints cannot hold, or a joint limit.
-pub(crate) fn cannot_get_there(s: Status) -> bool {
-    matches!(
-        s,
-        Status::OutOfReach | Status::UnreachableOrientation | Status::BeyondLimits
-    )
-}
-
 impl RobotModel {
     /// The model for `cfg`, link down.
     pub fn new(cfg: PioneerConfig) -> Self {
@@ -293,9 +368,14 @@ impl RobotModel {
         let limb_speed = cfg.limb_speed;
         RobotModel {
             cfg,
-            conn: None,
-            link_up_since_ns: 0,
-            last_rx: Instant::now(),
+            link: LinkState {
+                up: false,
+                up_since_ns: 0,
+                last_rx: Instant::now(),
+                up_at: Instant::now(),
+            },
+            arm_reported: true,
+            outbox: Outbox::default(),
             cal: None,
             has_arm: false,
             geom,
@@ -308,8 +388,9 @@ impl RobotModel {
                 ..PioneerIkOptions::default()
             },
             arm: ArmModel::default(),
-            limb_oor: false,
-            limb_adjustment: 0.0,
+            malformed: 0,
+            body_gripper: false,
+            limb: LimbOutcome::default(),
             vecmove: None,
             limb_speed,
             lift,
@@ -317,7 +398,6 @@ impl RobotModel {
             gripper_cmd: None,
             armgrip_cmd: None,
             dirty: Dirty::default(),
-            stats: LoopStats::default(),
         }
     }
 
@@ -333,7 +413,7 @@ impl RobotModel {
 
     /// Takes the calibration: sets the IK joint limits (in θ, from the driver-convention
     /// limits) and marks the arm present.
-    pub fn set_calibration(&mut self, cal: ArmCalibration) {
+    fn set_calibration(&mut self, cal: ArmCalibration) {
         let mut min = [0.0; PIONEER_DOF];
         let mut max = [0.0; PIONEER_DOF];
         for j in 0..PIONEER_DOF {
@@ -350,47 +430,230 @@ impl RobotModel {
         self.dirty.arm = true;
     }
 
-    /// Writes a command to the link. Refused (LinkDown) when the link is down, or when
-    /// the client sent it before the link came up (never replayed after a fault).
-    pub fn send(&mut self, cmd: &Command, from: &Origin) -> Result<(), Status> {
-        if from.sent_ns != 0 && from.sent_ns < self.link_up_since_ns {
+    /// Queues a command for the link. Refused (LinkDown) when the link is down, when the
+    /// client sent it before the link came up (never replayed after a fault), or when the
+    /// robot has been silent longer than [`PioneerConfig::command_silence`].
+    pub(crate) fn send(&mut self, cmd: &Command, from: &Origin) -> Result<(), Status> {
+        if !self.link.up || (from.sent_ns != 0 && from.sent_ns < self.link.up_since_ns) {
             return Err(Status::LinkDown);
         }
-        let conn = self.conn.as_mut().ok_or(Status::LinkDown)?;
-        let before = if from.received_ns != 0 {
-            monotonic_ns()
-        } else {
-            0
+        // A robot silent for a while may be gone: a client's command written now could be
+        // carried out much later (from the link's buffers, after a reconnect), or never.
+        if from.sent_ns != 0 {
+            let silent = Instant::now().saturating_duration_since(self.link.last_rx);
+            if silent > self.cfg.command_silence() {
+                tracing::debug!(?silent, "{cmd:?} refused: the robot is silent");
+                return Err(Status::LinkDown);
+            }
+        }
+        if let Err(e) = self.outbox.push(Queued {
+            cmd: *cmd,
+            from: *from,
+        }) {
+            // The driver drains the outbox after every call: a bug, never the client's.
+            tracing::error!("cannot queue {cmd:?}: {e}");
+            return Err(Status::Busy);
+        }
+        if let Command::ArmPower(on) = *cmd {
+            self.arm.power_commanded(on);
+        }
+        Ok(())
+    }
+
+    /// Queues one of the driver's own commands (power, autopark, the ARMpac stream).
+    pub fn send_internal(&mut self, cmd: &Command) -> Result<(), Status> {
+        self.send(cmd, &INTERNAL)
+    }
+
+    /// The commands waiting for the link (the driver drains them after every call).
+    pub fn outbox_mut(&mut self) -> &mut Outbox {
+        &mut self.outbox
+    }
+
+    /// The commands waiting for the link.
+    pub fn outbox(&self) -> &Outbox {
+        &self.outbox
+    }
+
+    /// Writing `failed` to the link failed: it and everything queued after it are
+    /// dropped, and what they would have started is forgotten (the joints hold wherever
+    /// they are, a VECMOVE is abandoned, never resumed on a later link).
+    pub fn write_failed(&mut self, failed: &Queued) {
+        let dropped = self.outbox.clear();
+        tracing::debug!("dropped {dropped} queued commands after {:?}", failed.cmd);
+        if failed.cmd == Command::ArmPower(true) {
+            self.arm.power_on_pending = 0;
+        }
+        self.arm.target = [None; ARM_JOINTS];
+        self.vecmove = None;
+        self.dirty.arm = true;
+    }
+
+    /// The link came up at `now`: commands are accepted again, those sent before refused;
+    /// whatever was commanded before is void (the arm holds where it is).
+    pub fn link_up(&mut self, now: Instant) {
+        self.link = LinkState {
+            up: true,
+            up_since_ns: monotonic_ns(),
+            last_rx: now,
+            up_at: now,
         };
-        let sent = conn.send(cmd);
-        // Read right after the write: the stages end when the bytes are on the wire.
-        let now = monotonic_ns();
-        match sent {
-            Ok(()) => {
-                if let Command::ArmPower(on) = *cmd {
-                    self.arm.power_commanded(on);
-                }
-                if from.sent_ns != 0 {
-                    self.stats
-                        .cmd_to_wire
-                        .push(now.saturating_sub(from.sent_ns));
-                }
-                if from.received_ns != 0 {
-                    self.stats
-                        .arrival_to_wire
-                        .push(now.saturating_sub(from.received_ns));
-                    self.stats.link_write.push(now.saturating_sub(before));
-                    self.stats
-                        .arrival_to_send
-                        .push(before.saturating_sub(from.received_ns));
-                }
-                Ok(())
+        self.arm.target = [None; ARM_JOINTS];
+        self.dirty.arm = true;
+        self.dirty.body = true;
+    }
+
+    /// The link went down: commands are refused (LinkDown), nothing queued is sent later,
+    /// a VECMOVE is abandoned. Returns how many queued commands were dropped.
+    pub fn link_down(&mut self) -> usize {
+        self.link.up = false;
+        self.vecmove = None;
+        self.dirty.arm = true;
+        self.dirty.body = true;
+        self.outbox.clear()
+    }
+
+    /// True while the arm reports: the link is up and an ARMpac arrived within
+    /// `link_timeout_ms` (counted from the link's coming up before the first). Otherwise
+    /// what the model holds of the arm is stale: its state does not say LINK_UP and its
+    /// commands are refused LINK_DOWN (the ARMpacs may be lost, or arrive malformed,
+    /// while the SIPs keep the link up).
+    pub fn arm_reporting(&self, now: Instant) -> bool {
+        let since = self
+            .arm
+            .last_packet
+            .map_or(self.link.up_at, |t| t.max(self.link.up_at));
+        self.link.up
+            && now.saturating_duration_since(since)
+                <= Duration::from_millis(self.cfg.link_timeout_ms)
+    }
+
+    /// Notes whether the arm reports (the timer's work): a change is logged and makes the
+    /// arm's devices publish their state.
+    pub fn check_arm_reporting(&mut self, now: Instant) {
+        let reporting = !self.has_arm || self.arm_reporting(now);
+        if reporting == self.arm_reported {
+            return;
+        }
+        self.arm_reported = reporting;
+        self.dirty.arm = true;
+        if reporting {
+            tracing::info!("the arm reports again (ARMpacs arrive)");
+        } else if self.link.up {
+            tracing::warn!(
+                "no ARMpac for {} ms while the link is up: the arm's state is stale, its \
+                 commands are refused until ARMpacs arrive ({} malformed packets so far)",
+                self.cfg.link_timeout_ms,
+                self.malformed
+            );
+        }
+    }
+
+    /// True while the link is up.
+    pub fn is_link_up(&self) -> bool {
+        self.link.up
+    }
+
+    /// When the robot last sent a packet.
+    pub fn last_rx(&self) -> Instant {
+        self.link.last_rx
+    }
+
+    /// Malformed input from the robot so far: packets that do not parse and ARMINFOpacs
+    /// that cannot be a calibration.
+    pub fn malformed(&self) -> u64 {
+        self.malformed
+    }
+
+    /// Counts malformed input from the robot and logs it: the first, then at powers of
+    /// two, so a robot that keeps sending it is visible without flooding the log.
+    pub fn note_malformed(&mut self, n: u64, what: &dyn core::fmt::Display) {
+        for _ in 0..n {
+            self.malformed += 1;
+            if self.malformed.is_power_of_two() {
+                tracing::warn!(
+                    "malformed input from the robot ({} so far): {what}",
+                    self.malformed
+                );
             }
-            Err(e) => {
-                // The loop notices the dead link (read error or silence) and reconnects.
-                tracing::warn!("cannot send {cmd:?} to the robot: {e}");
-                Err(Status::LinkDown)
+        }
+    }
+
+    /// Takes an ARMINFOpac's calibration if it can be one (at least one joint, each
+    /// with ticks per 90° and a range); otherwise it is counted and logged as malformed
+    /// and the calibration held (if any) stays. Returns whether it was taken.
+    pub fn take_calibration(&mut self, cal: ArmCalibration) -> bool {
+        // The robot answered ARM_INFO: it has an arm, calibrated or not.
+        self.has_arm = true;
+        self.dirty.arm = true;
+        match calibration_problem(&cal) {
+            None => {
+                self.set_calibration(cal);
+                true
             }
+            Some(problem) => {
+                self.note_malformed(1, &format_args!("ARMINFOpac not taken: {problem}"));
+                false
+            }
+        }
+    }
+
+    /// Whether the body gripper and lift are served: the robot has them now (asked at
+    /// every connection) or the configuration forces them.
+    pub fn set_body_gripper(&mut self, served: bool) {
+        self.body_gripper = served;
+        self.dirty.body = true;
+    }
+
+    /// True once the robot answered ARM_INFO with a calibration.
+    pub fn calibrated(&self) -> bool {
+        self.cal.is_some()
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &PioneerConfig {
+        &self.cfg
+    }
+
+    /// The arm as the last ARMpac described it, and what was commanded.
+    pub fn arm(&self) -> &ArmModel {
+        &self.arm
+    }
+
+    /// Takes a SIP that arrived outside the loop (the handshake's last).
+    pub fn set_sip(&mut self, sip: Sip) {
+        self.sip = Some(sip);
+        self.dirty.body = true;
+    }
+
+    /// Takes a packet from the robot at `now`: a SIP, an ARMpac (the next VECMOVE
+    /// waypoint is queued when the arm reached the current one) or an ARMINFOpac.
+    pub fn on_packet(&mut self, pkt: &RobotPacket<'_>, now: Instant) -> PacketEffect {
+        self.link.last_rx = now;
+        match pkt {
+            RobotPacket::Sip(s) => {
+                self.set_sip(*s);
+                PacketEffect::Sip
+            }
+            RobotPacket::Arm(a) => {
+                self.arm.update(a, self.cfg.armpac_layout, now);
+                self.dirty.arm = true;
+                if let Err(status) = self.stream_vecmove(&INTERNAL) {
+                    // The next waypoint could not be queued (the link is down): the line
+                    // is abandoned, never resumed on a later link.
+                    tracing::warn!("VECMOVE abandoned: {status}");
+                    self.vecmove = None;
+                }
+                PacketEffect::None
+            }
+            RobotPacket::ArmInfo(i) => {
+                if self.take_calibration(ArmCalibration::from(*i)) {
+                    PacketEffect::ArmInfo
+                } else {
+                    PacketEffect::None
+                }
+            }
+            _ => PacketEffect::None,
         }
     }
 
@@ -405,11 +668,14 @@ impl RobotModel {
     }
 
     pub(super) fn calibration(&self) -> Result<&ArmCalibration, Status> {
-        if self.conn.is_none() {
+        if !self.link.up {
             return Err(Status::LinkDown);
         }
         if !self.has_arm {
             return Err(Status::Unsupported);
+        }
+        if !self.arm_reporting(Instant::now()) {
+            return Err(Status::LinkDown);
         }
         self.cal.as_ref().ok_or(Status::NotCalibrated)
     }

@@ -10,12 +10,7 @@ use limber_services::{Motion, Origin};
 use super::*;
 
 /// The driver itself, as the origin of a deadman stop (never refused as stale).
-const DEADMAN: Origin = Origin {
-    client_id: 0,
-    seq: 0,
-    sent_ns: 0,
-    received_ns: 0,
-};
+const DEADMAN: Origin = INTERNAL;
 
 /// Bits of the five arm joints (the limb's), without the gripper (joint 5).
 const LIMB_JOINTS: u8 = 0b1_1111;

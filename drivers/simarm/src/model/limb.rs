@@ -2,11 +2,11 @@
 //! inverse kinematics, and VECMOVE planned completely (every waypoint solved) before it
 //! is streamed one waypoint at a time.
 
+use limber_interfaces::limb_outcome::adjustment_reported;
 use limber_interfaces::prelude::*;
 use nalgebra::Vector3;
 
 use limber_kinematics::chain::{ChainIkError, IkTarget, JointKind, JointVec, NearestSolution};
-use limber_kinematics::pioneer::ADJUSTMENT_REPORTED;
 use limber_kinematics::{Pose, fit_angle_to_limits, unit_direction};
 
 use super::{ArmModel, MAX_WAYPOINTS};
@@ -35,28 +35,9 @@ impl ArmModel {
     /// Carries out or refuses a limb command. OUT_OF_REACH sets the limb state to
     /// out-of-reach until the next valid limb command.
     pub fn limb_command(&mut self, cmd: &LimbCommand) -> Status {
-        self.limb_adjustment = 0.0;
-        match self.limb_command_inner(cmd) {
-            Ok(()) => {
-                self.limb_oor = false;
-                if self.limb_adjustment > 0.0 {
-                    Status::Adjusted
-                } else {
-                    Status::Ok
-                }
-            }
-            Err(e) => {
-                // The limb cannot get there: beyond its reach, an orientation its joints
-                // cannot hold, or a joint limit in the way.
-                if matches!(
-                    e,
-                    Status::OutOfReach | Status::UnreachableOrientation | Status::BeyondLimits
-                ) {
-                    self.limb_oor = true;
-                }
-                e
-            }
-        }
+        self.limb.begin();
+        let r = self.limb_command_inner(cmd);
+        self.limb.settle(r)
     }
 
     fn ik_to(&self, target: &IkTarget, seed: &[f64]) -> Result<JointVec, Status> {
@@ -166,9 +147,7 @@ impl ArmModel {
                 self.powered()?;
                 self.vecmove.active = false;
                 self.move_joints_together(&s.q, 0.0);
-                if s.adjustment > ADJUSTMENT_REPORTED {
-                    self.limb_adjustment = s.adjustment;
-                }
+                self.limb.adjusted_by(s.adjustment);
                 Ok(())
             }
             LimbCommand::SetPosition { position } => {
@@ -309,7 +288,7 @@ impl ArmModel {
                     orientation_adjustment: s.adjustment,
                     position_error: s.position_error,
                     approach_error: s.approach_error,
-                    adjusted: u32::from(s.adjustment > ADJUSTMENT_REPORTED),
+                    adjusted: u32::from(adjustment_reported(s.adjustment)),
                     _pad: 0,
                 }))
             }
@@ -324,8 +303,8 @@ impl ArmModel {
         s.position = Vec3::new(p.x, p.y, p.z);
         s.approach = Vec3::new(a.x, a.y, a.z);
         s.orientation = Vec3::new(o.x, o.y, o.z);
-        s.orientation_adjustment = self.limb_adjustment;
-        s.state = if self.limb_oor {
+        s.orientation_adjustment = self.limb.adjustment;
+        s.state = if self.limb.out_of_reach {
             LimbState::OutOfReach
         } else if self.limb_moving() {
             LimbState::Moving

@@ -55,10 +55,9 @@ pub struct ArmModel {
     /// End-effector speed set by the limb's SPEED request, m/s (`None`: joints at their
     /// configured speeds).
     limb_speed: Option<f64>,
-    limb_oor: bool,
-    /// How much the last SETPOSE adjusted the orientation, rad (0 after any other limb
-    /// command).
-    limb_adjustment: f64,
+    /// OUT_OF_REACH and the orientation adjustment of the last limb command (the rules
+    /// shared with the Pioneer driver: [`limber_interfaces::limb_outcome`]).
+    limb: limber_interfaces::limb_outcome::LimbOutcome,
     powered: bool,
     vecmove: VecMovePlan,
     object: Option<SimObject>,
@@ -115,8 +114,7 @@ impl ArmModel {
             gripper_config_speed: gspeed,
             gripper_cmd: GripperCmd::Open,
             limb_speed: None,
-            limb_oor: false,
-            limb_adjustment: 0.0,
+            limb: Default::default(),
             powered: true,
             vecmove: VecMovePlan {
                 waypoints: Vec::with_capacity(MAX_WAYPOINTS),
