@@ -34,7 +34,26 @@ fn move_joint_0(arm: &mut ActArrayClient, emu: &Emulator) {
 }
 
 fn name(sig: i32) -> String {
-    limber_services::signals::signal_name(sig)
+    let names = [
+        (libc::SIGQUIT, "SIGQUIT"),
+        (libc::SIGXCPU, "SIGXCPU"),
+        (libc::SIGPWR, "SIGPWR"),
+        (libc::SIGALRM, "SIGALRM"),
+        (libc::SIGIO, "SIGIO"),
+        (libc::SIGSTKFLT, "SIGSTKFLT"),
+        (libc::SIGXFSZ, "SIGXFSZ"),
+        (libc::SIGSYS, "SIGSYS"),
+        (libc::SIGTRAP, "SIGTRAP"),
+        (libc::SIGUSR1, "SIGUSR1"),
+        (libc::SIGUSR2, "SIGUSR2"),
+        (libc::SIGVTALRM, "SIGVTALRM"),
+        (libc::SIGPROF, "SIGPROF"),
+    ];
+    match names.iter().find(|(s, _)| *s == sig) {
+        Some((_, n)) => n.to_string(),
+        None if sig >= libc::SIGRTMIN() => format!("SIGRTMIN+{}", sig - libc::SIGRTMIN()),
+        None => format!("signal {sig}"),
+    }
 }
 
 /// `sig` ends the driver with exit 0 after it stopped the arm where it was (ARM_STOP) and
