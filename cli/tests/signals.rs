@@ -89,6 +89,10 @@ fn wait_proc_state(pid: u32, want: char) {
             return;
         }
         assert!(
+            !matches!(s, None | Some('Z')),
+            "process {pid} ended while waiting for state {want}"
+        );
+        assert!(
             Instant::now() < deadline,
             "process {pid} in state {s:?}, not {want}, after 10 s"
         );
