@@ -165,6 +165,10 @@ pub fn run(args: EmulatorArgs) -> Result<(), CliError> {
 
 fn serve(args: EmulatorArgs) -> Result<(), EmulatorError> {
     let cfg = args.config()?;
+    // Before the first line: whoever read it may signal at once. The termination signals
+    // end it; the other signals that would end a process are ignored
+    // (limber_services::signals).
+    signals::install().map_err(std::io::Error::from)?;
     let emu = match args.tcp {
         Some(port) => Emulator::start_tcp(cfg, SocketAddr::new(args.bind, port))?,
         None => Emulator::start_pty(cfg)?,
@@ -181,9 +185,6 @@ fn serve(args: EmulatorArgs) -> Result<(), EmulatorError> {
         }
         out.flush()?;
     }
-    // The termination signals end it; the other signals that would end a process are
-    // ignored (limber_services::signals).
-    signals::install().map_err(std::io::Error::from)?;
     let stop = Arc::new(AtomicBool::new(false));
     if !args.ignore_stdin {
         let s = Arc::clone(&stop);
