@@ -101,22 +101,34 @@ fn wait_proc_state(pid: u32, want: char) {
 }
 
 /// A test driver on a thread of this process that publishes only when commanded (its
-/// period is an hour), so that a client waiting for the next state blocks.
-fn quiet_driver(domain: &str) -> mpsc::Sender<()> {
-    let (tx, rx) = mpsc::channel::<()>();
+/// period is an hour), so that a client waiting for the next state blocks. It ends at its
+/// first wake-up after `stop` is sent or dropped, and then says so on `ended`.
+struct QuietDriver {
+    stop: mpsc::Sender<()>,
+    ended: mpsc::Receiver<()>,
+}
+
+fn quiet_driver(domain: &str) -> QuietDriver {
+    let (stop, rx) = mpsc::channel::<()>();
     let (ready_tx, ready_rx) = mpsc::channel();
+    let (ended_tx, ended) = mpsc::channel();
     let name = domain.to_string();
     std::thread::spawn(move || {
         let domain = Domain::new(&name).unwrap();
         let ctx = Context::new(&domain, Role::Driver, "quietdriver").unwrap();
         let mut d = TestDriver::new(&ctx, "quiet", 6).unwrap();
         ready_tx.send(()).unwrap();
-        let _ = d.run(Duration::from_secs(3600), || {
+        d.run(Duration::from_secs(3600), || {
             !matches!(rx.try_recv(), Err(mpsc::TryRecvError::Empty))
-        });
+        })
+        .expect("the quiet driver's loop");
+        drop(d);
+        drop(ctx);
+        // The test may have stopped waiting (it failed): nobody to tell.
+        ended_tx.send(()).ok();
     });
     ready_rx.recv_timeout(Duration::from_secs(10)).unwrap();
-    tx
+    QuietDriver { stop, ended }
 }
 
 /// Ctrl-Z and `fg` (SIGSTOP, SIGCONT) on a client blocked in a wait for the next state:
@@ -125,7 +137,7 @@ fn quiet_driver(domain: &str) -> mpsc::Sender<()> {
 #[test]
 fn a_client_stopped_and_continued_in_a_wait_resumes_it() {
     let d = Domain::unique_for_test();
-    let stop = quiet_driver(d.name());
+    let driver = quiet_driver(d.name());
     let ctx = Context::new(&d, Role::Client, "signals-test").unwrap();
     let mut arm =
         ActArrayClient::connect_timeout(&ctx, "quiet/actarray/0", Duration::from_secs(5)).unwrap();
@@ -176,5 +188,11 @@ fn a_client_stopped_and_continued_in_a_wait_resumes_it() {
         std::thread::sleep(Duration::from_millis(10));
     };
     assert_eq!(status.code(), Some(0), "{status:?}");
-    drop(stop);
+    // The driver ends at its next wake-up: a command gives it one.
+    drop(driver.stop);
+    let _wake = arm.move_to(0, 0.3).unwrap();
+    driver
+        .ended
+        .recv_timeout(Duration::from_secs(10))
+        .expect("the quiet driver ended");
 }
