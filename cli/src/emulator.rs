@@ -151,8 +151,8 @@ impl EmulatorArgs {
 
 /// Runs `limber emulator` until a termination signal (SIGINT, SIGTERM, SIGHUP, SIGQUIT,
 /// SIGXCPU, SIGPWR: [`limber_services::signals`]) or until stdin closes (unless
-/// `--ignore-stdin`); the other signals that would end a process are ignored. The first line on stdout is the pty path or the TCP
-/// address.
+/// `--ignore-stdin`); the other signals that would end a process are ignored. The first
+/// line on stdout is the pty path or the TCP address.
 pub fn run(args: EmulatorArgs) -> Result<(), CliError> {
     serve(args).map_err(|e| {
         let code = match e {
