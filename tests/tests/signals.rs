@@ -14,14 +14,26 @@ const PIONEER: &str = env!("CARGO_BIN_EXE_limber-test-pioneer");
 const CLI: &str = env!("CARGO_BIN_EXE_limber-test-cli");
 const T: Duration = Duration::from_secs(5);
 
-fn start(domain: &Domain, emu: &Emulator, name: &str) -> Proc {
+fn start(domain: &Domain, emu: &Emulator, label: &str) -> Proc {
+    start_with(domain, emu, label, &[])
+}
+
+/// The driver with `extra` arguments (`--spin`), once it is ready.
+fn start_with(domain: &Domain, emu: &Emulator, label: &str, extra: &[&str]) -> Proc {
     let cfg = limber_tests::pioneer_test_config(
         std::path::Path::new(env!("CARGO_TARGET_TMPDIR")),
-        name,
+        label,
         "",
     );
     let port = emu.pty_path().unwrap().display().to_string();
-    limber_tests::start_pioneer(PIONEER, domain.name(), &port, &cfg)
+    let mut args = vec!["--port", &port, "--config", cfg.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    let mut d = Proc::spawn(PIONEER, domain.name(), &args);
+    assert!(
+        d.read_until(|l| l.ends_with("ready")).is_some(),
+        "driver did not start"
+    );
+    d
 }
 
 /// Joint 0 moving slowly towards its limit, as the emulator shows it.
@@ -107,13 +119,14 @@ fn target_3(s: &EmulatorState) -> u8 {
 /// driver while joint 0 moves: the driver goes on serving through the same link (after
 /// each, a command reaches the robot: the emulator's target of joint 3 changes), and a
 /// SIGTERM still ends it cleanly, stopping the arm.
-#[test]
-fn the_other_terminating_signals_are_ignored_by_the_driver() {
+fn the_other_terminating_signals_are_ignored(extra: &[&str], label: &str) {
     let domain = Domain::unique_for_test();
     let emu = Emulator::start_pty(EmulatorConfig::default()).unwrap();
-    let mut driver = start(&domain, &emu, "ignored");
+    let mut driver = start_with(&domain, &emu, label, extra);
     let c = Context::new(&domain, Role::Client, "signals-test").unwrap();
     let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
+    // A spinning driver needs no wake-up.
+    arm.set_wake_driver(extra.is_empty());
     move_joint_0(&mut arm, &emu);
     let signals = [
         libc::SIGALRM,
@@ -166,6 +179,16 @@ fn the_other_terminating_signals_are_ignored_by_the_driver() {
     let (closed, st) = emu.wait_for(T, |s| s.robot.stage == SyncStage::NoSync);
     assert!(closed, "no CLOSE: {:?}", st.robot.stage);
     assert_eq!(st.robot.servo_targets[0], st.robot.servo_ticks[0]);
+}
+
+#[test]
+fn the_other_terminating_signals_are_ignored_by_the_driver() {
+    the_other_terminating_signals_are_ignored(&[], "ignored");
+}
+
+#[test]
+fn the_other_terminating_signals_are_ignored_by_the_spinning_driver() {
+    the_other_terminating_signals_are_ignored(&["--spin"], "ignored-spin");
 }
 
 fn free_port() -> u16 {
