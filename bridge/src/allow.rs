@@ -11,8 +11,13 @@ pub struct Allow {
     /// Device patterns (`robot/interface/index`, each part a name or `*`); empty: every
     /// device.
     pub devices: Vec<DevicePattern>,
-    /// The commands that pass; `None`: every command.
+    /// The commands that pass; `None`: every command (unless `requests` is a list: then
+    /// none).
     pub commands: Option<Vec<CommandKind>>,
+    /// The requests that change a device (power, brakes, speed, ...) that pass; `None`:
+    /// every one (unless `commands` is a list: then none). Read-only requests (geometry,
+    /// reach) always pass.
+    pub requests: Option<Vec<RequestKind>>,
     /// Refuse every command and every request that changes a device (power, brakes,
     /// speed, ...); reading the state and read-only requests (geometry) pass.
     pub read_only: bool,
@@ -24,13 +29,33 @@ impl Allow {
         self.devices.is_empty() || self.devices.iter().any(|p| p.matches(device))
     }
 
+    /// Whether the bridge lets through only what its lists name (`--allow-command`,
+    /// `--allow-request`): then neither leases nor anything unlisted pass.
+    pub fn filtered(&self) -> bool {
+        self.commands.is_some() || self.requests.is_some()
+    }
+
     /// Whether a command of `kind` to a device of `interface` passes.
     pub fn command(&self, interface: InterfaceKind, kind: u32) -> bool {
         !self.read_only
-            && self.commands.as_ref().is_none_or(|list| {
-                list.iter()
-                    .any(|c| c.interface == interface && c.kind == kind)
-            })
+            && (!self.filtered()
+                || self.commands.as_ref().is_some_and(|list| {
+                    list.iter()
+                        .any(|c| c.interface == interface && c.kind == kind)
+                }))
+    }
+
+    /// Whether a request of `kind` to a device of `interface` passes: a read-only one
+    /// (`read_only`: geometry, reach) always; one that changes the device by the same rule
+    /// as a command, from the list of requests.
+    pub fn request(&self, interface: InterfaceKind, kind: u32, read_only: bool) -> bool {
+        read_only
+            || (!self.read_only
+                && (!self.filtered()
+                    || self.requests.as_ref().is_some_and(|list| {
+                        list.iter()
+                            .any(|r| r.0.interface == interface && r.0.kind == kind)
+                    })))
     }
 }
 
@@ -69,6 +94,14 @@ pub enum AllowError {
         /// The commands there are.
         known: String,
     },
+    /// A request is not `interface:kind`, or names no request of that interface.
+    #[error("unknown request {given:?}: use interface:kind, one of {known}")]
+    Request {
+        /// What was given.
+        given: String,
+        /// The requests there are.
+        known: String,
+    },
 }
 
 impl std::str::FromStr for DevicePattern {
@@ -99,9 +132,15 @@ pub struct CommandKind {
     pub kind: u32,
 }
 
-/// The command kinds of `interface`: (lower-case name, code), from the layout manifest.
-fn kinds(interface: InterfaceKind) -> Vec<(String, u32)> {
-    let group = format!("{}_CMD", interface.name().to_ascii_uppercase());
+/// A request of one interface that changes the device (a `*_REQ` kind code of the layout
+/// manifest), for `--allow-request`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RequestKind(pub CommandKind);
+
+/// The kinds of `interface` in its manifest group `<INTERFACE>_<suffix>`: (lower-case name,
+/// code).
+fn kinds_of(interface: InterfaceKind, suffix: &str) -> Vec<(String, u32)> {
+    let group = format!("{}_{suffix}", interface.name().to_ascii_uppercase());
     limber_interfaces::manifest()
         .constants
         .iter()
@@ -109,6 +148,44 @@ fn kinds(interface: InterfaceKind) -> Vec<(String, u32)> {
         .flat_map(|g| g.constants.iter())
         .filter_map(|c| Some((c.name.to_ascii_lowercase(), u32::try_from(c.value).ok()?)))
         .collect()
+}
+
+/// The command kinds of `interface`: (lower-case name, code), from the layout manifest.
+fn kinds(interface: InterfaceKind) -> Vec<(String, u32)> {
+    kinds_of(interface, "CMD")
+}
+
+impl std::str::FromStr for RequestKind {
+    type Err = AllowError;
+    /// `interface:kind`, e.g. `actarray:power`, `limb:speed` (the names of the layout
+    /// manifest's `*_REQ` constants, any case).
+    fn from_str(s: &str) -> Result<Self, AllowError> {
+        let unknown = || AllowError::Request {
+            given: s.to_string(),
+            known: InterfaceKind::ALL
+                .iter()
+                .flat_map(|i| {
+                    kinds_of(*i, "REQ")
+                        .into_iter()
+                        .map(move |(n, _)| format!("{i}:{n}"))
+                })
+                .collect::<Vec<_>>()
+                .join(", "),
+        };
+        let (interface, kind) = s.split_once(':').ok_or_else(unknown)?;
+        let interface = InterfaceKind::from_name(interface).ok_or_else(unknown)?;
+        let kind = kind.to_ascii_lowercase();
+        kinds_of(interface, "REQ")
+            .into_iter()
+            .find(|(n, _)| *n == kind)
+            .map(|(_, code)| {
+                RequestKind(CommandKind {
+                    interface,
+                    kind: code,
+                })
+            })
+            .ok_or_else(unknown)
+    }
 }
 
 impl std::str::FromStr for CommandKind {
@@ -162,11 +239,32 @@ mod tests {
         let allow = Allow {
             devices: vec!["*/actarray/0".parse().unwrap()],
             commands: Some(vec![pos]),
+            requests: None,
             read_only: false,
         };
         assert!(allow.device(&arm) && !allow.device(&lift));
         assert!(allow.command(InterfaceKind::ActArray, 1));
         assert!(!allow.command(InterfaceKind::ActArray, 5));
+        // A bridge that lets POS alone through lets no request that changes the arm
+        // through (POWER, SPEED): only read-only ones.
+        let power: RequestKind = "actarray:power".parse().unwrap();
+        assert!(!allow.request(InterfaceKind::ActArray, power.0.kind, false));
+        assert!(allow.request(InterfaceKind::ActArray, power.0.kind, true));
+        let with_power = Allow {
+            requests: Some(vec![power]),
+            ..allow.clone()
+        };
+        assert!(with_power.request(InterfaceKind::ActArray, power.0.kind, false));
+        let e = "actarray:fly".parse::<RequestKind>().unwrap_err();
+        assert!(e.to_string().contains("actarray:power"), "{e}");
+        // A list of requests alone lets no command through.
+        let requests_only = Allow {
+            commands: None,
+            requests: Some(vec![power]),
+            ..Allow::default()
+        };
+        assert!(!requests_only.command(InterfaceKind::ActArray, 1));
+        assert!(Allow::default().request(InterfaceKind::ActArray, power.0.kind, false));
         assert!(
             !Allow {
                 read_only: true,

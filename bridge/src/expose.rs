@@ -282,8 +282,10 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
             return;
         };
         let remote = req.meta().client_id;
-        if self.allow.read_only && !I::Request::read(&req).is_ok_and(|r| r.is_read_only()) {
-            tracing::warn!(device = %self.device, origin, "a request that changes the device: refused (read-only bridge)");
+        let read_only = I::Request::read(&req).is_ok_and(|r| r.is_read_only());
+        if !self.allow.request(I::KIND, req.meta().kind, read_only) {
+            tracing::warn!(device = %self.device, origin, kind = req.meta().kind,
+                "a request that changes the device: refused (not let through by this bridge)");
             let out = keys::nack::<I>(&req, Status::Unsupported);
             if let Err(e) = query
                 .reply(query.key_expr().clone(), out.as_bytes().to_vec())
@@ -326,7 +328,7 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
             refuse(&query, Status::InvalidArgument);
             return;
         };
-        if self.allow.read_only || self.allow.commands.is_some() {
+        if self.allow.read_only || self.allow.filtered() {
             // A lease would let a remote client refuse the robot's own clients: only a
             // bridge that lets every command through carries leases.
             refuse(&query, Status::Unsupported);
@@ -453,6 +455,22 @@ impl<I: Interface> Exposed<I> {
                 }
             }
         });
+    }
+}
+
+/// [`expose_device`] for a device of any interface.
+struct Expose<'a> {
+    allow: &'a Allow,
+    ctx: &'a Context,
+    session: &'a Session,
+    device: &'a DeviceName,
+    tx: &'a Sender<Event>,
+}
+
+impl InterfaceVisitor for Expose<'_> {
+    type Output = Result<Box<dyn ExposedDevice>, String>;
+    fn visit<I: Interface>(self) -> Self::Output {
+        expose_device::<I>(self.allow, self.ctx, self.session, self.device, self.tx)
     }
 }
 
@@ -762,17 +780,13 @@ impl Exposer<'_> {
                 continue;
             }
             let (ctx, session, tx) = (&self.ctx, self.session, &self.tx);
-            let made = match info.interface() {
-                InterfaceKind::ActArray => {
-                    expose_device::<ActArray>(&config.allow, ctx, session, &info.name, tx)
-                }
-                InterfaceKind::Limb => {
-                    expose_device::<Limb>(&config.allow, ctx, session, &info.name, tx)
-                }
-                InterfaceKind::Gripper => {
-                    expose_device::<Gripper>(&config.allow, ctx, session, &info.name, tx)
-                }
-            };
+            let made = info.interface().visit(Expose {
+                allow: &config.allow,
+                ctx,
+                session,
+                device: &info.name,
+                tx,
+            });
             match made {
                 Ok(d) => {
                     tracing::info!(device = %info.name, "exposed");

@@ -22,7 +22,7 @@ pub mod mirror;
 mod session;
 mod waiting;
 
-pub use allow::{Allow, AllowError, CommandKind, DevicePattern};
+pub use allow::{Allow, AllowError, CommandKind, DevicePattern, RequestKind};
 pub use expose::{ExposeConfig, ExposeError, ExposeEvent, expose};
 pub use inbox::InboxError;
 pub use mirror::{MirrorConfig, MirrorError, MirrorEvent, mirror};

@@ -8,7 +8,9 @@
  * LIMBER_STATUS_* (refusal()). Timeouts are std::chrono durations.
  *
  * Commands return a limber_ticket at once; WaitOutcome(ticket, timeout) returns the
- * driver's verdict, a LIMBER_STATUS_* (limber::StatusText() describes it).
+ * driver's verdict, a limber::Status (ok(), carried_out(), name(), text(); it converts to
+ * the raw LIMBER_STATUS_*). A wait that may rightly end without news has a Try form that
+ * returns std::optional instead of throwing (TryWaitForData).
  *
  * Control: Acquire(name, heartbeat) takes the device's lease (other clients are refused
  * as LIMBER_STATUS_LEASED), Renew()/KeepLease() keep it, Release() gives it back;
@@ -62,6 +64,32 @@ private:
 /// The text of a driver's LIMBER_STATUS_*.
 inline std::string StatusText(uint32_t status) { return limber_status_text(status); }
 
+/// A command's outcome: the driver's LIMBER_STATUS_* with its name and text. Converts to
+/// the raw code (uint32_t), so `status == LIMBER_STATUS_OK` reads as in C.
+class Status {
+public:
+    /// The outcome of code `code` (a LIMBER_STATUS_*).
+    constexpr explicit Status(uint32_t code = LIMBER_STATUS_OK) noexcept : code_(code) {}
+    /// The raw LIMBER_STATUS_*.
+    constexpr uint32_t code() const noexcept { return code_; }
+    constexpr operator uint32_t() const noexcept { return code_; }
+    /// Carried out exactly as asked (LIMBER_STATUS_OK).
+    constexpr bool ok() const noexcept { return code_ == LIMBER_STATUS_OK; }
+    /// Carried out: OK, or CLAMPED (a value clamped to a limit), or ADJUSTED (a limb pose's
+    /// orientation turned to one the joints can hold).
+    bool carried_out() const noexcept { return limber_status_is_carried_out(code_); }
+    /// Its name as limber.h spells it without the prefix ("OUT_OF_REACH").
+    std::string name() const { return limber_status_name(code_); }
+    /// What it means ("the position lies beyond the limb's reach").
+    std::string text() const { return limber_status_text(code_); }
+
+private:
+    uint32_t code_;
+};
+
+/// A point or a direction in the robot frame (m): limber.h's limber_vec3.
+using Vec3 = limber_vec3;
+
 namespace detail {
 inline uint64_t Millis(Duration d) {
     if (d.count() <= 0) return 0;
@@ -73,7 +101,13 @@ inline void Check(limber_code code) {
     if (code == LIMBER_CODE_OK) return;
     std::string what = limber_strerror(code);
     std::string detail = limber_last_error();
-    if (!detail.empty()) what += ": " + detail;
+    // The detail says more than the code's message, or the same again ("the driver is
+    // gone"): never both the same.
+    if (detail.find(what) != std::string::npos) {
+        what = detail;
+    } else if (!detail.empty()) {
+        what += ": " + detail;
+    }
     throw Error(code, what, code == LIMBER_CODE_REFUSED ? limber_last_refusal() : LIMBER_STATUS_OK);
 }
 
@@ -165,17 +199,37 @@ public:
         detail::Check(T::borrow(h_, detail::Millis(timeout), &p));
         return Borrowed<T>(h_, p);
     }
-    /// Waits up to `timeout` for a state newer than the latest one taken.
+    /// Waits up to `timeout` for a state newer than the latest one taken; throws
+    /// LIMBER_CODE_TIMEOUT when none came (see TryWaitForData, which does not).
     Data WaitForData(Duration timeout) {
         Data d{};
         detail::Check(T::wait_state(h_, detail::Millis(timeout), &d));
         return d;
     }
-    /// Waits up to `timeout` for the outcome of a command: a LIMBER_STATUS_*.
-    uint32_t WaitOutcome(limber_ticket ticket, Duration timeout) {
+    /// Waits up to `timeout` for a state newer than the latest one taken: std::nullopt
+    /// when none came in time (the driver lives but said nothing new); throws for every
+    /// other failure (the driver gone, ...).
+    std::optional<Data> TryWaitForData(Duration timeout) {
+        Data d{};
+        limber_code c = T::wait_state(h_, detail::Millis(timeout), &d);
+        if (c == LIMBER_CODE_TIMEOUT) return std::nullopt;
+        detail::Check(c);
+        return d;
+    }
+    /// Waits up to `timeout` for the outcome of a command: the driver's verdict
+    /// (status.carried_out(), status.name(), status.text(); it converts to the raw
+    /// LIMBER_STATUS_*).
+    Status WaitOutcome(limber_ticket ticket, Duration timeout) {
         uint32_t status = LIMBER_STATUS_OK;
         detail::Check(T::wait_outcome(h_, ticket, detail::Millis(timeout), &status));
-        return status;
+        return Status(status);
+    }
+    /// Waits up to `timeout` for the outcome of a command, with the other client involved
+    /// (the holder, by id and name, when it is LIMBER_STATUS_LEASED).
+    limber_outcome WaitOutcomeDetail(limber_ticket ticket, Duration timeout) {
+        limber_outcome o{};
+        detail::Check(limber_device_outcome(h_, ticket, detail::Millis(timeout), &o));
+        return o;
     }
     /// Alive (a state younger than `max_age`), stale, gone, or no data yet.
     limber_liveness Liveness(Duration max_age) {
@@ -338,6 +392,23 @@ public:
         detail::Check(limber_limb_set_pose(h_, limber_vec3{px, py, pz}, limber_vec3{ax, ay, az},
                                            limber_vec3{ox, oy, oz}, &t));
         return t;
+    }
+    /// CMD SETPOSE: end effector at `position`, its approach vector along `approach` and
+    /// its orientation vector along `orientation` (robot frame, m).
+    limber_ticket SetPose(const Vec3& position, const Vec3& approach, const Vec3& orientation) {
+        limber_ticket t{};
+        detail::Check(limber_limb_set_pose(h_, position, approach, orientation, &t));
+        return t;
+    }
+    /// REQ REACH: where a SETPOSE to this pose would put the end effector and how much it
+    /// would adjust the orientation, without moving. A pose the limb cannot reach throws
+    /// LIMBER_CODE_REFUSED with its cause in refusal() (LIMBER_STATUS_OUT_OF_REACH, ...).
+    limber_limb_reach Reach(const Vec3& position, const Vec3& approach, const Vec3& orientation,
+                            Duration timeout = kRequestTimeout) {
+        limber_limb_reach r{};
+        detail::Check(limber_limb_can_reach(h_, position, approach, orientation,
+                                            detail::Millis(timeout), &r));
+        return r;
     }
     /// CMD SETPOSITION: end effector at (x, y, z), orientation chosen by the driver.
     limber_ticket SetPosition(double x, double y, double z) {

@@ -151,6 +151,35 @@ typedef int32_t limber_code;
 #endif // __cplusplus
 
 /*
+ Which interface a device offers.
+ */
+enum limber_interface
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : int32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /*
+   An actuator array (`limber_actarray_connect`).
+   */
+  LIMBER_INTERFACE_ACTARRAY = 0,
+  /*
+   A limb (`limber_limb_connect`).
+   */
+  LIMBER_INTERFACE_LIMB = 1,
+  /*
+   A gripper (`limber_gripper_connect`).
+   */
+  LIMBER_INTERFACE_GRIPPER = 2,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum limber_interface limber_interface;
+#else
+typedef int32_t limber_interface;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/*
  How fresh a handle's latest state is (`limber_*_liveness`).
  */
 enum limber_liveness
@@ -213,62 +242,56 @@ typedef int32_t limber_driver_status;
 #endif // __cplusplus
 
 /*
- Which interface a device offers.
+ How severe a log message is.
  */
-enum limber_interface
+enum limber_log_level
 #if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
   : int32_t
 #endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
  {
   /*
-   An actuator array (`limber_actarray_connect`).
+   Details for tracing a problem down.
    */
-  LIMBER_INTERFACE_ACTARRAY = 0,
+  LIMBER_LOG_LEVEL_TRACE = 0,
   /*
-   A limb (`limber_limb_connect`).
+   Details for debugging.
    */
-  LIMBER_INTERFACE_LIMB = 1,
+  LIMBER_LOG_LEVEL_DEBUG = 1,
   /*
-   A gripper (`limber_gripper_connect`).
+   Normal operation worth knowing (a device found, a reconnect).
    */
-  LIMBER_INTERFACE_GRIPPER = 2,
+  LIMBER_LOG_LEVEL_INFO = 2,
+  /*
+   Something went wrong and was handled (a driver gone, a lease lost).
+   */
+  LIMBER_LOG_LEVEL_WARN = 3,
+  /*
+   Something failed.
+   */
+  LIMBER_LOG_LEVEL_ERROR = 4,
+  /*
+   Nothing is logged.
+   */
+  LIMBER_LOG_LEVEL_OFF = 5,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
-typedef enum limber_interface limber_interface;
+typedef enum limber_log_level limber_log_level;
 #else
-typedef int32_t limber_interface;
+typedef int32_t limber_log_level;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
 /*
- A connection to an actuator array (opaque). Use it from one thread at a time.
+ A connection to one device, of any interface (opaque). Use it from one thread at a
+ time; different handles may be used by different threads at once.
  */
-typedef struct limber_actarray limber_actarray;
+typedef struct limber_device limber_device;
 
 /*
- A connection to a gripper (opaque). Use it from one thread at a time.
+ A reader of one driver's statistics (opaque).
  */
-typedef struct limber_gripper limber_gripper;
-
-/*
- A connection to a limb (opaque). Use it from one thread at a time.
- */
-typedef struct limber_limb limber_limb;
-
-/*
- A command that was sent: pass it to `limber_*_wait_outcome`.
- */
-typedef struct limber_ticket {
-  /*
-   The command's sequence number (per handle, from 1).
-   */
-  uint64_t seq;
-  /*
-   How many driver processes received it (normally 1).
-   */
-  uint64_t receivers;
-} limber_ticket;
+typedef struct limber_stats limber_stats;
 
 /*
  Who holds a device's control lease (`limber_*_holder`).
@@ -288,6 +311,59 @@ typedef struct limber_lease_holder {
    */
   char name[32];
 } limber_lease_holder;
+
+/*
+ A connection to an actuator array: a `limber_device` of this interface (the same type, so every
+ `limber_device_*` call takes it).
+ */
+typedef struct limber_device limber_actarray;
+
+/*
+ A command that was sent: pass it to `limber_*_wait_outcome`.
+ */
+typedef struct limber_ticket {
+  /*
+   The command's sequence number (per handle, from 1).
+   */
+  uint64_t seq;
+  /*
+   How many driver processes received it (normally 1).
+   */
+  uint64_t receivers;
+} limber_ticket;
+
+/*
+ The outcome of a command, with the other client involved
+ ([`limber_device_outcome`], [`limber_device_preemption`]).
+ */
+typedef struct limber_outcome {
+  /*
+   The command's sequence number (its ticket's `seq`).
+   */
+  uint64_t seq;
+  /*
+   The driver's verdict, a `LIMBER_STATUS_*` of limber.h.
+   */
+  uint32_t status;
+  /*
+   Explicit padding (zero).
+   */
+  uint32_t _pad;
+  /*
+   The other client involved: the one whose command preempted this one
+   (`LIMBER_STATUS_PREEMPTED`) or the holder of the device (`LIMBER_STATUS_LEASED`); 0
+   if none.
+   */
+  uint64_t other_client;
+  /*
+   When the driver published it (`CLOCK_MONOTONIC` ns).
+   */
+  uint64_t stamp_ns;
+  /*
+   The other client's lease name, NUL-terminated ("" when it has none).
+   */
+  char other_name[32];
+} limber_outcome;
 
 /*
  One device found by `limber_list_devices`.
@@ -314,6 +390,29 @@ typedef struct limber_device_info {
    */
   uint32_t nodes;
 } limber_device_info;
+
+/*
+ A connection to a gripper: a `limber_device` of this interface (the same type, so every
+ `limber_device_*` call takes it).
+ */
+typedef struct limber_device limber_gripper;
+
+/*
+ A connection to a limb: a `limber_device` of this interface (the same type, so every
+ `limber_device_*` call takes it).
+ */
+typedef struct limber_device limber_limb;
+
+/*
+ A log callback: called on the thread that logs, with the level, the module that logs
+ (e.g. "limber_services::client") and the message with its fields (e.g. "cannot receive
+ the state device=pioneer/limb/0"), both NUL-terminated and valid during the call only,
+ and the `user` pointer given to `limber_set_logger`. It must not call limber.
+ */
+typedef void (*limber_log_fn)(limber_log_level level,
+                              const char *target,
+                              const char *message,
+                              void *user);
 
 #ifdef __cplusplus
 extern "C" {
@@ -348,117 +447,35 @@ uint32_t limber_last_refusal(void);
 const char *limber_status_text(uint32_t status);
 
 /*
+ Returns the name of a driver's `LIMBER_STATUS_*` as limber.h spells it without its
+ prefix ("OK", "CLAMPED", "OUT_OF_REACH", ...), or "UNKNOWN" for a value that is none.
+ Never NULL.
+ */
+const char *limber_status_name(uint32_t status);
+
+/*
+ Whether a command with outcome `status` was carried out: `LIMBER_STATUS_OK`, and the
+ statuses that say how (`CLAMPED`: a value clamped to a limit; `ADJUSTED`: a limb pose's
+ orientation turned to one the joints can hold). False for every refusal and for a
+ value that is no status.
+ */
+bool limber_status_is_carried_out(uint32_t status);
+
+/*
+ Copies the holder of the device named by the last refusal on this thread because
+ another client holds it (`LIMBER_STATUS_LEASED`: a command's outcome, an acquire, a
+ request) into `*out`; `out->client_id` is 0 when the last failure was of another kind.
+ Does nothing for NULL.
+
+ # Safety
+ `out` is NULL or writable.
+ */
+void limber_last_holder(struct limber_lease_holder *out);
+
+/*
  Returns the layout version this library speaks (`LIMBER_LAYOUT_VERSION` of limber.h).
  */
 uint32_t limber_layout_version(void);
-
-/*
- What `limber_actarray_connect` (an inline function of limber_client.h) calls, with the
- layout the program was compiled against: `layout_version` (`LIMBER_LAYOUT_VERSION`),
- `data_size` (`sizeof(limber_actarray_data)`) and `geom_size` (`sizeof(limber_actarray_geom)`). A
- program compiled against another limber.h than this library's (a field moved, a
- struct grown: another layout version) is refused with `LIMBER_CODE_INCOMPATIBLE`
- before it connects, and `limber_last_error()` says which versions and sizes differ.
- Otherwise as `limber_actarray_connect`: call that.
-
- # Safety
- `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
- */
-limber_code limber_actarray_connect_checked(const char *device,
-                                            const char *domain,
-                                            uint64_t timeout_ms,
-                                            uint32_t layout_version,
-                                            size_t data_size,
-                                            size_t geom_size,
-                                            struct limber_actarray **out);
-
-/*
- Closes the connection and frees the handle (and any state borrowed from it). NULL is
- ignored.
-
- # Safety
- `h` is NULL or a handle of `limber_actarray_connect` not yet disconnected.
- */
-void limber_actarray_disconnect(struct limber_actarray *h);
-
-/*
- Copies the latest state into `*out`, waiting up to `timeout_ms` for a first one
- (`LIMBER_CODE_TIMEOUT` if none came).
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_actarray_state(struct limber_actarray *h,
-                                  uint64_t timeout_ms,
-                                  limber_actarray_data *out);
-
-/*
- Lends the latest state in place, without a copy (waiting up to `timeout_ms` for a
- first one): `*out` points into shared memory and stays valid and unchanged until
- `limber_actarray_release` (or disconnect). Meanwhile the calls that read states
- (state, borrow, wait_state, wait_outcome, preempted, liveness) fail with `LIMBER_CODE_BORROWED`;
- commands and requests work.
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_actarray_borrow(struct limber_actarray *h,
-                                   uint64_t timeout_ms,
-                                   const limber_actarray_data **out);
-
-/*
- Ends the loan of `limber_actarray_borrow` (the pointer it gave is invalid from now on).
- Releasing with nothing borrowed is harmless.
-
- # Safety
- `h` is NULL or a live handle.
- */
-limber_code limber_actarray_release(struct limber_actarray *h);
-
-/*
- Waits up to `timeout_ms` for a state newer than the latest one taken and copies it into
- `*out` (NULL: not copied).
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_actarray_wait_state(struct limber_actarray *h,
-                                       uint64_t timeout_ms,
-                                       limber_actarray_data *out);
-
-/*
- Waits up to `timeout_ms` for the outcome of the command of `ticket`; `*status` is the
- driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out). A status other than OK is
- also kept for `limber_last_refusal()` and `limber_last_error()`, which for
- `LIMBER_STATUS_LEASED` names the client holding the device ("refused: held by another
- client (alice, client 123)"); the call still returns `LIMBER_CODE_OK`.
-
- # Safety
- `h` is NULL or a live handle; `status` is NULL or writable.
- */
-limber_code limber_actarray_wait_outcome(struct limber_actarray *h,
-                                         struct limber_ticket ticket,
-                                         uint64_t timeout_ms,
-                                         uint32_t *status);
-
-/*
- Whether the driver publishes: `LIMBER_LIVENESS_ALIVE` if the latest state is younger
- than `max_age_ms`, `STALE` if older but the driver lives, `GONE`, or `NO_DATA`.
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_actarray_liveness(struct limber_actarray *h,
-                                     uint64_t max_age_ms,
-                                     limber_liveness *out);
-
-/*
- Whether the driver's process lives (costs tens of microseconds).
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_actarray_driver_status(struct limber_actarray *h, limber_driver_status *out);
 
 /*
  CMD POS: moves `joint` to `position` (rad or m). `*ticket` (NULL: not written) is for
@@ -467,7 +484,7 @@ limber_code limber_actarray_driver_status(struct limber_actarray *h, limber_driv
  # Safety
  `h` is NULL or a live handle; `ticket` is NULL or writable.
  */
-limber_code limber_actarray_move_to(struct limber_actarray *h,
+limber_code limber_actarray_move_to(limber_actarray *h,
                                     uint32_t joint,
                                     double position,
                                     struct limber_ticket *ticket);
@@ -479,7 +496,7 @@ limber_code limber_actarray_move_to(struct limber_actarray *h,
  `h` is NULL or a live handle; `positions` points to `count` doubles (or is NULL with
  `count` 0); `ticket` is NULL or writable.
  */
-limber_code limber_actarray_move_to_multi(struct limber_actarray *h,
+limber_code limber_actarray_move_to_multi(limber_actarray *h,
                                           const double *positions,
                                           size_t count,
                                           struct limber_ticket *ticket);
@@ -490,7 +507,7 @@ limber_code limber_actarray_move_to_multi(struct limber_actarray *h,
  # Safety
  `h` is NULL or a live handle; `ticket` is NULL or writable.
  */
-limber_code limber_actarray_move_at_speed(struct limber_actarray *h,
+limber_code limber_actarray_move_at_speed(limber_actarray *h,
                                           uint32_t joint,
                                           double speed,
                                           struct limber_ticket *ticket);
@@ -501,7 +518,7 @@ limber_code limber_actarray_move_at_speed(struct limber_actarray *h,
  # Safety
  As `limber_actarray_move_to_multi`.
  */
-limber_code limber_actarray_move_at_speed_multi(struct limber_actarray *h,
+limber_code limber_actarray_move_at_speed_multi(limber_actarray *h,
                                                 const double *speeds,
                                                 size_t count,
                                                 struct limber_ticket *ticket);
@@ -512,9 +529,7 @@ limber_code limber_actarray_move_at_speed_multi(struct limber_actarray *h,
  # Safety
  `h` is NULL or a live handle; `ticket` is NULL or writable.
  */
-limber_code limber_actarray_home(struct limber_actarray *h,
-                                 int32_t joint,
-                                 struct limber_ticket *ticket);
+limber_code limber_actarray_home(limber_actarray *h, int32_t joint, struct limber_ticket *ticket);
 
 /*
  CMD CURRENT: drives `joint` (every joint if negative) with `current` A.
@@ -522,7 +537,7 @@ limber_code limber_actarray_home(struct limber_actarray *h,
  # Safety
  `h` is NULL or a live handle; `ticket` is NULL or writable.
  */
-limber_code limber_actarray_set_current(struct limber_actarray *h,
+limber_code limber_actarray_set_current(limber_actarray *h,
                                         int32_t joint,
                                         double current,
                                         struct limber_ticket *ticket);
@@ -533,7 +548,7 @@ limber_code limber_actarray_set_current(struct limber_actarray *h,
  # Safety
  As `limber_actarray_move_to_multi`.
  */
-limber_code limber_actarray_set_current_multi(struct limber_actarray *h,
+limber_code limber_actarray_set_current_multi(limber_actarray *h,
                                               const double *currents,
                                               size_t count,
                                               struct limber_ticket *ticket);
@@ -544,7 +559,7 @@ limber_code limber_actarray_set_current_multi(struct limber_actarray *h,
  # Safety
  `h` is NULL or a live handle.
  */
-limber_code limber_actarray_power(struct limber_actarray *h, bool on, uint64_t timeout_ms);
+limber_code limber_actarray_power(limber_actarray *h, bool on, uint64_t timeout_ms);
 
 /*
  REQ BRAKES: brakes on or off; waits up to `timeout_ms` for the reply.
@@ -552,7 +567,7 @@ limber_code limber_actarray_power(struct limber_actarray *h, bool on, uint64_t t
  # Safety
  `h` is NULL or a live handle.
  */
-limber_code limber_actarray_brakes(struct limber_actarray *h, bool on, uint64_t timeout_ms);
+limber_code limber_actarray_brakes(limber_actarray *h, bool on, uint64_t timeout_ms);
 
 /*
  REQ SPEED: the speed of `joint` for later position moves.
@@ -560,7 +575,7 @@ limber_code limber_actarray_brakes(struct limber_actarray *h, bool on, uint64_t 
  # Safety
  `h` is NULL or a live handle.
  */
-limber_code limber_actarray_set_speed_config(struct limber_actarray *h,
+limber_code limber_actarray_set_speed_config(limber_actarray *h,
                                              uint32_t joint,
                                              double speed,
                                              uint64_t timeout_ms);
@@ -571,48 +586,260 @@ limber_code limber_actarray_set_speed_config(struct limber_actarray *h,
  # Safety
  `h` is NULL or a live handle.
  */
-limber_code limber_actarray_set_accel_config(struct limber_actarray *h,
+limber_code limber_actarray_set_accel_config(limber_actarray *h,
                                              uint32_t joint,
                                              double accel,
                                              uint64_t timeout_ms);
 
 /*
- REQ GET_GEOM: copies the geometry (kinds, limits, home positions of every actuator)
- into `*out`; waits up to `timeout_ms` for the reply.
+ Connects to `device` ("robot/interface/index") in `domain` (NULL: `LIMBER_DOMAIN`, or
+ "limber"), waiting up to `timeout_ms` for a driver to offer it; `*out` is the new
+ handle (free it with `limber_device_disconnect`). Call it through the inline functions
+ of limber_client.h (`limber_device_connect`, `limber_actarray_connect`, ...), which pass
+ the layout the program was compiled against: `layout_version`
+ (`LIMBER_LAYOUT_VERSION`), and, for a typed connect, the interface the program expects
+ (`interface`, a `LIMBER_INTERFACE_*`; -1: any) and the sizes of its state and geometry
+ structs (`data_size`, `geom_size`; 0: not checked). A program compiled against another
+ limber.h, or a device of another interface than the one asked for, is refused with
+ `LIMBER_CODE_INCOMPATIBLE` before it connects, and `limber_last_error()` says what differs.
 
  # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
+ `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
  */
-limber_code limber_actarray_geometry(struct limber_actarray *h,
-                                     uint64_t timeout_ms,
-                                     limber_actarray_geom *out);
+limber_code limber_device_connect_checked(const char *device,
+                                          const char *domain,
+                                          uint64_t timeout_ms,
+                                          uint32_t layout_version,
+                                          int32_t interface,
+                                          size_t data_size,
+                                          size_t geom_size,
+                                          struct limber_device **out);
 
 /*
- This handle's client id: how the driver, outcomes (`limber_actarray_preempted`) and
- `limber_actarray_holder` name it.
+ Closes the connection and frees the handle (and any state borrowed from it). NULL is
+ ignored.
+
+ # Safety
+ `h` is NULL or a handle of a connect call not yet disconnected.
+ */
+void limber_device_disconnect(struct limber_device *h);
+
+/*
+ The device's name ("robot/interface/index"), valid as long as the handle; "" for NULL.
+
+ # Safety
+ `h` is NULL or a live handle.
+ */
+const char *limber_device_name(const struct limber_device *h);
+
+/*
+ The device's interface.
 
  # Safety
  `h` is NULL or a live handle; `out` is NULL or writable.
  */
-limber_code limber_actarray_client_id(struct limber_actarray *h, uint64_t *out);
+limber_code limber_device_interface(struct limber_device *h, limber_interface *out);
+
+/*
+ Copies the latest state into `*out`, a struct of `size` bytes (the device's state
+ struct: `limber_actarray_data`, ...; another size is `LIMBER_CODE_INCOMPATIBLE`),
+ waiting up to `timeout_ms` for a first one (`LIMBER_CODE_TIMEOUT` if none came).
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or points to `size` writable bytes.
+ */
+limber_code limber_device_state(struct limber_device *h,
+                                uint64_t timeout_ms,
+                                void *out,
+                                size_t size);
+
+/*
+ Lends the latest state in place, without a copy (waiting up to `timeout_ms` for a
+ first one): `*out` points into shared memory at the device's state struct and stays
+ valid and unchanged until `limber_device_release` (or disconnect). Meanwhile the calls
+ that read states (state, borrow, wait_state, outcome, preemption, liveness) fail with
+ `LIMBER_CODE_BORROWED`; commands and requests work.
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_device_borrow(struct limber_device *h, uint64_t timeout_ms, const void **out);
+
+/*
+ Ends the loan of `limber_device_borrow` (the pointer it gave is invalid from now on).
+ Releasing with nothing borrowed is harmless.
+
+ # Safety
+ `h` is NULL or a live handle.
+ */
+limber_code limber_device_release(struct limber_device *h);
+
+/*
+ Takes every state and outcome that arrived, without waiting; `*fresh` (NULL: not
+ written) says whether a new state came. What a program that polls
+ `limber_device_fd` calls when the descriptor is readable.
+
+ # Safety
+ `h` is NULL or a live handle; `fresh` is NULL or writable.
+ */
+limber_code limber_device_refresh(struct limber_device *h, bool *fresh);
+
+/*
+ A file descriptor that becomes readable when the driver notifies this handle (a new
+ state, an outcome, a reply), for `poll(2)`, `select(2)` or `epoll(7)` over several
+ devices (or sockets, timers...) at once. When it is readable, call
+ `limber_device_refresh`, then read the state. The descriptor is the handle's: do not
+ close it; it is valid until `limber_device_disconnect`.
+
+ # Safety
+ `h` is NULL or a live handle; `fd` is NULL or writable.
+ */
+limber_code limber_device_fd(struct limber_device *h, int32_t *fd);
+
+/*
+ Waits up to `timeout_ms` for a state newer than the latest one taken and copies it into
+ `*out` (NULL: not copied; else a struct of `size` bytes, as `limber_device_state`).
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or points to `size` writable bytes.
+ */
+limber_code limber_device_wait_state(struct limber_device *h,
+                                     uint64_t timeout_ms,
+                                     void *out,
+                                     size_t size);
+
+/*
+ Waits up to `timeout_ms` for the outcome of the command of `ticket` and writes it to
+ `*out`: the driver's `LIMBER_STATUS_*`, and the other client involved (the holder of the
+ device for `LIMBER_STATUS_LEASED`, with its name). When it returns, the latest state
+ shows the command. A status other than OK is also kept for `limber_last_refusal()` and
+ `limber_last_error()`; the call still returns `LIMBER_CODE_OK`.
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_device_outcome(struct limber_device *h,
+                                  struct limber_ticket ticket,
+                                  uint64_t timeout_ms,
+                                  struct limber_outcome *out);
+
+/*
+ Waits up to `timeout_ms` for the outcome of the command of `ticket`; `*status` is the
+ driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out as asked;
+ `limber_status_is_carried_out` tells the other "ok" statuses apart). As
+ `limber_device_outcome`, with the status alone.
+
+ # Safety
+ `h` is NULL or a live handle; `status` is NULL or writable.
+ */
+limber_code limber_device_wait_outcome(struct limber_device *h,
+                                       struct limber_ticket ticket,
+                                       uint64_t timeout_ms,
+                                       uint32_t *status);
+
+/*
+ Whether another client's command cut short the motion that the command of `ticket`
+ started (`LIMBER_STATUS_PREEMPTED`): `*preempted`, and `*out` (NULL: not written; zero
+ if not preempted) the preempting client with its name. Looks at the outcomes that
+ arrived, without waiting; remembers this handle's last 16 commands.
+
+ # Safety
+ `h` is NULL or a live handle; `preempted` is NULL or writable; `out` is NULL or
+ writable.
+ */
+limber_code limber_device_preemption(struct limber_device *h,
+                                     struct limber_ticket ticket,
+                                     bool *preempted,
+                                     struct limber_outcome *out);
+
+/*
+ As `limber_device_preemption`, with the preempting client's id alone (`*by_client`,
+ NULL: not written; 0 if not preempted).
+
+ # Safety
+ `h` is NULL or a live handle; `preempted` is NULL or writable; `by_client` is NULL or
+ writable.
+ */
+limber_code limber_device_preempted(struct limber_device *h,
+                                    struct limber_ticket ticket,
+                                    bool *preempted,
+                                    uint64_t *by_client);
+
+/*
+ Whether the driver publishes: `LIMBER_LIVENESS_ALIVE` if the latest state is younger
+ than `max_age_ms`, `STALE` if older but the driver lives, `GONE`, or `NO_DATA`.
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_device_liveness(struct limber_device *h,
+                                   uint64_t max_age_ms,
+                                   limber_liveness *out);
+
+/*
+ The age of the latest state taken, in nanoseconds (`CLOCK_MONOTONIC` now minus its
+ acquisition stamp); `LIMBER_CODE_TIMEOUT` when no state was taken yet.
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_device_state_age(struct limber_device *h, uint64_t *out);
+
+/*
+ Whether the driver's process lives (costs tens of microseconds).
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_device_driver_status(struct limber_device *h, limber_driver_status *out);
+
+/*
+ REQ GET_GEOM (the limb's GEOM): copies the geometry into `*out`, a struct of `size`
+ bytes (the device's geometry struct: `limber_actarray_geom`, `limber_limb_geom`,
+ `limber_gripper_geom`); waits up to `timeout_ms` for the reply.
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or points to `size` writable bytes.
+ */
+limber_code limber_device_geometry(struct limber_device *h,
+                                   uint64_t timeout_ms,
+                                   void *out,
+                                   size_t size);
+
+/*
+ How this handle waits for states, outcomes and replies: `spin` false (the default)
+ blocks on the driver's notification after busy-polling for `spin_budget_us`
+ microseconds after each send (0: blocks at once; the default comes from
+ `LIMBER_SPIN_US`); `spin` true busy-polls shared memory (lowest latency; takes a core).
+
+ # Safety
+ `h` is NULL or a live handle.
+ */
+limber_code limber_device_set_wait(struct limber_device *h, bool spin, uint64_t spin_budget_us);
+
+/*
+ This handle's client id: how the driver, outcomes and `limber_device_holder` name it.
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_device_client_id(struct limber_device *h, uint64_t *out);
 
 /*
  Takes the device's control lease as `name` (NULL: this program's name; 1 to 31 bytes,
- else `LIMBER_CODE_INVALID_VALUE`). Until `limber_actarray_release_lease` (or disconnect),
+ else `LIMBER_CODE_INVALID_VALUE`). Until `limber_device_release_lease` (or disconnect),
  other clients' commands, and their requests that change the device, are refused as
  `LIMBER_STATUS_LEASED` naming `name`; readers are unaffected. Renew it at least every
- `heartbeat_ms` (`limber_actarray_renew`, or `limber_actarray_keep_lease` in a loop): when the
+ `heartbeat_ms` (`limber_device_renew`, or `limber_device_keep_lease` in a loop): when the
  heartbeat is missed, or this process dies, the driver stops the device and frees it.
  Acquiring again sets a new heartbeat. Held by another client: `LIMBER_CODE_REFUSED`,
- `limber_last_refusal()` is `LIMBER_STATUS_LEASED` and `limber_last_error()` names the
- holder. Waits for the driver's answer up to 2 s.
+ `limber_last_refusal()` is `LIMBER_STATUS_LEASED`, `limber_last_error()` and
+ `limber_last_holder()` name the holder. Waits for the driver's answer up to 2 s.
 
  # Safety
  `h` is NULL or a live handle; `name` is NULL or a NUL-terminated string.
  */
-limber_code limber_actarray_acquire(struct limber_actarray *h,
-                                    const char *name,
-                                    uint64_t heartbeat_ms);
+limber_code limber_device_acquire(struct limber_device *h, const char *name, uint64_t heartbeat_ms);
 
 /*
  The lease's heartbeat: tells the driver this holder lives. A lease that ended
@@ -622,26 +849,35 @@ limber_code limber_actarray_acquire(struct limber_actarray *h,
  # Safety
  `h` is NULL or a live handle.
  */
-limber_code limber_actarray_renew(struct limber_actarray *h);
+limber_code limber_device_renew(struct limber_device *h);
 
 /*
  For a control loop: renews the lease when a third of its heartbeat has passed since the
  last renewal (`*renewed`, if not NULL, says whether it did); does nothing when no lease
- is held. Fails as `limber_actarray_renew`.
+ is held. Fails as `limber_device_renew`.
 
  # Safety
  `h` is NULL or a live handle; `renewed` is NULL or writable.
  */
-limber_code limber_actarray_keep_lease(struct limber_actarray *h, bool *renewed);
+limber_code limber_device_keep_lease(struct limber_device *h, bool *renewed);
 
 /*
  Gives the control lease back (the motion in progress goes on). Without a lease it does
- nothing. (`limber_actarray_release` ends the loan of a borrowed state.)
+ nothing. (`limber_device_release` ends the loan of a borrowed state.)
 
  # Safety
  `h` is NULL or a live handle.
  */
-limber_code limber_actarray_release_lease(struct limber_actarray *h);
+limber_code limber_device_release_lease(struct limber_device *h);
+
+/*
+ Whether this handle holds the device's control lease (as far as it knows: a lease lost
+ to a missed heartbeat shows at the next renewal).
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_device_holds_lease(struct limber_device *h, bool *out);
 
 /*
  Who holds the device's control lease: `out->client_id` is 0 when nobody does. Asks the
@@ -650,23 +886,7 @@ limber_code limber_actarray_release_lease(struct limber_actarray *h);
  # Safety
  `h` is NULL or a live handle; `out` is NULL or writable.
  */
-limber_code limber_actarray_holder(struct limber_actarray *h, struct limber_lease_holder *out);
-
-/*
- Whether another client's command cut short the motion that the command of `ticket`
- started (the driver's second outcome, `LIMBER_STATUS_PREEMPTED`): `*preempted`, and
- `*by_client` (NULL: not written; 0 if not preempted) the preempting client's id. Looks
- at the outcomes that arrived, without waiting; remembers this handle's last 256
- commands.
-
- # Safety
- `h` is NULL or a live handle; `preempted` is NULL or writable; `by_client` is NULL or
- writable.
- */
-limber_code limber_actarray_preempted(struct limber_actarray *h,
-                                      struct limber_ticket ticket,
-                                      bool *preempted,
-                                      uint64_t *by_client);
+limber_code limber_device_holder(struct limber_device *h, struct limber_lease_holder *out);
 
 /*
  Lists the devices of `domain` (NULL: `LIMBER_DOMAIN`, or "limber"), sorted by name:
@@ -684,121 +904,13 @@ limber_code limber_list_devices(const char *domain,
                                 size_t *count);
 
 /*
- What `limber_gripper_connect` (an inline function of limber_client.h) calls, with the
- layout the program was compiled against: `layout_version` (`LIMBER_LAYOUT_VERSION`),
- `data_size` (`sizeof(limber_gripper_data)`) and `geom_size` (`sizeof(limber_gripper_geom)`). A
- program compiled against another limber.h than this library's (a field moved, a
- struct grown: another layout version) is refused with `LIMBER_CODE_INCOMPATIBLE`
- before it connects, and `limber_last_error()` says which versions and sizes differ.
- Otherwise as `limber_gripper_connect`: call that.
-
- # Safety
- `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
- */
-limber_code limber_gripper_connect_checked(const char *device,
-                                           const char *domain,
-                                           uint64_t timeout_ms,
-                                           uint32_t layout_version,
-                                           size_t data_size,
-                                           size_t geom_size,
-                                           struct limber_gripper **out);
-
-/*
- Closes the connection and frees the handle (and any state borrowed from it). NULL is
- ignored.
-
- # Safety
- `h` is NULL or a handle of `limber_gripper_connect` not yet disconnected.
- */
-void limber_gripper_disconnect(struct limber_gripper *h);
-
-/*
- Copies the latest state into `*out`, waiting up to `timeout_ms` for a first one
- (`LIMBER_CODE_TIMEOUT` if none came).
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_gripper_state(struct limber_gripper *h,
-                                 uint64_t timeout_ms,
-                                 limber_gripper_data *out);
-
-/*
- Lends the latest state in place, without a copy (waiting up to `timeout_ms` for a
- first one): `*out` points into shared memory and stays valid and unchanged until
- `limber_gripper_release` (or disconnect). Meanwhile the calls that read states
- (state, borrow, wait_state, wait_outcome, preempted, liveness) fail with `LIMBER_CODE_BORROWED`;
- commands and requests work.
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_gripper_borrow(struct limber_gripper *h,
-                                  uint64_t timeout_ms,
-                                  const limber_gripper_data **out);
-
-/*
- Ends the loan of `limber_gripper_borrow` (the pointer it gave is invalid from now on).
- Releasing with nothing borrowed is harmless.
-
- # Safety
- `h` is NULL or a live handle.
- */
-limber_code limber_gripper_release(struct limber_gripper *h);
-
-/*
- Waits up to `timeout_ms` for a state newer than the latest one taken and copies it into
- `*out` (NULL: not copied).
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_gripper_wait_state(struct limber_gripper *h,
-                                      uint64_t timeout_ms,
-                                      limber_gripper_data *out);
-
-/*
- Waits up to `timeout_ms` for the outcome of the command of `ticket`; `*status` is the
- driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out). A status other than OK is
- also kept for `limber_last_refusal()` and `limber_last_error()`, which for
- `LIMBER_STATUS_LEASED` names the client holding the device ("refused: held by another
- client (alice, client 123)"); the call still returns `LIMBER_CODE_OK`.
-
- # Safety
- `h` is NULL or a live handle; `status` is NULL or writable.
- */
-limber_code limber_gripper_wait_outcome(struct limber_gripper *h,
-                                        struct limber_ticket ticket,
-                                        uint64_t timeout_ms,
-                                        uint32_t *status);
-
-/*
- Whether the driver publishes: `LIMBER_LIVENESS_ALIVE` if the latest state is younger
- than `max_age_ms`, `STALE` if older but the driver lives, `GONE`, or `NO_DATA`.
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_gripper_liveness(struct limber_gripper *h,
-                                    uint64_t max_age_ms,
-                                    limber_liveness *out);
-
-/*
- Whether the driver's process lives (costs tens of microseconds).
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_gripper_driver_status(struct limber_gripper *h, limber_driver_status *out);
-
-/*
  CMD OPEN: opens the gripper. `*ticket` (NULL: not written) is for
  `limber_gripper_wait_outcome`. Returns at once.
 
  # Safety
  `h` is NULL or a live handle; `ticket` is NULL or writable.
  */
-limber_code limber_gripper_open(struct limber_gripper *h, struct limber_ticket *ticket);
+limber_code limber_gripper_open(limber_gripper *h, struct limber_ticket *ticket);
 
 /*
  CMD CLOSE: closes the gripper (on an object: the state becomes closed, the beams see it).
@@ -806,7 +918,7 @@ limber_code limber_gripper_open(struct limber_gripper *h, struct limber_ticket *
  # Safety
  `h` is NULL or a live handle; `ticket` is NULL or writable.
  */
-limber_code limber_gripper_close(struct limber_gripper *h, struct limber_ticket *ticket);
+limber_code limber_gripper_close(limber_gripper *h, struct limber_ticket *ticket);
 
 /*
  CMD STOP: stops the gripper where it is.
@@ -814,7 +926,7 @@ limber_code limber_gripper_close(struct limber_gripper *h, struct limber_ticket 
  # Safety
  `h` is NULL or a live handle; `ticket` is NULL or writable.
  */
-limber_code limber_gripper_stop(struct limber_gripper *h, struct limber_ticket *ticket);
+limber_code limber_gripper_stop(limber_gripper *h, struct limber_ticket *ticket);
 
 /*
  CMD STORE: stores the held object.
@@ -822,7 +934,7 @@ limber_code limber_gripper_stop(struct limber_gripper *h, struct limber_ticket *
  # Safety
  `h` is NULL or a live handle; `ticket` is NULL or writable.
  */
-limber_code limber_gripper_store(struct limber_gripper *h, struct limber_ticket *ticket);
+limber_code limber_gripper_store(limber_gripper *h, struct limber_ticket *ticket);
 
 /*
  CMD RETRIEVE: retrieves a stored object.
@@ -830,203 +942,7 @@ limber_code limber_gripper_store(struct limber_gripper *h, struct limber_ticket 
  # Safety
  `h` is NULL or a live handle; `ticket` is NULL or writable.
  */
-limber_code limber_gripper_retrieve(struct limber_gripper *h, struct limber_ticket *ticket);
-
-/*
- REQ GET_GEOM: copies the gripper's geometry into `*out`; waits up to `timeout_ms`
- for the reply.
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_gripper_geometry(struct limber_gripper *h,
-                                    uint64_t timeout_ms,
-                                    limber_gripper_geom *out);
-
-/*
- This handle's client id: how the driver, outcomes (`limber_gripper_preempted`) and
- `limber_gripper_holder` name it.
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_gripper_client_id(struct limber_gripper *h, uint64_t *out);
-
-/*
- Takes the device's control lease as `name` (NULL: this program's name; 1 to 31 bytes,
- else `LIMBER_CODE_INVALID_VALUE`). Until `limber_gripper_release_lease` (or disconnect),
- other clients' commands, and their requests that change the device, are refused as
- `LIMBER_STATUS_LEASED` naming `name`; readers are unaffected. Renew it at least every
- `heartbeat_ms` (`limber_gripper_renew`, or `limber_gripper_keep_lease` in a loop): when the
- heartbeat is missed, or this process dies, the driver stops the device and frees it.
- Acquiring again sets a new heartbeat. Held by another client: `LIMBER_CODE_REFUSED`,
- `limber_last_refusal()` is `LIMBER_STATUS_LEASED` and `limber_last_error()` names the
- holder. Waits for the driver's answer up to 2 s.
-
- # Safety
- `h` is NULL or a live handle; `name` is NULL or a NUL-terminated string.
- */
-limber_code limber_gripper_acquire(struct limber_gripper *h,
-                                   const char *name,
-                                   uint64_t heartbeat_ms);
-
-/*
- The lease's heartbeat: tells the driver this holder lives. A lease that ended
- meanwhile: `LIMBER_CODE_LEASE_LOST` (nobody holds it now) or `LIMBER_CODE_REFUSED` with
- `LIMBER_STATUS_LEASED` (another client took it).
-
- # Safety
- `h` is NULL or a live handle.
- */
-limber_code limber_gripper_renew(struct limber_gripper *h);
-
-/*
- For a control loop: renews the lease when a third of its heartbeat has passed since the
- last renewal (`*renewed`, if not NULL, says whether it did); does nothing when no lease
- is held. Fails as `limber_gripper_renew`.
-
- # Safety
- `h` is NULL or a live handle; `renewed` is NULL or writable.
- */
-limber_code limber_gripper_keep_lease(struct limber_gripper *h, bool *renewed);
-
-/*
- Gives the control lease back (the motion in progress goes on). Without a lease it does
- nothing. (`limber_gripper_release` ends the loan of a borrowed state.)
-
- # Safety
- `h` is NULL or a live handle.
- */
-limber_code limber_gripper_release_lease(struct limber_gripper *h);
-
-/*
- Who holds the device's control lease: `out->client_id` is 0 when nobody does. Asks the
- driver (waits for its answer up to 2 s).
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_gripper_holder(struct limber_gripper *h, struct limber_lease_holder *out);
-
-/*
- Whether another client's command cut short the motion that the command of `ticket`
- started (the driver's second outcome, `LIMBER_STATUS_PREEMPTED`): `*preempted`, and
- `*by_client` (NULL: not written; 0 if not preempted) the preempting client's id. Looks
- at the outcomes that arrived, without waiting; remembers this handle's last 256
- commands.
-
- # Safety
- `h` is NULL or a live handle; `preempted` is NULL or writable; `by_client` is NULL or
- writable.
- */
-limber_code limber_gripper_preempted(struct limber_gripper *h,
-                                     struct limber_ticket ticket,
-                                     bool *preempted,
-                                     uint64_t *by_client);
-
-/*
- What `limber_limb_connect` (an inline function of limber_client.h) calls, with the
- layout the program was compiled against: `layout_version` (`LIMBER_LAYOUT_VERSION`),
- `data_size` (`sizeof(limber_limb_data)`) and `geom_size` (`sizeof(limber_limb_geom)`). A
- program compiled against another limber.h than this library's (a field moved, a
- struct grown: another layout version) is refused with `LIMBER_CODE_INCOMPATIBLE`
- before it connects, and `limber_last_error()` says which versions and sizes differ.
- Otherwise as `limber_limb_connect`: call that.
-
- # Safety
- `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
- */
-limber_code limber_limb_connect_checked(const char *device,
-                                        const char *domain,
-                                        uint64_t timeout_ms,
-                                        uint32_t layout_version,
-                                        size_t data_size,
-                                        size_t geom_size,
-                                        struct limber_limb **out);
-
-/*
- Closes the connection and frees the handle (and any state borrowed from it). NULL is
- ignored.
-
- # Safety
- `h` is NULL or a handle of `limber_limb_connect` not yet disconnected.
- */
-void limber_limb_disconnect(struct limber_limb *h);
-
-/*
- Copies the latest state into `*out`, waiting up to `timeout_ms` for a first one
- (`LIMBER_CODE_TIMEOUT` if none came).
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_limb_state(struct limber_limb *h, uint64_t timeout_ms, limber_limb_data *out);
-
-/*
- Lends the latest state in place, without a copy (waiting up to `timeout_ms` for a
- first one): `*out` points into shared memory and stays valid and unchanged until
- `limber_limb_release` (or disconnect). Meanwhile the calls that read states
- (state, borrow, wait_state, wait_outcome, preempted, liveness) fail with `LIMBER_CODE_BORROWED`;
- commands and requests work.
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_limb_borrow(struct limber_limb *h,
-                               uint64_t timeout_ms,
-                               const limber_limb_data **out);
-
-/*
- Ends the loan of `limber_limb_borrow` (the pointer it gave is invalid from now on).
- Releasing with nothing borrowed is harmless.
-
- # Safety
- `h` is NULL or a live handle.
- */
-limber_code limber_limb_release(struct limber_limb *h);
-
-/*
- Waits up to `timeout_ms` for a state newer than the latest one taken and copies it into
- `*out` (NULL: not copied).
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_limb_wait_state(struct limber_limb *h,
-                                   uint64_t timeout_ms,
-                                   limber_limb_data *out);
-
-/*
- Waits up to `timeout_ms` for the outcome of the command of `ticket`; `*status` is the
- driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out). A status other than OK is
- also kept for `limber_last_refusal()` and `limber_last_error()`, which for
- `LIMBER_STATUS_LEASED` names the client holding the device ("refused: held by another
- client (alice, client 123)"); the call still returns `LIMBER_CODE_OK`.
-
- # Safety
- `h` is NULL or a live handle; `status` is NULL or writable.
- */
-limber_code limber_limb_wait_outcome(struct limber_limb *h,
-                                     struct limber_ticket ticket,
-                                     uint64_t timeout_ms,
-                                     uint32_t *status);
-
-/*
- Whether the driver publishes: `LIMBER_LIVENESS_ALIVE` if the latest state is younger
- than `max_age_ms`, `STALE` if older but the driver lives, `GONE`, or `NO_DATA`.
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_limb_liveness(struct limber_limb *h, uint64_t max_age_ms, limber_liveness *out);
-
-/*
- Whether the driver's process lives (costs tens of microseconds).
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_limb_driver_status(struct limber_limb *h, limber_driver_status *out);
+limber_code limber_gripper_retrieve(limber_gripper *h, struct limber_ticket *ticket);
 
 /*
  CMD HOME: moves the limb to its home pose. `*ticket` (NULL: not written) is for
@@ -1035,7 +951,7 @@ limber_code limber_limb_driver_status(struct limber_limb *h, limber_driver_statu
  # Safety
  `h` is NULL or a live handle; `ticket` is NULL or writable.
  */
-limber_code limber_limb_home(struct limber_limb *h, struct limber_ticket *ticket);
+limber_code limber_limb_home(limber_limb *h, struct limber_ticket *ticket);
 
 /*
  CMD STOP: stops every joint now.
@@ -1043,7 +959,7 @@ limber_code limber_limb_home(struct limber_limb *h, struct limber_ticket *ticket
  # Safety
  `h` is NULL or a live handle; `ticket` is NULL or writable.
  */
-limber_code limber_limb_stop(struct limber_limb *h, struct limber_ticket *ticket);
+limber_code limber_limb_stop(limber_limb *h, struct limber_ticket *ticket);
 
 /*
  CMD SETPOSE: the end effector to `position` (robot frame, m), its approach vector
@@ -1054,7 +970,7 @@ limber_code limber_limb_stop(struct limber_limb *h, struct limber_ticket *ticket
  # Safety
  `h` is NULL or a live handle; `ticket` is NULL or writable.
  */
-limber_code limber_limb_set_pose(struct limber_limb *h,
+limber_code limber_limb_set_pose(limber_limb *h,
                                  limber_vec3 position,
                                  limber_vec3 approach,
                                  limber_vec3 orientation,
@@ -1066,7 +982,7 @@ limber_code limber_limb_set_pose(struct limber_limb *h,
  # Safety
  `h` is NULL or a live handle; `ticket` is NULL or writable.
  */
-limber_code limber_limb_set_position(struct limber_limb *h,
+limber_code limber_limb_set_position(limber_limb *h,
                                      limber_vec3 position,
                                      struct limber_ticket *ticket);
 
@@ -1076,7 +992,7 @@ limber_code limber_limb_set_position(struct limber_limb *h,
  # Safety
  `h` is NULL or a live handle; `ticket` is NULL or writable.
  */
-limber_code limber_limb_vec_move(struct limber_limb *h,
+limber_code limber_limb_vec_move(limber_limb *h,
                                  limber_vec3 direction,
                                  double length,
                                  struct limber_ticket *ticket);
@@ -1087,7 +1003,7 @@ limber_code limber_limb_vec_move(struct limber_limb *h,
  # Safety
  `h` is NULL or a live handle.
  */
-limber_code limber_limb_power(struct limber_limb *h, bool on, uint64_t timeout_ms);
+limber_code limber_limb_power(limber_limb *h, bool on, uint64_t timeout_ms);
 
 /*
  REQ BRAKES: brakes on or off; waits up to `timeout_ms` for the reply.
@@ -1095,7 +1011,7 @@ limber_code limber_limb_power(struct limber_limb *h, bool on, uint64_t timeout_m
  # Safety
  `h` is NULL or a live handle.
  */
-limber_code limber_limb_brakes(struct limber_limb *h, bool on, uint64_t timeout_ms);
+limber_code limber_limb_brakes(limber_limb *h, bool on, uint64_t timeout_ms);
 
 /*
  REQ SPEED: the end effector's speed (m/s) for later moves.
@@ -1103,16 +1019,7 @@ limber_code limber_limb_brakes(struct limber_limb *h, bool on, uint64_t timeout_
  # Safety
  `h` is NULL or a live handle.
  */
-limber_code limber_limb_set_speed(struct limber_limb *h, double speed, uint64_t timeout_ms);
-
-/*
- REQ GEOM: copies the limb's geometry (its base position) into `*out`; waits up to
- `timeout_ms` for the reply.
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_limb_geometry(struct limber_limb *h, uint64_t timeout_ms, limber_limb_geom *out);
+limber_code limber_limb_set_speed(limber_limb *h, double speed, uint64_t timeout_ms);
 
 /*
  REQ REACH: where the end effector would end for this pose (as
@@ -1125,7 +1032,7 @@ limber_code limber_limb_geometry(struct limber_limb *h, uint64_t timeout_ms, lim
  # Safety
  `h` is NULL or a live handle; `out` is NULL or writable.
  */
-limber_code limber_limb_can_reach(struct limber_limb *h,
+limber_code limber_limb_can_reach(limber_limb *h,
                                   limber_vec3 position,
                                   limber_vec3 approach,
                                   limber_vec3 orientation,
@@ -1133,83 +1040,54 @@ limber_code limber_limb_can_reach(struct limber_limb *h,
                                   limber_limb_reach *out);
 
 /*
- This handle's client id: how the driver, outcomes (`limber_limb_preempted`) and
- `limber_limb_holder` name it.
+ Hands the library's log messages of level `min_level` and above to `callback` (with
+ `user`), from now on; NULL stops it (nothing is logged then, the default). Installs
+ the library's log collector the first time: `LIMBER_CODE_TRANSPORT` if the process
+ already has another `tracing` collector (a Rust program that set its own).
 
  # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
+ `callback` is NULL or a function that is safe to call from any thread while it is
+ set; `user` is what it expects.
  */
-limber_code limber_limb_client_id(struct limber_limb *h, uint64_t *out);
+limber_code limber_set_logger(limber_log_fn callback, void *user, limber_log_level min_level);
 
 /*
- Takes the device's control lease as `name` (NULL: this program's name; 1 to 31 bytes,
- else `LIMBER_CODE_INVALID_VALUE`). Until `limber_limb_release_lease` (or disconnect),
- other clients' commands, and their requests that change the device, are refused as
- `LIMBER_STATUS_LEASED` naming `name`; readers are unaffected. Renew it at least every
- `heartbeat_ms` (`limber_limb_renew`, or `limber_limb_keep_lease` in a loop): when the
- heartbeat is missed, or this process dies, the driver stops the device and frees it.
- Acquiring again sets a new heartbeat. Held by another client: `LIMBER_CODE_REFUSED`,
- `limber_last_refusal()` is `LIMBER_STATUS_LEASED` and `limber_last_error()` names the
- holder. Waits for the driver's answer up to 2 s.
+ Opens the statistics of the driver of `robot` (e.g. "pioneer") in `domain` (NULL:
+ `LIMBER_DOMAIN`, or "limber"); `LIMBER_CODE_NO_DRIVER` if no driver publishes them.
+ Free the reader with `limber_stats_close`.
 
  # Safety
- `h` is NULL or a live handle; `name` is NULL or a NUL-terminated string.
+ `robot` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
  */
-limber_code limber_limb_acquire(struct limber_limb *h, const char *name, uint64_t heartbeat_ms);
+limber_code limber_stats_open(const char *robot, const char *domain, struct limber_stats **out);
 
 /*
- The lease's heartbeat: tells the driver this holder lives. A lease that ended
- meanwhile: `LIMBER_CODE_LEASE_LOST` (nobody holds it now) or `LIMBER_CODE_REFUSED` with
- `LIMBER_STATUS_LEASED` (another client took it).
+ Closes the reader. NULL is ignored.
 
  # Safety
- `h` is NULL or a live handle.
+ `h` is NULL or a reader of `limber_stats_open` not yet closed.
  */
-limber_code limber_limb_renew(struct limber_limb *h);
+void limber_stats_close(struct limber_stats *h);
 
 /*
- For a control loop: renews the lease when a third of its heartbeat has passed since the
- last renewal (`*renewed`, if not NULL, says whether it did); does nothing when no lease
- is held. Fails as `limber_limb_renew`.
+ Copies the latest statistics into `*out` (taking what arrived first);
+ `LIMBER_CODE_TIMEOUT` when none arrived yet. Never waits.
 
  # Safety
- `h` is NULL or a live handle; `renewed` is NULL or writable.
+ `h` is NULL or a live reader; `out` is NULL or writable.
  */
-limber_code limber_limb_keep_lease(struct limber_limb *h, bool *renewed);
+limber_code limber_stats_latest(struct limber_stats *h, limber_driver_stats *out);
 
 /*
- Gives the control lease back (the motion in progress goes on). Without a lease it does
- nothing. (`limber_limb_release` ends the loan of a borrowed state.)
+ Waits up to `timeout_ms` for statistics newer than the latest taken and copies them
+ into `*out`.
 
  # Safety
- `h` is NULL or a live handle.
+ `h` is NULL or a live reader; `out` is NULL or writable.
  */
-limber_code limber_limb_release_lease(struct limber_limb *h);
-
-/*
- Who holds the device's control lease: `out->client_id` is 0 when nobody does. Asks the
- driver (waits for its answer up to 2 s).
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_limb_holder(struct limber_limb *h, struct limber_lease_holder *out);
-
-/*
- Whether another client's command cut short the motion that the command of `ticket`
- started (the driver's second outcome, `LIMBER_STATUS_PREEMPTED`): `*preempted`, and
- `*by_client` (NULL: not written; 0 if not preempted) the preempting client's id. Looks
- at the outcomes that arrived, without waiting; remembers this handle's last 256
- commands.
-
- # Safety
- `h` is NULL or a live handle; `preempted` is NULL or writable; `by_client` is NULL or
- writable.
- */
-limber_code limber_limb_preempted(struct limber_limb *h,
-                                  struct limber_ticket ticket,
-                                  bool *preempted,
-                                  uint64_t *by_client);
+limber_code limber_stats_wait(struct limber_stats *h,
+                              uint64_t timeout_ms,
+                              limber_driver_stats *out);
 
 #ifdef __cplusplus
 }  // extern "C"
@@ -1217,78 +1095,104 @@ limber_code limber_limb_preempted(struct limber_limb *h,
 
 #endif  /* LIMBER_CLIENT_H */
 
-/* The connect functions: inline, so that they pass the layout this program is compiled
- * against (see limber_*_connect_checked). */
-#ifndef LIMBER_CLIENT_CONNECT_H
-#define LIMBER_CLIENT_CONNECT_H
+/* Typed calls, the same for every interface X (actarray, limb, gripper), each a one-line
+ * inline function over the limber_device_* call of the same name: it passes the program's
+ * own state or geometry struct with its size, so that a program compiled against another
+ * limber.h is refused (LIMBER_CODE_INCOMPATIBLE) instead of misreading shared memory.
+ *
+ *   limber_X_connect(device, domain, timeout_ms, &h)   a device of interface X, or INCOMPATIBLE
+ *   limber_X_disconnect(h)
+ *   limber_X_state(h, timeout_ms, &data)               limber_X_data
+ *   limber_X_borrow(h, timeout_ms, &const_data_ptr)    in place, until limber_X_release(h)
+ *   limber_X_wait_state(h, timeout_ms, &data or NULL)
+ *   limber_X_geometry(h, timeout_ms, &geom)            limber_X_geom
+ *   limber_X_wait_outcome(h, ticket, timeout_ms, &status)
+ *   limber_X_liveness(h, max_age_ms, &liveness)   limber_X_driver_status(h, &status)
+ *   limber_X_client_id(h, &id)   limber_X_acquire(h, name, heartbeat_ms)   limber_X_renew(h)
+ *   limber_X_keep_lease(h, &renewed)   limber_X_release_lease(h)   limber_X_holder(h, &holder)
+ *   limber_X_preempted(h, ticket, &preempted, &by_client)
+ *
+ * A handle of any interface is a limber_device: every limber_device_* call takes it as it
+ * is (outcomes with the other client's name, the descriptor to poll, the wait mode...). */
+#ifndef LIMBER_CLIENT_TYPED_H
+#define LIMBER_CLIENT_TYPED_H
 
-/*
- Connects to the actuator array `device` ("robot/actarray/index") in `domain` (NULL:
- the `LIMBER_DOMAIN` environment variable, or "limber"), waiting up to `timeout_ms` for a
- driver to offer it. On success `*out` is the new handle; free it with
- `limber_actarray_disconnect`.
-
- It first checks that this program and the library agree on the wire layout (the
- LIMBER_LAYOUT_VERSION of the limber.h it was compiled with, sizeof(limber_actarray_data) and
- sizeof(limber_actarray_geom)): a program built against another limber.h gets
- LIMBER_CODE_INCOMPATIBLE, with the versions and sizes in limber_last_error(), instead
- of states read with the wrong layout.
-
- # Safety
- `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
- */
-static inline limber_code limber_actarray_connect(const char *device,
-                                                  const char *domain,
-                                                  uint64_t timeout_ms,
-                                                  limber_actarray **out) {
-    return limber_actarray_connect_checked(device, domain, timeout_ms, LIMBER_LAYOUT_VERSION,
-                                           sizeof(limber_actarray_data), sizeof(limber_actarray_geom), out);
+/* Connects to any device (its interface from its name); check it with
+ * limber_device_interface. */
+static inline limber_code limber_device_connect(const char *device, const char *domain,
+                                                uint64_t timeout_ms, limber_device **out) {
+    return limber_device_connect_checked(device, domain, timeout_ms, LIMBER_LAYOUT_VERSION, -1,
+                                         0, 0, out);
 }
 
-/*
- Connects to the limb `device` ("robot/limb/index") in `domain` (NULL:
- the `LIMBER_DOMAIN` environment variable, or "limber"), waiting up to `timeout_ms` for a
- driver to offer it. On success `*out` is the new handle; free it with
- `limber_limb_disconnect`.
+#define LIMBER_TYPED_CLIENT_(X, KIND)                                                        \
+    static inline limber_code limber_##X##_connect(const char *device, const char *domain,   \
+                                                   uint64_t timeout_ms, limber_##X **out) {  \
+        return limber_device_connect_checked(device, domain, timeout_ms, LIMBER_LAYOUT_VERSION,\
+                                             KIND, sizeof(limber_##X##_data),                \
+                                             sizeof(limber_##X##_geom), out);                \
+    }                                                                                        \
+    static inline void limber_##X##_disconnect(limber_##X *h) { limber_device_disconnect(h); } \
+    static inline limber_code limber_##X##_state(limber_##X *h, uint64_t timeout_ms,         \
+                                                 limber_##X##_data *out) {                   \
+        return limber_device_state(h, timeout_ms, out, sizeof(limber_##X##_data));           \
+    }                                                                                        \
+    static inline limber_code limber_##X##_borrow(limber_##X *h, uint64_t timeout_ms,        \
+                                                  const limber_##X##_data **out) {           \
+        const void *p = NULL;                                                                \
+        limber_code c = limber_device_borrow(h, timeout_ms, out ? &p : NULL);                \
+        if (c == LIMBER_CODE_OK) *out = (const limber_##X##_data *)p;                        \
+        return c;                                                                            \
+    }                                                                                        \
+    static inline limber_code limber_##X##_release(limber_##X *h) {                          \
+        return limber_device_release(h);                                                     \
+    }                                                                                        \
+    static inline limber_code limber_##X##_wait_state(limber_##X *h, uint64_t timeout_ms,    \
+                                                      limber_##X##_data *out) {              \
+        return limber_device_wait_state(h, timeout_ms, out, sizeof(limber_##X##_data));      \
+    }                                                                                        \
+    static inline limber_code limber_##X##_geometry(limber_##X *h, uint64_t timeout_ms,      \
+                                                    limber_##X##_geom *out) {                \
+        return limber_device_geometry(h, timeout_ms, out, sizeof(limber_##X##_geom));        \
+    }                                                                                        \
+    static inline limber_code limber_##X##_wait_outcome(limber_##X *h, limber_ticket ticket, \
+                                                        uint64_t timeout_ms, uint32_t *st) { \
+        return limber_device_wait_outcome(h, ticket, timeout_ms, st);                        \
+    }                                                                                        \
+    static inline limber_code limber_##X##_liveness(limber_##X *h, uint64_t max_age_ms,      \
+                                                    limber_liveness *out) {                  \
+        return limber_device_liveness(h, max_age_ms, out);                                   \
+    }                                                                                        \
+    static inline limber_code limber_##X##_driver_status(limber_##X *h,                      \
+                                                         limber_driver_status *out) {        \
+        return limber_device_driver_status(h, out);                                          \
+    }                                                                                        \
+    static inline limber_code limber_##X##_client_id(limber_##X *h, uint64_t *out) {         \
+        return limber_device_client_id(h, out);                                              \
+    }                                                                                        \
+    static inline limber_code limber_##X##_acquire(limber_##X *h, const char *name,          \
+                                                   uint64_t heartbeat_ms) {                  \
+        return limber_device_acquire(h, name, heartbeat_ms);                                 \
+    }                                                                                        \
+    static inline limber_code limber_##X##_renew(limber_##X *h) {                            \
+        return limber_device_renew(h);                                                       \
+    }                                                                                        \
+    static inline limber_code limber_##X##_keep_lease(limber_##X *h, bool *renewed) {        \
+        return limber_device_keep_lease(h, renewed);                                         \
+    }                                                                                        \
+    static inline limber_code limber_##X##_release_lease(limber_##X *h) {                    \
+        return limber_device_release_lease(h);                                               \
+    }                                                                                        \
+    static inline limber_code limber_##X##_holder(limber_##X *h, limber_lease_holder *out) { \
+        return limber_device_holder(h, out);                                                 \
+    }                                                                                        \
+    static inline limber_code limber_##X##_preempted(limber_##X *h, limber_ticket ticket,    \
+                                                     bool *preempted, uint64_t *by_client) { \
+        return limber_device_preempted(h, ticket, preempted, by_client);                     \
+    }
 
- It first checks that this program and the library agree on the wire layout (the
- LIMBER_LAYOUT_VERSION of the limber.h it was compiled with, sizeof(limber_limb_data) and
- sizeof(limber_limb_geom)): a program built against another limber.h gets
- LIMBER_CODE_INCOMPATIBLE, with the versions and sizes in limber_last_error(), instead
- of states read with the wrong layout.
+LIMBER_TYPED_CLIENT_(actarray, LIMBER_INTERFACE_ACTARRAY)
+LIMBER_TYPED_CLIENT_(limb, LIMBER_INTERFACE_LIMB)
+LIMBER_TYPED_CLIENT_(gripper, LIMBER_INTERFACE_GRIPPER)
 
- # Safety
- `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
- */
-static inline limber_code limber_limb_connect(const char *device,
-                                              const char *domain,
-                                              uint64_t timeout_ms,
-                                              limber_limb **out) {
-    return limber_limb_connect_checked(device, domain, timeout_ms, LIMBER_LAYOUT_VERSION,
-                                       sizeof(limber_limb_data), sizeof(limber_limb_geom), out);
-}
-
-/*
- Connects to the gripper `device` ("robot/gripper/index") in `domain` (NULL:
- the `LIMBER_DOMAIN` environment variable, or "limber"), waiting up to `timeout_ms` for a
- driver to offer it. On success `*out` is the new handle; free it with
- `limber_gripper_disconnect`.
-
- It first checks that this program and the library agree on the wire layout (the
- LIMBER_LAYOUT_VERSION of the limber.h it was compiled with, sizeof(limber_gripper_data) and
- sizeof(limber_gripper_geom)): a program built against another limber.h gets
- LIMBER_CODE_INCOMPATIBLE, with the versions and sizes in limber_last_error(), instead
- of states read with the wrong layout.
-
- # Safety
- `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
- */
-static inline limber_code limber_gripper_connect(const char *device,
-                                                 const char *domain,
-                                                 uint64_t timeout_ms,
-                                                 limber_gripper **out) {
-    return limber_gripper_connect_checked(device, domain, timeout_ms, LIMBER_LAYOUT_VERSION,
-                                          sizeof(limber_gripper_data), sizeof(limber_gripper_geom), out);
-}
-
-#endif  /* LIMBER_CLIENT_CONNECT_H */
+#endif  /* LIMBER_CLIENT_TYPED_H */

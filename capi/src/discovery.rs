@@ -2,9 +2,9 @@
 
 use core::ffi::c_char;
 
-use limber_interfaces::InterfaceKind;
 use limber_services::list_devices;
 
+use crate::device::copy_str;
 use crate::{Fail, LimberCode, arg, domain_of, guard, opt_str};
 
 /// Longest device name kept in `limber_device_info.name`, with its NUL.
@@ -40,15 +40,6 @@ pub struct LimberDeviceInfo {
     pub nodes: u32,
 }
 
-/// Copies `s` into `dst` as a NUL-terminated string, cut to fit.
-fn copy_str(dst: &mut [c_char], s: &str) {
-    let n = s.len().min(dst.len() - 1);
-    for (d, b) in dst.iter_mut().zip(s.as_bytes()[..n].iter()) {
-        *d = *b as c_char;
-    }
-    dst[n] = 0;
-}
-
 /// Lists the devices of `domain` (NULL: `LIMBER_DOMAIN`, or "limber"), sorted by name:
 /// writes the first `capacity` into `out[]` and the number found into `*count` (which
 /// may exceed `capacity`: call again with a larger array). `out` may be NULL when
@@ -76,11 +67,7 @@ pub unsafe extern "C" fn limber_list_devices(
             let mut info = LimberDeviceInfo {
                 name: [0; LIMBER_DEVICE_NAME_CAPACITY],
                 driver: [0; LIMBER_DRIVER_NAME_CAPACITY],
-                interface: match d.interface() {
-                    InterfaceKind::ActArray => LimberInterface::Actarray,
-                    InterfaceKind::Limb => LimberInterface::Limb,
-                    InterfaceKind::Gripper => LimberInterface::Gripper,
-                },
+                interface: LimberInterface::of(d.interface()),
                 alive: d.alive,
                 nodes: u32::try_from(d.nodes).unwrap_or(u32::MAX),
             };

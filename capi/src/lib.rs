@@ -27,22 +27,29 @@ use std::ffi::CString;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::OnceLock;
 
+use limber_interfaces::InterfaceVisitor;
 use limber_interfaces::prelude::*;
 use limber_services::client::{
-    Client, CommandError, ConnectError, DriverStatus, Freshness, LeaseError, Outcome, RequestError,
+    CommandError, ConnectError, DriverStatus, LeaseError, LeaseHolder, Outcome, RequestError,
     Ticket, WaitError,
 };
-use limber_services::{Context, Domain, ListError, NameError, Role};
+use limber_services::{Domain, ListError, NameError};
 
 mod actarray;
+mod device;
 mod discovery;
 mod gripper;
 mod limb;
+mod log;
+mod stats;
 
 pub use actarray::*;
+pub use device::*;
 pub use discovery::*;
 pub use gripper::*;
 pub use limb::*;
+pub use log::*;
+pub use stats::*;
 
 /// What a call returned: `LIMBER_CODE_OK` (0), or why it failed. The detail of a failure is
 /// in `limber_last_error()`.
@@ -228,47 +235,52 @@ pub extern "C" fn limber_status_text(status: u32) -> *const c_char {
         .map_or(c"unknown status".as_ptr(), |t| t.as_ptr())
 }
 
+/// Returns the name of a driver's `LIMBER_STATUS_*` as limber.h spells it without its
+/// prefix ("OK", "CLAMPED", "OUT_OF_REACH", ...), or "UNKNOWN" for a value that is none.
+/// Never NULL.
+#[unsafe(no_mangle)]
+pub extern "C" fn limber_status_name(status: u32) -> *const c_char {
+    static NAMES: OnceLock<Vec<CString>> = OnceLock::new();
+    let names = NAMES.get_or_init(|| {
+        Status::ALL
+            .iter()
+            .map(|s| CString::new(s.name()).unwrap_or_default())
+            .collect()
+    });
+    Status::try_from(status)
+        .ok()
+        .and_then(|s| names.get(Status::ALL.iter().position(|x| *x == s)?))
+        .map_or(c"UNKNOWN".as_ptr(), |t| t.as_ptr())
+}
+
+/// Whether a command with outcome `status` was carried out: `LIMBER_STATUS_OK`, and the
+/// statuses that say how (`CLAMPED`: a value clamped to a limit; `ADJUSTED`: a limb pose's
+/// orientation turned to one the joints can hold). False for every refusal and for a
+/// value that is no status.
+#[unsafe(no_mangle)]
+pub extern "C" fn limber_status_is_carried_out(status: u32) -> bool {
+    Status::try_from(status).is_ok_and(Status::is_carried_out)
+}
+
+/// Copies the holder of the device named by the last refusal on this thread because
+/// another client holds it (`LIMBER_STATUS_LEASED`: a command's outcome, an acquire, a
+/// request) into `*out`; `out->client_id` is 0 when the last failure was of another kind.
+/// Does nothing for NULL.
+///
+/// # Safety
+/// `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_last_holder(out: *mut LimberLeaseHolder) {
+    // SAFETY: the caller's promise: NULL or writable.
+    if let Some(out) = unsafe { out.as_mut() } {
+        *out = LAST_HOLDER.with(Cell::get);
+    }
+}
+
 /// Returns the layout version this library speaks (`LIMBER_LAYOUT_VERSION` of limber.h).
 #[unsafe(no_mangle)]
 pub extern "C" fn limber_layout_version() -> u32 {
     limber_interfaces::LAYOUT_VERSION
-}
-
-/// The layout a program was compiled against: the `LIMBER_LAYOUT_VERSION` of its limber.h
-/// and the sizes of the state and geometry structs it passes (`limber_*_connect`, the
-/// header's inline functions, fill them in).
-pub(crate) struct CompiledLayout {
-    /// `LIMBER_LAYOUT_VERSION` of the program's limber.h.
-    pub version: u32,
-    /// `sizeof` the state struct in the program.
-    pub data_size: usize,
-    /// `sizeof` the geometry struct in the program.
-    pub geom_size: usize,
-}
-
-impl CompiledLayout {
-    /// Refuses (`LIMBER_CODE_INCOMPATIBLE`) a program whose limber.h is not this library's:
-    /// another layout version, or a state or geometry struct of another size. A field moved
-    /// in a message bumps the layout version (the rule of limber.h), so such a program
-    /// cannot connect and misread the states.
-    pub(crate) fn check<D, G>(&self, data: &str, geom: &str) -> Result<(), Fail> {
-        let ours = (
-            limber_interfaces::LAYOUT_VERSION,
-            size_of::<D>(),
-            size_of::<G>(),
-        );
-        if (self.version, self.data_size, self.geom_size) == ours {
-            return Ok(());
-        }
-        let detail = format!(
-            "this program was compiled against limber.h layout version {} ({data} {} bytes, \
-             {geom} {} bytes), but this liblimber speaks layout version {} ({} and {} bytes): \
-             rebuild the program against the limber.h installed with this library",
-            self.version, self.data_size, self.geom_size, ours.0, ours.1, ours.2
-        );
-        tracing::warn!("{detail}");
-        Err(Fail::new(LimberCode::Incompatible, detail))
-    }
 }
 
 // ----- failures, recorded per thread ---------------------------------------------------
@@ -276,6 +288,7 @@ impl CompiledLayout {
 thread_local! {
     static LAST_ERROR: RefCell<CString> = RefCell::new(CString::default());
     static LAST_REFUSAL: Cell<u32> = const { Cell::new(0) };
+    static LAST_HOLDER: Cell<LimberLeaseHolder> = Cell::new(LimberLeaseHolder::default());
 }
 
 /// A failed call: its code and detail.
@@ -284,6 +297,8 @@ pub(crate) struct Fail {
     code: LimberCode,
     detail: String,
     refusal: u32,
+    /// The holder of the device, for a refusal because another client holds it.
+    holder: Option<LeaseHolder>,
 }
 
 impl Fail {
@@ -292,6 +307,7 @@ impl Fail {
             code,
             detail: detail.into(),
             refusal: Status::Ok as u32,
+            holder: None,
         }
     }
 
@@ -314,6 +330,12 @@ impl Fail {
         let text = CString::new(self.detail.replace('\0', "?")).unwrap_or_default();
         LAST_ERROR.with(|e| *e.borrow_mut() = text);
         LAST_REFUSAL.with(|r| r.set(self.refusal));
+        let holder = self
+            .holder
+            .as_ref()
+            .map(LimberLeaseHolder::of)
+            .unwrap_or_default();
+        LAST_HOLDER.with(|h| h.set(holder));
         self.code
     }
 }
@@ -389,6 +411,13 @@ impl From<LeaseError> for Fail {
         };
         let mut f = Fail::from_error(code, &e);
         f.refusal = refusal as u32;
+        if let LeaseError::Held { client_id, name } = &e {
+            f.holder = Some(LeaseHolder {
+                client_id: *client_id,
+                name: name.clone(),
+                timeout: Duration::ZERO,
+            });
+        }
         f
     }
 }
@@ -494,235 +523,116 @@ pub(crate) fn ms(timeout_ms: u64) -> Duration {
     Duration::from_millis(timeout_ms)
 }
 
-// ----- one handle, any interface --------------------------------------------------------
+// ----- conversions at the boundary -----------------------------------------------------
 
-/// The state of one C handle: its client (with its own iceoryx2 node) and whether a state
-/// sample is lent to the caller.
-///
-/// A lent sample is the client's latest one, which only [`Client::refresh`] replaces (and
-/// with it releases the old one to the driver, who may overwrite it). Every call that
-/// refreshes (state, current, wait_state, wait_outcome, preempted, freshness) is refused while a
-/// sample is lent; commands, requests and `driver_status` do not refresh and stay allowed.
-pub(crate) struct Handle<I: Interface> {
-    pub(crate) client: Client<I>,
-    borrowed: bool,
+impl LimberInterface {
+    /// The C code of an interface.
+    pub fn of(kind: InterfaceKind) -> Self {
+        match kind {
+            InterfaceKind::ActArray => LimberInterface::Actarray,
+            InterfaceKind::Limb => LimberInterface::Limb,
+            InterfaceKind::Gripper => LimberInterface::Gripper,
+        }
+    }
+
+    /// The interface of a C code, if it is one.
+    pub fn kind_of(code: i32) -> Option<InterfaceKind> {
+        InterfaceKind::ALL
+            .into_iter()
+            .find(|k| LimberInterface::of(*k) as i32 == code)
+    }
 }
 
-/// The name this process shows in `limber list`: its executable's.
-fn process_name() -> String {
-    std::env::args()
-        .next()
-        .and_then(|a| {
-            std::path::Path::new(&a)
-                .file_name()
-                .map(|s| s.to_string_lossy().to_string())
-        })
-        .filter(|n| n.len() <= 60 && n.bytes().all(|b| b.is_ascii_graphic()))
-        .unwrap_or_else(|| "c-client".to_string())
-}
-
-impl<I: Interface> Handle<I> {
-    /// Connects to `device` in `domain` (NULL: `LIMBER_DOMAIN`), waiting up to
-    /// `timeout_ms` for a driver to offer it. Each handle joins the domain with a node of
-    /// its own.
-    pub(crate) fn connect(
-        device: &str,
-        domain: Option<&str>,
-        timeout_ms: u64,
-    ) -> Result<Self, Fail> {
-        let domain = domain_of(domain)?;
-        let ctx = Context::new(&domain, Role::Client, &process_name())
-            .map_err(|e| Fail::from(ConnectError::from(e)))?;
-        let client = Client::<I>::connect_timeout(&ctx, device, ms(timeout_ms))?;
-        Ok(Handle {
-            client,
-            borrowed: false,
-        })
-    }
-
-    fn not_borrowed(&self) -> Result<(), Fail> {
-        if self.borrowed {
-            Err(Fail::new(
-                LimberCode::Borrowed,
-                "a state borrowed from this handle is still held: release it first",
-            ))
-        } else {
-            Ok(())
-        }
-    }
-
-    /// Copies the latest state into `out`, waiting up to `timeout_ms` for a first one.
-    pub(crate) fn state(&mut self, timeout_ms: u64, out: &mut I::Data) -> Result<(), Fail> {
-        self.not_borrowed()?;
-        *out = *self.client.current(ms(timeout_ms))?;
-        Ok(())
-    }
-
-    /// Lends the latest state in place (waiting up to `timeout_ms` for a first one) until
-    /// [`Handle::release`].
-    pub(crate) fn borrow(&mut self, timeout_ms: u64) -> Result<*const I::Data, Fail> {
-        self.not_borrowed()?;
-        let p: *const I::Data = self.client.current(ms(timeout_ms))?;
-        self.borrowed = true;
-        Ok(p)
-    }
-
-    /// Ends the loan of [`Handle::borrow`].
-    pub(crate) fn release(&mut self) {
-        self.borrowed = false;
-    }
-
-    /// Waits up to `timeout_ms` for a state newer than the latest taken; copies it into
-    /// `out` if given.
-    pub(crate) fn wait_state(
-        &mut self,
-        timeout_ms: u64,
-        out: Option<&mut I::Data>,
-    ) -> Result<(), Fail> {
-        self.not_borrowed()?;
-        let d = *self.client.wait_state(ms(timeout_ms))?;
-        if let Some(out) = out {
-            *out = d;
-        }
-        Ok(())
-    }
-
-    /// Waits up to `timeout_ms` for the outcome of `ticket` (a `LIMBER_STATUS_*`). An
-    /// outcome other than `LIMBER_STATUS_OK` is kept for `limber_last_error` and
-    /// `limber_last_refusal` too (for `LIMBER_STATUS_LEASED`, with the holder's name).
-    pub(crate) fn wait_outcome(
-        &mut self,
-        ticket: &LimberTicket,
-        timeout_ms: u64,
-    ) -> Result<u32, Fail> {
-        self.not_borrowed()?;
-        let o = self
-            .client
-            .wait_outcome_detail(ticket_of(ticket), ms(timeout_ms))?;
-        if o.status != Status::Ok {
-            let mut f = Fail::new(LimberCode::Refused, outcome_text(&o));
-            f.refusal = o.status as u32;
-            f.record();
-        }
-        Ok(o.status as u32)
-    }
-
-    /// Takes the device's control lease as `name` (`None`: this process's name),
-    /// renewed at least every `heartbeat_ms`.
-    pub(crate) fn acquire(&mut self, name: Option<&str>, heartbeat_ms: u64) -> Result<(), Fail> {
-        let name = match name {
-            Some(n) => n.to_string(),
-            None => {
-                let mut n = process_name();
-                n.truncate(LIMBER_LEASE_NAME_MAX);
-                n
-            }
-        };
-        if name.is_empty() || name.len() > LIMBER_LEASE_NAME_MAX {
-            return Err(Fail::new(
-                LimberCode::InvalidValue,
-                format!(
-                    "a lease name has 1 to {LIMBER_LEASE_NAME_MAX} bytes, not {} ({name:?})",
-                    name.len()
-                ),
-            ));
-        }
-        self.client.acquire(&name, ms(heartbeat_ms))?;
-        Ok(())
-    }
-
-    /// The heartbeat of the lease.
-    pub(crate) fn renew(&mut self) -> Result<(), Fail> {
-        Ok(self.client.renew()?)
-    }
-
-    /// Renews the lease when a third of its heartbeat has passed; whether it did.
-    pub(crate) fn keep_lease(&mut self) -> Result<bool, Fail> {
-        Ok(self.client.keep_lease()?)
-    }
-
-    /// Gives the lease back (nothing to do when none is held).
-    pub(crate) fn release_lease(&mut self) -> Result<(), Fail> {
-        Ok(self.client.release()?)
-    }
-
-    /// Who holds the device (client id 0: nobody).
-    pub(crate) fn holder(&mut self) -> Result<LimberLeaseHolder, Fail> {
-        let mut out = LimberLeaseHolder::default();
-        if let Some(h) = self.client.holder()? {
-            out.client_id = h.client_id;
-            out.heartbeat_ms = u64::try_from(h.timeout.as_millis()).unwrap_or(u64::MAX);
-            let mut n = h.name.len().min(LIMBER_LEASE_NAME_MAX);
-            while !h.name.is_char_boundary(n) {
-                n -= 1;
-            }
-            for (d, b) in out.name.iter_mut().zip(&h.name.as_bytes()[..n]) {
-                *d = *b as c_char;
-            }
-        }
-        Ok(out)
-    }
-
-    /// Whether another client's command cut short the motion of `ticket`'s command (as
-    /// far as the outcomes that arrived tell): the preempting client's id if so.
-    pub(crate) fn preempted(&mut self, ticket: &LimberTicket) -> Result<Option<u64>, Fail> {
-        self.not_borrowed()?;
-        Ok(self
-            .client
-            .preempted(ticket_of(ticket))?
-            .map(|o| o.other_client))
-    }
-
-    /// Alive (a state younger than `max_age_ms`), stale, gone, or no data yet.
-    pub(crate) fn liveness(&mut self, max_age_ms: u64) -> Result<LimberLiveness, Fail> {
-        self.not_borrowed()?;
-        Ok(match self.client.freshness(ms(max_age_ms)) {
-            Freshness::Fresh => LimberLiveness::Alive,
-            Freshness::Stale => LimberLiveness::Stale,
-            Freshness::Gone => LimberLiveness::Gone,
-            Freshness::NoData => LimberLiveness::NoData,
-        })
-    }
-
-    /// Whether the driver's process lives.
-    pub(crate) fn driver_status(&self) -> LimberDriverStatus {
-        match self.client.driver_status() {
+impl LimberDriverStatus {
+    pub(crate) fn of(s: DriverStatus) -> Self {
+        match s {
             DriverStatus::Alive => LimberDriverStatus::Alive,
             DriverStatus::Dead => LimberDriverStatus::Dead,
             DriverStatus::Absent => LimberDriverStatus::Absent,
         }
     }
-
-    /// A request with its timeout.
-    pub(crate) fn request(&mut self, req: &I::Request, timeout_ms: u64) -> Result<I::Reply, Fail> {
-        Ok(self.client.request_with_timeout(req, ms(timeout_ms))?)
-    }
 }
 
-fn ticket_of(t: &LimberTicket) -> Ticket {
-    Ticket {
-        seq: t.seq,
-        receivers: usize::try_from(t.receivers).unwrap_or(usize::MAX),
-    }
-}
-
-/// The detail of an outcome that is not OK: its status, and the other client involved.
-fn outcome_text(o: &Outcome) -> String {
-    let mut t = format!("refused: {}", o.status.describe());
-    if o.status == Status::Leased {
-        let name = if o.other_name().is_empty() {
-            "unnamed"
-        } else {
-            o.other_name()
+impl LimberLeaseHolder {
+    pub(crate) fn of(h: &LeaseHolder) -> Self {
+        let mut out = LimberLeaseHolder {
+            client_id: h.client_id,
+            heartbeat_ms: u64::try_from(h.timeout.as_millis()).unwrap_or(u64::MAX),
+            name: [0; 32],
         };
-        t = format!(
-            "refused: held by another client ({name}, client {})",
-            o.other_client
-        );
-    } else if o.other_client != 0 {
-        t.push_str(&format!(" (by client {})", o.other_client));
+        device::copy_str(&mut out.name, &h.name);
+        out
     }
-    t
+}
+
+/// The sizes of an interface's state and geometry structs.
+pub(crate) struct Sizes;
+
+impl InterfaceVisitor for Sizes {
+    type Output = (usize, usize);
+    fn visit<I: Interface>(self) -> (usize, usize) {
+        (size_of::<I::Data>(), size_of::<I::Geom>())
+    }
+}
+
+/// A program compiled against another limber.h: another layout version, or (for a typed
+/// connect, with the interface and the sizes of its state and geometry structs) structs of
+/// other sizes.
+pub(crate) fn incompatible_layout(
+    version: u32,
+    sizes: Option<(InterfaceKind, usize, usize)>,
+) -> Fail {
+    let ours = limber_interfaces::LAYOUT_VERSION;
+    let detail = match sizes {
+        Some((kind, data, geom)) => {
+            let (d, g) = kind.visit(Sizes);
+            format!(
+                "this program was compiled against limber.h layout version {version} \
+                 (limber_{k}_data {data} bytes, limber_{k}_geom {geom} bytes), but this \
+                 liblimber speaks layout version {ours} ({d} and {g} bytes): rebuild the \
+                 program against the limber.h installed with this library",
+                k = kind.name()
+            )
+        }
+        None => format!(
+            "this program was compiled against limber.h layout version {version}, but this \
+             liblimber speaks layout version {ours}: rebuild the program against the \
+             limber.h installed with this library"
+        ),
+    };
+    tracing::warn!("{detail}");
+    Fail::new(LimberCode::Incompatible, detail)
+}
+
+impl Fail {
+    /// The detail of an outcome that is not OK: its status, and the other client involved
+    /// (for `LIMBER_STATUS_LEASED`, the holder, also kept for `limber_last_holder`).
+    pub(crate) fn refused_outcome(o: &Outcome) -> Fail {
+        let mut t = format!("refused: {}", o.status.describe());
+        let mut holder = None;
+        if o.status == Status::Leased {
+            let name = if o.other_name().is_empty() {
+                "unnamed"
+            } else {
+                o.other_name()
+            };
+            t = format!(
+                "refused: held by another client ({name}, client {})",
+                o.other_client
+            );
+            holder = Some(LeaseHolder {
+                client_id: o.other_client,
+                name: o.other_name().to_string(),
+                timeout: Duration::ZERO,
+            });
+        } else if o.other_client != 0 {
+            t.push_str(&format!(" (by client {})", o.other_client));
+        }
+        let mut f = Fail::new(LimberCode::Refused, t);
+        f.refusal = o.status as u32;
+        f.holder = holder;
+        f
+    }
 }
 
 /// Writes a sent command's ticket (if `out` is given).
@@ -738,4 +648,13 @@ pub(crate) fn sent(
         };
     }
     Ok(())
+}
+
+/// A request of interface `I` with its timeout.
+pub(crate) fn request<I: Interface>(
+    c: &mut limber_services::Client<I>,
+    req: &I::Request,
+    timeout_ms: u64,
+) -> Result<I::Reply, Fail> {
+    Ok(c.request_with_timeout(req, ms(timeout_ms))?)
 }

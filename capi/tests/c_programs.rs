@@ -723,18 +723,22 @@ fn a_handle_sees_its_driver_go() {
     let mut data = ActArrayData::default();
     // SAFETY: valid strings, and pointers to locals that outlive the calls.
     unsafe {
-        let c = limber_actarray_connect_checked(
+        let c = limber_device_connect_checked(
             c"pioneer/actarray/0".as_ptr(),
             domain.as_ptr(),
             5000,
             limber_interfaces::LAYOUT_VERSION,
+            LimberInterface::Actarray as i32,
             size_of::<ActArrayData>(),
             size_of::<limber_interfaces::prelude::ActArrayGeom>(),
             &mut h,
         );
         assert_eq!(c, LimberCode::Ok);
-        assert_eq!(limber_actarray_state(h, 5000, &mut data), LimberCode::Ok);
-        assert_eq!(limber_actarray_liveness(h, 5000, &mut live), LimberCode::Ok);
+        assert_eq!(
+            limber_device_state(h, 5000, (&raw mut data).cast(), size_of::<ActArrayData>()),
+            LimberCode::Ok
+        );
+        assert_eq!(limber_device_liveness(h, 5000, &mut live), LimberCode::Ok);
     }
     assert_eq!(live, LimberLiveness::Alive);
     // The domain outlives the driver: its files go once the handle is disconnected too.
@@ -745,20 +749,22 @@ fn a_handle_sees_its_driver_go() {
         // The states published as it stopped, then the news that it is gone.
         let mut c = LimberCode::Ok;
         for _ in 0..100 {
-            c = limber_actarray_wait_state(h, 10_000, &mut data);
+            c = limber_device_wait_state(
+                h,
+                10_000,
+                (&raw mut data).cast(),
+                size_of::<ActArrayData>(),
+            );
             if c != LimberCode::Ok {
                 break;
             }
         }
         assert_eq!(c, LimberCode::DriverGone);
-        assert_eq!(limber_actarray_liveness(h, 0, &mut live), LimberCode::Ok);
+        assert_eq!(limber_device_liveness(h, 0, &mut live), LimberCode::Ok);
         let mut status = LimberDriverStatus::Alive;
-        assert_eq!(
-            limber_actarray_driver_status(h, &mut status),
-            LimberCode::Ok
-        );
+        assert_eq!(limber_device_driver_status(h, &mut status), LimberCode::Ok);
         assert_ne!(status, LimberDriverStatus::Alive);
-        limber_actarray_disconnect(h);
+        limber_device_disconnect(h);
     }
     assert_eq!(live, LimberLiveness::Gone);
 }
@@ -991,4 +997,90 @@ fn a_field_moved_in_a_message_makes_c_cpp_and_python_refuse_to_connect() {
     let out = text(&o.stdout);
     assert!(o.status.success(), "{out}\n{}", text(&o.stderr));
     assert!(out.starts_with("connected: joint 0 at "), "{out}");
+}
+
+#[test]
+fn the_calls_every_interface_shares_work_from_c_and_cpp() {
+    let dir = scratch("device");
+    let (c, cpp) = (dir.join("device"), dir.join("device_cpp"));
+    compile("device.c", &c, &[]);
+    compile("device.cpp", &cpp, &[]);
+    let p = Pioneer::start();
+    let o = run_in(&p, &c, &[]);
+    let out = text(&o.stdout);
+    assert!(o.status.success(), "{out}\n{}", text(&o.stderr));
+    for line in [
+        "status OUT_OF_REACH CLAMPED UNKNOWN",
+        "name pioneer/actarray/0 interface 0",
+        "gripper call on the arm: the device is of another interface or layout version: \
+         pioneer/actarray/0 is an actarray, not a gripper",
+        "wrong size: refused",
+        "gripper connect to the arm: the device is of another interface or layout version: \
+         pioneer/actarray/0 is an actarray, not a gripper",
+        "poll: the arm's state came; move OK",
+        "other's move: LEASED by alice (the holder: yes)",
+        "other's acquire: the driver refused the request; last holder alice (the holder: yes)",
+        "stats: some cycles latest ok",
+        "log: 1 warning(s): this program was compiled against limber.h layout version",
+        "all device steps ok",
+    ] {
+        assert!(out.contains(line), "{line:?} not in:\n{out}");
+    }
+    // C++: run until it is ready, stop the driver, let it see the driver gone.
+    let mut child = Command::new(&cpp)
+        .env("LIMBER_DOMAIN", p.name())
+        .env_remove("LD_LIBRARY_PATH")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("device_cpp runs");
+    let stdout = child.stdout.take().expect("its stdout");
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let mut lines = Vec::new();
+    let deadline = Instant::now() + RUN_LIMIT;
+    while lines.last().is_none_or(|l: &String| l != "ready") {
+        match rx.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
+            Ok(l) => lines.push(l),
+            Err(_) => {
+                let _ = child.kill();
+                let o = child.wait_with_output().expect("its output");
+                panic!("device_cpp never got ready: {lines:?}\n{}", text(&o.stderr));
+            }
+        }
+    }
+    let _domain = p.domain.clone();
+    drop(p);
+    {
+        use std::io::Write as _;
+        let mut stdin = child.stdin.take().expect("its stdin");
+        writeln!(stdin).expect("a line to device_cpp");
+    }
+    while let Ok(l) = rx.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
+        lines.push(l);
+    }
+    let status = child.wait().expect("device_cpp ends");
+    let out = lines.join("\n");
+    assert!(status.success(), "{out}");
+    for line in [
+        "move: OK carried out 1 text ok raw 1",
+        "no news without an exception: 1",
+        "reach: adjusted 1",
+        "setpose: ADJUSTED carried out 1",
+        "reach far: OUT_OF_REACH",
+        "gone: the driver is gone",
+    ] {
+        assert!(out.contains(line), "{line:?} not in:\n{out}");
+    }
+    assert!(
+        !out.contains("the driver is gone: the driver is gone"),
+        "what() repeats itself:\n{out}"
+    );
 }

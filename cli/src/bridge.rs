@@ -6,7 +6,9 @@ use std::path::PathBuf;
 use clap::{Args, Subcommand};
 use limber_bridge::expose::ExposeEvent;
 use limber_bridge::mirror::MirrorEvent;
-use limber_bridge::{Allow, CommandKind, DevicePattern, ExposeConfig, MirrorConfig, NetConfig};
+use limber_bridge::{
+    Allow, CommandKind, DevicePattern, ExposeConfig, MirrorConfig, NetConfig, RequestKind,
+};
 use limber_services::signals;
 
 use crate::out::noteln;
@@ -67,6 +69,12 @@ struct ExposeArgs {
     /// every command.
     #[arg(long = "allow-command", value_name = "INTERFACE:KIND")]
     allow_commands: Vec<CommandKind>,
+    /// Let only these requests that change a device through (repeatable; interface:kind,
+    /// e.g. actarray:power, limb:speed). With an --allow-command or --allow-request list,
+    /// every request that changes a device and is not listed is refused ("unsupported");
+    /// read-only requests (geometry, reach) always pass.
+    #[arg(long = "allow-request", value_name = "INTERFACE:KIND")]
+    allow_requests: Vec<RequestKind>,
     /// Refuse every command and every request that changes a device (power, brakes,
     /// speed); the state and read-only requests (geometry) still pass.
     #[arg(long)]
@@ -117,12 +125,14 @@ pub fn run(args: BridgeArgs) -> Result<(), CliError> {
     let stop = signals::termination_requested;
     match args.role {
         Role::Expose(a) => {
+            let filtered = !a.allow_commands.is_empty() || !a.allow_requests.is_empty();
             let config = ExposeConfig {
                 net: net_config(a.net, &["tcp/127.0.0.1:7447"], &[]),
                 request_timeout: std::time::Duration::from_secs_f64(a.request_timeout),
                 allow: Allow {
                     devices: a.devices,
-                    commands: (!a.allow_commands.is_empty()).then_some(a.allow_commands),
+                    commands: filtered.then_some(a.allow_commands),
+                    requests: filtered.then_some(a.allow_requests),
                     read_only: a.read_only,
                 },
                 ..ExposeConfig::default()

@@ -1,10 +1,10 @@
 //! `limber echo <device>`: the live state, like `ros2 topic echo` or playerprint.
 
-use std::fmt::Write as _;
 use std::time::Duration;
 
 use clap::Args;
-use limber_interfaces::common::{StateHeader, device_flag};
+use limber_interfaces::common::device_flag;
+use limber_interfaces::describe::header_json;
 use limber_interfaces::diagnostics::DriverStats;
 use limber_services::prelude::*;
 use limber_services::{DeviceName, WaitError};
@@ -31,176 +31,9 @@ pub struct EchoArgs {
     timeout: f64,
 }
 
-/// A state that `echo` can print.
-pub trait Show {
-    /// One human-readable line.
-    fn human(&self) -> String;
-    /// One JSON object.
-    fn json(&self) -> Value;
-}
-
-fn header_json(h: &StateHeader) -> Value {
-    json!({
-        "seq": h.seq,
-        "stamp_ns": h.stamp_ns,
-        "link_up": h.flags & device_flag::LINK_UP != 0,
-        "calibrated": h.flags & device_flag::CALIBRATED != 0,
-        "flags": h.flags,
-        "cmd_overflows": h.cmd_overflows,
-        "last_cmd": {
-            "client_id": h.last_cmd.client_id,
-            "seq": h.last_cmd.cmd_seq,
-            "kind": h.last_cmd.kind,
-            "status": Status::try_from(h.last_cmd.status).map(|s| s.describe()).unwrap_or("?"),
-        },
-    })
-}
-
-fn header_human(h: &StateHeader) -> String {
-    let mut s = format!("#{:<6}", h.seq);
-    if h.flags & device_flag::LINK_UP == 0 && h.flags != 0 {
-        s.push_str(" LINK DOWN");
-    }
-    if h.last_cmd.client_id != 0 && h.last_cmd.status != 0 {
-        match Status::try_from(h.last_cmd.status) {
-            // "ok, clamped to the limit", "ok, orientation adjusted": carried out.
-            Ok(st) if st.is_carried_out() => {
-                s.push_str(&format!(" [last command: {st}]"));
-            }
-            Ok(st) => {
-                s.push_str(&format!(" [last command refused: {st}]"));
-            }
-            Err(_) => s.push_str(" [last command refused: ?]"),
-        }
-    }
-    s
-}
-
-fn flags_name(bits: u32) -> &'static str {
-    match ActuatorFlags::from_bits(bits) {
-        Some(f) if f.contains(ActuatorFlags::STALLED) => "stalled",
-        Some(f) if f.contains(ActuatorFlags::MOVING) => "moving",
-        Some(f) if f.contains(ActuatorFlags::BRAKED) => "braked",
-        Some(f) if f.contains(ActuatorFlags::IDLE) => "idle",
-        Some(_) => "-",
-        None => "?",
-    }
-}
-
-impl Show for ActArrayData {
-    fn human(&self) -> String {
-        let mut s = header_human(&self.header);
-        let _ = write!(
-            s,
-            " power {}",
-            if self.motor_state != 0 { "on " } else { "off" }
-        );
-        for (i, a) in self.actuators().iter().enumerate() {
-            let _ = write!(s, " | j{i} {:+.4} {}", a.position, flags_name(a.state));
-        }
-        s
-    }
-    fn json(&self) -> Value {
-        json!({
-            "header": header_json(&self.header),
-            "motor_state": self.motor_state,
-            "actuators": self.actuators().iter().map(|a| json!({
-                "position": a.position,
-                "speed": a.speed,
-                "acceleration": a.acceleration,
-                "current": a.current,
-                "state": flags_name(a.state),
-            })).collect::<Vec<_>>(),
-        })
-    }
-}
-
-fn limb_state_name(v: u32) -> &'static str {
-    match LimbState::try_from(v) {
-        Ok(LimbState::Idle) => "idle",
-        Ok(LimbState::Braked) => "braked",
-        Ok(LimbState::Moving) => "moving",
-        Ok(LimbState::OutOfReach) => "out-of-reach",
-        Ok(LimbState::Collision) => "collision",
-        Err(_) => "?",
-    }
-}
-
-impl Show for LimbData {
-    fn human(&self) -> String {
-        let (p, a, o) = (self.position, self.approach, self.orientation);
-        let adjusted = if self.orientation_adjustment > 0.0 {
-            format!(
-                " (orientation adjusted by {:.6} rad)",
-                self.orientation_adjustment
-            )
-        } else {
-            String::new()
-        };
-        format!(
-            "{} {:<12} pos ({:+.4}, {:+.4}, {:+.4}) approach ({:+.3}, {:+.3}, {:+.3}) orient ({:+.3}, {:+.3}, {:+.3}){adjusted}",
-            header_human(&self.header),
-            limb_state_name(self.state),
-            p.x,
-            p.y,
-            p.z,
-            a.x,
-            a.y,
-            a.z,
-            o.x,
-            o.y,
-            o.z
-        )
-    }
-    fn json(&self) -> Value {
-        json!({
-            "header": header_json(&self.header),
-            "state": limb_state_name(self.state),
-            "position": self.position.to_array(),
-            "approach": self.approach.to_array(),
-            "orientation": self.orientation.to_array(),
-            "orientation_adjustment": self.orientation_adjustment,
-        })
-    }
-}
-
-fn gripper_state_name(v: u32) -> &'static str {
-    match GripperState::try_from(v) {
-        Ok(GripperState::Open) => "open",
-        Ok(GripperState::Closed) => "closed",
-        Ok(GripperState::Moving) => "moving",
-        Ok(GripperState::Error) => "error",
-        Err(_) => "?",
-    }
-}
-
-impl Show for GripperData {
-    fn human(&self) -> String {
-        format!(
-            "{} {:<7} beams {:#06b} stored {}",
-            header_human(&self.header),
-            gripper_state_name(self.state),
-            self.beams,
-            self.stored
-        )
-    }
-    fn json(&self) -> Value {
-        json!({
-            "header": header_json(&self.header),
-            "state": gripper_state_name(self.state),
-            "beams": self.beams,
-            "stored": self.stored,
-        })
-    }
-}
-
-fn echo<I: Interface>(a: &EchoArgs) -> Result<(), CliError>
-where
-    I::Data: Show,
-{
+fn echo(a: &EchoArgs) -> Result<(), CliError> {
     let ctx = crate::client_context()?;
-    let mut c = Client::<I>::connect_timeout(&ctx, &a.device, Duration::from_millis(500))
-        .map_err(connect_err)?;
+    let mut c = connect_device(&ctx, &a.device, Duration::from_millis(500)).map_err(connect_err)?;
     let timeout = Duration::from_secs_f64(a.timeout.clamp(0.01, 3600.0));
     let mut n = 0;
     // The latest sample (history 1) first, then every new one.
@@ -210,12 +43,12 @@ where
         }
         let got = if n == 0 {
             c.refresh().map_err(wait_err)?;
-            match c.last_state() {
+            match c.header() {
                 Some(_) => Ok(()),
-                None => c.wait_state(timeout).map(|_| ()),
+                None => c.wait_state_bytes(timeout).map(|_| ()),
             }
         } else {
-            c.wait_state(timeout).map(|_| ())
+            c.wait_state_bytes(timeout).map(|_| ())
         };
         match got {
             Ok(()) => {}
@@ -227,7 +60,7 @@ where
             }
             Err(e) => return Err(wait_err(e)),
         }
-        let Some(s) = c.last_state() else {
+        let Some(s) = c.describe() else {
             continue;
         };
         if a.json {
@@ -338,13 +171,9 @@ pub fn run(a: EchoArgs) -> Result<(), CliError> {
     if let [robot, "driver"] | [robot, "driver", "0"] = parts.as_slice() {
         return echo_driver(robot, &a);
     }
-    let dev: DeviceName = a
+    let _: DeviceName = a
         .device
         .parse()
         .map_err(|e: limber_services::NameError| CliError::new(exit::USAGE, e.to_string()))?;
-    match dev.interface() {
-        InterfaceKind::ActArray => echo::<ActArray>(&a),
-        InterfaceKind::Limb => echo::<Limb>(&a),
-        InterfaceKind::Gripper => echo::<Gripper>(&a),
-    }
+    echo(&a)
 }

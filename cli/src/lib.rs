@@ -12,6 +12,7 @@ use limber_services::{Context, Domain, Role};
 
 #[cfg(feature = "bridge")]
 mod bridge;
+mod clean;
 mod demo;
 mod device;
 mod echo;
@@ -64,6 +65,13 @@ enum Command {
     List(list::ListArgs),
     /// Print the live state of a device (one line per sample; --json for scripts).
     Echo(echo::EchoArgs),
+    /// Remove every file of the domain (its /dev/shm segments, its iceoryx2 files, its
+    /// token) once no live process uses it: what a SIGKILLed driver or client left. Refused
+    /// (exit 5, naming them) while a driver or client runs in it; `--all` for every domain
+    /// of this user.
+    ///
+    /// Example: limber clean --domain scratch
+    Clean(clean::CleanArgs),
     /// A live terminal view of every device of the domain, like Player's playerv: joints
     /// against their limits, states, limb pose, grippers, lift, drivers' link statistics.
     ///
@@ -140,6 +148,7 @@ where
         Command::Layout(args) => layout::run(args),
         Command::List(args) => list::run(args),
         Command::Echo(args) => echo::run(args),
+        Command::Clean(args) => clean::run(args),
         Command::Monitor(args) => monitor::run(args),
         Command::Actarray(args) => device::actarray(args),
         Command::Limb(args) => device::limb(args),

@@ -24,7 +24,7 @@ mod app;
 #[path = "../src/monitor/ui.rs"]
 mod ui;
 
-use app::{App, Conn, StatusKind};
+use app::{App, StatusKind};
 
 fn monitor(domain: &Domain) -> App {
     let ctx = Context::new(domain, Role::Client, "monitor-test").unwrap();
@@ -65,8 +65,12 @@ fn gripper_state(app: &App, device: &str) -> u32 {
         .find(|d| d.info.name.to_string() == device)
         .unwrap();
     match &d.conn {
-        Ok(Conn::Gripper { client, .. }) => client.last_state().unwrap().state,
-        _ => panic!("{device} is not a connected gripper"),
+        Ok(c) => {
+            c.state::<Gripper>()
+                .unwrap_or_else(|| panic!("{device} is not a gripper with a state"))
+                .state
+        }
+        Err(e) => panic!("{device} is not connected: {e}"),
     }
 }
 

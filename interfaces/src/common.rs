@@ -196,6 +196,16 @@ impl Status {
         self as u32
     }
 
+    /// Its name as limber.h spells it without the prefix (`OK`, `OUT_OF_REACH`, ...), from
+    /// the layout manifest: the same in every language.
+    pub fn name(self) -> &'static str {
+        STATUS_GROUP
+            .constants
+            .iter()
+            .find(|c| c.value == i64::from(self.code()))
+            .map_or("UNKNOWN", |c| c.name)
+    }
+
     /// True for `Ok` only (carried out exactly as asked); see also
     /// [`Status::is_carried_out`].
     pub const fn is_ok(self) -> bool {

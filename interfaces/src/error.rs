@@ -23,7 +23,7 @@ pub enum ValueError {
         max: usize,
     },
     /// A joint index that cannot exist (negative, or beyond the array capacity).
-    #[error("joint {joint} is not a valid joint index (0..{max})")]
+    #[error("joint {joint} is not a valid joint index (0 to {})", max.saturating_sub(1))]
     BadJoint {
         /// The index given.
         joint: i64,

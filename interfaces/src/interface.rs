@@ -7,16 +7,17 @@ use core::fmt::Debug;
 use iceoryx2_bb_elementary_traits::zero_copy_send::ZeroCopySend;
 
 use crate::actarray::{
-    ActArrayCmdMsg, ActArrayCommand, ActArrayData, ActArrayReply, ActArrayReplyMsg, ActArrayReqMsg,
-    ActArrayRequest,
+    ActArrayCmdMsg, ActArrayCommand, ActArrayData, ActArrayGeom, ActArrayReply, ActArrayReplyMsg,
+    ActArrayReqMsg, ActArrayRequest,
 };
 use crate::common::StateHeader;
+use crate::describe::Describe;
 use crate::gripper::{
-    GripperCmdMsg, GripperCommand, GripperData, GripperReply, GripperReplyMsg, GripperReqMsg,
-    GripperRequest,
+    GripperCmdMsg, GripperCommand, GripperData, GripperGeom, GripperReply, GripperReplyMsg,
+    GripperReqMsg, GripperRequest,
 };
 use crate::limb::{
-    LimbCmdMsg, LimbCommand, LimbData, LimbReply, LimbReplyMsg, LimbReqMsg, LimbRequest,
+    LimbCmdMsg, LimbCommand, LimbData, LimbGeom, LimbReply, LimbReplyMsg, LimbReqMsg, LimbRequest,
 };
 use crate::message::{Envelope, Message, ReplyBody, ReplyEnvelope};
 use crate::wire::WireStruct;
@@ -82,6 +83,26 @@ impl InterfaceKind {
     pub fn from_name(s: &str) -> Option<Self> {
         InterfaceKind::ALL.into_iter().find(|k| k.name() == s)
     }
+
+    /// Calls `visitor` with this kind's [`Interface`] type: the one place in limber where
+    /// the kind is matched. Every generic consumer (a client of any device, the bridge, the
+    /// CLI's `echo`, the C API) writes its per-interface code once, generic over
+    /// `I: Interface`, and reaches it through here; a new interface is one arm below.
+    pub fn visit<V: InterfaceVisitor>(self, visitor: V) -> V::Output {
+        match self {
+            InterfaceKind::ActArray => visitor.visit::<ActArray>(),
+            InterfaceKind::Limb => visitor.visit::<Limb>(),
+            InterfaceKind::Gripper => visitor.visit::<Gripper>(),
+        }
+    }
+}
+
+/// Code generic over the interface, called through [`InterfaceKind::visit`].
+pub trait InterfaceVisitor {
+    /// What the visit returns.
+    type Output;
+    /// The visit, with the interface as a type.
+    fn visit<I: Interface>(self) -> Self::Output;
 }
 
 impl core::fmt::Display for InterfaceKind {
@@ -103,7 +124,15 @@ pub trait Interface: 'static {
     /// Which one.
     const KIND: InterfaceKind;
     /// The state (channel `data`).
-    type Data: HasHeader + Default + Copy + Debug + ZeroCopySend + Send + WireBytes + 'static;
+    type Data: HasHeader
+        + Describe
+        + Default
+        + Copy
+        + Debug
+        + ZeroCopySend
+        + Send
+        + WireBytes
+        + 'static;
     /// The command envelope (channel `cmd`).
     type CmdMsg: Envelope + Debug + ZeroCopySend + WireBytes;
     /// The typed command.
@@ -116,6 +145,12 @@ pub trait Interface: 'static {
     type ReplyMsg: ReplyEnvelope + Debug + ZeroCopySend + WireBytes;
     /// The typed payload of an ACK.
     type Reply: ReplyBody<Raw = Self::ReplyMsg> + Debug;
+    /// The device's geometry: the reply to [`Interface::GEOMETRY`].
+    type Geom: Copy + Debug + WireBytes + 'static;
+    /// The request that asks for the geometry.
+    const GEOMETRY: Self::Request;
+    /// The geometry in a reply (`None`: the reply is of another request).
+    fn geometry_of(reply: Self::Reply) -> Option<Self::Geom>;
 }
 
 macro_rules! has_header {
@@ -153,6 +188,14 @@ impl Interface for ActArray {
     type Request = ActArrayRequest;
     type ReplyMsg = ActArrayReplyMsg;
     type Reply = ActArrayReply;
+    type Geom = ActArrayGeom;
+    const GEOMETRY: ActArrayRequest = ActArrayRequest::GetGeom;
+    fn geometry_of(reply: ActArrayReply) -> Option<ActArrayGeom> {
+        match reply {
+            ActArrayReply::Geom(g) => Some(g),
+            ActArrayReply::Done => None,
+        }
+    }
 }
 
 impl Interface for Limb {
@@ -164,6 +207,14 @@ impl Interface for Limb {
     type Request = LimbRequest;
     type ReplyMsg = LimbReplyMsg;
     type Reply = LimbReply;
+    type Geom = LimbGeom;
+    const GEOMETRY: LimbRequest = LimbRequest::Geom;
+    fn geometry_of(reply: LimbReply) -> Option<LimbGeom> {
+        match reply {
+            LimbReply::Geom(g) => Some(g),
+            LimbReply::Done | LimbReply::Reach(_) => None,
+        }
+    }
 }
 
 impl Interface for Gripper {
@@ -175,4 +226,11 @@ impl Interface for Gripper {
     type Request = GripperRequest;
     type ReplyMsg = GripperReplyMsg;
     type Reply = GripperReply;
+    type Geom = GripperGeom;
+    const GEOMETRY: GripperRequest = GripperRequest::GetGeom;
+    fn geometry_of(reply: GripperReply) -> Option<GripperGeom> {
+        match reply {
+            GripperReply::Geom(g) => Some(g),
+        }
+    }
 }

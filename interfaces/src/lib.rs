@@ -39,6 +39,7 @@ pub mod actarray;
 pub mod codegen;
 pub mod common;
 pub mod control;
+pub mod describe;
 pub mod diagnostics;
 pub mod error;
 pub mod gripper;
@@ -53,8 +54,11 @@ pub use common::{
     Bbox3, CmdOutcome, MAX_ACTUATORS, MsgMeta, Orientation3, Pose3, ReplyMeta, StateHeader, Status,
     Vec3, device_flag,
 };
+pub use describe::Describe;
 pub use error::{DecodeError, ValueError};
-pub use interface::{ActArray, Gripper, HasHeader, Interface, InterfaceKind, Limb, WireBytes};
+pub use interface::{
+    ActArray, Gripper, HasHeader, Interface, InterfaceKind, InterfaceVisitor, Limb, WireBytes,
+};
 pub use manifest::Manifest;
 pub use message::{Envelope, Message, ReplyBody, ReplyEnvelope};
 pub use wire::{WireField, WireStruct};
@@ -79,13 +83,16 @@ pub mod prelude {
         Status, Vec3, device_flag,
     };
     pub use crate::control::{LeaseReply, LeaseReq, OutcomeMsg, lease_op};
+    pub use crate::describe::Describe;
     pub use crate::diagnostics::DriverStats;
     pub use crate::error::{DecodeError, ValueError};
     pub use crate::gripper::{
         GripperCmdMsg, GripperCommand, GripperData, GripperGeom, GripperReply, GripperReplyMsg,
         GripperReqMsg, GripperRequest, GripperState,
     };
-    pub use crate::interface::{ActArray, Gripper, HasHeader, Interface, InterfaceKind, Limb};
+    pub use crate::interface::{
+        ActArray, Gripper, HasHeader, Interface, InterfaceKind, InterfaceVisitor, Limb,
+    };
     pub use crate::limb::{
         LimbCmdMsg, LimbCommand, LimbData, LimbGeom, LimbReach, LimbReply, LimbReplyMsg,
         LimbReqMsg, LimbRequest, LimbState,

@@ -359,6 +359,11 @@ fn non_finite_values_are_rejected() {
         ActArrayCommand::position(32, 0.0),
         Err(ValueError::BadJoint { joint: 32, .. })
     ));
+    // The valid range as a person reads it: 32 is not valid, 31 is the last.
+    assert_eq!(
+        ActArrayCommand::position(32, 0.0).unwrap_err().to_string(),
+        "joint 32 is not a valid joint index (0 to 31)"
+    );
     assert!(matches!(
         ActArrayCommand::position(-1, 0.0),
         Err(ValueError::BadJoint { .. })

@@ -72,41 +72,17 @@ def cli_bin() -> str:
 
 
 _used_domains = []
+# The prefix of this session's domains: conftest.py removes their files at the end with
+# `limber clean --all --prefix DOMAIN_PREFIX`.
+DOMAIN_PREFIX = f"limber_tpy{os.getpid()}_"
 
 
 def unique_domain() -> str:
     # `limber_t*`, like the Rust tests' domains; their files go at the end of the run
-    # (conftest.py, remove_domain_files).
-    d = f"limber_tpy{os.getpid()}_{next(_domains)}"
+    # (conftest.py, `limber clean`).
+    d = f"{DOMAIN_PREFIX}{next(_domains)}"
     _used_domains.append(d)
     return d
-
-
-def remove_domain_files(domain):
-    """Every file of a test's domain once no process runs in it, as the Rust tests' domains
-    do (limber_services::cleanup, TESTING.md): the files of the drivers a test killed, the
-    node counter iceoryx2 leaves in /dev/shm, the token. A domain with a live node, or
-    without a token (it has no files), is left as it is."""
-    root = limber.Domain(domain).root_path
-    token = os.path.join(os.path.dirname(root.rstrip("/")), f"{domain}.token")
-    if not os.path.exists(token) or any(s == "Alive" for s, _ in node_states(domain)):
-        return
-    prefix = limber.Domain(domain).prefix
-    nodes = os.path.join(root, "nodes")
-
-    def remove_ours(d):
-        for f in os.listdir(d) if os.path.isdir(d) else []:
-            if f.startswith(prefix):
-                os.unlink(os.path.join(d, f))
-
-    for n in os.listdir(nodes) if os.path.isdir(nodes) else []:
-        node = os.path.join(nodes, n)
-        if os.path.isdir(node) and any(f.startswith(prefix) for f in os.listdir(node)):
-            remove_ours(node)
-            os.rmdir(node)
-    for d in ["/dev/shm", root, os.path.join(root, "services"), nodes]:
-        remove_ours(d)
-    os.unlink(token)
 
 
 def state_where(client, pred, timeout=T):

@@ -8,7 +8,8 @@ use iceoryx2::node::NodeCreationFailure;
 use iceoryx2::prelude::*;
 use thiserror::Error;
 
-use crate::naming::{CLIENT_NODE_PREFIX, DRIVER_NODE_PREFIX, Domain};
+use crate::domain::Domain;
+use crate::naming::{CLIENT_NODE_PREFIX, DRIVER_NODE_PREFIX};
 
 /// The monotonic clock in ns (`CLOCK_MONOTONIC`), the time base of every stamp.
 pub fn monotonic_ns() -> u64 {
@@ -38,7 +39,7 @@ pub enum ContextError {
         domain: String,
         /// Why.
         #[source]
-        source: Box<crate::domain_dir::DomainError>,
+        source: Box<crate::domain::DomainError>,
     },
     /// iceoryx2 was refused access to the domain's files (iceoryx2's
     /// `NodeCreationFailure::InsufficientPermissions`): they belong to another user.
@@ -151,16 +152,10 @@ impl Context {
             source: Box::new(e),
         };
         let config = domain.config().map_err(domain_err)?;
-        if role == Role::Driver {
-            crate::domain_dir::check_shm_space().map_err(domain_err)?;
-        }
-        let prefix = domain.prefix().map_err(domain_err)?;
-        let group = domain.group().map_err(domain_err)?;
-        if let Some(g) = group {
-            // Before iceoryx2 makes this process's files: they are opened to the group as
-            // they appear (crate::widen).
-            crate::widen::start(prefix, domain.root().map_err(domain_err)?, g);
-        }
+        domain
+            .before_join(role == Role::Driver)
+            .map_err(domain_err)?;
+        let iox_prefix = domain.prefix().map_err(domain_err)?;
         let node = NodeBuilder::new()
             .name(&node_name)
             .config(config)
@@ -177,7 +172,7 @@ impl Context {
                     NodeCreationFailure::UnableToGenerateUniqueNodeId => {
                         ContextError::NodeCounter {
                             domain,
-                            prefix: prefix.to_string(),
+                            prefix: iox_prefix.to_string(),
                             source: e,
                         }
                     }
@@ -185,12 +180,7 @@ impl Context {
                 }
             })?;
         // iceoryx2 makes the domain's node counter world-writable (0666).
-        crate::domain_dir::secure_shm(prefix, group).map_err(domain_err)?;
-        if group.is_some() {
-            let root = domain.root().map_err(domain_err)?;
-            crate::widen::cleanup_own_dead_nodes(config, root);
-            crate::widen::remove_orphans(prefix, root);
-        }
+        domain.after_join().map_err(domain_err)?;
         Ok(Context {
             inner: Rc::new(Inner {
                 domain: domain.clone(),

@@ -6,7 +6,8 @@ use iceoryx2::service::static_config::messaging_pattern::MessagingPattern as Pat
 use limber_interfaces::InterfaceKind;
 use thiserror::Error;
 
-use crate::naming::{Channel, DRIVER_NODE_PREFIX, DeviceName, Domain, attr};
+use crate::domain::Domain;
+use crate::naming::{Channel, DRIVER_NODE_PREFIX, DeviceName, attr};
 
 /// One device found in a domain.
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
@@ -40,7 +41,7 @@ pub enum ListError {
         domain: String,
         /// Why.
         #[source]
-        source: Box<crate::domain_dir::DomainError>,
+        source: Box<crate::domain::DomainError>,
     },
     /// iceoryx2 could not read the service directory (permissions?).
     #[error("cannot list the services of domain {domain}: {source}")]

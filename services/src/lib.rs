@@ -4,8 +4,10 @@
 //! its state, command it and ask it things: zero-copy shared memory, no copy of a sample,
 //! no broker.
 //!
-//! * [`naming`]: domains (`LIMBER_DOMAIN` → iceoryx2 prefix), device names
-//!   `robot/interface/index`, service names `limber/<robot>/<interface>/<index>/<channel>`.
+//! * [`naming`]: device names `robot/interface/index`, service names
+//!   `limber/<robot>/<interface>/<index>/<channel>`, domain names.
+//! * [`domain`]: [`Domain`] (`LIMBER_DOMAIN` → iceoryx2 prefix), its files, who may touch
+//!   them (group mode), and their removal (`limber clean`).
 //! * [`host`]: [`DeviceHost`] offers a device; a driver implements [`DeviceHandler`] for
 //!   each interface it serves.
 //! * [`device_set`]: [`DeviceSet`], the hosts of one driver process as one group, served
@@ -68,13 +70,12 @@
 
 #![warn(missing_docs)]
 
-pub mod cleanup;
 pub mod client;
 pub mod context;
 pub mod device_set;
 pub mod diagnostics;
 pub mod discovery;
-pub mod domain_dir;
+pub mod domain;
 pub mod error;
 pub mod event_loop;
 pub mod host;
@@ -83,35 +84,41 @@ pub mod qos;
 pub mod relay;
 pub mod signals;
 pub mod testing;
-pub mod widen;
+
+/// The old path of [`domain::cleanup`].
+pub use domain::cleanup;
+/// The old path of [`domain::dir`] (other crates use it).
+pub use domain::dir as domain_dir;
 
 pub use client::{
-    ActArrayClient, Client, CommandError, ConnectError, DriverStatus, Freshness, GripperClient,
-    Incompatibility, LeaseError, LeaseHolder, LimbClient, Outcome, RequestError, Ticket, WaitError,
-    WaitMode,
+    ActArrayClient, AnyGeom, Client, CommandError, ConnectError, DeviceClient, DriverStatus,
+    Freshness, GripperClient, Incompatibility, LeaseError, LeaseHolder, LimbClient, Outcome,
+    RequestError, Ticket, WaitError, WaitMode, connect_device,
 };
 pub use context::{Context, ContextError, Role, monotonic_ns};
 pub use device_set::{DeviceError, DeviceSet, DeviceSetHandler, Drain};
 pub use discovery::{DeviceInfo, ListError, list_devices};
-pub use domain_dir::DomainError;
+pub use domain::Domain;
+pub use domain::DomainError;
 pub use error::Iox2Error;
 pub use host::{
     Activity, CLIENT_SLOTS, DeviceHandler, DeviceHost, Holder, HostError, HostStats, Motion,
     Origin, ProcessError, PublishError,
 };
-pub use naming::{Channel, DeviceName, Domain, NameError};
+pub use naming::{Channel, DeviceName, NameError};
 pub use relay::{AnswerError, PendingLease, PendingRelay, RelayedLease, RelayedRequest};
 
 /// Everything a driver or client author needs, in one `use`.
 pub mod prelude {
     pub use crate::client::{
-        ActArrayClient, Client, CommandError, ConnectError, DriverStatus, Freshness, GripperClient,
-        LimbClient, RequestError, Ticket, WaitError, WaitMode,
+        ActArrayClient, Client, CommandError, ConnectError, DeviceClient, DriverStatus, Freshness,
+        GripperClient, LimbClient, RequestError, Ticket, WaitError, WaitMode, connect_device,
     };
     pub use crate::context::{Context, Role, monotonic_ns};
     pub use crate::device_set::{DeviceSet, DeviceSetHandler};
     pub use crate::discovery::{DeviceInfo, list_devices};
+    pub use crate::domain::Domain;
     pub use crate::host::{DeviceHandler, DeviceHost, Motion, Origin};
-    pub use crate::naming::{DeviceName, Domain};
+    pub use crate::naming::DeviceName;
     pub use limber_interfaces::prelude::*;
 }

@@ -5,20 +5,18 @@
 //! `data` (state, pub/sub, history 1), `cmd` (commands, pub/sub, many clients), `req`
 //! (request/response), `wake` (event: clients → driver) and `notify` (event: driver →
 //! clients, new state or reply ready). A domain maps onto an iceoryx2 prefix and root
-//! path of its owner's (see [`crate::domain_dir`]), so robots and tests on one PC never
+//! path of its owner's (see [`crate::domain`]), so robots and tests on one PC never
 //! meet and no other user can read, command or deny a domain.
+//!
+//! Names only: no file is touched here, and nothing of [`crate::domain`] is used (the
+//! domain module uses the names of this one, never the other way round).
 
 use core::fmt;
 use std::str::FromStr;
-use std::sync::atomic::{AtomicU32, Ordering};
-use std::sync::{Arc, OnceLock};
 
-use iceoryx2::config::Config;
-use iceoryx2::prelude::{FileName, Path as IoxPath, SemanticString, ServiceName};
+use iceoryx2::prelude::ServiceName;
 use limber_interfaces::InterfaceKind;
 use thiserror::Error;
-
-use crate::domain_dir::{self, DomainError};
 
 /// The environment variable that selects the domain.
 pub const DOMAIN_ENV: &str = "LIMBER_DOMAIN";
@@ -45,172 +43,11 @@ pub enum NameError {
     Device(String),
 }
 
-fn valid_ident(s: &str, max: usize) -> bool {
+pub(crate) fn valid_ident(s: &str, max: usize) -> bool {
     !s.is_empty()
         && s.len() <= max
         && s.bytes()
             .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-')
-}
-
-/// A domain: the set of devices and clients that can see each other.
-#[derive(Debug, Clone)]
-pub struct Domain {
-    name: String,
-    /// The iceoryx2 configuration, made on first use (it needs the domain's files).
-    config: Arc<OnceLock<Resolved>>,
-    /// A test's domain ([`Domain::unique_for_test`]): removes the domain's files when the
-    /// last clone is dropped.
-    remove_on_drop: Option<Arc<RemoveOnDrop>>,
-}
-
-/// Removes the files of a test's domain when dropped ([`crate::cleanup`]).
-#[derive(Debug)]
-struct RemoveOnDrop(String);
-
-impl Drop for RemoveOnDrop {
-    fn drop(&mut self) {
-        crate::cleanup::remove_when_idle(&self.0, crate::cleanup::IDLE_WAIT);
-    }
-}
-
-/// A domain's iceoryx2 configuration, prefix and group, made once.
-#[derive(Debug)]
-struct Resolved {
-    config: Config,
-    prefix: String,
-    root: std::path::PathBuf,
-    group: Option<domain_dir::Group>,
-}
-
-impl Domain {
-    /// A domain by name (`[A-Za-z0-9_-]`, 1 to 48 characters).
-    pub fn new(name: &str) -> Result<Self, NameError> {
-        if !valid_ident(name, MAX_DOMAIN_LEN) {
-            return Err(NameError::Domain(name.to_string()));
-        }
-        Ok(Domain {
-            name: name.to_string(),
-            config: Arc::new(OnceLock::new()),
-            remove_on_drop: None,
-        })
-    }
-
-    /// The domain named by `LIMBER_DOMAIN`, or `limber`.
-    pub fn from_env() -> Result<Self, NameError> {
-        match std::env::var(DOMAIN_ENV) {
-            Ok(v) if !v.is_empty() => Domain::new(&v),
-            _ => Domain::new(DEFAULT_DOMAIN),
-        }
-    }
-
-    /// A fresh domain for one test: `limber_t<pid>_<n>_<nanos>`, unique on this machine.
-    ///
-    /// It cleans up after itself: when its last clone is dropped, once no process runs in it
-    /// any more (waiting a few seconds at most for processes just killed or told to stop),
-    /// every file of the domain is removed, those of processes the test killed included
-    /// ([`crate::cleanup::remove_domain_files`]). Keep it alive for as long as the test uses
-    /// the domain, also when only its name is handed to other processes.
-    pub fn unique_for_test() -> Self {
-        static N: AtomicU32 = AtomicU32::new(0);
-        let n = N.fetch_add(1, Ordering::Relaxed);
-        // The pid alone repeats over a long run of test processes, and a test that
-        // SIGKILLs a driver leaves its files behind: the clock makes a reused pid a new
-        // domain.
-        let nanos = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map_or(0, |d| d.subsec_nanos());
-        let name = format!("limber_t{}_{}_{nanos:x}", std::process::id(), n);
-        Domain::for_test(&name).expect("generated test domain names are valid")
-    }
-
-    /// A test's domain of a name the test chose (one made from a [`Domain::unique_for_test`]
-    /// name, for a test that needs several domains): it cleans up after itself as that one
-    /// does.
-    pub fn for_test(name: &str) -> Result<Self, NameError> {
-        let mut domain = Domain::new(name)?;
-        domain.remove_on_drop = Some(Arc::new(RemoveOnDrop(name.to_string())));
-        Ok(domain)
-    }
-
-    /// The name.
-    pub fn name(&self) -> &str {
-        &self.name
-    }
-
-    /// The iceoryx2 configuration of this domain: iceoryx2's built-in defaults (a stray
-    /// `./config/iceoryx2.toml` does not change a robot's behaviour) with the root path and
-    /// prefix of the domain's files, which are prepared (and checked) on the first call; see
-    /// [`crate::domain_dir`].
-    pub fn config(&self) -> Result<&Config, DomainError> {
-        Ok(&self.resolved()?.config)
-    }
-
-    /// The iceoryx2 prefix of this domain's files (`limber_<token>_`).
-    pub fn prefix(&self) -> Result<&str, DomainError> {
-        Ok(&self.resolved()?.prefix)
-    }
-
-    /// The iceoryx2 root path of this domain's files (`<runtime>/iceoryx2/`).
-    pub fn root(&self) -> Result<&std::path::Path, DomainError> {
-        Ok(&self.resolved()?.root)
-    }
-
-    /// The Unix group that shares this domain (group mode, `LIMBER_GROUP`), or None: the
-    /// domain is its user's alone.
-    pub fn group(&self) -> Result<Option<&domain_dir::Group>, DomainError> {
-        Ok(self.resolved()?.group.as_ref())
-    }
-
-    /// In group mode, opens this user's files of the domain to the group now (the watch of
-    /// [`crate::widen`] does as they appear; this covers the files a port made before a
-    /// short-lived process ends). Nothing otherwise.
-    pub(crate) fn widen_now(&self) {
-        if let Some(r) = self.config.get()
-            && let Some(g) = &r.group
-        {
-            crate::widen::sweep(&r.prefix, &r.root, g);
-        }
-    }
-
-    fn resolved(&self) -> Result<&Resolved, DomainError> {
-        if let Some(c) = self.config.get() {
-            return Ok(c);
-        }
-        let files = domain_dir::prepare(&self.name)?;
-        let mut config = Config::default();
-        let bad = |what: &str| DomainError::Io {
-            what: "use",
-            path: files.root.clone(),
-            source: std::io::Error::new(std::io::ErrorKind::InvalidInput, what.to_string()).into(),
-        };
-        config.global.prefix = FileName::new(files.prefix.as_bytes())
-            .map_err(|_| bad("an invalid iceoryx2 prefix"))?;
-        let root = files
-            .root
-            .to_str()
-            .ok_or_else(|| bad("a path that is not UTF-8"))?;
-        config.global.set_root_path(
-            &IoxPath::new(root.as_bytes()).map_err(|_| bad("an invalid iceoryx2 root path"))?,
-        );
-        if files.group.is_some() {
-            // Each member cleans up after its own dead processes only (crate::widen).
-            config.global.node.cleanup_dead_nodes_on_creation = false;
-            config.global.node.cleanup_dead_nodes_on_destruction = false;
-            config.global.service.cleanup_dead_nodes_on_open = false;
-        }
-        Ok(self.config.get_or_init(|| Resolved {
-            config,
-            prefix: files.prefix,
-            root: files.root,
-            group: files.group,
-        }))
-    }
-}
-
-impl fmt::Display for Domain {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.name)
-    }
 }
 
 /// A channel of a device.
@@ -388,17 +225,5 @@ mod tests {
         ] {
             assert!(bad.parse::<DeviceName>().is_err(), "{bad}");
         }
-    }
-
-    #[test]
-    fn domains_validate() {
-        assert!(Domain::new("robot_1").is_ok());
-        assert!(Domain::new("").is_err());
-        assert!(Domain::new("a b").is_err());
-        assert!(Domain::new(&"x".repeat(49)).is_err());
-        assert_ne!(
-            Domain::unique_for_test().name(),
-            Domain::unique_for_test().name()
-        );
     }
 }

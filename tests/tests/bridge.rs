@@ -295,7 +295,8 @@ fn a_dead_driver_or_bridge_makes_the_mirrored_arm_gone() {
 }
 
 /// `expose --device ... --allow-command ...`: only the allowed device is exposed, and a
-/// command not allowed is refused ("unsupported") to its sender; `--read-only` refuses
+/// command not allowed is refused ("unsupported") to its sender, and so is a request that
+/// changes the device (POWER, SPEED) that no `--allow-request` names; `--read-only` refuses
 /// every command and the requests that change the device, and lets geometry through.
 #[test]
 fn the_allow_list_keeps_devices_and_commands_out() {
@@ -337,6 +338,22 @@ fn the_allow_list_keeps_devices_and_commands_out() {
         arm.wait_outcome(t, Duration::from_secs(5))
             .expect("outcome"),
         Status::Unsupported
+    );
+    // Requests that change the arm pass the same filter: POS alone lets neither POWER nor
+    // SPEED through (both were carried out before).
+    assert!(
+        matches!(
+            arm.power(false),
+            Err(RequestError::Nack(Status::Unsupported))
+        ),
+        "power must be refused"
+    );
+    assert!(
+        matches!(
+            arm.set_speed_config(2, 0.5),
+            Err(RequestError::Nack(Status::Unsupported))
+        ),
+        "speed must be refused"
     );
     // One discovery pass found every device of A: it ends before the bridge does.
     expose.signal(libc::SIGTERM);

@@ -13,7 +13,7 @@ use crossterm::event::KeyCode;
 use limber_interfaces::diagnostics::DriverStats;
 use limber_services::diagnostics::StatsReader;
 use limber_services::prelude::*;
-use limber_services::{CommandError, DeviceInfo, DeviceName, WaitError};
+use limber_services::{AnyGeom, CommandError, DeviceInfo, DeviceName, WaitError};
 
 /// How often the device list is read again (devices appearing, drivers dying).
 pub const REDISCOVER_EVERY: Duration = Duration::from_secs(1);
@@ -27,121 +27,69 @@ pub const STALE_RECONNECT: Duration = Duration::from_secs(5);
 /// How many times the geometry of a device is asked for (once per rediscovery).
 const GEOMETRY_TRIES: u32 = 3;
 
-/// A connection to one device, with its geometry once known.
-pub enum Conn {
-    /// An actuator array (an arm, or the Pioneer's lift).
-    ActArray {
-        /// The client.
-        client: ActArrayClient,
-        /// Its geometry (joint limits), if the driver answered.
-        geom: Option<Box<ActArrayGeom>>,
-    },
-    /// A limb.
-    Limb {
-        /// The client.
-        client: LimbClient,
-        /// Its geometry, if the driver answered.
-        geom: Option<LimbGeom>,
-    },
-    /// A gripper.
-    Gripper {
-        /// The client.
-        client: GripperClient,
-        /// Its geometry (number of beams, capacity), if the driver answered.
-        geom: Option<GripperGeom>,
-    },
+/// A connection to one device of any interface, with its geometry once known.
+pub struct Conn {
+    /// The client.
+    pub client: Box<dyn DeviceClient>,
+    /// Its geometry (joint limits, beams...), if the driver answered.
+    pub geom: Option<AnyGeom>,
 }
 
 impl Conn {
     fn connect(ctx: &Context, name: &DeviceName) -> Result<Conn, String> {
-        let dev = name.to_string();
-        let mut conn = match name.interface() {
-            InterfaceKind::ActArray => Conn::ActArray {
-                client: ActArrayClient::connect(ctx, &dev).map_err(|e| e.to_string())?,
-                geom: None,
-            },
-            InterfaceKind::Limb => Conn::Limb {
-                client: LimbClient::connect(ctx, &dev).map_err(|e| e.to_string())?,
-                geom: None,
-            },
-            InterfaceKind::Gripper => Conn::Gripper {
-                client: GripperClient::connect(ctx, &dev).map_err(|e| e.to_string())?,
-                geom: None,
-            },
-        };
-        match &mut conn {
-            Conn::ActArray { client, .. } => client.set_request_timeout(REQUEST_TIMEOUT),
-            Conn::Limb { client, .. } => client.set_request_timeout(REQUEST_TIMEOUT),
-            Conn::Gripper { client, .. } => client.set_request_timeout(REQUEST_TIMEOUT),
-        }
+        let mut client =
+            connect_device(ctx, &name.to_string(), Duration::ZERO).map_err(|e| e.to_string())?;
+        client.set_request_timeout(REQUEST_TIMEOUT);
+        let mut conn = Conn { client, geom: None };
         conn.refresh();
         Ok(conn)
     }
 
+    /// The latest state of interface `I` (`None` for a device of another interface).
+    pub fn state<I: Interface>(&self) -> Option<&I::Data> {
+        self.client.typed_ref::<I>().and_then(|c| c.last_state())
+    }
+
+    /// The geometry of interface `I`, once known.
+    pub fn geometry<I: Interface>(&self) -> Option<&I::Geom> {
+        self.geom.as_ref().and_then(|g| g.get::<I::Geom>())
+    }
+
     /// Asks for the geometry (a request: waits up to [`REQUEST_TIMEOUT`]).
     fn ask_geometry(&mut self) -> bool {
-        match self {
-            Conn::ActArray { client, geom } => *geom = client.geometry().ok().map(Box::new),
-            Conn::Limb { client, geom } => *geom = client.geometry().ok(),
-            Conn::Gripper { client, geom } => *geom = client.geometry().ok(),
-        }
+        self.geom = self.client.geometry_within(REQUEST_TIMEOUT).ok();
         self.has_geometry()
     }
 
     fn has_geometry(&self) -> bool {
-        match self {
-            Conn::ActArray { geom, .. } => geom.is_some(),
-            Conn::Limb { geom, .. } => geom.is_some(),
-            Conn::Gripper { geom, .. } => geom.is_some(),
-        }
+        self.geom.is_some()
     }
 
     /// Takes every state that arrived (never waits).
     fn refresh(&mut self) -> bool {
-        match self {
-            Conn::ActArray { client, .. } => client.refresh().unwrap_or(false),
-            Conn::Limb { client, .. } => client.refresh().unwrap_or(false),
-            Conn::Gripper { client, .. } => client.refresh().unwrap_or(false),
-        }
+        self.client.refresh().unwrap_or(false)
     }
 
     /// The header of the latest state.
     pub fn header(&self) -> Option<&StateHeader> {
-        match self {
-            Conn::ActArray { client, .. } => client.last_state().map(|s| &s.header),
-            Conn::Limb { client, .. } => client.last_state().map(|s| &s.header),
-            Conn::Gripper { client, .. } => client.last_state().map(|s| &s.header),
-        }
+        self.client.header()
     }
 
     /// Age of the latest state.
     pub fn state_age(&self) -> Option<Duration> {
-        match self {
-            Conn::ActArray { client, .. } => client.state_age(),
-            Conn::Limb { client, .. } => client.state_age(),
-            Conn::Gripper { client, .. } => client.state_age(),
-        }
+        self.client.state_age()
     }
 
     /// The outcome of `ticket` if it is known now (never waits).
     fn poll_outcome(&mut self, ticket: Ticket) -> Result<Status, WaitError> {
-        match self {
-            Conn::ActArray { client, .. } => client.wait_outcome(ticket, Duration::ZERO),
-            Conn::Limb { client, .. } => client.wait_outcome(ticket, Duration::ZERO),
-            Conn::Gripper { client, .. } => client.wait_outcome(ticket, Duration::ZERO),
-        }
+        self.client.wait_outcome(ticket, Duration::ZERO)
     }
 
     /// The name of the client holding the device (a request: waits up to
     /// [`REQUEST_TIMEOUT`]).
     fn holder_name(&mut self) -> String {
-        let h = match self {
-            Conn::ActArray { client, .. } => client.holder(),
-            Conn::Limb { client, .. } => client.holder(),
-            Conn::Gripper { client, .. } => client.holder(),
-        };
-        match h {
-            Ok(Some(h)) if h.name.is_empty() => format!("client {:x}", h.client_id),
+        match self.client.holder() {
+            Ok(Some(h)) if h.name.is_empty() => format!("client {}", h.client_id),
             Ok(Some(h)) => h.name,
             // Released between the state and the question.
             Ok(None) => "nobody now".to_string(),
@@ -150,11 +98,7 @@ impl Conn {
     }
 
     fn driver_status(&self) -> DriverStatus {
-        match self {
-            Conn::ActArray { client, .. } => client.driver_status(),
-            Conn::Limb { client, .. } => client.driver_status(),
-            Conn::Gripper { client, .. } => client.driver_status(),
-        }
+        self.client.driver_status()
     }
 }
 
@@ -253,37 +197,42 @@ impl From<CommandError> for Refusal {
     }
 }
 
+/// The typed client of a device whose kind was checked.
+fn typed<I: Interface>(c: &mut Box<dyn DeviceClient>) -> Result<&mut Client<I>, Refusal> {
+    let kind = c.kind();
+    c.typed::<I>()
+        .ok_or_else(|| Refusal::Other(format!("not {}: {kind}", I::KIND.with_article())))
+}
+
 /// Sends the command of `action` to a device.
 fn send(conn: &mut Conn, action: Action) -> Result<Ticket, Refusal> {
-    let ticket = match (conn, action) {
-        (Conn::Limb { client, .. }, Action::Home) => client.home()?,
-        (Conn::Limb { client, .. }, Action::Stop) => client.stop()?,
-        (Conn::ActArray { client, .. }, Action::Home) => client.home(None)?,
-        (Conn::ActArray { client, geom }, Action::Stop) => {
-            let n = client
-                .last_state()
-                .map(|s| s.actuators().len())
-                .filter(|&n| n > 0)
-                .or_else(|| geom.as_ref().map(|g| g.actuators().len()))
-                .unwrap_or(0);
-            if n == 0 {
+    let kind = conn.client.kind();
+    let joints = conn
+        .state::<ActArray>()
+        .map(|s| s.actuators().len())
+        .filter(|&n| n > 0)
+        .or_else(|| conn.geometry::<ActArray>().map(|g| g.actuators().len()))
+        .unwrap_or(0);
+    let c = &mut conn.client;
+    let ticket = match (kind, action) {
+        (InterfaceKind::Limb, Action::Home) => typed::<Limb>(c)?.home()?,
+        (InterfaceKind::Limb, Action::Stop) => typed::<Limb>(c)?.stop()?,
+        (InterfaceKind::ActArray, Action::Home) => typed::<ActArray>(c)?.home(None)?,
+        (InterfaceKind::ActArray, Action::Stop) => {
+            if joints == 0 {
                 return Err(Refusal::Other(
                     "the number of joints is not known yet".to_string(),
                 ));
             }
-            client.move_at_speed_multi(&vec![0.0; n])?
+            typed::<ActArray>(c)?.move_at_speed_multi(&vec![0.0; joints])?
         }
-        (Conn::Gripper { client, .. }, Action::Open) => client.open()?,
-        (Conn::Gripper { client, .. }, Action::Close) => client.close()?,
-        (Conn::Gripper { client, .. }, Action::Stop) => client.stop()?,
-        (c, _) => {
-            let iface = match c {
-                Conn::ActArray { .. } => "an actarray",
-                Conn::Limb { .. } => "a limb",
-                Conn::Gripper { .. } => "a gripper",
-            };
+        (InterfaceKind::Gripper, Action::Open) => typed::<Gripper>(c)?.open()?,
+        (InterfaceKind::Gripper, Action::Close) => typed::<Gripper>(c)?.close()?,
+        (InterfaceKind::Gripper, Action::Stop) => typed::<Gripper>(c)?.stop()?,
+        _ => {
             return Err(Refusal::Other(format!(
-                "not a command of {iface} (select another device)"
+                "not a command of {} (select another device)",
+                kind.with_article()
             )));
         }
     };

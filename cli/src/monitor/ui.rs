@@ -19,7 +19,7 @@ use ratatui::style::{Color, Modifier, Style};
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Paragraph};
 
-use super::app::{App, Conn, Device, Robot, StatusKind};
+use super::app::{App, Device, Robot, StatusKind};
 
 const DEAD: Color = Color::DarkGray;
 const KEYS: &str = "↑↓ select  h home  s stop  o open  c close  q quit";
@@ -36,19 +36,22 @@ struct Panel<'a> {
 }
 
 fn device_lines(d: &Device) -> u16 {
-    match &d.conn {
-        Ok(Conn::ActArray { client, geom }) => {
-            let n = client
-                .last_state()
-                .map(|s| s.actuators().len())
-                .filter(|&n| n > 0)
-                .or_else(|| geom.as_ref().map(|g| g.actuators().len()))
-                .unwrap_or(0);
-            1 + n.max(1) as u16
-        }
-        Ok(Conn::Limb { .. }) => 3,
-        Ok(Conn::Gripper { .. }) => 1,
-        Err(_) => 1,
+    let Ok(c) = &d.conn else {
+        return 1;
+    };
+    if c.client.kind() == InterfaceKind::ActArray {
+        let n = c
+            .state::<ActArray>()
+            .map(|s| s.actuators().len())
+            .filter(|&n| n > 0)
+            .or_else(|| c.geometry::<ActArray>().map(|g| g.actuators().len()))
+            .unwrap_or(0);
+        1 + n.max(1) as u16
+    } else if c.client.kind() == InterfaceKind::Limb {
+        3
+    } else {
+        // A gripper, and any interface without a panel of its own: one line.
+        1
     }
 }
 
@@ -374,9 +377,7 @@ fn draw_device(frame: &mut Frame, area: Rect, d: &Device, selected: bool) {
             h,
             if d.alive() { c.state_age() } else { None },
         ));
-        if let Conn::ActArray { geom, .. } = c
-            && is_lift(geom.as_deref())
-        {
+        if c.client.kind() == InterfaceKind::ActArray && is_lift(c.geometry::<ActArray>()) {
             title.push(Span::raw(" · lift"));
         }
         if let Some(holder) = &d.holder {
@@ -390,11 +391,13 @@ fn draw_device(frame: &mut Frame, area: Rect, d: &Device, selected: bool) {
     let inner_width = area.width.saturating_sub(2);
     let lines = match &d.conn {
         Err(e) => vec![Line::from(format!("not connected: {e}"))],
-        Ok(Conn::ActArray { client, geom }) => {
-            actarray_lines(client.last_state(), geom.as_deref(), inner_width)
-        }
-        Ok(Conn::Limb { client, .. }) => limb_lines(client.last_state()),
-        Ok(Conn::Gripper { client, geom }) => gripper_lines(client.last_state(), geom.as_ref()),
+        Ok(c) => match c.client.kind() {
+            InterfaceKind::ActArray => {
+                actarray_lines(c.state::<ActArray>(), c.geometry::<ActArray>(), inner_width)
+            }
+            InterfaceKind::Limb => limb_lines(c.state::<Limb>()),
+            InterfaceKind::Gripper => gripper_lines(c.state::<Gripper>(), c.geometry::<Gripper>()),
+        },
     };
     let mut block = Block::bordered().title(Line::from(title));
     if selected {

@@ -1,5 +1,10 @@
 //! The emulated controller's state and behaviour, independent of I/O: it
 //! takes command payloads and the time, and produces packets.
+//!
+//! One file over 800 lines, for a stated reason: it is one state machine, the controller's
+//! 100 ms cycle, whose SIP, ARMpac and gripper bytes are all built from the same fields in
+//! the same step (as the vendor's firmware does); split by device, each part would reach
+//! into the others' state every cycle.
 
 use limber_p2os::vendor_conventions as vc;
 use limber_p2os::{

@@ -65,11 +65,4 @@ impl Client<ActArray> {
         self.request(&ActArrayRequest::accel(joint_index(joint), accel)?)
             .map(|_| ())
     }
-    /// REQ GET_GEOM.
-    pub fn geometry(&mut self) -> Result<ActArrayGeom, RequestError> {
-        match self.request(&ActArrayRequest::GetGeom)? {
-            ActArrayReply::Geom(g) => Ok(g),
-            ActArrayReply::Done => Err(RequestError::Unexpected),
-        }
-    }
 }

@@ -189,7 +189,7 @@ impl<I: Interface> Client<I> {
                 ConnectError::NoDriver {
                     device: dev.clone(),
                     domain: domain.clone(),
-                    elsewhere: crate::domain_dir::elsewhere_note(&domain),
+                    elsewhere: crate::domain::dir::elsewhere_note(&domain),
                 }
             } else if e.is_permission_denied() {
                 let hint = match ctx.domain().group().ok().flatten() {
@@ -381,7 +381,7 @@ impl<I: Interface> Client<I> {
 /// The status of the driver attached to a device's data service.
 pub(super) fn driver_status_of<P: PortFactory<Service = ipc::Service>>(
     svc: &P,
-    domain: &crate::naming::Domain,
+    domain: &crate::domain::Domain,
 ) -> DriverStatus {
     let mut alive = false;
     let mut dead = false;
@@ -405,7 +405,7 @@ pub(super) fn driver_status_of<P: PortFactory<Service = ipc::Service>>(
     if alive {
         DriverStatus::Alive
     } else if dead {
-        crate::widen::cleanup_dead_nodes(svc, domain);
+        domain.cleanup_dead_nodes(svc);
         DriverStatus::Dead
     } else {
         DriverStatus::Absent

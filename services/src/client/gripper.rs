@@ -2,7 +2,7 @@
 
 use limber_interfaces::prelude::*;
 
-use super::{Client, CommandError, RequestError, Ticket};
+use super::{Client, CommandError, Ticket};
 
 /// Player's `GripperProxy`: every gripper command and request.
 impl Client<Gripper> {
@@ -25,11 +25,5 @@ impl Client<Gripper> {
     /// CMD RETRIEVE.
     pub fn retrieve(&mut self) -> Result<Ticket, CommandError> {
         self.send(&GripperCommand::Retrieve)
-    }
-    /// REQ GET_GEOM.
-    pub fn geometry(&mut self) -> Result<GripperGeom, RequestError> {
-        match self.request(&GripperRequest::GetGeom)? {
-            GripperReply::Geom(g) => Ok(g),
-        }
     }
 }

@@ -48,13 +48,6 @@ impl Client<Limb> {
     pub fn set_speed(&mut self, speed: f64) -> Result<(), RequestError> {
         self.request(&LimbRequest::speed(speed)?).map(|_| ())
     }
-    /// REQ GEOM.
-    pub fn geometry(&mut self) -> Result<LimbGeom, RequestError> {
-        match self.request(&LimbRequest::Geom)? {
-            LimbReply::Geom(g) => Ok(g),
-            LimbReply::Done | LimbReply::Reach(_) => Err(RequestError::Unexpected),
-        }
-    }
     /// REQ REACH: where a SETPOSE to this pose would end and how much its orientation
     /// would be adjusted; nothing moves. A pose the limb cannot get to is refused with
     /// its cause (`RequestError::Nack`).

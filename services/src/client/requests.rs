@@ -18,6 +18,12 @@ impl<I: Interface> Client<I> {
         self.request_with_timeout(req, timeout)
     }
 
+    /// Asks for the device's geometry ([`Interface::GEOMETRY`]: GET_GEOM, or the limb's
+    /// GEOM), waiting up to the request timeout.
+    pub fn geometry(&mut self) -> Result<I::Geom, RequestError> {
+        I::geometry_of(self.request(&I::GEOMETRY)?).ok_or(RequestError::Unexpected)
+    }
+
     /// Sends a typed request and waits up to `timeout` for the reply.
     pub fn request_with_timeout(
         &mut self,

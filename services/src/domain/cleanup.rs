@@ -16,8 +16,8 @@ use iceoryx2::node::{NodeListFailure, NodeView};
 use iceoryx2::prelude::{CallbackProgression, Node, NodeState, ipc};
 use thiserror::Error;
 
-use crate::domain_dir::{self, DomainError};
-use crate::naming::Domain;
+use super::Domain;
+use super::dir::{self, DomainError};
 
 /// The files of a domain could not be removed.
 #[derive(Debug, Error)]
@@ -35,33 +35,61 @@ pub enum RemoveError {
         source: NodeListFailure,
     },
     /// Processes still run in the domain: its files are theirs.
-    #[error("{alive} process(es) still run in domain {domain}: stop them first")]
+    #[error(
+        "domain {domain} is in use by {alive} live process(es) ({}): stop them first",
+        .processes.join(", ")
+    )]
     Alive {
         /// The domain.
         domain: String,
         /// How many of its iceoryx2 nodes are alive.
         alive: usize,
+        /// Each live process, `NODE (pid N)` (`limber-driver:pioneer (pid 4242)`).
+        processes: Vec<String>,
     },
+}
+
+/// What [`remove`] removed.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Removed {
+    /// Dead processes of the domain whose resources iceoryx2 removed (their segments,
+    /// ports and node directories).
+    pub dead_processes: usize,
+    /// The files and directories removed after that ([`dir::files_of`]: the node counter,
+    /// what iceoryx2 could not clean up, the token).
+    pub files: usize,
+}
+
+impl Removed {
+    /// Nothing was there.
+    pub fn is_nothing(&self) -> bool {
+        self.dead_processes == 0 && self.files == 0
+    }
 }
 
 /// Removes every file of `domain` when no process runs in it: first the resources of its
 /// dead processes, as iceoryx2 removes them, then what is left of the domain
-/// ([`domain_dir::files_of`]: the node counter in `/dev/shm`, the files of processes
+/// ([`dir::files_of`]: the node counter in `/dev/shm`, the files of processes
 /// iceoryx2 could not clean up, the token). Only this user's files are removed (in group
 /// mode the other members' stay theirs). Returns how many files and directories were
 /// removed; a domain without files (no token) is left as it is, and nothing is created.
 pub fn remove_domain_files(domain: &Domain) -> Result<usize, RemoveError> {
-    let Some(files) = domain_dir::existing(domain.name())? else {
-        return Ok(0);
+    remove(domain).map(|r| r.files)
+}
+
+/// [`remove_domain_files`], saying also how many dead processes were cleaned up after.
+pub fn remove(domain: &Domain) -> Result<Removed, RemoveError> {
+    let Some(files) = dir::existing(domain.name())? else {
+        return Ok(Removed::default());
     };
     // The token exists: this reads it, it does not make one.
     let config = domain.config()?;
-    let mut alive = 0;
+    let mut processes = Vec::new();
     let mut dead = Vec::new();
     Node::<ipc::Service>::list(config, |n| {
         match n {
-            NodeState::Alive(_) => alive += 1,
-            NodeState::Dead(v) if crate::widen::node_is_mine(&files.root, v.id().value()) => {
+            NodeState::Alive(v) => processes.push(describe_node(v.details())),
+            NodeState::Dead(v) if super::group::node_is_mine(&files.root, v.id().value()) => {
                 dead.push(v);
             }
             _ => {}
@@ -72,20 +100,25 @@ pub fn remove_domain_files(domain: &Domain) -> Result<usize, RemoveError> {
         domain: domain.name().to_string(),
         source,
     })?;
+    let mut dead_processes = 0;
     for v in dead {
-        if let Err(e) = v.blocking_remove_stale_resources(Duration::ZERO) {
-            tracing::debug!(error = ?e, "cannot clean up after a dead process of the domain");
+        match v.blocking_remove_stale_resources(Duration::ZERO) {
+            Ok(_) => dead_processes += 1,
+            Err(e) => {
+                tracing::debug!(error = ?e, "cannot clean up after a dead process of the domain");
+            }
         }
     }
-    if alive > 0 {
+    if !processes.is_empty() {
         return Err(RemoveError::Alive {
             domain: domain.name().to_string(),
-            alive,
+            alive: processes.len(),
+            processes,
         });
     }
-    let me = domain_dir::euid();
+    let me = dir::euid();
     let mut removed = 0;
-    for path in domain_dir::files_of(domain.name(), &files) {
+    for path in dir::files_of(domain.name(), &files) {
         let Ok(md) = fs::symlink_metadata(&path) else {
             continue;
         };
@@ -105,7 +138,18 @@ pub fn remove_domain_files(domain: &Domain) -> Result<usize, RemoveError> {
             }
         }
     }
-    Ok(removed)
+    Ok(Removed {
+        dead_processes,
+        files: removed,
+    })
+}
+
+/// `NODE (pid N)` for a live node (`a process` when its details cannot be read).
+fn describe_node(details: &Option<iceoryx2::node::NodeDetails>) -> String {
+    match details {
+        Some(d) => format!("{} (pid {})", d.name(), d.process_id()),
+        None => "a process".to_string(),
+    }
 }
 
 /// How long a test's domain, when its last handle is dropped, waits for the processes
@@ -144,16 +188,18 @@ mod tests {
         let domain = Domain::new(&format!("limber_cleanup{}", std::process::id())).unwrap();
         assert_eq!(remove_domain_files(&domain).unwrap(), 0, "no token yet");
         assert!(
-            domain_dir::existing(domain.name()).unwrap().is_none(),
+            dir::existing(domain.name()).unwrap().is_none(),
             "nothing was made"
         );
         let ctx = Context::new(&domain, Role::Client, "cleanup").unwrap();
-        let files = domain_dir::existing(domain.name()).unwrap().unwrap();
-        let in_use = domain_dir::files_of(domain.name(), &files);
+        let files = dir::existing(domain.name()).unwrap().unwrap();
+        let in_use = dir::files_of(domain.name(), &files);
         assert!(
             matches!(
                 remove_domain_files(&domain),
-                Err(RemoveError::Alive { alive: 1, .. })
+                Err(RemoveError::Alive { alive: 1, ref processes, .. })
+                    if processes.len() == 1
+                        && processes[0].starts_with("limber-client:cleanup (pid ")
             ),
             "a process runs in it"
         );
@@ -161,7 +207,7 @@ mod tests {
         drop(ctx);
         assert!(remove_domain_files(&domain).unwrap() > 0);
         assert_eq!(
-            domain_dir::files_of(domain.name(), &files),
+            dir::files_of(domain.name(), &files),
             Vec::<std::path::PathBuf>::new()
         );
         assert!(in_use.iter().all(|p| !p.exists()), "all gone: {in_use:?}");

@@ -24,7 +24,7 @@
 //! group or mode, or when this user is not in the group. iceoryx2 0.10 creates every file
 //! owner-only (0600 segments, 0400 static configurations, 0750 directories), so each
 //! process of the group widens the domain's files *it owns* as soon as iceoryx2 has
-//! finished them ([`crate::widen`]): segments and sockets 0660, static files 0440,
+//! finished them ([`super::group`]): segments and sockets 0660, static files 0440,
 //! directories 2770, all of the group. Everyone outside the group stays locked out.
 
 use std::fs;
@@ -509,6 +509,39 @@ pub fn existing(domain: &str) -> Result<Option<DomainFiles>, DomainError> {
         prefix: format!("limber_{token}_"),
         group,
     }))
+}
+
+/// The names of the domains that have files in this process's runtime directory (each has
+/// a token there), sorted. None when the directory does not exist; a directory that is not
+/// ours (or, in group mode, the group's) is refused, as [`prepare`] refuses it.
+pub fn domain_names() -> Result<Vec<String>, DomainError> {
+    let group = group_from_env()?;
+    let dir = runtime_dir_for(group.as_ref());
+    let md = match fs::symlink_metadata(&dir) {
+        Ok(md) => md,
+        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(io_err("inspect", &dir)(e)),
+    };
+    if !md.file_type().is_dir() {
+        return Err(DomainError::NotADirectory(dir));
+    }
+    if !trusted(&md, group.as_ref()) {
+        return Err(untrusted(&dir, &md, group.as_ref()));
+    }
+    let mut names: Vec<String> = fs::read_dir(&dir)
+        .map_err(io_err("list", &dir))?
+        .map(|e| e.map_err(io_err("list", &dir)))
+        .collect::<Result<Vec<_>, _>>()?
+        .into_iter()
+        .filter_map(|e| {
+            let name = e.file_name().into_string().ok()?;
+            let domain = name.strip_suffix(".token")?;
+            crate::naming::valid_ident(domain, crate::naming::MAX_DOMAIN_LEN)
+                .then(|| domain.to_string())
+        })
+        .collect();
+    names.sort();
+    Ok(names)
 }
 
 /// Every file of the domain named `domain` whose files are `files`, as found now: its

@@ -3,7 +3,7 @@
 //! iceoryx2 0.10 gives everything it creates a fixed owner-only mode (0600 segments and
 //! sockets, 0400 static configurations, 0750 directories; its `dev_permissions` feature
 //! makes them world-accessible instead, which limber never uses). In group mode
-//! (`LIMBER_GROUP`, see [`crate::domain_dir`]) every process of the group therefore watches
+//! (`LIMBER_GROUP`, see [`super::dir`]) every process of the group therefore watches
 //! (inotify) the domain's files in `/dev/shm` (its prefix) and the iceoryx2 root path, and
 //! widens the ones *it owns* as soon as iceoryx2 has finished them:
 //!
@@ -30,7 +30,7 @@ use std::sync::Mutex;
 use iceoryx2::node::NodeView;
 use rustix::fs::inotify;
 
-use crate::domain_dir::{DomainError, GROUP_DIR_MODE, Group, IoError, euid};
+use super::dir::{DomainError, GROUP_DIR_MODE, Group, IoError, euid};
 
 const SHM_DIR: &str = "/dev/shm";
 
@@ -271,7 +271,7 @@ pub(crate) fn start(prefix: &str, root: &Path, group: &Group) {
 }
 
 /// Widens, once, every file of the domain with `prefix` (iceoryx2 root `root`) that this
-/// process's user owns (what [`start`]'s thread does as files appear).
+/// process's user owns (what the thread of `start` does as files appear).
 pub fn sweep(prefix: &str, root: &Path, group: &Group) {
     let watch = Watch {
         prefix: prefix.to_string(),
@@ -386,8 +386,8 @@ pub(crate) fn node_is_mine(root: &Path, id: u128) -> bool {
 /// dead process removes its registrations but not its files, and leaves its services marked
 /// for destruction with files nobody but their owner (or root) can remove, which no driver
 /// can offer again. So iceoryx2's own cleanup of dead nodes is off in group mode
-/// ([`crate::naming::Domain::config`]) and each member's processes clean up after its own.
-pub(crate) fn cleanup_dead_nodes<P>(svc: &P, domain: &crate::naming::Domain)
+/// ([`super::Domain::config`]) and each member's processes clean up after its own.
+pub(crate) fn cleanup_dead_nodes<P>(svc: &P, domain: &super::Domain)
 where
     P: iceoryx2::service::port_factory::PortFactory<Service = iceoryx2::prelude::ipc::Service>,
 {

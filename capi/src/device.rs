@@ -1,0 +1,785 @@
+//! `limber_device_*`: everything an interface does not change, once for every interface:
+//! connect, states (copied or borrowed), waits, outcomes, liveness, the control lease,
+//! preemption, the geometry. A handle of any interface is a `limber_device`; the typed
+//! handles of limber_client.h (`limber_actarray`, `limber_limb`, `limber_gripper`) are the
+//! same type, so every call here takes them as they are. Only commands and requests are
+//! per interface (`actarray.rs`, `limb.rs`, `gripper.rs`).
+
+use core::ffi::{c_char, c_void};
+use std::ffi::CString;
+
+use limber_interfaces::prelude::*;
+use limber_services::client::{DeviceClient, Freshness, Ticket, WaitMode, connect_device};
+use limber_services::{ConnectError, Context, Role};
+
+use crate::{
+    Fail, LimberCode, LimberDriverStatus, LimberInterface, LimberLeaseHolder, LimberLiveness,
+    LimberTicket, arg, domain_of, guard, ms, opt_str, req_str,
+};
+
+/// A connection to one device, of any interface (opaque). Use it from one thread at a
+/// time; different handles may be used by different threads at once.
+pub struct LimberDevice {
+    client: Box<dyn DeviceClient>,
+    /// A state sample is lent to the caller ([`limber_device_borrow`]).
+    borrowed: bool,
+    name: CString,
+}
+
+/// The outcome of a command, with the other client involved
+/// ([`limber_device_outcome`], [`limber_device_preemption`]).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct LimberOutcome {
+    /// The command's sequence number (its ticket's `seq`).
+    pub seq: u64,
+    /// The driver's verdict, a `LIMBER_STATUS_*` of limber.h.
+    pub status: u32,
+    /// Explicit padding (zero).
+    pub _pad: u32,
+    /// The other client involved: the one whose command preempted this one
+    /// (`LIMBER_STATUS_PREEMPTED`) or the holder of the device (`LIMBER_STATUS_LEASED`); 0
+    /// if none.
+    pub other_client: u64,
+    /// When the driver published it (`CLOCK_MONOTONIC` ns).
+    pub stamp_ns: u64,
+    /// The other client's lease name, NUL-terminated ("" when it has none).
+    pub other_name: [c_char; 32],
+}
+
+/// The name this process shows in `limber list`: its executable's.
+pub(crate) fn process_name() -> String {
+    std::env::args()
+        .next()
+        .and_then(|a| {
+            std::path::Path::new(&a)
+                .file_name()
+                .map(|s| s.to_string_lossy().to_string())
+        })
+        .filter(|n| n.len() <= 60 && n.bytes().all(|b| b.is_ascii_graphic()))
+        .unwrap_or_else(|| "c-client".to_string())
+}
+
+/// Copies `s` into `dst` as a NUL-terminated string, cut at a character boundary to fit.
+pub(crate) fn copy_str(dst: &mut [c_char], s: &str) {
+    let mut n = s.len().min(dst.len() - 1);
+    while !s.is_char_boundary(n) {
+        n -= 1;
+    }
+    for (d, b) in dst.iter_mut().zip(&s.as_bytes()[..n]) {
+        *d = *b as c_char;
+    }
+    dst[n] = 0;
+}
+
+impl LimberDevice {
+    fn not_borrowed(&self) -> Result<(), Fail> {
+        if self.borrowed {
+            Err(Fail::new(
+                LimberCode::Borrowed,
+                "a state borrowed from this handle is still held: release it first",
+            ))
+        } else {
+            Ok(())
+        }
+    }
+
+    /// The typed client of interface `I`, or `LIMBER_CODE_INCOMPATIBLE` naming both.
+    pub(crate) fn typed<I: Interface>(&mut self) -> Result<&mut limber_services::Client<I>, Fail> {
+        let (kind, name) = (self.client.kind(), self.client.device().to_string());
+        (*self.client).typed::<I>().ok_or_else(|| {
+            Fail::new(
+                LimberCode::Incompatible,
+                format!(
+                    "{name} is {}, not {}: use the functions of its interface",
+                    kind.with_article(),
+                    I::KIND.with_article()
+                ),
+            )
+        })
+    }
+}
+
+fn ticket_of(t: &LimberTicket) -> Ticket {
+    Ticket {
+        seq: t.seq,
+        receivers: usize::try_from(t.receivers).unwrap_or(usize::MAX),
+    }
+}
+
+/// `LIMBER_CODE_INCOMPATIBLE` unless `size` is `expected` (the caller's struct is this
+/// library's).
+fn check_size(what: &str, size: usize, expected: usize, kind: InterfaceKind) -> Result<(), Fail> {
+    if size == expected {
+        return Ok(());
+    }
+    Err(Fail::new(
+        LimberCode::Incompatible,
+        format!(
+            "the {what} of {} has {expected} bytes in this liblimber, the caller's struct \
+             {size}: pass the struct of the device's interface, from the limber.h installed \
+             with this library",
+            kind.with_article()
+        ),
+    ))
+}
+
+/// Copies `bytes` to `out`, which the caller says has `size` bytes.
+///
+/// # Safety
+/// `out` is NULL or points to `size` writable bytes.
+unsafe fn copy_out(
+    what: &str,
+    bytes: &[u8],
+    out: *mut c_void,
+    size: usize,
+    kind: InterfaceKind,
+) -> Result<(), Fail> {
+    if out.is_null() {
+        return Err(Fail::new(LimberCode::NullArgument, "out is NULL"));
+    }
+    check_size(what, size, bytes.len(), kind)?;
+    // SAFETY: `out` is not NULL and, per the caller, has `size` == bytes.len() writable
+    // bytes; the source is a live sample or buffer that does not overlap it.
+    unsafe { core::ptr::copy_nonoverlapping(bytes.as_ptr(), out.cast::<u8>(), bytes.len()) };
+    Ok(())
+}
+
+/// Connects to `device` ("robot/interface/index") in `domain` (NULL: `LIMBER_DOMAIN`, or
+/// "limber"), waiting up to `timeout_ms` for a driver to offer it; `*out` is the new
+/// handle (free it with `limber_device_disconnect`). Call it through the inline functions
+/// of limber_client.h (`limber_device_connect`, `limber_actarray_connect`, ...), which pass
+/// the layout the program was compiled against: `layout_version`
+/// (`LIMBER_LAYOUT_VERSION`), and, for a typed connect, the interface the program expects
+/// (`interface`, a `LIMBER_INTERFACE_*`; -1: any) and the sizes of its state and geometry
+/// structs (`data_size`, `geom_size`; 0: not checked). A program compiled against another
+/// limber.h, or a device of another interface than the one asked for, is refused with
+/// `LIMBER_CODE_INCOMPATIBLE` before it connects, and `limber_last_error()` says what differs.
+///
+/// # Safety
+/// `device` and `domain` are NULL or NUL-terminated strings; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_connect_checked(
+    device: *const c_char,
+    domain: *const c_char,
+    timeout_ms: u64,
+    layout_version: u32,
+    interface: i32,
+    data_size: usize,
+    geom_size: usize,
+    out: *mut *mut LimberDevice,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the arguments, checked for NULL here.
+        let (device, domain, out) = unsafe {
+            (
+                req_str(device, "device")?,
+                opt_str(domain, "domain")?,
+                arg(out, "out")?,
+            )
+        };
+        let name: limber_services::DeviceName = device.parse()?;
+        let kind = name.interface();
+        if interface >= 0 && LimberInterface::of(kind) as i32 != interface {
+            let asked = LimberInterface::kind_of(interface)
+                .map_or("an unknown interface", |k| k.with_article());
+            return Err(Fail::new(
+                LimberCode::Incompatible,
+                format!("{device} is {}, not {asked}", kind.with_article()),
+            ));
+        }
+        let (ds, gs) = kind.visit(crate::Sizes);
+        let sizes_differ =
+            (data_size != 0 && data_size != ds) || (geom_size != 0 && geom_size != gs);
+        if layout_version != limber_interfaces::LAYOUT_VERSION || sizes_differ {
+            return Err(crate::incompatible_layout(
+                layout_version,
+                (data_size != 0).then_some((kind, data_size, geom_size)),
+            ));
+        }
+        let ctx = Context::new(&domain_of(domain)?, Role::Client, &process_name())
+            .map_err(|e| Fail::from(ConnectError::from(e)))?;
+        let client = connect_device(&ctx, device, ms(timeout_ms))?;
+        let name = CString::new(device).unwrap_or_default();
+        *out = Box::into_raw(Box::new(LimberDevice {
+            client,
+            borrowed: false,
+            name,
+        }));
+        Ok(())
+    })
+}
+
+/// Closes the connection and frees the handle (and any state borrowed from it). NULL is
+/// ignored.
+///
+/// # Safety
+/// `h` is NULL or a handle of a connect call not yet disconnected.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_disconnect(h: *mut LimberDevice) {
+    // SAFETY: the caller's promise: NULL or a handle of a connect call, freed once.
+    unsafe { crate::free_handle(h) }
+}
+
+/// The device's name ("robot/interface/index"), valid as long as the handle; "" for NULL.
+///
+/// # Safety
+/// `h` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_name(h: *const LimberDevice) -> *const c_char {
+    // SAFETY: the caller's promise: NULL or a live handle.
+    match unsafe { h.as_ref() } {
+        Some(h) => h.name.as_ptr(),
+        None => c"".as_ptr(),
+    }
+}
+
+/// The device's interface.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_interface(
+    h: *mut LimberDevice,
+    out: *mut LimberInterface,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        *out = LimberInterface::of(h.client.kind());
+        Ok(())
+    })
+}
+
+/// Copies the latest state into `*out`, a struct of `size` bytes (the device's state
+/// struct: `limber_actarray_data`, ...; another size is `LIMBER_CODE_INCOMPATIBLE`),
+/// waiting up to `timeout_ms` for a first one (`LIMBER_CODE_TIMEOUT` if none came).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or points to `size` writable bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_state(
+    h: *mut LimberDevice,
+    timeout_ms: u64,
+    out: *mut c_void,
+    size: usize,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the handle, checked for NULL here.
+        let h = unsafe { arg(h, "handle")? };
+        h.not_borrowed()?;
+        let kind = h.client.kind();
+        let bytes = h.client.current_bytes(ms(timeout_ms))?;
+        // SAFETY: the caller's promise on `out` and `size`.
+        unsafe { copy_out("state", bytes, out, size, kind) }
+    })
+}
+
+/// Lends the latest state in place, without a copy (waiting up to `timeout_ms` for a
+/// first one): `*out` points into shared memory at the device's state struct and stays
+/// valid and unchanged until `limber_device_release` (or disconnect). Meanwhile the calls
+/// that read states (state, borrow, wait_state, outcome, preemption, liveness) fail with
+/// `LIMBER_CODE_BORROWED`; commands and requests work.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_borrow(
+    h: *mut LimberDevice,
+    timeout_ms: u64,
+    out: *mut *const c_void,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        h.not_borrowed()?;
+        *out = h.client.current_bytes(ms(timeout_ms))?.as_ptr().cast();
+        h.borrowed = true;
+        Ok(())
+    })
+}
+
+/// Ends the loan of `limber_device_borrow` (the pointer it gave is invalid from now on).
+/// Releasing with nothing borrowed is harmless.
+///
+/// # Safety
+/// `h` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_release(h: *mut LimberDevice) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the handle, checked for NULL here.
+        unsafe { arg(h, "handle")? }.borrowed = false;
+        Ok(())
+    })
+}
+
+/// Takes every state and outcome that arrived, without waiting; `*fresh` (NULL: not
+/// written) says whether a new state came. What a program that polls
+/// `limber_device_fd` calls when the descriptor is readable.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `fresh` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_refresh(
+    h: *mut LimberDevice,
+    fresh: *mut bool,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, fresh) = unsafe { (arg(h, "handle")?, fresh.as_mut()) };
+        h.not_borrowed()?;
+        h.client.take_notifications()?;
+        let f = h.client.refresh()?;
+        if let Some(out) = fresh {
+            *out = f;
+        }
+        Ok(())
+    })
+}
+
+/// A file descriptor that becomes readable when the driver notifies this handle (a new
+/// state, an outcome, a reply), for `poll(2)`, `select(2)` or `epoll(7)` over several
+/// devices (or sockets, timers...) at once. When it is readable, call
+/// `limber_device_refresh`, then read the state. The descriptor is the handle's: do not
+/// close it; it is valid until `limber_device_disconnect`.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `fd` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_fd(h: *mut LimberDevice, fd: *mut i32) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, fd) = unsafe { (arg(h, "handle")?, arg(fd, "fd")?) };
+        *fd = h.client.notification_fd()?;
+        Ok(())
+    })
+}
+
+/// Waits up to `timeout_ms` for a state newer than the latest one taken and copies it into
+/// `*out` (NULL: not copied; else a struct of `size` bytes, as `limber_device_state`).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or points to `size` writable bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_wait_state(
+    h: *mut LimberDevice,
+    timeout_ms: u64,
+    out: *mut c_void,
+    size: usize,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the handle, checked for NULL here.
+        let h = unsafe { arg(h, "handle")? };
+        h.not_borrowed()?;
+        let kind = h.client.kind();
+        let bytes = h.client.wait_state_bytes(ms(timeout_ms))?;
+        if out.is_null() {
+            return Ok(());
+        }
+        // SAFETY: the caller's promise on `out` and `size`.
+        unsafe { copy_out("state", bytes, out, size, kind) }
+    })
+}
+
+/// Waits up to `timeout_ms` for the outcome of the command of `ticket` and writes it to
+/// `*out`: the driver's `LIMBER_STATUS_*`, and the other client involved (the holder of the
+/// device for `LIMBER_STATUS_LEASED`, with its name). When it returns, the latest state
+/// shows the command. A status other than OK is also kept for `limber_last_refusal()` and
+/// `limber_last_error()`; the call still returns `LIMBER_CODE_OK`.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_outcome(
+    h: *mut LimberDevice,
+    ticket: LimberTicket,
+    timeout_ms: u64,
+    out: *mut LimberOutcome,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        outcome_into(h, &ticket, timeout_ms, out)
+    })
+}
+
+fn outcome_into(
+    h: &mut LimberDevice,
+    ticket: &LimberTicket,
+    timeout_ms: u64,
+    out: &mut LimberOutcome,
+) -> Result<(), Fail> {
+    {
+        h.not_borrowed()?;
+        let o = h
+            .client
+            .wait_outcome_detail(ticket_of(ticket), ms(timeout_ms))?;
+        if o.status != Status::Ok {
+            Fail::refused_outcome(&o).record();
+        }
+        *out = outcome_of(&o);
+        Ok(())
+    }
+}
+
+/// Waits up to `timeout_ms` for the outcome of the command of `ticket`; `*status` is the
+/// driver's `LIMBER_STATUS_*` (`LIMBER_STATUS_OK`: carried out as asked;
+/// `limber_status_is_carried_out` tells the other "ok" statuses apart). As
+/// `limber_device_outcome`, with the status alone.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `status` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_wait_outcome(
+    h: *mut LimberDevice,
+    ticket: LimberTicket,
+    timeout_ms: u64,
+    status: *mut u32,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, status) = unsafe { (arg(h, "handle")?, arg(status, "status")?) };
+        let mut o = LimberOutcome::default();
+        outcome_into(h, &ticket, timeout_ms, &mut o)?;
+        *status = o.status;
+        Ok(())
+    })
+}
+
+fn outcome_of(o: &limber_services::Outcome) -> LimberOutcome {
+    let mut out = LimberOutcome {
+        seq: o.seq,
+        status: o.status as u32,
+        _pad: 0,
+        other_client: o.other_client,
+        stamp_ns: o.stamp_ns,
+        other_name: [0; 32],
+    };
+    copy_str(&mut out.other_name, o.other_name());
+    out
+}
+
+/// Whether another client's command cut short the motion that the command of `ticket`
+/// started (`LIMBER_STATUS_PREEMPTED`): `*preempted`, and `*out` (NULL: not written; zero
+/// if not preempted) the preempting client with its name. Looks at the outcomes that
+/// arrived, without waiting; remembers this handle's last 16 commands.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `preempted` is NULL or writable; `out` is NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_preemption(
+    h: *mut LimberDevice,
+    ticket: LimberTicket,
+    preempted: *mut bool,
+    out: *mut LimberOutcome,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, preempted, out) = unsafe {
+            (
+                arg(h, "handle")?,
+                arg(preempted, "preempted")?,
+                out.as_mut(),
+            )
+        };
+        h.not_borrowed()?;
+        let p = h.client.preempted(ticket_of(&ticket))?;
+        *preempted = p.is_some();
+        if let Some(out) = out {
+            *out = p.as_ref().map(outcome_of).unwrap_or_default();
+        }
+        Ok(())
+    })
+}
+
+/// As `limber_device_preemption`, with the preempting client's id alone (`*by_client`,
+/// NULL: not written; 0 if not preempted).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `preempted` is NULL or writable; `by_client` is NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_preempted(
+    h: *mut LimberDevice,
+    ticket: LimberTicket,
+    preempted: *mut bool,
+    by_client: *mut u64,
+) -> LimberCode {
+    let mut o = LimberOutcome::default();
+    // SAFETY: forwarded from the caller; `o` is a local.
+    let code = unsafe { limber_device_preemption(h, ticket, preempted, &mut o) };
+    if code == LimberCode::Ok {
+        // SAFETY: the caller's promise: NULL or writable.
+        if let Some(b) = unsafe { by_client.as_mut() } {
+            *b = o.other_client;
+        }
+    }
+    code
+}
+
+/// Whether the driver publishes: `LIMBER_LIVENESS_ALIVE` if the latest state is younger
+/// than `max_age_ms`, `STALE` if older but the driver lives, `GONE`, or `NO_DATA`.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_liveness(
+    h: *mut LimberDevice,
+    max_age_ms: u64,
+    out: *mut LimberLiveness,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        h.not_borrowed()?;
+        *out = match h.client.freshness(ms(max_age_ms)) {
+            Freshness::Fresh => LimberLiveness::Alive,
+            Freshness::Stale => LimberLiveness::Stale,
+            Freshness::Gone => LimberLiveness::Gone,
+            Freshness::NoData => LimberLiveness::NoData,
+        };
+        Ok(())
+    })
+}
+
+/// The age of the latest state taken, in nanoseconds (`CLOCK_MONOTONIC` now minus its
+/// acquisition stamp); `LIMBER_CODE_TIMEOUT` when no state was taken yet.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_state_age(
+    h: *mut LimberDevice,
+    out: *mut u64,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        let age = h
+            .client
+            .state_age()
+            .ok_or_else(|| Fail::new(LimberCode::Timeout, "no state was taken yet"))?;
+        *out = u64::try_from(age.as_nanos()).unwrap_or(u64::MAX);
+        Ok(())
+    })
+}
+
+/// Whether the driver's process lives (costs tens of microseconds).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_driver_status(
+    h: *mut LimberDevice,
+    out: *mut LimberDriverStatus,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        *out = LimberDriverStatus::of(h.client.driver_status());
+        Ok(())
+    })
+}
+
+/// REQ GET_GEOM (the limb's GEOM): copies the geometry into `*out`, a struct of `size`
+/// bytes (the device's geometry struct: `limber_actarray_geom`, `limber_limb_geom`,
+/// `limber_gripper_geom`); waits up to `timeout_ms` for the reply.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or points to `size` writable bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_geometry(
+    h: *mut LimberDevice,
+    timeout_ms: u64,
+    out: *mut c_void,
+    size: usize,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the handle, checked for NULL here.
+        let h = unsafe { arg(h, "handle")? };
+        let kind = h.client.kind();
+        let g = h.client.geometry_within(ms(timeout_ms))?;
+        // SAFETY: the caller's promise on `out` and `size`.
+        unsafe { copy_out("geometry", g.bytes(), out, size, kind) }
+    })
+}
+
+/// How this handle waits for states, outcomes and replies: `spin` false (the default)
+/// blocks on the driver's notification after busy-polling for `spin_budget_us`
+/// microseconds after each send (0: blocks at once; the default comes from
+/// `LIMBER_SPIN_US`); `spin` true busy-polls shared memory (lowest latency; takes a core).
+///
+/// # Safety
+/// `h` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_set_wait(
+    h: *mut LimberDevice,
+    spin: bool,
+    spin_budget_us: u64,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the handle, checked for NULL here.
+        let h = unsafe { arg(h, "handle")? };
+        h.client.set_wait_mode(if spin {
+            WaitMode::Spin
+        } else {
+            WaitMode::Event
+        });
+        h.client
+            .set_spin_budget(core::time::Duration::from_micros(spin_budget_us));
+        Ok(())
+    })
+}
+
+// ----- control: who commands the device ------------------------------------------------
+
+/// This handle's client id: how the driver, outcomes and `limber_device_holder` name it.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_client_id(
+    h: *mut LimberDevice,
+    out: *mut u64,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        *out = h.client.client_id();
+        Ok(())
+    })
+}
+
+/// Takes the device's control lease as `name` (NULL: this program's name; 1 to 31 bytes,
+/// else `LIMBER_CODE_INVALID_VALUE`). Until `limber_device_release_lease` (or disconnect),
+/// other clients' commands, and their requests that change the device, are refused as
+/// `LIMBER_STATUS_LEASED` naming `name`; readers are unaffected. Renew it at least every
+/// `heartbeat_ms` (`limber_device_renew`, or `limber_device_keep_lease` in a loop): when the
+/// heartbeat is missed, or this process dies, the driver stops the device and frees it.
+/// Acquiring again sets a new heartbeat. Held by another client: `LIMBER_CODE_REFUSED`,
+/// `limber_last_refusal()` is `LIMBER_STATUS_LEASED`, `limber_last_error()` and
+/// `limber_last_holder()` name the holder. Waits for the driver's answer up to 2 s.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `name` is NULL or a NUL-terminated string.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_acquire(
+    h: *mut LimberDevice,
+    name: *const c_char,
+    heartbeat_ms: u64,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, name) = unsafe { (arg(h, "handle")?, opt_str(name, "name")?) };
+        let name = match name {
+            Some(n) => n.to_string(),
+            None => {
+                let mut n = process_name();
+                n.truncate(crate::LIMBER_LEASE_NAME_MAX);
+                n
+            }
+        };
+        if name.is_empty() || name.len() > crate::LIMBER_LEASE_NAME_MAX {
+            return Err(Fail::new(
+                LimberCode::InvalidValue,
+                format!(
+                    "a lease name has 1 to {} bytes, not {} ({name:?})",
+                    crate::LIMBER_LEASE_NAME_MAX,
+                    name.len()
+                ),
+            ));
+        }
+        Ok(h.client.acquire(&name, ms(heartbeat_ms))?)
+    })
+}
+
+/// The lease's heartbeat: tells the driver this holder lives. A lease that ended
+/// meanwhile: `LIMBER_CODE_LEASE_LOST` (nobody holds it now) or `LIMBER_CODE_REFUSED` with
+/// `LIMBER_STATUS_LEASED` (another client took it).
+///
+/// # Safety
+/// `h` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_renew(h: *mut LimberDevice) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointer, checked for NULL here.
+        Ok(unsafe { arg(h, "handle")? }.client.renew()?)
+    })
+}
+
+/// For a control loop: renews the lease when a third of its heartbeat has passed since the
+/// last renewal (`*renewed`, if not NULL, says whether it did); does nothing when no lease
+/// is held. Fails as `limber_device_renew`.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `renewed` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_keep_lease(
+    h: *mut LimberDevice,
+    renewed: *mut bool,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, renewed) = unsafe { (arg(h, "handle")?, renewed.as_mut()) };
+        let r = h.client.keep_lease()?;
+        if let Some(out) = renewed {
+            *out = r;
+        }
+        Ok(())
+    })
+}
+
+/// Gives the control lease back (the motion in progress goes on). Without a lease it does
+/// nothing. (`limber_device_release` ends the loan of a borrowed state.)
+///
+/// # Safety
+/// `h` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_release_lease(h: *mut LimberDevice) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointer, checked for NULL here.
+        Ok(unsafe { arg(h, "handle")? }.client.release()?)
+    })
+}
+
+/// Whether this handle holds the device's control lease (as far as it knows: a lease lost
+/// to a missed heartbeat shows at the next renewal).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_holds_lease(
+    h: *mut LimberDevice,
+    out: *mut bool,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        *out = h.client.holds_lease();
+        Ok(())
+    })
+}
+
+/// Who holds the device's control lease: `out->client_id` is 0 when nobody does. Asks the
+/// driver (waits for its answer up to 2 s).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_holder(
+    h: *mut LimberDevice,
+    out: *mut LimberLeaseHolder,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, out) = unsafe { (arg(h, "handle")?, arg(out, "out")?) };
+        *out = h
+            .client
+            .holder()?
+            .as_ref()
+            .map(LimberLeaseHolder::of)
+            .unwrap_or_default();
+        Ok(())
+    })
+}

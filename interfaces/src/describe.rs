@@ -1,0 +1,188 @@
+//! How a state reads for people and scripts: one line of text ([`Describe::human`], what
+//! `limber echo` and the monitor print) and one JSON object ([`Describe::json`], what
+//! `limber echo --json` prints). Each interface's state implements it next to its layout,
+//! so every generic consumer (the CLI, the monitor, a recorder) prints any interface without
+//! naming it.
+
+use core::fmt::Write as _;
+
+use serde_json::{Value, json};
+
+use crate::actarray::{ActArrayData, ActuatorFlags};
+use crate::common::{StateHeader, Status, device_flag};
+use crate::gripper::{GripperData, GripperState};
+use crate::limb::{LimbData, LimbState};
+
+/// A state that can be printed: one human-readable line, one JSON object.
+pub trait Describe {
+    /// One human-readable line.
+    fn human(&self) -> String;
+    /// One JSON object (the schema of `limber echo --json`).
+    fn json(&self) -> Value;
+}
+
+/// The JSON of a state header (`"header"` of every state).
+pub fn header_json(h: &StateHeader) -> Value {
+    json!({
+        "seq": h.seq,
+        "stamp_ns": h.stamp_ns,
+        "link_up": h.flags & device_flag::LINK_UP != 0,
+        "calibrated": h.flags & device_flag::CALIBRATED != 0,
+        "flags": h.flags,
+        "cmd_overflows": h.cmd_overflows,
+        "last_cmd": {
+            "client_id": h.last_cmd.client_id,
+            "seq": h.last_cmd.cmd_seq,
+            "kind": h.last_cmd.kind,
+            "status": Status::try_from(h.last_cmd.status).map(|s| s.describe()).unwrap_or("?"),
+        },
+    })
+}
+
+/// The start of every human line: the sequence number, a link that is down, and the last
+/// command's outcome when it was not a plain OK.
+pub fn header_human(h: &StateHeader) -> String {
+    let mut s = format!("#{:<6}", h.seq);
+    if h.flags & device_flag::LINK_UP == 0 && h.flags != 0 {
+        s.push_str(" LINK DOWN");
+    }
+    if h.last_cmd.client_id != 0 && h.last_cmd.status != 0 {
+        match Status::try_from(h.last_cmd.status) {
+            // "ok, clamped to the limit", "ok, orientation adjusted": carried out.
+            Ok(st) if st.is_carried_out() => {
+                let _ = write!(s, " [last command: {st}]");
+            }
+            Ok(st) => {
+                let _ = write!(s, " [last command refused: {st}]");
+            }
+            Err(_) => s.push_str(" [last command refused: ?]"),
+        }
+    }
+    s
+}
+
+/// The name of an actuator's state bits: `stalled`, `moving`, `braked`, `idle`, `-`, `?`.
+pub fn actuator_state_name(bits: u32) -> &'static str {
+    match ActuatorFlags::from_bits(bits) {
+        Some(f) if f.contains(ActuatorFlags::STALLED) => "stalled",
+        Some(f) if f.contains(ActuatorFlags::MOVING) => "moving",
+        Some(f) if f.contains(ActuatorFlags::BRAKED) => "braked",
+        Some(f) if f.contains(ActuatorFlags::IDLE) => "idle",
+        Some(_) => "-",
+        None => "?",
+    }
+}
+
+impl Describe for ActArrayData {
+    fn human(&self) -> String {
+        let mut s = header_human(&self.header);
+        let _ = write!(
+            s,
+            " power {}",
+            if self.motor_state != 0 { "on " } else { "off" }
+        );
+        for (i, a) in self.actuators().iter().enumerate() {
+            let _ = write!(
+                s,
+                " | j{i} {:+.4} {}",
+                a.position,
+                actuator_state_name(a.state)
+            );
+        }
+        s
+    }
+    fn json(&self) -> Value {
+        json!({
+            "header": header_json(&self.header),
+            "motor_state": self.motor_state,
+            "actuators": self.actuators().iter().map(|a| json!({
+                "position": a.position,
+                "speed": a.speed,
+                "acceleration": a.acceleration,
+                "current": a.current,
+                "state": actuator_state_name(a.state),
+            })).collect::<Vec<_>>(),
+        })
+    }
+}
+
+/// The name of a limb state: `idle`, `braked`, `moving`, `out-of-reach`, `collision`, `?`.
+pub fn limb_state_name(v: u32) -> &'static str {
+    match LimbState::try_from(v) {
+        Ok(LimbState::Idle) => "idle",
+        Ok(LimbState::Braked) => "braked",
+        Ok(LimbState::Moving) => "moving",
+        Ok(LimbState::OutOfReach) => "out-of-reach",
+        Ok(LimbState::Collision) => "collision",
+        Err(_) => "?",
+    }
+}
+
+impl Describe for LimbData {
+    fn human(&self) -> String {
+        let (p, a, o) = (self.position, self.approach, self.orientation);
+        let adjusted = if self.orientation_adjustment > 0.0 {
+            format!(
+                " (orientation adjusted by {:.6} rad)",
+                self.orientation_adjustment
+            )
+        } else {
+            String::new()
+        };
+        format!(
+            "{} {:<12} pos ({:+.4}, {:+.4}, {:+.4}) approach ({:+.3}, {:+.3}, {:+.3}) orient ({:+.3}, {:+.3}, {:+.3}){adjusted}",
+            header_human(&self.header),
+            limb_state_name(self.state),
+            p.x,
+            p.y,
+            p.z,
+            a.x,
+            a.y,
+            a.z,
+            o.x,
+            o.y,
+            o.z
+        )
+    }
+    fn json(&self) -> Value {
+        json!({
+            "header": header_json(&self.header),
+            "state": limb_state_name(self.state),
+            "position": self.position.to_array(),
+            "approach": self.approach.to_array(),
+            "orientation": self.orientation.to_array(),
+            "orientation_adjustment": self.orientation_adjustment,
+        })
+    }
+}
+
+/// The name of a gripper state: `open`, `closed`, `moving`, `error`, `?`.
+pub fn gripper_state_name(v: u32) -> &'static str {
+    match GripperState::try_from(v) {
+        Ok(GripperState::Open) => "open",
+        Ok(GripperState::Closed) => "closed",
+        Ok(GripperState::Moving) => "moving",
+        Ok(GripperState::Error) => "error",
+        Err(_) => "?",
+    }
+}
+
+impl Describe for GripperData {
+    fn human(&self) -> String {
+        format!(
+            "{} {:<7} beams {:#06b} stored {}",
+            header_human(&self.header),
+            gripper_state_name(self.state),
+            self.beams,
+            self.stored
+        )
+    }
+    fn json(&self) -> Value {
+        json!({
+            "header": header_json(&self.header),
+            "state": gripper_state_name(self.state),
+            "beams": self.beams,
+            "stored": self.stored,
+        })
+    }
+}

@@ -1,0 +1,161 @@
+//! Draining the `cmd` channel: each command decoded, admitted or refused by the arbiter,
+//! carried out by the handler, and its outcome (and those of the motions it preempted)
+//! published.
+
+use core::mem::MaybeUninit;
+
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::prelude::*;
+use iceoryx2::sample_mut_uninit::SampleMutUninit;
+use limber_interfaces::prelude::*;
+
+use super::arbiter::{CmdRef, Told};
+use super::{DeviceHandler, DeviceHost, HostStats, Origin, ProcessError, loan_ahead};
+use crate::context::monotonic_ns;
+use crate::error::Iox2Error;
+use crate::naming::DeviceName;
+
+impl<I: Interface> DeviceHost<I> {
+    /// Drains every pending command. A command that does not decode is refused with the
+    /// matching status without reaching the handler.
+    pub fn process_commands<H: DeviceHandler<I>>(
+        &mut self,
+        handler: &mut H,
+    ) -> Result<usize, ProcessError> {
+        let mut n = 0;
+        loop {
+            let sample = match self.commands.receive() {
+                Ok(Some(s)) => s,
+                Ok(None) => break,
+                Err(e) => return Err(ProcessError::Receive(e)),
+            };
+            let raw: &I::CmdMsg = &sample;
+            let meta = *raw.meta();
+            let origin = Origin {
+                client_id: meta.client_id,
+                seq: meta.seq,
+                sent_ns: meta.stamp_ns,
+                received_ns: monotonic_ns(),
+            };
+            let cmd = CmdRef {
+                client_id: meta.client_id,
+                seq: meta.seq,
+                kind: meta.kind,
+            };
+            self.stats.overflows += self.arbiter.arrived(cmd);
+            let status = match I::Command::read(raw) {
+                Ok(decoded) => {
+                    drop(sample);
+                    if self.arbiter.refusing(cmd.client_id).is_some() {
+                        self.stats.leased_refusals += 1;
+                        Status::Leased
+                    } else {
+                        self.apply(handler, &decoded, &origin, cmd)
+                    }
+                }
+                Err(e) => e.status(),
+            };
+            self.outcome = CmdOutcome {
+                client_id: meta.client_id,
+                cmd_seq: meta.seq,
+                kind: meta.kind,
+                status: status.code(),
+            };
+            // The state that shows the command goes out before its outcome: a client that
+            // has seen the outcome and then takes the state sees the command's effect.
+            // (Clients are notified after both.)
+            let state_sent = self.publish_each_outcome.then(|| self.send_state());
+            let told = self.arbiter.outcome(cmd, status);
+            publish_outcome(
+                &self.outcomes,
+                &mut self.outcome_loan,
+                &mut self.stats,
+                &self.device,
+                told,
+            );
+            self.stats.commands += 1;
+            if !status.is_carried_out() {
+                self.stats.refused += 1;
+            }
+            n += 1;
+            if let Some(sent) = state_sent {
+                sent?;
+                self.state_sent();
+            }
+            // The next command's outcome sample, loaned now rather than on its path.
+            if self.outcome_loan.is_none() {
+                self.outcome_loan = loan_ahead(&self.outcomes, &self.device, "outcome");
+            }
+        }
+        Ok(n)
+    }
+
+    /// Carries out one decoded command of a client allowed to command the device, and
+    /// tells the client whose running motion it cuts short that it was preempted.
+    fn apply<H: DeviceHandler<I>>(
+        &mut self,
+        handler: &mut H,
+        decoded: &I::Command,
+        origin: &Origin,
+        cmd: CmdRef,
+    ) -> Status {
+        let motion = handler.motion(decoded, &self.state);
+        let status = handler.command(decoded, origin, &mut self.state);
+        if !status.is_carried_out() {
+            return status;
+        }
+        let (outcomes, loan, stats, device) = (
+            &self.outcomes,
+            &mut self.outcome_loan,
+            &mut self.stats,
+            &self.device,
+        );
+        self.arbiter.carried_out(cmd, motion, |told| {
+            stats.preempted += 1;
+            publish_outcome(outcomes, loan, stats, device, told);
+        });
+        status
+    }
+}
+
+/// Publishes one outcome on the `outcome` channel (in the sample loaned ahead, if any); a
+/// failure is counted and logged (that client then waits up to its timeout), never fatal to
+/// the loop.
+fn publish_outcome(
+    outcomes: &Publisher<ipc::Service, OutcomeMsg, ()>,
+    loan_ahead: &mut Option<SampleMutUninit<ipc::Service, MaybeUninit<OutcomeMsg>, ()>>,
+    stats: &mut HostStats,
+    device: &DeviceName,
+    told: Told,
+) {
+    let loan = match loan_ahead.take() {
+        Some(l) => Ok(l),
+        None => outcomes.loan_uninit(),
+    };
+    let sent = match loan {
+        Ok(loan) => {
+            let mut msg = OutcomeMsg {
+                client_id: told.cmd.client_id,
+                cmd_seq: told.cmd.seq,
+                other_client: told.other_client,
+                stamp_ns: monotonic_ns(),
+                kind: told.cmd.kind,
+                status: told.status.code(),
+                ..OutcomeMsg::default()
+            };
+            if let Some(n) = told.other_name {
+                msg.other_name = n;
+            }
+            loan.write_payload(msg).send().map_err(Iox2Error::from)
+        }
+        Err(e) => Err(e.into()),
+    };
+    match sent {
+        Ok(_) => stats.outcomes += 1,
+        Err(e) => {
+            stats.failed_outcomes += 1;
+            tracing::warn!(device = %device, client = told.cmd.client_id, seq = told.cmd.seq,
+                error = %e, "cannot publish an outcome");
+        }
+    }
+}

@@ -1,0 +1,79 @@
+//! What a driver implements: [`DeviceHandler`], with the [`Origin`] of each message and the
+//! [`Motion`] a command drives.
+
+use limber_interfaces::prelude::*;
+
+/// Who sent a command or request.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Origin {
+    /// The client's id.
+    pub client_id: u64,
+    /// The client's sequence number of this message.
+    pub seq: u64,
+    /// When the client sent it (`CLOCK_MONOTONIC` ns).
+    pub sent_ns: u64,
+    /// When the driver took it from the channel (`CLOCK_MONOTONIC` ns; 0 for the driver's
+    /// own commands): what the driver does from here on is its own cost.
+    pub received_ns: u64,
+}
+
+/// What a driver implements for each interface it serves: `DeviceHandler<ActArray>`,
+/// `DeviceHandler<Limb>`, `DeviceHandler<Gripper>`. The Pioneer driver, the simulated arm
+/// and test doubles plug into a [`DeviceHost`](super::DeviceHost) the same way.
+pub trait DeviceHandler<I: Interface> {
+    /// Carries out (or refuses) a validated command; `state` is the device state the host
+    /// publishes next. The returned status reaches the sender in the next state sample's
+    /// `last_cmd`. Must not block.
+    fn command(&mut self, cmd: &I::Command, from: &Origin, state: &mut I::Data) -> Status;
+
+    /// Answers a validated request: `Ok` is an ACK with that payload, `Err` a NACK with
+    /// the reason. Must not block.
+    fn request(
+        &mut self,
+        req: &I::Request,
+        from: &Origin,
+        state: &mut I::Data,
+    ) -> Result<I::Reply, Status>;
+
+    /// Asked before `cmd` is carried out: which parts of the device it drives, and which
+    /// of those are still moving from an earlier command (a new motion of the same joints
+    /// or a stop cuts that one short). The host remembers which client's command drives
+    /// each part and tells a client whose motion another client's command cut short that
+    /// it was [`Status::Preempted`]. Default: [`Motion::NONE`] (nothing runs on by itself).
+    fn motion(&mut self, cmd: &I::Command, state: &I::Data) -> Motion {
+        let _ = (cmd, state);
+        Motion::NONE
+    }
+
+    /// Stops every motion of the device now (the deadman: the holder of the device's
+    /// lease died or missed its heartbeat). Must not block. Default: unsupported (logged
+    /// by the host); every driver of moving hardware implements it.
+    fn stop(&mut self, state: &mut I::Data) -> Status {
+        let _ = state;
+        Status::Unsupported
+    }
+}
+
+/// The parts of a device a command drives, and those of them still moving
+/// ([`DeviceHandler::motion`]). Bit i is a part that moves on its own: joint i of an arm;
+/// a limb's joints; bit 0 for a gripper.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Motion {
+    /// The parts the command drives (a new target, a speed, a stop).
+    pub drives: u64,
+    /// Those of them still moving now: the command cuts their motion short.
+    pub cuts: u64,
+}
+
+impl Motion {
+    /// Drives nothing that runs on by itself.
+    pub const NONE: Motion = Motion { drives: 0, cuts: 0 };
+
+    /// `drives`, of which the parts in `running` are still moving.
+    pub const fn of(drives: u64, running: u64) -> Motion {
+        Motion {
+            drives,
+            cuts: drives & running,
+        }
+    }
+}

@@ -1,0 +1,114 @@
+//! The lease channel and the deadman around the arbiter's lease state machine: lease
+//! requests answered, the holder's node looked up when the arbiter asks, the device stopped
+//! when a lease ends.
+
+use iceoryx2::node::NodeView;
+use iceoryx2::prelude::*;
+use limber_interfaces::prelude::*;
+
+use super::arbiter::{Deadman, LeaseEvent};
+use super::{DeviceHandler, DeviceHost, ProcessError};
+use crate::context::monotonic_ns;
+use crate::error::Iox2Error;
+use crate::qos;
+
+impl<I: Interface> DeviceHost<I> {
+    /// The deadman: ends the lease and stops the device (with [`DeviceHandler::stop`]) when
+    /// its holder's node died or its heartbeat is overdue. [`DeviceHost::process`] calls
+    /// it; a driver that processes only when clients wake it calls it on its ticks too.
+    /// Cheap unless a lease is held (then the holder's node is looked up at most every
+    /// [`HOLDER_CHECK_NS`](super::HOLDER_CHECK_NS)).
+    pub fn check_lease<H: DeviceHandler<I>>(
+        &mut self,
+        handler: &mut H,
+    ) -> Result<(), ProcessError> {
+        let (ended, why) = match self.arbiter.deadman(monotonic_ns()) {
+            Deadman::Fine => return Ok(()),
+            Deadman::Expired(l) => (l, "it missed its heartbeat"),
+            Deadman::CheckNode(node) => {
+                if !self.holder_node_gone(node) {
+                    return Ok(());
+                }
+                match self.arbiter.holder_died(node) {
+                    Some(l) => (l, "its process died"),
+                    None => return Ok(()),
+                }
+            }
+        };
+        let status = handler.stop(&mut self.state);
+        tracing::warn!(device = %self.device, holder = ended.name(), client = ended.client_id,
+            stop = %status, "lease ended because {why}: device stopped");
+        self.stats.deadman_stops += 1;
+        self.publish()?;
+        Ok(())
+    }
+
+    /// True when the node `id` is dead or no longer attached to the lease channel.
+    fn holder_node_gone(&self, id: u128) -> bool {
+        use iceoryx2::service::port_factory::PortFactory;
+        let (mut alive, mut dead) = (false, false);
+        if let Err(e) = self.lease_svc.nodes(|n| {
+            match &n {
+                NodeState::Alive(v) if v.id().value() == id => alive = true,
+                NodeState::Dead(v) if v.id().value() == id => dead = true,
+                NodeState::Inaccessible(n) | NodeState::Undefined(n) if n.value() == id => {
+                    alive = true
+                }
+                _ => {}
+            }
+            CallbackProgression::Continue
+        }) {
+            // Not known to be dead: the heartbeat timeout still ends the lease.
+            tracing::warn!(device = %self.device, error = %e, "cannot list the holder's node");
+            return false;
+        }
+        dead || !alive
+    }
+
+    /// Answers every pending lease request (acquire, renew, release, query).
+    pub(super) fn process_leases(&mut self) -> Result<usize, ProcessError> {
+        let mut n = 0;
+        let mut changed = false;
+        loop {
+            let active = match self.lease_server.receive() {
+                Ok(Some(a)) => a,
+                Ok(None) => break,
+                Err(e) => return Err(ProcessError::Receive(e)),
+            };
+            let req: LeaseReq = *active.payload();
+            let answer = self.arbiter.lease_request(&req, monotonic_ns());
+            changed |= answer.holder_changed;
+            match answer.event {
+                Some(LeaseEvent::Acquired) => {
+                    tracing::info!(device = %self.device,
+                        holder = self.arbiter.holder().map_or("", |h| h.name()),
+                        client = req.client_id, "lease acquired");
+                }
+                Some(LeaseEvent::Released) => {
+                    tracing::info!(device = %self.device, client = req.client_id, "lease released");
+                }
+                None => {}
+            }
+            let reply = self.arbiter.lease_reply(&req, answer.status);
+            let sent = match active.loan_uninit() {
+                Ok(loan) => loan.write_payload(reply).send().map_err(Iox2Error::from),
+                Err(e) => Err(e.into()),
+            };
+            if let Err(e) = sent {
+                self.stats.undelivered_replies += 1;
+                tracing::debug!(device = %self.device, client = req.client_id, error = %e,
+                    "lease reply not delivered");
+            }
+            self.stats.lease_requests += 1;
+            n += 1;
+        }
+        if n > 0 {
+            self.notify_clients(qos::EVENT_REPLY);
+        }
+        // The LEASED flag of the state follows the lease at once.
+        if changed {
+            self.publish()?;
+        }
+        Ok(n)
+    }
+}

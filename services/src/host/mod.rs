@@ -1,0 +1,360 @@
+//! The driver side: [`DeviceHost`] offers one device and [`DeviceHandler`] is what a driver
+//! implements for each interface it serves.
+//!
+//! The host does the port I/O; the decisions are the arbiter's, which does none:
+//!
+//! * [`handler`]: [`DeviceHandler`], [`Origin`], [`Motion`]: what a driver implements.
+//! * [`error`], [`stats`]: how offering and processing fail, and what the host counts.
+//! * `open`: opening the device's channels ([`DeviceHost::new`]).
+//! * `arbiter`: who may command the device (leases, the deadman), preemption, the
+//!   per-client gap table (`gaps`) and the outcome rules; plain data in, decisions out.
+//! * `commands`, `requests`, `lease`: draining each channel around the arbiter.
+
+use core::marker::PhantomData;
+use core::mem::MaybeUninit;
+
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::server::Server;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::port::update_connections::UpdateConnections;
+use iceoryx2::prelude::*;
+use iceoryx2::sample_mut_uninit::SampleMutUninit;
+use limber_interfaces::prelude::*;
+
+use crate::context::monotonic_ns;
+use crate::domain::Domain;
+use crate::naming::DeviceName;
+use crate::qos;
+
+mod arbiter;
+mod commands;
+pub mod error;
+mod gaps;
+pub mod handler;
+mod lease;
+mod open;
+mod requests;
+pub mod stats;
+
+use arbiter::Arbiter;
+pub use arbiter::{HOLDER_CHECK_NS, Holder, MAX_LEASE_TIMEOUT_NS, MIN_LEASE_TIMEOUT_NS};
+pub use error::{HostError, ProcessError, PublishError};
+pub use gaps::CLIENT_SLOTS;
+pub use handler::{DeviceHandler, Motion, Origin};
+pub use stats::{Activity, HostStats};
+
+/// [`DeviceHost::process_spin`] looks for requests on every this many calls.
+pub const SPIN_REQUEST_EVERY: u32 = 16;
+
+/// Loans a sample ahead of its use: a loan (taking back the samples that clients released,
+/// allocating the chunk, iceoryx2's bookkeeping) costs about as much as the send, so a
+/// host loans the next outcome and state samples right after it published, and a command
+/// finds them ready. A failure is logged; the publication then loans for itself (and
+/// reports its own failure). Clients loan their next command sample so too.
+pub(crate) fn loan_ahead<T: core::fmt::Debug + ZeroCopySend>(
+    port: &Publisher<ipc::Service, T, ()>,
+    device: &DeviceName,
+    what: &'static str,
+) -> Option<SampleMutUninit<ipc::Service, MaybeUninit<T>, ()>> {
+    match port.loan_uninit() {
+        Ok(l) => Some(l),
+        Err(e) => {
+            tracing::debug!(device = %device, error = %e, "cannot loan the next {what} sample ahead");
+            None
+        }
+    }
+}
+
+/// Offers one device of interface `I`: publishes its state, drains its commands in
+/// arrival order, answers its requests, and wakes its clients.
+///
+/// Steady state allocates nothing: state samples are loaned from shared memory and written
+/// in place, commands and requests are read in place.
+pub struct DeviceHost<I: Interface> {
+    device: DeviceName,
+    data_svc:
+        iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, I::Data, ()>,
+    publisher: Publisher<ipc::Service, I::Data, ()>,
+    commands: Subscriber<ipc::Service, I::CmdMsg, ()>,
+    server: Server<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()>,
+    wake: Option<Listener<ipc::Service>>,
+    notify: Notifier<ipc::Service>,
+    outcomes: Publisher<ipc::Service, OutcomeMsg, ()>,
+    lease_svc: iceoryx2::service::port_factory::request_response::PortFactory<
+        ipc::Service,
+        LeaseReq,
+        (),
+        LeaseReply,
+        (),
+    >,
+    lease_server: Server<ipc::Service, LeaseReq, (), LeaseReply, ()>,
+    /// Leases, preemption, the gap table and the outcome rules: no I/O.
+    arbiter: Arbiter,
+    state: I::Data,
+    seq: u64,
+    outcome: CmdOutcome,
+    flags: u32,
+    stats: HostStats,
+    publish_each_outcome: bool,
+    spin_calls: u32,
+    /// A state sample loaned ahead, for the next publication (see `loan_ahead`).
+    state_loan: Option<SampleMutUninit<ipc::Service, MaybeUninit<I::Data>, ()>>,
+    /// An outcome sample loaned ahead, for the next command's outcome.
+    outcome_loan: Option<SampleMutUninit<ipc::Service, MaybeUninit<OutcomeMsg>, ()>>,
+    _i: PhantomData<I>,
+    /// The domain (group mode decides whose dead processes this host may clean up). Last:
+    /// dropped after the ports, so a test's domain whose last handle this is finds them gone.
+    domain: Domain,
+}
+
+impl<I: Interface> core::fmt::Debug for DeviceHost<I> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("DeviceHost")
+            .field("device", &self.device.to_string())
+            .field("stats", &self.stats)
+            .finish()
+    }
+}
+
+impl<I: Interface> DeviceHost<I> {
+    /// The device.
+    pub fn device(&self) -> &DeviceName {
+        &self.device
+    }
+
+    /// The state that [`DeviceHost::publish`] sends.
+    pub fn state(&self) -> &I::Data {
+        &self.state
+    }
+
+    /// The state, to update before publishing.
+    pub fn state_mut(&mut self) -> &mut I::Data {
+        &mut self.state
+    }
+
+    /// Sets the `DEVICE_FLAG` bits carried in every sample.
+    pub fn set_flags(&mut self, flags: u32) {
+        self.flags = flags;
+    }
+
+    /// The flags.
+    pub fn flags(&self) -> u32 {
+        self.flags
+    }
+
+    /// Whether a state sample is published after every command, so each sender sees its
+    /// own outcome (default: yes). Turn off to publish only when the driver calls
+    /// [`DeviceHost::publish`].
+    pub fn set_publish_each_outcome(&mut self, on: bool) {
+        self.publish_each_outcome = on;
+    }
+
+    /// Counters.
+    pub fn stats(&self) -> HostStats {
+        self.stats
+    }
+
+    /// Who holds the device's control lease, if anybody.
+    pub fn holder(&self) -> Option<&Holder> {
+        self.arbiter.holder()
+    }
+
+    /// The listener that a client's command or request wakes, while the host owns it.
+    pub fn wake_listener(&self) -> Option<&Listener<ipc::Service>> {
+        self.wake.as_ref()
+    }
+
+    /// Hands the wake listener to the driver's event loop (a WaitSet attachment borrows
+    /// it, so the loop must own it while the host is processed mutably). See
+    /// [`crate::event_loop::run`].
+    pub fn take_wake_listener(&mut self) -> Option<Listener<ipc::Service>> {
+        self.wake.take()
+    }
+
+    /// Consumes pending wake-up events (without blocking) while the host owns the
+    /// listener; returns how many there were.
+    pub fn consume_wakeups(&self) -> u64 {
+        let Some(w) = self.wake.as_ref() else {
+            return 0;
+        };
+        match w.try_wait(|_| {}) {
+            Ok(n) => n,
+            Err(e) => {
+                tracing::warn!(device = %self.device, error = %e, "cannot consume wake-ups");
+                0
+            }
+        }
+    }
+
+    /// Publishes the state acquired at `stamp_ns` (`CLOCK_MONOTONIC`).
+    pub fn publish_acquired(&mut self, stamp_ns: u64) -> Result<(), PublishError> {
+        self.state.header_mut().stamp_ns = stamp_ns;
+        self.publish()
+    }
+
+    /// Publishes the current state (with a new sequence number, the last command's outcome,
+    /// the flags and the overflow count) and notifies waiting clients.
+    pub fn publish(&mut self) -> Result<(), PublishError> {
+        self.send_state()?;
+        self.state_sent();
+        Ok(())
+    }
+
+    /// The sending half of [`DeviceHost::publish`]: the header filled in and the sample
+    /// sent, without notifying clients or loaning the next sample.
+    fn send_state(&mut self) -> Result<(), PublishError> {
+        self.seq += 1;
+        let h = self.state.header_mut();
+        h.seq = self.seq;
+        if h.stamp_ns == 0 {
+            h.stamp_ns = monotonic_ns();
+        }
+        h.last_cmd = self.outcome;
+        h.flags = self.flags
+            | if self.arbiter.holder().is_some() {
+                device_flag::LEASED
+            } else {
+                0
+            };
+        h.cmd_overflows = self.stats.overflows.min(u32::MAX as u64) as u32;
+        self.send_verbatim()
+    }
+
+    /// Publishes the state as it is, header included (a relayed device's), and notifies;
+    /// then loans the sample of the next publication, off the clients' path.
+    pub(crate) fn publish_verbatim(&mut self) -> Result<(), PublishError> {
+        self.send_verbatim()?;
+        self.state_sent();
+        Ok(())
+    }
+
+    /// Sends the state as it is.
+    fn send_verbatim(&mut self) -> Result<(), PublishError> {
+        let sample = match self.state_loan.take() {
+            Some(s) => s,
+            None => self.publisher.loan_uninit().map_err(PublishError::Loan)?,
+        };
+        sample
+            .write_payload(self.state)
+            .send()
+            .map_err(PublishError::Send)?;
+        self.stats.published += 1;
+        Ok(())
+    }
+
+    /// After a state was sent (and the outcome or reply it goes with): notifies waiting
+    /// clients, then loans the sample of the next publication, off the clients' path.
+    fn state_sent(&mut self) {
+        // A client that waits with a timeout re-checks anyway: counted, not fatal.
+        self.notify_clients(qos::EVENT_STATE);
+        self.state_loan = loan_ahead(&self.publisher, &self.device, "state");
+    }
+
+    pub(crate) fn commands_port(&self) -> &Subscriber<ipc::Service, I::CmdMsg, ()> {
+        &self.commands
+    }
+
+    pub(crate) fn server_port(&self) -> &Server<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()> {
+        &self.server
+    }
+
+    pub(crate) fn outcome_port(&self) -> &Publisher<ipc::Service, OutcomeMsg, ()> {
+        &self.outcomes
+    }
+
+    pub(crate) fn data_port(&self) -> &Publisher<ipc::Service, I::Data, ()> {
+        &self.publisher
+    }
+
+    pub(crate) fn lease_port(&self) -> &Server<ipc::Service, LeaseReq, (), LeaseReply, ()> {
+        &self.lease_server
+    }
+
+    pub(crate) fn notify_clients_of(&mut self, event: usize) {
+        self.notify_clients(event);
+    }
+
+    /// Notifies waiting clients; a failure is counted and logged.
+    fn notify_clients(&mut self, event: usize) {
+        if let Err(e) = self.notify.notify_with_custom_event_id(EventId::new(event)) {
+            self.stats.failed_notifies += 1;
+            tracing::debug!(device = %self.device, error = %e, "cannot notify clients");
+        }
+    }
+
+    /// Connects the state publisher to clients that came since the last call, so they
+    /// get the latest state (history 1) now; a failure is counted and logged.
+    fn update_connections(&mut self) {
+        if let Err(e) = self.publisher.update_connections() {
+            self.stats.failed_connection_updates += 1;
+            tracing::debug!(device = %self.device, error = %e, "cannot connect new clients");
+        }
+        if let Err(e) = self.outcomes.update_connections() {
+            self.stats.failed_connection_updates += 1;
+            tracing::debug!(device = %self.device, error = %e, "cannot connect new clients");
+        }
+    }
+
+    /// Drains every pending command (in arrival order, per client in sending order) and
+    /// answers every pending request, calling `handler`. Never blocks.
+    pub fn process<H: DeviceHandler<I>>(
+        &mut self,
+        handler: &mut H,
+    ) -> Result<Activity, ProcessError> {
+        // New clients get the latest state (history 1) now rather than at the next
+        // publication; cheap when no client came or went.
+        self.update_connections();
+        self.check_lease(handler)?;
+        let commands = self.process_commands(handler)?;
+        let requests = self.process_requests(handler)? + self.process_leases()?;
+        Ok(Activity { commands, requests })
+    }
+
+    /// For a busy-polling loop: drains the commands on every call, and looks for requests
+    /// only on every [`SPIN_REQUEST_EVERY`]th call (a request costs the server a poll of
+    /// ~100 ns; commands are the hot path). Never blocks.
+    pub fn process_spin<H: DeviceHandler<I>>(
+        &mut self,
+        handler: &mut H,
+    ) -> Result<Activity, ProcessError> {
+        self.spin_calls = self.spin_calls.wrapping_add(1);
+        let commands = self.process_commands(handler)?;
+        let requests = if self.spin_calls.is_multiple_of(SPIN_REQUEST_EVERY) {
+            self.update_connections();
+            self.check_lease(handler)?;
+            self.process_requests(handler)? + self.process_leases()?
+        } else {
+            0
+        };
+        Ok(Activity { commands, requests })
+    }
+
+    /// For the linger of an event-driven loop after activity ([`crate::event_loop::linger`]):
+    /// drains the commands and answers the requests and lease operations on every call, so
+    /// that a client's next request in a tight loop is answered within one poll instead of
+    /// up to [`SPIN_REQUEST_EVERY`] polls; connects new clients and checks the lease only on
+    /// every [`SPIN_REQUEST_EVERY`]th call. Never blocks.
+    pub fn process_linger<H: DeviceHandler<I>>(
+        &mut self,
+        handler: &mut H,
+    ) -> Result<Activity, ProcessError> {
+        self.spin_calls = self.spin_calls.wrapping_add(1);
+        if self.spin_calls.is_multiple_of(SPIN_REQUEST_EVERY) {
+            self.update_connections();
+            self.check_lease(handler)?;
+        }
+        let commands = self.process_commands(handler)?;
+        let requests = self.process_requests(handler)? + self.process_leases()?;
+        Ok(Activity { commands, requests })
+    }
+
+    /// Removes the resources of dead processes (crashed clients) from this device's
+    /// services (in group mode, of this user's processes only: README, Security). Cheap
+    /// enough for a 1 Hz housekeeping tick, not for every cycle.
+    pub fn cleanup_dead(&self) {
+        self.domain.cleanup_dead_nodes(&self.data_svc);
+        self.domain.cleanup_dead_nodes(&self.lease_svc);
+    }
+}

@@ -1,0 +1,220 @@
+//! Opening a device's channels: [`DeviceHost::new`].
+
+use core::marker::PhantomData;
+
+use iceoryx2::prelude::*;
+use iceoryx2::service::attribute::{AttributeKey, AttributeValue};
+use limber_interfaces::prelude::*;
+
+use super::arbiter::Arbiter;
+use super::{DeviceHost, HostError, HostStats};
+use crate::context::Context;
+use crate::error::Iox2Error;
+use crate::naming::{Channel, DeviceName, attr};
+use crate::qos;
+
+fn attribute_verifier(device: &DeviceName, driver: &str) -> Result<AttributeVerifier, HostError> {
+    let err = |e: Iox2Error| HostError::Transport {
+        device: device.to_string(),
+        channel: "attributes",
+        source: e,
+    };
+    let kv = |k: &str, v: &str| -> Result<(AttributeKey, AttributeValue), HostError> {
+        Ok((
+            AttributeKey::new(k.as_bytes()).map_err(|e| err(e.into()))?,
+            AttributeValue::new(v.as_bytes()).map_err(|e| err(e.into()))?,
+        ))
+    };
+    let mut v = AttributeVerifier::new();
+    for (k, val) in [
+        (attr::ROBOT, device.robot().to_string()),
+        (attr::INTERFACE, device.interface().name().to_string()),
+        (attr::INDEX, device.index().to_string()),
+        (attr::DRIVER, driver.to_string()),
+        (attr::LAYOUT, limber_interfaces::LAYOUT_VERSION.to_string()),
+    ] {
+        let (k, val) = kv(k, &val)?;
+        v = v.require(&k, &val).map_err(|e| err(e.into()))?;
+    }
+    Ok(v)
+}
+
+impl<I: Interface> DeviceHost<I> {
+    /// Offers `device` in the context's domain, as driver `driver` (shown by
+    /// `limber list`). The initial state is all zero: set it with [`DeviceHost::state_mut`]
+    /// and [`DeviceHost::publish`] before clients act on it.
+    pub fn new(ctx: &Context, device: &DeviceName, driver: &str) -> Result<Self, HostError> {
+        if device.interface() != I::KIND {
+            return Err(HostError::WrongInterface {
+                device: device.to_string(),
+                expected: I::KIND,
+            });
+        }
+        let node = ctx.node();
+        let dev = device.to_string();
+        let verifier = attribute_verifier(device, driver)?;
+        let transport = |channel: &'static str, e: Iox2Error| {
+            if e.is_incompatible_attributes_or_types() {
+                HostError::Incompatible {
+                    device: dev.clone(),
+                    source: e,
+                }
+            } else {
+                HostError::Transport {
+                    device: dev.clone(),
+                    channel,
+                    source: e,
+                }
+            }
+        };
+
+        let data_svc = node
+            .service_builder(&device.service_name(Channel::Data))
+            .publish_subscribe::<I::Data>()
+            .history_size(1)
+            .subscriber_max_buffer_size(qos::DATA_BUFFER)
+            .subscriber_max_borrowed_samples(qos::DATA_BORROWED)
+            .max_publishers(qos::DATA_PUBLISHERS)
+            .max_subscribers(qos::MAX_CLIENTS)
+            .max_nodes(qos::MAX_NODES)
+            .enable_safe_overflow(true)
+            .open_or_create_with_attributes(&verifier)
+            .map_err(|e| transport("data", e.into()))?;
+        // A live driver already publishing this device: refuse to serve it twice.
+        if data_svc.dynamic_config().number_of_publishers() > 0 {
+            ctx.domain().cleanup_dead_nodes(&data_svc);
+            if data_svc.dynamic_config().number_of_publishers() > 0 {
+                if let Some(owner) = ctx.domain().dead_node_of_another_user(&data_svc) {
+                    return Err(HostError::DeadDriverOfAnotherMember { device: dev, owner });
+                }
+                return Err(HostError::AlreadyServed { device: dev });
+            }
+        }
+        // One sample loaned ahead for the next publication, one for anybody else.
+        let publisher = data_svc
+            .publisher_builder()
+            .max_loaned_samples(2)
+            .create()
+            .map_err(|e| transport("data", e.into()))?;
+
+        let cmd_svc = node
+            .service_builder(&device.service_name(Channel::Cmd))
+            .publish_subscribe::<I::CmdMsg>()
+            .history_size(0)
+            .subscriber_max_buffer_size(qos::CMD_BUFFER)
+            .subscriber_max_borrowed_samples(2)
+            .max_publishers(qos::MAX_CLIENTS)
+            .max_subscribers(qos::CMD_SUBSCRIBERS)
+            .max_nodes(qos::MAX_NODES)
+            .enable_safe_overflow(true)
+            .open_or_create_with_attributes(&verifier)
+            .map_err(|e| transport("cmd", e.into()))?;
+        let commands = cmd_svc
+            .subscriber_builder()
+            .buffer_size(qos::CMD_BUFFER)
+            .create()
+            .map_err(|e| transport("cmd", e.into()))?;
+
+        let req_svc = node
+            .service_builder(&device.service_name(Channel::Req))
+            .request_response::<I::ReqMsg, I::ReplyMsg>()
+            .max_clients(qos::MAX_CLIENTS)
+            .max_servers(qos::REQ_SERVERS)
+            .max_nodes(qos::MAX_NODES)
+            .max_active_requests_per_client(qos::MAX_ACTIVE_REQUESTS)
+            .max_response_buffer_size(2)
+            .enable_fire_and_forget_requests(false)
+            .open_or_create_with_attributes(&verifier)
+            .map_err(|e| transport("req", e.into()))?;
+        let server = req_svc
+            .server_builder()
+            .create()
+            .map_err(|e| transport("req", e.into()))?;
+
+        let wake_svc = node
+            .service_builder(&device.service_name(Channel::Wake))
+            .event()
+            .max_listeners(qos::WAKE_LISTENERS)
+            .max_notifiers(qos::MAX_CLIENTS)
+            .max_nodes(qos::MAX_NODES)
+            .open_or_create_with_attributes(&verifier)
+            .map_err(|e| transport("wake", e.into()))?;
+        let wake = wake_svc
+            .listener_builder()
+            .create()
+            .map_err(|e| transport("wake", e.into()))?;
+
+        let notify_svc = node
+            .service_builder(&device.service_name(Channel::Notify))
+            .event()
+            .max_listeners(qos::MAX_CLIENTS)
+            .max_notifiers(qos::NOTIFY_NOTIFIERS)
+            .max_nodes(qos::MAX_NODES)
+            .open_or_create_with_attributes(&verifier)
+            .map_err(|e| transport("notify", e.into()))?;
+        let notify = notify_svc
+            .notifier_builder()
+            .create()
+            .map_err(|e| transport("notify", e.into()))?;
+
+        let outcomes = node
+            .service_builder(&device.service_name(Channel::Outcome))
+            .publish_subscribe::<OutcomeMsg>()
+            .history_size(0)
+            .subscriber_max_buffer_size(qos::OUTCOME_BUFFER)
+            .subscriber_max_borrowed_samples(2)
+            .max_publishers(qos::DATA_PUBLISHERS)
+            .max_subscribers(qos::MAX_CLIENTS)
+            .max_nodes(qos::MAX_NODES)
+            .enable_safe_overflow(true)
+            .open_or_create_with_attributes(&verifier)
+            .map_err(|e| transport("outcome", e.into()))?
+            .publisher_builder()
+            .max_loaned_samples(2)
+            .create()
+            .map_err(|e| transport("outcome", e.into()))?;
+
+        let lease_svc = node
+            .service_builder(&device.service_name(Channel::Lease))
+            .request_response::<LeaseReq, LeaseReply>()
+            .max_clients(qos::MAX_CLIENTS)
+            .max_servers(qos::REQ_SERVERS)
+            .max_nodes(qos::MAX_NODES)
+            .max_active_requests_per_client(qos::MAX_ACTIVE_REQUESTS)
+            .max_response_buffer_size(2)
+            .enable_fire_and_forget_requests(false)
+            .open_or_create_with_attributes(&verifier)
+            .map_err(|e| transport("lease", e.into()))?;
+        let lease_server = lease_svc
+            .server_builder()
+            .create()
+            .map_err(|e| transport("lease", e.into()))?;
+
+        // Group mode: this device's files open to the group at once.
+        ctx.domain().widen_now();
+        Ok(DeviceHost {
+            domain: ctx.domain().clone(),
+            device: device.clone(),
+            data_svc,
+            publisher,
+            commands,
+            server,
+            wake: Some(wake),
+            notify,
+            outcomes,
+            lease_svc,
+            lease_server,
+            arbiter: Arbiter::new(),
+            state: I::Data::default(),
+            seq: 0,
+            outcome: CmdOutcome::default(),
+            flags: 0,
+            stats: HostStats::default(),
+            publish_each_outcome: true,
+            spin_calls: 0,
+            state_loan: None,
+            outcome_loan: None,
+            _i: PhantomData,
+        })
+    }
+}
