@@ -44,7 +44,7 @@ pub enum BenchError {
     #[error("invalid argument: {0}")]
     Args(String),
     /// `--only` named a scenario that does not exist.
-    #[error("unknown scenario {name:?} (known: {known})")]
+    #[error("--only: unknown scenario {name:?}; the scenarios are {known} (see --list)")]
     UnknownScenario {
         /// The name given.
         name: String,
@@ -115,6 +115,17 @@ pub enum BenchError {
     /// One or more scenarios failed; the report (table, JSON, plot) was still written.
     #[error("{0} scenario(s) failed (see the report)")]
     ScenariosFailed(usize),
+}
+
+impl BenchError {
+    /// Whether the command line was wrong (an unknown scenario, a bad value): a usage
+    /// error (exit 2), not a failed run.
+    pub fn is_usage(&self) -> bool {
+        matches!(
+            self,
+            BenchError::Args(_) | BenchError::UnknownScenario { .. }
+        )
+    }
 }
 
 impl BenchError {

@@ -169,9 +169,10 @@ fn unknown_scenario_is_an_error_not_a_panic() {
         Command::new(env!("CARGO_BIN_EXE_limber-bench")).args(["--only", "nosuch"]),
         Duration::from_secs(60),
     );
-    assert!(!out.status.success());
+    assert_eq!(out.status.code(), Some(2), "a usage error");
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("unknown scenario"), "{err}");
+    assert!(err.contains("the scenarios are floor, "), "{err}");
     assert!(!err.contains("panicked"), "{err}");
 }
 

@@ -34,6 +34,7 @@ use zerocopy::{FromBytes, IntoBytes};
 use crate::allow::Allow;
 use crate::inbox::{Inbox, InboxError, Sender};
 use crate::keys::{self, TypeNames};
+use crate::malformed;
 use crate::session::{self, NetConfig, SessionError};
 use crate::waiting::{Attached, with_waitset};
 
@@ -227,8 +228,15 @@ trait ExposedDevice {
 impl<I: Interface> ExposedDevice for Exposed<I> {
     fn command(&mut self, session: &Session, origin: &str, payload: &[u8]) {
         let Ok(mut cmd) = I::CmdMsg::read_from_bytes(payload) else {
-            tracing::warn!(device = %self.device, origin, len = payload.len(),
-                "a command of the wrong size ({} expected): dropped", self.names.cmd);
+            malformed::note(
+                &self.device,
+                origin,
+                &format!(
+                    "a command of the wrong size ({} bytes, {} expected): dropped",
+                    payload.len(),
+                    self.names.cmd
+                ),
+            );
             return;
         };
         let meta = *cmd.meta();
@@ -255,12 +263,21 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
 
     fn query(&mut self, query: Query, timeout: Duration) {
         let Some(origin) = origin_of(query.attachment()) else {
+            malformed::note(
+                &self.device,
+                "?",
+                "a request without a valid origin: refused",
+            );
             refuse(&query, Status::InvalidArgument);
             return;
         };
         let bytes = query.payload().map(|p| p.to_bytes().into_owned());
         let Some(Ok(mut req)) = bytes.as_deref().map(I::ReqMsg::read_from_bytes) else {
-            tracing::warn!(device = %self.device, "a request of the wrong size: refused");
+            malformed::note(
+                &self.device,
+                &origin,
+                "a request of the wrong size: refused",
+            );
             refuse(&query, Status::InvalidArgument);
             return;
         };
@@ -293,12 +310,21 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
 
     fn lease(&mut self, query: Query, timeout: Duration) {
         let Some(origin) = origin_of(query.attachment()) else {
+            malformed::note(
+                &self.device,
+                "?",
+                "a lease request without a valid origin: refused",
+            );
             refuse(&query, Status::InvalidArgument);
             return;
         };
         let bytes = query.payload().map(|p| p.to_bytes().into_owned());
         let Some(Ok(mut req)) = bytes.as_deref().map(LeaseReq::read_from_bytes) else {
-            tracing::warn!(device = %self.device, "a lease request of the wrong size: refused");
+            malformed::note(
+                &self.device,
+                &origin,
+                "a lease request of the wrong size: refused",
+            );
             refuse(&query, Status::InvalidArgument);
             return;
         };
@@ -472,7 +498,7 @@ fn expose_device<I: Interface>(
         .declare_subscriber(keys::device_key(device, "cmd"))
         .callback(move |s: Sample| {
             let Some(origin) = origin_of(s.attachment()) else {
-                tracing::warn!(device = %d, "a command with an invalid origin: dropped");
+                malformed::note(&d, "?", "a command without a valid origin: dropped");
                 return;
             };
             let ev = Event::Command {
@@ -575,6 +601,7 @@ pub fn expose(
         next_liveness: Instant::now(),
     };
     let result = exposer.run(&inbox, stop, report);
+    malformed::summarise_now();
     drop(exposer);
     session::close(&session);
     result
@@ -653,6 +680,7 @@ impl Exposer<'_> {
     /// Looks for new devices and checks the drivers' life when their time has come;
     /// returns whether devices came or went.
     fn timers(&mut self, report: &mut dyn FnMut(ExposeEvent)) -> bool {
+        malformed::summarise_if_due();
         let now = Instant::now();
         let mut changed = false;
         if now >= self.next_discovery {

@@ -17,6 +17,7 @@ pub mod allow;
 pub mod expose;
 mod inbox;
 pub mod keys;
+mod malformed;
 pub mod mirror;
 mod session;
 mod waiting;

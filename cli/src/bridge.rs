@@ -26,14 +26,14 @@ enum Role {
     /// On the robot's PC: put every device of this domain on Zenoh (state, commands,
     /// requests, a liveliness token per device). Listens on loopback unless told otherwise.
     ///
-    /// Runs until SIGINT/SIGTERM; prints "exposed DEVICE" and "gone DEVICE" as drivers come
-    /// and go.
+    /// Runs until SIGINT, SIGTERM, SIGHUP (or SIGQUIT); prints "exposed DEVICE" and "gone
+    /// DEVICE" as drivers come and go.
     Expose(ExposeArgs),
     /// On another host: host the devices of a remote `expose` in this domain under the same
     /// names, so that unchanged clients use them.
     ///
-    /// Runs until SIGINT/SIGTERM; prints "mirrored DEVICE as NAME" and "gone NAME" as
-    /// remote devices come and go.
+    /// Runs until SIGINT, SIGTERM, SIGHUP (or SIGQUIT); prints "mirrored DEVICE as NAME" and
+    /// "gone NAME" as remote devices come and go.
     Mirror(MirrorArgs),
 }
 

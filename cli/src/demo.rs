@@ -237,6 +237,14 @@ fn step_name(s: &Step) -> String {
 /// Runs `limber demo`.
 pub fn run(a: DemoArgs) -> Result<(), CliError> {
     let domain = crate::domain()?;
+    // Before the robot starts: a termination signal stops the arm (the driver thread's
+    // loop ends), the other signals that would end a process are ignored.
+    limber_services::signals::install().map_err(|e| {
+        CliError::new(
+            exit::FAILURE,
+            format!("cannot install the signal handlers: {e}"),
+        )
+    })?;
     outln!(
         "limber demo: the paper's pick-a-block program on the {} (domain {}; watch it with `limber monitor` in another terminal)",
         match a.on {
@@ -357,6 +365,12 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
     });
     if closed {
         return Err(CliError::stdout_closed());
+    }
+    if limber_services::signals::termination_requested() {
+        return Err(CliError::new(
+            exit::FAILURE,
+            "stopped by a signal: the driver stopped the arm",
+        ));
     }
     match result {
         Ok(s) => {

@@ -4,6 +4,7 @@ use crate::{CliError, exit};
 use limber_emulator::{
     ArmpacLayout, Emulator, EmulatorConfig, EmulatorError, Faults, ObjectPlacement, Timing,
 };
+use limber_services::signals;
 use std::io::{Read, Write};
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
 use std::sync::Arc;
@@ -88,7 +89,7 @@ pub struct EmulatorArgs {
     #[arg(long)]
     pub watchdog_ms: Option<u64>,
     /// Keep running when stdin closes (for `&` in scripts, whose stdin is
-    /// /dev/null); stop with SIGINT/SIGTERM/SIGHUP only.
+    /// /dev/null); stop with SIGINT/SIGTERM/SIGHUP (or SIGQUIT) only.
     #[arg(long)]
     pub ignore_stdin: bool,
 }
@@ -148,9 +149,10 @@ impl EmulatorArgs {
     }
 }
 
-/// Runs `limber emulator` until SIGINT/SIGTERM/SIGHUP or until stdin closes (unless
-/// `--ignore-stdin`). The first line on stdout is the pty path or the TCP
-/// address.
+/// Runs `limber emulator` until a termination signal (SIGINT, SIGTERM, SIGHUP, SIGQUIT,
+/// SIGXCPU, SIGPWR: [`limber_services::signals`]) or until stdin closes (unless
+/// `--ignore-stdin`); the other signals that would end a process are ignored. The first
+/// line on stdout is the pty path or the TCP address.
 pub fn run(args: EmulatorArgs) -> Result<(), CliError> {
     serve(args).map_err(|e| {
         let code = match e {
@@ -163,6 +165,10 @@ pub fn run(args: EmulatorArgs) -> Result<(), CliError> {
 
 fn serve(args: EmulatorArgs) -> Result<(), EmulatorError> {
     let cfg = args.config()?;
+    // Before the first line: whoever read it may signal at once. The termination signals
+    // end it; the other signals that would end a process are ignored
+    // (limber_services::signals).
+    signals::install().map_err(std::io::Error::from)?;
     let emu = match args.tcp {
         Some(port) => Emulator::start_tcp(cfg, SocketAddr::new(args.bind, port))?,
         None => Emulator::start_pty(cfg)?,
@@ -180,9 +186,6 @@ fn serve(args: EmulatorArgs) -> Result<(), EmulatorError> {
         out.flush()?;
     }
     let stop = Arc::new(AtomicBool::new(false));
-    signal_hook::flag::register(signal_hook::consts::SIGINT, Arc::clone(&stop))?;
-    signal_hook::flag::register(signal_hook::consts::SIGTERM, Arc::clone(&stop))?;
-    signal_hook::flag::register(signal_hook::consts::SIGHUP, Arc::clone(&stop))?;
     if !args.ignore_stdin {
         let s = Arc::clone(&stop);
         std::thread::Builder::new()
@@ -194,7 +197,7 @@ fn serve(args: EmulatorArgs) -> Result<(), EmulatorError> {
                 s.store(true, Ordering::SeqCst);
             })?;
     }
-    while !stop.load(Ordering::SeqCst) {
+    while !stop.load(Ordering::SeqCst) && !signals::termination_requested() {
         if !emu.is_running() {
             break;
         }

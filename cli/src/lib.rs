@@ -158,9 +158,14 @@ where
         Command::Simarm(args) => simarm::run(args),
         #[cfg(feature = "bridge")]
         Command::Bridge(args) => bridge::run(args),
-        Command::Bench(args) => {
-            limber_bench::run_cli(args).map_err(|e| CliError::new(exit::FAILURE, e.to_string()))
-        }
+        Command::Bench(args) => limber_bench::run_cli(args).map_err(|e| {
+            let code = if e.is_usage() {
+                exit::USAGE
+            } else {
+                exit::FAILURE
+            };
+            CliError::new(code, e.to_string())
+        }),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -88,7 +88,8 @@ pub fn config_from(args: &PioneerArgs) -> Result<PioneerConfig, PioneerCliError>
     Ok(cfg)
 }
 
-/// Runs `limber pioneer` until SIGINT/SIGTERM/SIGHUP.
+/// Runs `limber pioneer` until a termination signal ([`limber_services::signals`]: SIGINT,
+/// SIGTERM, SIGHUP, SIGQUIT, SIGXCPU, SIGPWR), which stops the arm first.
 pub fn run(args: PioneerArgs) -> Result<(), CliError> {
     let to_cli = |e: PioneerCliError| {
         let code = match e {

@@ -95,9 +95,9 @@ fn parse_object(s: &str) -> Result<SimObject, String> {
     Ok(SimObject::block([v[0], v[1], v[2]], v[3]))
 }
 
-/// Runs `limber simarm` until SIGINT/SIGTERM/SIGHUP: joins the domain of `LIMBER_DOMAIN`,
-/// prints `serving <robot>/actarray/0, <robot>/limb/0, <robot>/gripper/0; ready` and
-/// serves.
+/// Runs `limber simarm` until a termination signal ([`limber_services::signals`]): joins
+/// the domain of `LIMBER_DOMAIN`, prints `serving <robot>/actarray/0, <robot>/limb/0,
+/// <robot>/gripper/0; ready` and serves.
 pub fn run(args: SimArmArgs) -> Result<(), CliError> {
     let fail = |e: SimArmError| CliError::new(exit::FAILURE, e.to_string());
     let chain = args

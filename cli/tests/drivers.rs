@@ -250,3 +250,43 @@ fn ok_means_it_on_the_emulated_pioneer() {
     refused(&limb(&["setposition", "1.5", "0", "0.3"]), "out of reach");
     assert_eq!(drv.term(), Some(0));
 }
+
+/// A finite approach vector whose length overflows (1e308 per component) is a direction
+/// like any other: SETPOSE answers for it what it answers for the unit vector, never "not
+/// finite" or "invalid argument" because a norm overflowed.
+#[test]
+fn setpose_with_a_huge_finite_approach_is_the_unit_approach() {
+    let d = Domain::unique_for_test();
+    let mut drv = Bg::spawn(d.name(), &["pioneer", "--emulated"]);
+    drv.line(|l| l.ends_with("ready"));
+    let setpose = |a: [&str; 3], o: [&str; 3]| {
+        let mut args = vec!["limb", "pioneer/limb/0", "setpose", "0.38", "0.1", "0.22"];
+        args.push("--approach");
+        args.extend(a);
+        args.push("--orient");
+        args.extend(o);
+        let out = limber(d.name(), &args);
+        (out.status.code(), stdout(&out), stderr(&out))
+    };
+    for (huge, unit, o) in [
+        (
+            ["0", "0", "-1e308"],
+            ["0", "0", "-1"],
+            ["0.94", "0.34", "0"],
+        ),
+        (
+            ["1e308", "1e308", "-1e308"],
+            ["1", "1", "-1"],
+            ["1", "0", "1"],
+        ),
+    ] {
+        let want = setpose(unit, o);
+        let got = setpose(huge, o);
+        assert_eq!(got, want, "approach {huge:?} against {unit:?}");
+        assert!(!got.2.contains("not finite"), "{got:?}");
+    }
+    // The first one is the README's pose: carried out.
+    let (code, out, _) = setpose(["0", "0", "-1e308"], ["0.94", "0.34", "0"]);
+    assert_eq!(code, Some(0), "{out}");
+    assert_eq!(drv.term(), Some(0));
+}

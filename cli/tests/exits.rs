@@ -210,3 +210,18 @@ fn a_closed_stdout_ends_the_demo_quietly() {
         assert!(!err.contains("panicked"), "{args:?}: {err}");
     }
 }
+
+/// `limber bench --only` with a scenario that does not exist is a usage error (exit 2),
+/// refused with a sentence that names the scenarios there are.
+#[test]
+fn bench_only_an_unknown_scenario_is_a_usage_error() {
+    let d = Domain::unique_for_test();
+    let o = limber(d.name(), &["bench", "--only", "nonsense"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(err.contains("unknown scenario \"nonsense\""), "{err}");
+    assert!(
+        err.contains("the scenarios are floor, state, command"),
+        "{err}"
+    );
+}

@@ -79,9 +79,8 @@ pub enum ContextError {
         #[source]
         source: NodeCreationFailure,
     },
-    /// The handlers of the termination signals (SIGINT, SIGTERM, SIGHUP) could not be
-    /// installed (driver contexts).
-    #[error("cannot install the SIGINT/SIGTERM/SIGHUP handlers: {0}")]
+    /// The signal handlers ([`crate::signals`]) could not be installed (driver contexts).
+    #[error("cannot install the signal handlers: {0}")]
     Signals(#[source] rustix::io::Errno),
 }
 
@@ -126,10 +125,11 @@ impl Context {
     /// Joins `domain` as a driver or a client named `name` (shown by `limber list`).
     ///
     /// iceoryx2's own log output is limited to errors unless `IOX2_LOG_LEVEL` says
-    /// otherwise. A client context leaves signals to the program; a driver context catches
-    /// SIGINT, SIGTERM and SIGHUP ([`crate::signals`]) so the driver loop can stop its
-    /// hardware and end cleanly (see [`Context::termination_requested`]); other signals do
-    /// not end it.
+    /// otherwise. A client context leaves signals to the program; a driver context installs
+    /// [`crate::signals`]: the termination signals (SIGINT, SIGTERM, SIGHUP, SIGQUIT,
+    /// SIGXCPU, SIGPWR) let the driver loop stop its hardware and end cleanly (see
+    /// [`Context::termination_requested`]); the other signals that would end a process are
+    /// ignored.
     pub fn new(domain: &Domain, role: Role, name: &str) -> Result<Self, ContextError> {
         set_log_level_from_env_or(LogLevel::Error);
         let prefix = match role {
@@ -221,8 +221,9 @@ impl Context {
         &self.inner.node
     }
 
-    /// True once SIGINT, SIGTERM or SIGHUP arrived (driver contexts only; always false
-    /// for clients, whose signals are the program's own). Other signals never make it true.
+    /// True once a termination signal ([`crate::signals::TERMINATION_SIGNALS`]) arrived
+    /// (driver contexts only; always false for clients, whose signals are the program's
+    /// own). Other signals never make it true.
     pub fn termination_requested(&self) -> bool {
         self.inner.role == Role::Driver && crate::signals::termination_requested()
     }

@@ -1,8 +1,8 @@
 //! The driver loop's waiting: a WaitSet over the wake listeners of a driver's devices, a
 //! precise periodic timer (`timerfd`, not the WaitSet's 1 ms-rounded interval) and any
 //! other file descriptor (a serial port), returning on a termination request (SIGINT,
-//! SIGTERM, SIGHUP: [`crate::signals`]) and on nothing else: a signal that merely
-//! interrupts the wait (SIGCONT, SIGWINCH, SIGCHLD...) is waited through.
+//! SIGTERM, SIGHUP, SIGQUIT, SIGXCPU, SIGPWR: [`crate::signals`]) and on nothing else: a
+//! signal that merely interrupts the wait (SIGCONT, SIGALRM, SIGUSR1...) is waited through.
 
 use core::ops::ControlFlow;
 use core::time::Duration;
@@ -39,7 +39,7 @@ pub enum LoopError {
 /// Why the loop returned.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LoopExit {
-    /// A termination request arrived (SIGINT, SIGTERM or SIGHUP).
+    /// A termination request arrived ([`crate::signals::TERMINATION_SIGNALS`]).
     Signal,
     /// The callback asked to stop.
     Stopped,
@@ -140,7 +140,7 @@ impl SynchronousMultiplexing for FdSource {}
 
 /// Runs the loop of a driver: waits on the wake `listeners` of its devices, a timer of
 /// `period`, and `extra` (e.g. the serial port), and calls `on` for each wake-up until it
-/// returns `Break` or a termination request (SIGINT, SIGTERM, SIGHUP) arrives; any other
+/// returns `Break` or a termination request ([`crate::signals`]) arrives; any other
 /// signal that interrupts the wait is waited through. Listener events are consumed before
 /// `on` runs.
 pub fn run<F>(

@@ -25,7 +25,12 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("limber-bench: {e}");
-            ExitCode::FAILURE
+            // 2: usage, as clap's own errors and the `limber` verbs.
+            if e.is_usage() {
+                ExitCode::from(2)
+            } else {
+                ExitCode::FAILURE
+            }
         }
     }
 }

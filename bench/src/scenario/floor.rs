@@ -15,7 +15,7 @@
 
 use std::time::{Duration, Instant};
 
-use iceoryx2::port::listener::Listener;
+use iceoryx2::port::listener::{Listener, ListenerWaitError};
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
@@ -189,8 +189,7 @@ fn recv_pong(
                         timeout,
                     });
                 }
-                l.timed_wait(|_| {}, left)
-                    .map_err(|e| BenchError::transport("wait for pong", e))?;
+                wait_through_signals(l, left, "wait for pong")?;
             }
             None => {
                 spins = spins.wrapping_add(1);
@@ -452,8 +451,7 @@ pub fn echo_role(args: &BenchArgs, echo: Echo) -> Result<(), BenchError> {
                         .map_err(|e| BenchError::transport("echo waitset wait", e))?;
                     }
                     _ => {
-                        l.timed_wait(|_| {}, Duration::from_millis(50))
-                            .map_err(|e| BenchError::transport("echo wait", e))?;
+                        wait_through_signals(l, Duration::from_millis(50), "echo wait")?;
                     }
                 }
                 if Instant::now() > deadline {
@@ -474,5 +472,18 @@ pub fn echo_role(args: &BenchArgs, echo: Echo) -> Result<(), BenchError> {
                 core::hint::spin_loop();
             }
         }
+    }
+}
+
+/// `l.timed_wait` for up to `d`, for a loop that looks again after it: a wait interrupted
+/// by a signal (a stop and continue, Ctrl-Z and `fg`) is no failure.
+fn wait_through_signals(
+    l: &Listener<ipc::Service>,
+    d: Duration,
+    what: &'static str,
+) -> Result<(), BenchError> {
+    match l.timed_wait(|_| {}, d) {
+        Ok(_) | Err(ListenerWaitError::InterruptSignal) => Ok(()),
+        Err(e) => Err(BenchError::transport(what, e)),
     }
 }

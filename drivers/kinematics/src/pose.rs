@@ -82,16 +82,17 @@ impl Pose {
         {
             return Err(FrameError::NonFinite);
         }
-        let na = approach.norm();
-        if na < 1e-12 {
+        // The norm of a finite vector may overflow (1e308, 1e308, -1e308): such a vector
+        // is long, not zero, and its direction comes from [`unit_direction`], which scales
+        // before it normalises (dividing by an infinite norm would give a zero vector).
+        if approach.norm() < 1e-12 {
             return Err(FrameError::ZeroApproach);
         }
-        let no = orientation.norm();
-        if no < 1e-12 {
+        if orientation.norm() < 1e-12 {
             return Err(FrameError::ZeroOrientation);
         }
-        let a = approach / na;
-        let o = orientation / no;
+        let a = unit_direction(&approach).ok_or(FrameError::ZeroApproach)?;
+        let o = unit_direction(&orientation).ok_or(FrameError::ZeroOrientation)?;
         let cos = a.dot(&o).clamp(-1.0, 1.0);
         let deviation = cos.abs().asin();
         if deviation > tolerance.max(0.0) {
@@ -231,5 +232,31 @@ mod tests {
             1e-6,
         );
         assert!(matches!(e, Err(FrameError::NotPerpendicular { .. })));
+    }
+
+    /// A finite vector whose norm overflows is a long vector with a direction, not a
+    /// zero or non-finite one: the frame is the one of the unit vectors.
+    #[test]
+    fn frame_from_vectors_whose_norm_overflows() {
+        let big = Pose::from_approach_orientation(
+            Vector3::zeros(),
+            Vector3::new(1e308, 1e308, -1e308),
+            Vector3::new(f64::MAX, 0.0, f64::MAX),
+            1e-6,
+        )
+        .unwrap();
+        let unit = Pose::from_approach_orientation(
+            Vector3::zeros(),
+            Vector3::new(1.0, 1.0, -1.0),
+            Vector3::new(1.0, 0.0, 1.0),
+            1e-6,
+        )
+        .unwrap();
+        assert!(big.is_finite());
+        assert!((big.approach() - unit.approach()).norm() < 1e-15, "{big:?}");
+        assert!(
+            (big.orientation() - unit.orientation()).norm() < 1e-15,
+            "{big:?}"
+        );
     }
 }

@@ -4,6 +4,7 @@
 use core::time::Duration;
 use std::time::Instant;
 
+use iceoryx2::port::listener::ListenerWaitError;
 use limber_interfaces::prelude::*;
 
 use super::{Client, LIVENESS_PERIOD, OUTCOME_SLOTS, Outcome, Ticket, WaitError};
@@ -324,7 +325,16 @@ impl<I: Interface> Client<I> {
                     return Ok(());
                 }
                 if let Some(l) = &self.notify {
-                    l.timed_wait(|_| {}, left)?;
+                    match l.timed_wait(|_| {}, left) {
+                        // A signal interrupted the wait (a stop and continue, Ctrl-Z and
+                        // `fg`, interrupts it even without a handler): no failure. The
+                        // caller's loop looks again and waits what is left of its timeout.
+                        Err(ListenerWaitError::InterruptSignal) => {
+                            tracing::debug!(device = %self.device, "a wait was interrupted by a signal: resumed");
+                        }
+                        Err(e) => return Err(e.into()),
+                        Ok(_woken) => {}
+                    }
                 }
                 Ok(())
             }

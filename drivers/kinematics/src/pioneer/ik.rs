@@ -358,11 +358,11 @@ impl PioneerGeometry {
         if !(all_finite(position) && all_finite(approach)) {
             return Err(PioneerIkError::NonFinite);
         }
-        let na = approach.norm();
-        if na < 1e-12 {
+        if approach.norm() < 1e-12 {
             return Err(FrameError::ZeroApproach.into());
         }
-        let a = approach / na;
+        // Scaled before it is normalised: a finite vector whose norm overflows is long.
+        let a = crate::pose::unit_direction(approach).ok_or(FrameError::ZeroApproach)?;
         self.candidates(
             position,
             WristGoal::Approach(&a),

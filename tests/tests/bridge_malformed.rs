@@ -1,0 +1,111 @@
+//! The exposing bridge under a flood of malformed messages from the network (commands of
+//! the wrong size, commands and requests without a valid origin): it logs the first one
+//! and then a count, not one line per message, and keeps serving.
+
+use std::path::PathBuf;
+use std::process::Command;
+use std::time::Duration;
+
+use limber_services::Domain;
+use limber_tests::Proc;
+use zenoh::Wait;
+use zenoh::qos::CongestionControl;
+
+const CLI: &str = env!("CARGO_BIN_EXE_limber-test-cli");
+
+fn free_port() -> u16 {
+    std::net::TcpListener::bind("127.0.0.1:0")
+        .and_then(|l| l.local_addr())
+        .map(|a| a.port())
+        .expect("a free loopback port")
+}
+
+/// A Zenoh client session of the test's own, connected to `endpoint` only.
+fn session(endpoint: &str) -> zenoh::Session {
+    let mut config = zenoh::Config::default();
+    for (key, value) in [
+        ("mode", "\"client\"".to_string()),
+        ("connect/endpoints", format!("[\"{endpoint}\"]")),
+        ("scouting/multicast/enabled", "false".to_string()),
+    ] {
+        config.insert_json5(key, &value).unwrap();
+    }
+    zenoh::open(config).wait().unwrap()
+}
+
+#[test]
+fn a_flood_of_malformed_messages_is_counted_not_logged_one_by_one() {
+    let a = Domain::unique_for_test();
+    let endpoint = format!("tcp/127.0.0.1:{}", free_port());
+    let mut driver = Proc::spawn(CLI, a.name(), &["pioneer", "--emulated"]);
+    assert!(driver.read_until(|l| l.ends_with("ready")).is_some());
+    let log = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("bridge-malformed-{}.log", std::process::id()));
+    let mut c = Command::new("sh");
+    c.args([
+        "-c",
+        "exec \"$0\" bridge expose --listen \"$1\" 2>\"$2\"",
+        CLI,
+        &endpoint,
+        log.to_str().unwrap(),
+    ])
+    .env("LIMBER_DOMAIN", a.name());
+    let mut expose = Proc::spawn_command(c);
+    assert!(
+        expose
+            .read_until(|l| l == "exposed pioneer/actarray/0")
+            .is_some()
+    );
+    let s = session(&endpoint);
+    let cmd = "limber/pioneer/actarray/0/cmd";
+    // 1,000 commands of the wrong size, 788 without a valid origin.
+    for i in 0..1788 {
+        let origin = if i < 1000 {
+            "tester"
+        } else {
+            "not a valid origin!"
+        };
+        s.put(cmd, vec![0u8; 3])
+            .attachment(origin)
+            .congestion_control(CongestionControl::Block)
+            .wait()
+            .unwrap();
+    }
+    // Then a request of the wrong size, refused: its answer comes after the commands
+    // before it were handled (one link, handled in order).
+    let replies = s
+        .get("limber/pioneer/actarray/0/req")
+        .payload(vec![0u8; 5])
+        .attachment("tester")
+        .timeout(Duration::from_secs(10))
+        .wait()
+        .unwrap();
+    let reply = replies.recv().expect("the bridge answers the request");
+    assert!(
+        reply.result().is_err(),
+        "a malformed request was answered ok"
+    );
+    s.close().wait().unwrap();
+    expose.signal(libc::SIGTERM);
+    assert_eq!(expose.wait_timeout(Duration::from_secs(10)), Some(0));
+    driver.signal(libc::SIGTERM);
+    assert_eq!(driver.wait_timeout(Duration::from_secs(10)), Some(0));
+    let text = std::fs::read_to_string(&log).unwrap();
+    std::fs::remove_file(&log).unwrap();
+    let lines: Vec<&str> = text
+        .lines()
+        .filter(|l| {
+            l.contains("malformed") || l.contains("wrong size") || l.contains("valid origin")
+        })
+        .collect();
+    assert!(
+        lines.len() <= 3,
+        "{} log lines about 1,789 malformed messages:\n{}",
+        lines.len(),
+        lines[..lines.len().min(10)].join("\n")
+    );
+    assert!(
+        text.contains("(1789 in all)"),
+        "no count of all 1,789 malformed messages:\n{text}"
+    );
+}
