@@ -39,7 +39,18 @@ import sys
 import weakref
 from ctypes import byref, c_bool, c_double, c_int32, c_size_t, c_uint64, c_void_p, sizeof
 from dataclasses import dataclass
-from typing import Any, ClassVar, Dict, Generic, Optional, Sequence, Tuple, Type, TypeVar
+from typing import (
+    Any,
+    ClassVar,
+    Dict,
+    Generic,
+    NamedTuple,
+    Optional,
+    Sequence,
+    Tuple,
+    Type,
+    TypeVar,
+)
 
 from . import _layout as L
 from . import _lib
@@ -235,35 +246,16 @@ def default_spin_budget() -> float:
     return us / 1e6
 
 
-class Ticket:
+class Ticket(NamedTuple):
     """A command that was sent, to wait for its outcome (Rust ``Ticket``). Immutable."""
-
-    __slots__ = ("seq", "receivers")
 
     #: The command's sequence number (per client, from 1).
     seq: int
     #: How many driver processes received it (normally 1).
     receivers: int
 
-    def __init__(self, seq: int, receivers: int) -> None:
-        object.__setattr__(self, "seq", seq)
-        object.__setattr__(self, "receivers", receivers)
 
-    def __setattr__(self, name: str, value: object) -> None:
-        raise AttributeError("a Ticket is immutable")
-
-    def __eq__(self, other: object) -> bool:
-        return (
-            isinstance(other, Ticket)
-            and other.seq == self.seq
-            and other.receivers == self.receivers
-        )
-
-    def __hash__(self) -> int:
-        return hash((self.seq, self.receivers))
-
-    def __repr__(self) -> str:
-        return f"Ticket(seq={self.seq}, receivers={self.receivers})"
+_tuple_new = tuple.__new__
 
 
 # ----- errors ----------------------------------------------------------------------------
@@ -816,14 +808,24 @@ class _Client(Generic[_D]):
         if rc:
             raise self._fail(rc)
         t = self._ticket
-        return Ticket(t.seq, t.receivers)
+        return _tuple_new(Ticket, (t.seq, t.receivers))
 
     def wait_outcome(self, ticket: Ticket, timeout: float) -> Status:
         """Waits up to ``timeout`` s for the outcome of the command of ``ticket`` and returns
         its :class:`Status` (``Status.OK`` if carried out). When it returns, the latest state
         shows the command. Raises :class:`OutcomeMissed`, :class:`WaitTimeout` or
         :class:`DriverGoneError`."""
-        return self.outcome(ticket, timeout).status
+        tk = self._tk
+        tk.seq, tk.receivers = ticket
+        s = float(timeout)
+        if not 0.0 <= s <= 1e9:
+            raise ValueError(f"timeout must be a finite number of seconds >= 0, not {timeout!r}")
+        rc = _outcome(self._h, tk, math.ceil(s * 1000.0), self._out_ref)
+        if rc:
+            if rc == _lib.CODE_OUTCOME_MISSED and self._h is not None:
+                raise _error(rc, newer_seq=self._out.seq)
+            raise self._fail(rc)
+        return _STATUS.get(self._out.status, Status.INVALID_ARGUMENT)
 
     def outcome(self, ticket: Ticket, timeout: float) -> Outcome:
         """As :meth:`wait_outcome`, with the other client involved (the holder of the device
@@ -1013,7 +1015,7 @@ class ActArrayClient(_Client[L.ActArrayData]):
         if rc:
             raise self._fail(rc)
         t = self._ticket
-        return Ticket(t.seq, t.receivers)
+        return _tuple_new(Ticket, (t.seq, t.receivers))
 
     def move_to_multi(self, positions: Sequence[float]) -> Ticket:
         """CMD MULTI_POS: move joints 0..n to ``positions``."""
