@@ -378,6 +378,18 @@ def _error(code: int, timeout: "Type[LimberError]" = WaitTimeout, newer_seq: int
     return cls(message)
 
 
+def _check_layout(what: str) -> None:
+    """IncompatibleError unless this package's ``_layout.py`` is of the layout version the
+    library speaks (``limber_layout_version``)."""
+    ours = _c.limber_layout_version()
+    if L.LAYOUT_VERSION != ours:
+        raise IncompatibleError(
+            f"{what} is incompatible: this package's limber/_layout.py is layout version "
+            f"{L.LAYOUT_VERSION}, but liblimber ({_lib.path}) speaks layout version {ours}: "
+            "use the limber package built with this library"
+        )
+
+
 def _ms(what: str, seconds: float) -> int:
     """Seconds as whole milliseconds (rounded up), for the library; ValueError when it is
     not a finite number >= 0."""
@@ -630,13 +642,7 @@ class _Client(Generic[_D]):
         dom = Domain(domain) if not isinstance(domain, Domain) else domain
         wait_ms = _ms("timeout", timeout)
         req_ms = _ms("request_timeout", request_timeout)
-        ours = _c.limber_layout_version()
-        if L.LAYOUT_VERSION != ours:
-            raise IncompatibleError(
-                f"{device} is incompatible: this package's limber/_layout.py is layout version "
-                f"{L.LAYOUT_VERSION}, but liblimber ({_lib.path}) speaks layout version {ours}: "
-                "use the limber package built with this library"
-            )
+        _check_layout(device)
         rc = _c.limber_set_program_name((name or _default_process_name()).encode("utf-8"))
         if rc:
             raise _error(rc)
@@ -1246,6 +1252,7 @@ class DriverStatsReader:
         :class:`ValueError` for a bad robot name, :class:`TransportError` otherwise."""
         if not isinstance(robot, str):
             raise ValueError(f"a robot name is a string, not {robot!r}")
+        _check_layout(f"the statistics of {robot}")
         rc = _c.limber_set_program_name(_default_process_name().encode("utf-8"))
         if rc:
             raise _error(rc)

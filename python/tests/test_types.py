@@ -65,3 +65,22 @@ def test_the_public_api_is_fully_annotated():
             missing.append((qual, bad))
     assert checked > 50
     assert missing == []
+
+
+def test_every_c_function_called_has_its_prototype():
+    """Each liblimber function the package calls is in the one table of prototypes
+    (argtypes and restype set at load), so that a wrong call is a Python error."""
+    import re
+
+    from limber import _lib
+
+    called = set()
+    for name in os.listdir(PKG):
+        if name.endswith(".py") and name != "_lib.py":
+            with open(os.path.join(PKG, name)) as f:
+                called |= set(re.findall(r"\.(limber_[a-z0-9_]+)\b", f.read()))
+    assert called, "no C call found"
+    assert sorted(called - set(_lib.PROTOTYPES)) == []
+    for name, (res, args) in _lib.PROTOTYPES.items():
+        f = getattr(_lib.lib, name)
+        assert f.argtypes == args and f.restype is res, name
