@@ -84,3 +84,17 @@ def test_every_c_function_called_has_its_prototype():
     for name, (res, args) in _lib.PROTOTYPES.items():
         f = getattr(_lib.lib, name)
         assert f.argtypes == args and f.restype is res, name
+
+
+def test_the_package_imports_no_iceoryx2(tmp_path):
+    """Every rule is liblimber's: the package does not use the iceoryx2 binding."""
+    import subprocess
+
+    for name in os.listdir(PKG):
+        if name.endswith(".py"):
+            with open(os.path.join(PKG, name)) as f:
+                assert "import iceoryx2" not in f.read(), name
+    script = "import sys, limber; assert 'iceoryx2' not in sys.modules; print('ok')"
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         timeout=60, env=dict(os.environ, PYTHONPATH=os.path.dirname(PKG)))
+    assert out.stdout.strip() == "ok", out.stderr
