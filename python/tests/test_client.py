@@ -633,11 +633,11 @@ def test_python_and_rust_clients_command_one_device_together(own_driver):
 def test_every_limber_code_has_its_exception_and_the_library_s_message(driver):
     """One table maps each LIMBER_CODE_* to its exception; the message is
     limber_last_error()'s."""
-    from limber import _lib, client
+    from limber import _lib, _types
 
     codes = [c for c in range(1, 64) if _lib.lib.limber_strerror(c) != b"unknown limber code"]
     assert codes == list(range(1, 16))
-    assert sorted(client._ERRORS) == codes
+    assert sorted(_types._ERRORS) == codes
     with pytest.raises(NoDriverError) as e:
         ActArrayClient.connect("nobody/actarray/0", driver.domain)
     assert str(e.value) == _lib.last_error()

@@ -38,7 +38,7 @@ def public_callables():
             yield name, obj
         elif inspect.isclass(obj):
             for klass in obj.__mro__:
-                if klass.__module__ != client.__name__:
+                if not klass.__module__.startswith("limber."):
                     continue
                 for n, f in vars(klass).items():
                     if n.startswith("_") and n not in ("__init__", "__enter__", "__exit__"):
