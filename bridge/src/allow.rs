@@ -150,9 +150,31 @@ fn kinds_of(interface: InterfaceKind, suffix: &str) -> Vec<(String, u32)> {
         .collect()
 }
 
-/// The command kinds of `interface`: (lower-case name, code), from the layout manifest.
-fn kinds(interface: InterfaceKind) -> Vec<(String, u32)> {
-    kinds_of(interface, "CMD")
+/// `interface:kind` of the manifest's `<INTERFACE>_<suffix>` group (`CMD`, `REQ`): the
+/// kind, or the list of every `interface:kind` there is (for the error).
+fn parse_kind(s: &str, suffix: &str) -> Result<CommandKind, String> {
+    let unknown = || {
+        InterfaceKind::ALL
+            .iter()
+            .flat_map(|i| {
+                kinds_of(*i, suffix)
+                    .into_iter()
+                    .map(move |(n, _)| format!("{i}:{n}"))
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let (interface, kind) = s.split_once(':').ok_or_else(unknown)?;
+    let interface = InterfaceKind::from_name(interface).ok_or_else(unknown)?;
+    let kind = kind.to_ascii_lowercase();
+    kinds_of(interface, suffix)
+        .into_iter()
+        .find(|(n, _)| *n == kind)
+        .map(|(_, code)| CommandKind {
+            interface,
+            kind: code,
+        })
+        .ok_or_else(unknown)
 }
 
 impl std::str::FromStr for RequestKind {
@@ -160,31 +182,12 @@ impl std::str::FromStr for RequestKind {
     /// `interface:kind`, e.g. `actarray:power`, `limb:speed` (the names of the layout
     /// manifest's `*_REQ` constants, any case).
     fn from_str(s: &str) -> Result<Self, AllowError> {
-        let unknown = || AllowError::Request {
-            given: s.to_string(),
-            known: InterfaceKind::ALL
-                .iter()
-                .flat_map(|i| {
-                    kinds_of(*i, "REQ")
-                        .into_iter()
-                        .map(move |(n, _)| format!("{i}:{n}"))
-                })
-                .collect::<Vec<_>>()
-                .join(", "),
-        };
-        let (interface, kind) = s.split_once(':').ok_or_else(unknown)?;
-        let interface = InterfaceKind::from_name(interface).ok_or_else(unknown)?;
-        let kind = kind.to_ascii_lowercase();
-        kinds_of(interface, "REQ")
-            .into_iter()
-            .find(|(n, _)| *n == kind)
-            .map(|(_, code)| {
-                RequestKind(CommandKind {
-                    interface,
-                    kind: code,
-                })
+        parse_kind(s, "REQ")
+            .map(RequestKind)
+            .map_err(|known| AllowError::Request {
+                given: s.to_string(),
+                known,
             })
-            .ok_or_else(unknown)
     }
 }
 
@@ -193,25 +196,10 @@ impl std::str::FromStr for CommandKind {
     /// `interface:kind`, e.g. `actarray:pos`, `gripper:open` (the names of the layout
     /// manifest's `*_CMD` constants, any case).
     fn from_str(s: &str) -> Result<Self, AllowError> {
-        let unknown = || AllowError::Command {
+        parse_kind(s, "CMD").map_err(|known| AllowError::Command {
             given: s.to_string(),
-            known: InterfaceKind::ALL
-                .iter()
-                .flat_map(|i| kinds(*i).into_iter().map(move |(n, _)| format!("{i}:{n}")))
-                .collect::<Vec<_>>()
-                .join(", "),
-        };
-        let (interface, kind) = s.split_once(':').ok_or_else(unknown)?;
-        let interface = InterfaceKind::from_name(interface).ok_or_else(unknown)?;
-        let kind = kind.to_ascii_lowercase();
-        kinds(interface)
-            .into_iter()
-            .find(|(n, _)| *n == kind)
-            .map(|(_, code)| CommandKind {
-                interface,
-                kind: code,
-            })
-            .ok_or_else(unknown)
+            known,
+        })
     }
 }
 

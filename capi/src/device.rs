@@ -262,6 +262,28 @@ pub unsafe extern "C" fn limber_device_interface(
     })
 }
 
+/// A state that `take` gives, copied to `out` (`size` bytes): the body of the calls that
+/// copy a state out (state, last state, wait state).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or points to `size` writable bytes.
+unsafe fn state_into(
+    h: *mut LimberDevice,
+    out: *mut c_void,
+    size: usize,
+    take: impl FnOnce(&mut dyn DeviceClient) -> Result<&[u8], Fail>,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the handle, checked for NULL here.
+        let h = unsafe { arg(h, "handle")? };
+        h.not_borrowed()?;
+        let kind = h.client.kind();
+        let bytes = take(&mut *h.client)?;
+        // SAFETY: the caller's promise on `out` and `size`.
+        unsafe { copy_out("state", bytes, out, size, kind) }
+    })
+}
+
 /// Copies the latest state into `*out`, a struct of `size` bytes (the device's state
 /// struct: `limber_actarray_data`, ...; another size is `LIMBER_CODE_INCOMPATIBLE`),
 /// waiting up to `timeout_ms` for a first one (`LIMBER_CODE_TIMEOUT` if none came).
@@ -275,15 +297,8 @@ pub unsafe extern "C" fn limber_device_state(
     out: *mut c_void,
     size: usize,
 ) -> LimberCode {
-    guard(|| {
-        // SAFETY: the caller's promise on the handle, checked for NULL here.
-        let h = unsafe { arg(h, "handle")? };
-        h.not_borrowed()?;
-        let kind = h.client.kind();
-        let bytes = h.client.current_bytes(ms(timeout_ms))?;
-        // SAFETY: the caller's promise on `out` and `size`.
-        unsafe { copy_out("state", bytes, out, size, kind) }
-    })
+    // SAFETY: forwarded from the caller.
+    unsafe { state_into(h, out, size, |c| Ok(c.current_bytes(ms(timeout_ms))?)) }
 }
 
 /// Copies the latest state already taken into `*out` (a struct of `size` bytes, as
@@ -298,18 +313,13 @@ pub unsafe extern "C" fn limber_device_last_state(
     out: *mut c_void,
     size: usize,
 ) -> LimberCode {
-    guard(|| {
-        // SAFETY: the caller's promise on the handle, checked for NULL here.
-        let h = unsafe { arg(h, "handle")? };
-        h.not_borrowed()?;
-        let kind = h.client.kind();
-        let bytes = h
-            .client
-            .state_bytes()
-            .ok_or_else(|| Fail::new(LimberCode::Timeout, "no state was taken yet"))?;
-        // SAFETY: the caller's promise on `out` and `size`.
-        unsafe { copy_out("state", bytes, out, size, kind) }
-    })
+    // SAFETY: forwarded from the caller.
+    unsafe {
+        state_into(h, out, size, |c| {
+            c.state_bytes()
+                .ok_or_else(|| Fail::new(LimberCode::Timeout, "no state was taken yet"))
+        })
+    }
 }
 
 /// Lends the latest state in place, without a copy (waiting up to `timeout_ms` for a
@@ -404,18 +414,18 @@ pub unsafe extern "C" fn limber_device_wait_state(
     out: *mut c_void,
     size: usize,
 ) -> LimberCode {
-    guard(|| {
-        // SAFETY: the caller's promise on the handle, checked for NULL here.
-        let h = unsafe { arg(h, "handle")? };
-        h.not_borrowed()?;
-        let kind = h.client.kind();
-        let bytes = h.client.wait_state_bytes(ms(timeout_ms))?;
-        if out.is_null() {
-            return Ok(());
-        }
-        // SAFETY: the caller's promise on `out` and `size`.
-        unsafe { copy_out("state", bytes, out, size, kind) }
-    })
+    if out.is_null() {
+        // Waited for, not copied.
+        return guard(|| {
+            // SAFETY: the caller's promise on the handle, checked for NULL here.
+            let h = unsafe { arg(h, "handle")? };
+            h.not_borrowed()?;
+            h.client.wait_state_bytes(ms(timeout_ms))?;
+            Ok(())
+        });
+    }
+    // SAFETY: forwarded from the caller.
+    unsafe { state_into(h, out, size, |c| Ok(c.wait_state_bytes(ms(timeout_ms))?)) }
 }
 
 /// Waits up to `timeout_ms` for the outcome of the command of `ticket` and writes it to
