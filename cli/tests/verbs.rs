@@ -148,11 +148,17 @@ fn echo_prints_states_as_text_and_json() {
         let v: serde_json::Value = serde_json::from_str(line).unwrap();
         assert_eq!(v["device"], "cli/limb/0");
         assert!(v["header"]["seq"].as_u64().unwrap() > 0);
-        assert_eq!(v["state"], "idle");
+        assert_eq!(v["state_name"], "idle");
+        assert!(v["position"]["x"].is_f64(), "a limber_vec3: {v}");
     }
     let o = limber(dom, &["echo", "cli/gripper/0", "--json", "--count", "1"]);
     let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
-    assert_eq!(v["state"], "open");
+    assert_eq!(v["state_name"], "open");
+    assert_eq!(
+        v["state"],
+        limber_services::prelude::GripperState::Open as u32,
+        "the code, as in limber_gripper_data"
+    );
     let o = limber(dom, &["echo", "nobody/gripper/0", "--count", "1"]);
     assert_eq!(o.status.code(), Some(3));
 }

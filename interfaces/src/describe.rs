@@ -17,26 +17,37 @@ use crate::limb::{LimbData, LimbState};
 pub trait Describe {
     /// One human-readable line.
     fn human(&self) -> String;
-    /// One JSON object (the schema of `limber echo --json`).
+    /// One JSON object (the schema of `limber echo --json`, docs/echo-json.md): the fields
+    /// of the state's C struct (limber.h) by their names, with their values (codes as
+    /// numbers, vectors as `{"x", "y", "z"}`, the `actuators` array cut to
+    /// `actuators_count`), and beside each code its name (`state_name`, `status_name`).
     fn json(&self) -> Value;
 }
 
-/// The JSON of a state header (`"header"` of every state).
+/// The JSON of a state header (`"header"` of every state): the fields of
+/// `limber_state_header` by their C names and values, and beside them what they mean
+/// (`link_up`, `calibrated` from `flags`; `status_name` of `last_cmd.status`).
 pub fn header_json(h: &StateHeader) -> Value {
     json!({
         "seq": h.seq,
         "stamp_ns": h.stamp_ns,
-        "link_up": h.flags & device_flag::LINK_UP != 0,
-        "calibrated": h.flags & device_flag::CALIBRATED != 0,
-        "flags": h.flags,
-        "cmd_overflows": h.cmd_overflows,
         "last_cmd": {
             "client_id": h.last_cmd.client_id,
-            "seq": h.last_cmd.cmd_seq,
+            "cmd_seq": h.last_cmd.cmd_seq,
             "kind": h.last_cmd.kind,
-            "status": Status::try_from(h.last_cmd.status).map(|s| s.describe()).unwrap_or("?"),
+            "status": h.last_cmd.status,
+            "status_name": Status::try_from(h.last_cmd.status).map_or("UNKNOWN", Status::name),
         },
+        "flags": h.flags,
+        "cmd_overflows": h.cmd_overflows,
+        "link_up": h.flags & device_flag::LINK_UP != 0,
+        "calibrated": h.flags & device_flag::CALIBRATED != 0,
     })
+}
+
+/// A `limber_vec3` as JSON: `{"x", "y", "z"}`.
+fn vec3_json(v: crate::common::Vec3) -> Value {
+    json!({"x": v.x, "y": v.y, "z": v.z})
 }
 
 /// The start of every human line: the sequence number, a link that is down, and the last
@@ -95,12 +106,14 @@ impl Describe for ActArrayData {
         json!({
             "header": header_json(&self.header),
             "motor_state": self.motor_state,
+            "actuators_count": self.actuators_count,
             "actuators": self.actuators().iter().map(|a| json!({
                 "position": a.position,
                 "speed": a.speed,
                 "acceleration": a.acceleration,
                 "current": a.current,
-                "state": actuator_state_name(a.state),
+                "state": a.state,
+                "state_name": actuator_state_name(a.state),
             })).collect::<Vec<_>>(),
         })
     }
@@ -147,10 +160,11 @@ impl Describe for LimbData {
     fn json(&self) -> Value {
         json!({
             "header": header_json(&self.header),
-            "state": limb_state_name(self.state),
-            "position": self.position.to_array(),
-            "approach": self.approach.to_array(),
-            "orientation": self.orientation.to_array(),
+            "position": vec3_json(self.position),
+            "approach": vec3_json(self.approach),
+            "orientation": vec3_json(self.orientation),
+            "state": self.state,
+            "state_name": limb_state_name(self.state),
             "orientation_adjustment": self.orientation_adjustment,
         })
     }
@@ -180,7 +194,8 @@ impl Describe for GripperData {
     fn json(&self) -> Value {
         json!({
             "header": header_json(&self.header),
-            "state": gripper_state_name(self.state),
+            "state": self.state,
+            "state_name": gripper_state_name(self.state),
             "beams": self.beams,
             "stored": self.stored,
         })
