@@ -389,6 +389,10 @@ typedef struct limber_device_info {
    Processes attached to its state channel (the driver and the clients).
    */
   uint32_t nodes;
+  /*
+   The layout version it speaks (`LIMBER_LAYOUT_VERSION`); 0 if it does not say.
+   */
+  uint32_t layout;
 } limber_device_info;
 
 /*
@@ -654,6 +658,16 @@ limber_code limber_device_state(struct limber_device *h,
                                 size_t size);
 
 /*
+ Copies the latest state already taken into `*out` (a struct of `size` bytes, as
+ `limber_device_state`), without looking for a newer one; `LIMBER_CODE_TIMEOUT` when no
+ state was taken yet.
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or points to `size` writable bytes.
+ */
+limber_code limber_device_last_state(struct limber_device *h, void *out, size_t size);
+
+/*
  Lends the latest state in place, without a copy (waiting up to `timeout_ms` for a
  first one): `*out` points into shared memory at the device's state struct and stays
  valid and unchanged until `limber_device_release` (or disconnect). Meanwhile the calls
@@ -713,7 +727,9 @@ limber_code limber_device_wait_state(struct limber_device *h,
  `*out`: the driver's `LIMBER_STATUS_*`, and the other client involved (the holder of the
  device for `LIMBER_STATUS_LEASED`, with its name). When it returns, the latest state
  shows the command. A status other than OK is also kept for `limber_last_refusal()` and
- `limber_last_error()`; the call still returns `LIMBER_CODE_OK`.
+ `limber_last_error()`; the call still returns `LIMBER_CODE_OK`. On
+ `LIMBER_CODE_OUTCOME_MISSED`, `out->seq` is the later command of this handle whose
+ outcome was seen (the rest is zero).
 
  # Safety
  `h` is NULL or a live handle; `out` is NULL or writable.
@@ -818,6 +834,32 @@ limber_code limber_device_geometry(struct limber_device *h,
 limber_code limber_device_set_wait(struct limber_device *h, bool spin, uint64_t spin_budget_us);
 
 /*
+ How long this handle's requests that take no timeout of their own wait for the
+ driver's answer (the lease calls: acquire, renew, release, holder); 2000 ms by default.
+
+ # Safety
+ `h` is NULL or a live handle.
+ */
+limber_code limber_device_set_request_timeout(struct limber_device *h, uint64_t timeout_ms);
+
+/*
+ The spin budget a new handle starts with, in microseconds: `LIMBER_SPIN_US` if set (at
+ most 1 s), else 30 on a machine with two or more cores and 0 on one (read once per
+ process).
+ */
+uint64_t limber_default_spin_budget_us(void);
+
+/*
+ Names this process in `limber list` (and in leases taken with a NULL name) for the
+ handles and readers opened from now on: 1 to 60 printable ASCII characters, else
+ `LIMBER_CODE_INVALID_VALUE`; NULL goes back to the executable's name (the default).
+
+ # Safety
+ `name` is NULL or a NUL-terminated string.
+ */
+limber_code limber_set_program_name(const char *name);
+
+/*
  This handle's client id: how the driver, outcomes and `limber_device_holder` name it.
 
  # Safety
@@ -902,6 +944,18 @@ limber_code limber_list_devices(const char *domain,
                                 struct limber_device_info *out,
                                 size_t capacity,
                                 size_t *count);
+
+/*
+ Removes every file of `domain` (NULL: `LIMBER_DOMAIN`, or "limber") once no process runs
+ in it: the files its killed processes left, the node counter in `/dev/shm`, its token;
+ `*removed` (NULL: not written) is how many files and directories went. A domain without
+ files is left as it is. Processes still running in it: `LIMBER_CODE_TRANSPORT`, naming
+ how many.
+
+ # Safety
+ `domain` is NULL or a NUL-terminated string; `removed` is NULL or writable.
+ */
+limber_code limber_remove_domain_files(const char *domain, size_t *removed);
 
 /*
  CMD OPEN: opens the gripper. `*ticket` (NULL: not written) is for

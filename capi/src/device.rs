@@ -47,8 +47,19 @@ pub struct LimberOutcome {
     pub other_name: [c_char; 32],
 }
 
-/// The name this process shows in `limber list`: its executable's.
+/// The name set by [`limber_set_program_name`], if any.
+static PROGRAM_NAME: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
+
+/// The name this process shows in `limber list`: the one set by `limber_set_program_name`,
+/// else its executable's.
 pub(crate) fn process_name() -> String {
+    if let Some(n) = PROGRAM_NAME
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+        .clone()
+    {
+        return n;
+    }
     std::env::args()
         .next()
         .and_then(|a| {
@@ -275,6 +286,32 @@ pub unsafe extern "C" fn limber_device_state(
     })
 }
 
+/// Copies the latest state already taken into `*out` (a struct of `size` bytes, as
+/// `limber_device_state`), without looking for a newer one; `LIMBER_CODE_TIMEOUT` when no
+/// state was taken yet.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `out` is NULL or points to `size` writable bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_last_state(
+    h: *mut LimberDevice,
+    out: *mut c_void,
+    size: usize,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the handle, checked for NULL here.
+        let h = unsafe { arg(h, "handle")? };
+        h.not_borrowed()?;
+        let kind = h.client.kind();
+        let bytes = h
+            .client
+            .state_bytes()
+            .ok_or_else(|| Fail::new(LimberCode::Timeout, "no state was taken yet"))?;
+        // SAFETY: the caller's promise on `out` and `size`.
+        unsafe { copy_out("state", bytes, out, size, kind) }
+    })
+}
+
 /// Lends the latest state in place, without a copy (waiting up to `timeout_ms` for a
 /// first one): `*out` points into shared memory at the device's state struct and stays
 /// valid and unchanged until `limber_device_release` (or disconnect). Meanwhile the calls
@@ -385,7 +422,9 @@ pub unsafe extern "C" fn limber_device_wait_state(
 /// `*out`: the driver's `LIMBER_STATUS_*`, and the other client involved (the holder of the
 /// device for `LIMBER_STATUS_LEASED`, with its name). When it returns, the latest state
 /// shows the command. A status other than OK is also kept for `limber_last_refusal()` and
-/// `limber_last_error()`; the call still returns `LIMBER_CODE_OK`.
+/// `limber_last_error()`; the call still returns `LIMBER_CODE_OK`. On
+/// `LIMBER_CODE_OUTCOME_MISSED`, `out->seq` is the later command of this handle whose
+/// outcome was seen (the rest is zero).
 ///
 /// # Safety
 /// `h` is NULL or a live handle; `out` is NULL or writable.
@@ -411,9 +450,21 @@ fn outcome_into(
 ) -> Result<(), Fail> {
     {
         h.not_borrowed()?;
-        let o = h
+        let o = match h
             .client
-            .wait_outcome_detail(ticket_of(ticket), ms(timeout_ms))?;
+            .wait_outcome_detail(ticket_of(ticket), ms(timeout_ms))
+        {
+            Ok(o) => o,
+            Err(e) => {
+                if let limber_services::client::WaitError::Missed { newer_seq } = e {
+                    *out = LimberOutcome {
+                        seq: newer_seq,
+                        ..LimberOutcome::default()
+                    };
+                }
+                return Err(e.into());
+            }
+        };
         if o.status != Status::Ok {
             Fail::refused_outcome(&o).record();
         }
@@ -628,6 +679,59 @@ pub unsafe extern "C" fn limber_device_set_wait(
         });
         h.client
             .set_spin_budget(core::time::Duration::from_micros(spin_budget_us));
+        Ok(())
+    })
+}
+
+/// How long this handle's requests that take no timeout of their own wait for the
+/// driver's answer (the lease calls: acquire, renew, release, holder); 2000 ms by default.
+///
+/// # Safety
+/// `h` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_device_set_request_timeout(
+    h: *mut LimberDevice,
+    timeout_ms: u64,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the handle, checked for NULL here.
+        unsafe { arg(h, "handle")? }
+            .client
+            .set_request_timeout(ms(timeout_ms));
+        Ok(())
+    })
+}
+
+/// The spin budget a new handle starts with, in microseconds: `LIMBER_SPIN_US` if set (at
+/// most 1 s), else 30 on a machine with two or more cores and 0 on one (read once per
+/// process).
+#[unsafe(no_mangle)]
+pub extern "C" fn limber_default_spin_budget_us() -> u64 {
+    u64::try_from(limber_services::qos::default_spin_budget().as_micros()).unwrap_or(u64::MAX)
+}
+
+/// Names this process in `limber list` (and in leases taken with a NULL name) for the
+/// handles and readers opened from now on: 1 to 60 printable ASCII characters, else
+/// `LIMBER_CODE_INVALID_VALUE`; NULL goes back to the executable's name (the default).
+///
+/// # Safety
+/// `name` is NULL or a NUL-terminated string.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_set_program_name(name: *const c_char) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointer.
+        let name = unsafe { opt_str(name, "name")? };
+        if let Some(n) = name
+            && (n.is_empty() || n.len() > 60 || !n.bytes().all(|b| b.is_ascii_graphic()))
+        {
+            return Err(Fail::new(
+                LimberCode::InvalidValue,
+                format!("a program name has 1 to 60 printable ASCII characters, not {n:?}"),
+            ));
+        }
+        *PROGRAM_NAME
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner) = name.map(str::to_string);
         Ok(())
     })
 }

@@ -38,6 +38,8 @@ pub struct LimberDeviceInfo {
     pub alive: bool,
     /// Processes attached to its state channel (the driver and the clients).
     pub nodes: u32,
+    /// The layout version it speaks (`LIMBER_LAYOUT_VERSION`); 0 if it does not say.
+    pub layout: u32,
 }
 
 /// Lists the devices of `domain` (NULL: `LIMBER_DOMAIN`, or "limber"), sorted by name:
@@ -70,11 +72,37 @@ pub unsafe extern "C" fn limber_list_devices(
                 interface: LimberInterface::of(d.interface()),
                 alive: d.alive,
                 nodes: u32::try_from(d.nodes).unwrap_or(u32::MAX),
+                layout: d.layout.parse().unwrap_or(0),
             };
             copy_str(&mut info.name, &d.name.to_string());
             copy_str(&mut info.driver, &d.driver);
             // SAFETY: i < capacity, and `out` points to `capacity` writable entries.
             unsafe { out.add(i).write(info) };
+        }
+        Ok(())
+    })
+}
+
+/// Removes every file of `domain` (NULL: `LIMBER_DOMAIN`, or "limber") once no process runs
+/// in it: the files its killed processes left, the node counter in `/dev/shm`, its token;
+/// `*removed` (NULL: not written) is how many files and directories went. A domain without
+/// files is left as it is. Processes still running in it: `LIMBER_CODE_TRANSPORT`, naming
+/// how many.
+///
+/// # Safety
+/// `domain` is NULL or a NUL-terminated string; `removed` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_remove_domain_files(
+    domain: *const c_char,
+    removed: *mut usize,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers.
+        let (domain, removed) = unsafe { (opt_str(domain, "domain")?, removed.as_mut()) };
+        let n = limber_services::cleanup::remove_domain_files(&domain_of(domain)?)
+            .map_err(|e| Fail::from_error(LimberCode::Transport, &e))?;
+        if let Some(out) = removed {
+            *out = n;
         }
         Ok(())
     })

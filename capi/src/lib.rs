@@ -311,7 +311,7 @@ impl Fail {
         }
     }
 
-    fn from_error(code: LimberCode, e: &dyn std::error::Error) -> Self {
+    pub(crate) fn from_error(code: LimberCode, e: &dyn std::error::Error) -> Self {
         let mut detail = e.to_string();
         let mut source = e.source();
         while let Some(s) = source {

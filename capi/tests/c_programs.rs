@@ -542,9 +542,10 @@ impl Drop for Running {
     }
 }
 
-/// A Python that imports iceoryx2, to run python/limber with: `LIMBER_PYTHON`, else the
-/// venv `.ci/run` makes (`target/py-venv`). None, with the reason printed, when there is
-/// none on a developer's machine; in CI (`CI=true`) a missing one fails the test.
+/// A Python (>= 3.9) to run python/limber with: `LIMBER_PYTHON`, else the venv `.ci/run`
+/// makes (`target/py-venv`). None, with the reason printed, when there is none on a
+/// developer's machine; in CI (`CI=true`) a missing one fails the test. The package is a
+/// ctypes binding over liblimber: [`python_cmd`] points it at this build's library.
 fn python() -> Option<PathBuf> {
     let candidates: Vec<PathBuf> = match std::env::var_os("LIMBER_PYTHON") {
         Some(p) => vec![PathBuf::from(p)],
@@ -552,7 +553,7 @@ fn python() -> Option<PathBuf> {
     };
     for py in &candidates {
         let mut cmd = Command::new(py);
-        cmd.args(["-c", "import iceoryx2"]);
+        cmd.args(["-c", "import sys; assert sys.version_info >= (3, 9)"]);
         if py.is_file()
             && limber_bounded_run::output_within(cmd, RUN_LIMIT)
                 .status
@@ -562,11 +563,21 @@ fn python() -> Option<PathBuf> {
         }
     }
     let reason = format!(
-        "no Python with iceoryx2 at {candidates:?}: set LIMBER_PYTHON, or run .ci/run once (it makes target/py-venv)"
+        "no Python >= 3.9 at {candidates:?}: set LIMBER_PYTHON, or run .ci/run once (it makes target/py-venv)"
     );
     assert!(std::env::var("CI").as_deref() != Ok("true"), "{reason}");
     eprintln!("skipped: {reason}");
     None
+}
+
+/// `python script` with the package of `package_dir` on `PYTHONPATH`, over this build's
+/// liblimber.so (`LIMBER_LIB`).
+fn python_cmd(python: &Path, script: &Path, package_dir: &Path) -> Command {
+    let mut cmd = Command::new(python);
+    cmd.arg(script)
+        .env("PYTHONPATH", package_dir)
+        .env("LIMBER_LIB", lib_dir().join("liblimber.so"));
+    cmd
 }
 
 /// The joint positions and gripper state of a `seen:` line, as every client prints them
@@ -604,9 +615,11 @@ fn rust_python_c_and_cpp_clients_work_on_one_driver_at_once() {
 
     let mut c = Command::new(&arm_exe);
     c.args([JOINT.to_string(), TARGET.to_string()]);
-    let mut py = Command::new(&python);
-    py.arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/py/geometry.py"))
-        .env("PYTHONPATH", root().join("python"));
+    let py = python_cmd(
+        &python,
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/py/geometry.py"),
+        &root().join("python"),
+    );
     let mut clients = [
         ("C", Running::spawn(&p, c)),
         ("C++", Running::spawn(&p, Command::new(&gripper_exe))),
@@ -895,8 +908,12 @@ fn a_field_moved_in_a_message_makes_c_cpp_and_python_refuse_to_connect() {
     // Python: the package as it is, with the moved _layout.py.
     let package = dir.join("py/limber");
     std::fs::create_dir_all(&package).unwrap();
-    for f in ["__init__.py", "client.py", "py.typed"] {
-        std::fs::copy(root().join("python/limber").join(f), package.join(f)).unwrap();
+    for e in std::fs::read_dir(root().join("python/limber")).unwrap() {
+        let f = e.unwrap().file_name();
+        let f = f.to_str().unwrap();
+        if f != "_layout.py" && (f.ends_with(".py") || f == "py.typed") {
+            std::fs::copy(root().join("python/limber").join(f), package.join(f)).unwrap();
+        }
     }
     std::fs::write(
         package.join("_layout.py"),
@@ -975,10 +992,8 @@ fn a_field_moved_in_a_message_makes_c_cpp_and_python_refuse_to_connect() {
     );
 
     let Some(python) = python() else { return };
-    let mut cmd = Command::new(&python);
-    cmd.arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/py/connect.py"))
-        .env("PYTHONPATH", dir.join("py"));
-    let o = run_in_cmd(&p, cmd);
+    let connect = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/py/connect.py");
+    let o = run_in_cmd(&p, python_cmd(&python, &connect, &dir.join("py")));
     let out = text(&o.stdout);
     assert_eq!(o.status.code(), Some(3), "{out}\n{}", text(&o.stderr));
     assert!(
@@ -990,10 +1005,7 @@ fn a_field_moved_in_a_message_makes_c_cpp_and_python_refuse_to_connect() {
         "{out}"
     );
     // The real package connects (the refusal is the layout's, not the script's).
-    let mut cmd = Command::new(&python);
-    cmd.arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/py/connect.py"))
-        .env("PYTHONPATH", root().join("python"));
-    let o = run_in_cmd(&p, cmd);
+    let o = run_in_cmd(&p, python_cmd(&python, &connect, &root().join("python")));
     let out = text(&o.stdout);
     assert!(o.status.success(), "{out}\n{}", text(&o.stderr));
     assert!(out.starts_with("connected: joint 0 at "), "{out}");

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Read an arm's state and command one joint over Zenoh alone: no iceoryx2, no limber
 domain on this host, only `eclipse-zenoh` and the wire layouts of `limber/_layout.py`
-(pure ctypes, loaded by path so that the `limber` package and its iceoryx2 binding are not
-imported).
+(pure ctypes, loaded by path so that the `limber` package and the liblimber it binds are
+not needed).
 
 The robot's PC runs `limber bridge expose` (see bridge/README.md for the keys and payloads):
 

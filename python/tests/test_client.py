@@ -9,7 +9,6 @@ import itertools
 import json
 import math
 import os
-import re
 import select
 import signal
 import subprocess
@@ -94,15 +93,10 @@ def state_where(client, pred, timeout=T):
     return s
 
 
-def node_states(domain):
-    """(state, node name) of every node of `domain`."""
-    import iceoryx2 as iox2
-
-    out = []
-    for n in iox2.Node.list(iox2.ServiceType.Ipc, limber.Domain(domain).iceoryx2_config()):
-        d = n[0].details
-        out.append((type(n).__name__, d.name.as_str() if d is not None else None))
-    return out
+def nodes_of(domain, device):
+    """How many processes (alive, or dead and not cleaned up) are attached to `device`'s
+    state channel in `domain`, as `limber list` counts them: 1 is the driver alone."""
+    return next(d.nodes for d in limber.list_devices(domain) if str(d.name) == device)
 
 
 class Driver:
@@ -434,7 +428,9 @@ def test_incompatible_and_invalid_names(driver):
             LimbClient.connect(bad, driver.domain)
     for bad in ["", "a b", "x" * 49]:
         with pytest.raises(ValueError):
-            limber.Domain(bad)
+            limber.list_devices(bad)
+        with pytest.raises(ValueError):
+            LimbClient.connect(driver.dev("limb"), bad)
 
 
 def test_another_layout_version_or_type_is_incompatible(driver, monkeypatch):
@@ -447,7 +443,7 @@ def test_another_layout_version_or_type_is_incompatible(driver, monkeypatch):
     with pytest.raises(IncompatibleError, match="layout"):
         ActArrayClient.connect(driver.dev("actarray"), driver.domain, timeout=T)
     # The failed attempts left no node behind, alive or dead.
-    assert [n for _, n in node_states(driver.domain) if n != "limber-driver:testdriver"] == []
+    assert nodes_of(driver.domain, driver.dev("actarray")) == 1
 
 
 def test_domain_from_env(monkeypatch):
@@ -456,8 +452,7 @@ def test_domain_from_env(monkeypatch):
     robot, other = unique_domain(), unique_domain()
     monkeypatch.setenv("LIMBER_DOMAIN", robot)
     assert limber.Domain().name == robot
-    assert re.fullmatch(r"limber_[0-9a-f]{16}_", limber.Domain().prefix)
-    assert limber.Domain().prefix == limber.Domain(robot).prefix != limber.Domain(other).prefix
+    assert limber.Domain() == limber.Domain(robot) != limber.Domain(other)
     assert limber.Domain(other).name == other
 
 
@@ -503,9 +498,9 @@ def test_driver_killed(own_driver):
 
 
 def test_close_releases_everything(driver):
-    arm = ActArrayClient.connect(driver.dev("actarray"), driver.domain, timeout=T)
-    assert any(s == "Alive" and n and n.startswith("limber-client:")
-               for s, n in node_states(driver.domain))
+    dev = driver.dev("actarray")
+    arm = ActArrayClient.connect(dev, driver.domain, timeout=T)
+    assert nodes_of(driver.domain, dev) == 2  # the driver and this client
     arm.close()
     arm.close()  # idempotent
     assert arm.closed
@@ -514,9 +509,7 @@ def test_close_releases_everything(driver):
     with ActArrayClient.connect(driver.dev("actarray"), driver.domain, timeout=T) as arm2:
         assert not arm2.closed
     assert arm2.closed
-    states = node_states(driver.domain)
-    assert [n for _, n in states if n and n.startswith("limber-client:")] == []
-    assert [s for s, _ in states if s != "Alive"] == []
+    assert nodes_of(driver.domain, dev) == 1  # nothing left, alive or dead
 
 
 def test_a_client_in_module_globals_leaves_no_dead_node(driver):
@@ -530,9 +523,7 @@ def test_a_client_in_module_globals_leaves_no_dead_node(driver):
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                          timeout=60, env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path)))
     assert out.stdout.strip() == "connected", out.stderr
-    states = node_states(driver.domain)
-    assert [s for s in states if s[1] == "limber-client:globalclient"] == []
-    assert [s for s, _ in states if s != "Alive"] == []
+    assert nodes_of(driver.domain, driver.dev("actarray")) == 1  # nothing left, alive or dead
 
 
 def test_status_names_are_the_rust_names():
@@ -639,15 +630,24 @@ def test_python_and_rust_clients_command_one_device_together(own_driver):
     assert "overflows=0" in d.output
 
 
-def test_an_open_error_is_classified_by_its_variant_not_its_text() -> None:
-    """The binding's exception class and variant decide, never words in a message."""
-    import iceoryx2 as iox2
+def test_every_limber_code_has_its_exception_and_the_library_s_message(driver):
+    """One table maps each LIMBER_CODE_* to its exception; the message is
+    limber_last_error()'s."""
+    from limber import _lib, _types
 
-    from limber.client import _open_error_kind
+    codes = [c for c in range(1, 64) if _lib.lib.limber_strerror(c) != b"unknown limber code"]
+    assert codes == list(range(1, 16))
+    assert sorted(_types._ERRORS) == codes
+    with pytest.raises(NoDriverError) as e:
+        ActArrayClient.connect("nobody/actarray/0", driver.domain)
+    assert str(e.value) == _lib.last_error()
+    assert "no driver offers nobody/actarray/0" in str(e.value)
 
-    assert _open_error_kind(iox2.PublishSubscribeOpenError("DoesNotExist")) == "DoesNotExist"
-    assert _open_error_kind(iox2.EventOpenError("DoesNotExist")) == "DoesNotExist"
-    assert _open_error_kind(iox2.RequestResponseOpenError("IncompatibleTypes")) == "IncompatibleTypes"
-    # Another error that merely mentions the word is not a missing service.
-    assert _open_error_kind(RuntimeError("DoesNotExist")) is None
-    assert _open_error_kind(iox2.PublisherCreateError("DoesNotExist")) is None
+
+def test_a_closed_client_says_so(driver):
+    arm = ActArrayClient.connect(driver.dev("actarray"), driver.domain, timeout=T)
+    arm.close()
+    for call in (lambda: arm.move_to(0, 0.0), arm.state, lambda: arm.wait_state(T),
+                 arm.holder, lambda: arm.geometry()):
+        with pytest.raises(LimberError, match="ActArrayClient is closed"):
+            call()

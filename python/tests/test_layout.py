@@ -108,17 +108,17 @@ def test_status_texts_are_rusts(manifest):
     assert limber.Status.LEASED.describe() == "held by another client"
 
 
-def test_client_protocol_numbers_come_from_the_manifest(manifest):
-    from limber import client
+def test_the_library_speaks_this_layout_and_enforces_the_manifest_s_name_limits():
+    from limber import _lib
 
-    assert client.MAX_DOMAIN_LEN == _layout.NAME_MAX_DOMAIN_LEN
-    assert client.MAX_ROBOT_LEN == _layout.NAME_MAX_ROBOT_LEN
-    assert client._EVENT_COMMAND == _layout.WAKE_COMMAND
-    assert client._EVENT_REQUEST == _layout.WAKE_REQUEST
-    assert client._OUTCOME_BUFFER == _layout.QOS_OUTCOME_BUFFER
-    limber.Domain("d" * _layout.NAME_MAX_DOMAIN_LEN)
+    assert _lib.lib.limber_layout_version() == _layout.LAYOUT_VERSION
+    limber.list_devices("d" * _layout.NAME_MAX_DOMAIN_LEN)
     with pytest.raises(ValueError):
-        limber.Domain("d" * (_layout.NAME_MAX_DOMAIN_LEN + 1))
-    limber.DeviceName.parse("r" * _layout.NAME_MAX_ROBOT_LEN + "/limb/0")
+        limber.list_devices("d" * (_layout.NAME_MAX_DOMAIN_LEN + 1))
+    with pytest.raises(limber.NoDriverError):
+        limber.LimbClient.connect("r" * _layout.NAME_MAX_ROBOT_LEN + "/limb/0",
+                                  "d" * _layout.NAME_MAX_DOMAIN_LEN)
     with pytest.raises(ValueError):
-        limber.DeviceName.parse("r" * (_layout.NAME_MAX_ROBOT_LEN + 1) + "/limb/0")
+        limber.LimbClient.connect("r" * (_layout.NAME_MAX_ROBOT_LEN + 1) + "/limb/0",
+                                  "d" * _layout.NAME_MAX_DOMAIN_LEN)
+    limber.remove_domain_files("d" * _layout.NAME_MAX_DOMAIN_LEN)

@@ -8,8 +8,8 @@ import time
 
 import pytest
 
-from limber import (ActArrayClient, DriverStatus, LeaseHeldError, LeaseHolder, Status,
-                    Outcome)
+from limber import (ActArrayClient, DriverStatus, LeaseHeldError, LeaseHolder, NackError,
+                    Outcome, Status)
 from limber import _layout as L
 
 from test_client import T, cli_bin, unique_domain
@@ -52,9 +52,17 @@ def test_a_lease_refuses_others_and_names_its_holder(pioneer):
         # B's command is refused, naming the holder; B cannot take the device.
         t = b.move_to(2, 0.1)
         assert b.wait_outcome(t, T) is Status.LEASED
+        t = b.move_to(2, 0.1)
+        o = b.outcome(t, T)
+        assert o == Outcome(t.seq, Status.LEASED, a.client_id, "py-owner")
         with pytest.raises(LeaseHeldError) as e:
             b.acquire("py-other", 1.0)
         assert e.value.client_id == a.client_id and e.value.name == "py-owner"
+        assert "py-owner" in str(e.value) and f"{a.client_id:x}" not in str(e.value)
+        # A request that changes the device is refused, with the reason.
+        with pytest.raises(NackError) as n:
+            b.power(True)
+        assert n.value.status is Status.LEASED
         # The holder commands; renewing and keeping the lease go on working.
         assert a.keep_lease() is False  # a third of the heartbeat has not passed
         a.renew()
@@ -89,6 +97,7 @@ def test_a_motion_cut_short_by_another_client_is_told_preempted(pioneer):
         while not a.wait_state(T).actuators[0].state & L.ACTSTATE_MOVING:
             assert time.monotonic() < deadline, "joint 0 never moved"
         assert a.preempted(ta) is None
+        b.acquire("py-stopper", 2.0)  # a holder's command names it in the preemption
         tb = b.move_at_speed(0, 0.0)  # B stops joint 0: A's motion is cut short
         assert b.wait_outcome(tb, T).is_carried_out
         deadline = time.monotonic() + T
@@ -98,5 +107,7 @@ def test_a_motion_cut_short_by_another_client_is_told_preempted(pioneer):
         assert isinstance(p, Outcome)
         assert p.status is Status.PREEMPTED and p.seq == ta.seq
         assert p.other_client == b.client_id
+        assert p.other_name == "py-stopper"
         assert b.preempted(tb) is None
+        b.release()
         assert a.driver_status() is DriverStatus.ALIVE

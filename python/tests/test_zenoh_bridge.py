@@ -1,7 +1,7 @@
 """Python across hosts: python/examples/zenoh_remote.py, a program with only Zenoh's
 Python package (`eclipse-zenoh`), reads the emulated Pioneer's state and commands it
 through `limber bridge expose`, and a refusal keeps its reason; and the unchanged Python
-client (iceoryx2) in another domain commands the arm through `limber bridge mirror`.
+client (over liblimber) in another domain commands the arm through `limber bridge mirror`.
 Every wait has a timeout.
 """
 

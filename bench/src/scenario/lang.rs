@@ -12,9 +12,10 @@
 //! The C client is `bench/clients/lang_client.c`, compiled here with `cc` against the
 //! source tree's headers and the `liblimber.so` beside this executable (or in
 //! `LIMBER_LIB_DIR`); the Python client is `bench/clients/lang_client.py`, run by
-//! `LIMBER_PYTHON` (default `python3`) with the source tree's `python/` on `PYTHONPATH`.
-//! Each language that cannot run (no C compiler, no liblimber.so, no Python with
-//! iceoryx2) is skipped with the reason, printed and noted in the report; Rust always runs.
+//! `LIMBER_PYTHON` (default `python3`) with the source tree's `python/` on `PYTHONPATH` and
+//! `LIMBER_LIB` set to that same `liblimber.so` (the package is a ctypes binding over it).
+//! Each language that cannot run (no C compiler, no liblimber.so, no Python that imports
+//! limber) is skipped with the reason, printed and noted in the report; Rust always runs.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -78,7 +79,7 @@ fn skip(ctx: &mut RunCtx, lang: &str, why: String) {
 fn run(ctx: &mut RunCtx) -> Result<(), BenchError> {
     let domain = ctx.domain();
     let (warm, n) = (ctx.count(500, 50), ctx.count(5_000, 300));
-    // Three clients, one after the other; Python's exchanges are the slowest (~100 µs).
+    // Three clients, one after the other; Python's exchanges are the slowest.
     let deadline = ctx.deadline_for(3 * (warm + n), Duration::from_micros(500));
     let driver = start_event_driver(ctx, &domain, "lang-driver.hdr", deadline)?;
     let cctx =
@@ -247,20 +248,28 @@ fn c_client(ctx: &RunCtx) -> Result<PathBuf, String> {
     Ok(exe)
 }
 
-/// The Python client's command; `Err(why)` when there is no Python that imports limber
-/// (from the source tree) and iceoryx2.
+/// The Python client's command; `Err(why)` when there is no liblimber.so or no Python that
+/// imports limber (from the source tree, over that liblimber.so).
 fn python(ctx: &RunCtx) -> Result<Command, String> {
     let py = std::env::var_os("LIMBER_PYTHON").unwrap_or_else(|| "python3".into());
     let path = Path::new(TREE).join("python");
+    // The C client's liblimber.so; without one, the package looks for its own (and says
+    // where it looked when it finds none).
+    let lib = lib_dir().map(|d| d.join("liblimber.so"));
     let mut probe = Command::new(&py);
     probe
-        .args(["-c", "import limber.client, iceoryx2"])
+        .args(["-c", "import limber.client"])
         .env("PYTHONPATH", &path);
+    if let Ok(lib) = &lib {
+        probe.env("LIMBER_LIB", lib);
+    }
     let o = run_bounded(probe, Duration::from_secs(60))?;
     if !o.status.success() {
         return Err(format!(
-            "{py:?} cannot import limber (from {}) and iceoryx2: {} (set LIMBER_PYTHON to a Python with iceoryx2 0.10, e.g. the venv of .ci/run)",
+            "{py:?} cannot import limber (from {}, over {}): {} (set LIMBER_PYTHON to a Python >= 3.9, e.g. the venv of .ci/run, and LIMBER_LIB_DIR to the directory of liblimber.so)",
             path.display(),
+            lib.as_ref()
+                .map_or_else(|why| why.clone(), |l| l.display().to_string()),
             String::from_utf8_lossy(&o.stderr)
                 .lines()
                 .last()
@@ -272,6 +281,9 @@ fn python(ctx: &RunCtx) -> Result<Command, String> {
     std::fs::write(&script, PY_CLIENT).map_err(|e| format!("{}: {e}", script.display()))?;
     let mut cmd = Command::new(py);
     cmd.arg(script).env("PYTHONPATH", path);
+    if let Ok(lib) = lib {
+        cmd.env("LIMBER_LIB", lib);
+    }
     Ok(cmd)
 }
 
