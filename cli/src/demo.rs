@@ -70,7 +70,7 @@ impl Drop for Running {
 
 fn start_pioneer(domain: &Domain) -> Result<Running, CliError> {
     use limber_emulator::{Emulator, EmulatorConfig};
-    use limber_pioneer::{PioneerConfig, PioneerDriver, RunOptions};
+    use limber_pioneer::{PioneerConfig, PioneerDriver, RunOptions, StartOptions};
     let stop = Arc::new(AtomicBool::new(false));
     let (tx, rx) = mpsc::channel::<Result<String, String>>();
     let d = domain.clone();
@@ -100,7 +100,9 @@ fn start_pioneer(domain: &Domain) -> Result<Running, CliError> {
                 port: path.clone(),
                 ..PioneerConfig::default()
             };
-            let mut driver = match PioneerDriver::start(&ctx, cfg, emu.link_target()) {
+            // The emulator's devices say SIMULATED.
+            let start = StartOptions { simulated: true };
+            let mut driver = match PioneerDriver::start_with(&ctx, cfg, emu.link_target(), start) {
                 Ok(d) => d,
                 Err(e) => {
                     report(&tx, Err(e.to_string()));
@@ -111,7 +113,8 @@ fn start_pioneer(domain: &Domain) -> Result<Running, CliError> {
             if let Err(e) = driver.run_until(RunOptions::default(), || s.load(Ordering::Relaxed)) {
                 tracing::error!("the Pioneer driver stopped: {e}");
             }
-            driver.shutdown();
+            let report = driver.shutdown();
+            tracing::info!("the Pioneer driver: {report}");
             drop(driver);
             if let Err(e) = emu.stop() {
                 tracing::warn!("stopping the emulator: {e}");

@@ -6,8 +6,8 @@ use clap::Args;
 use limber_emulator::{Emulator, EmulatorConfig};
 use limber_p2os::LinkTarget;
 use limber_pioneer::{
-    ConfigError, DriverError, LoopMode, PioneerConfig, PioneerDriver, RunOptions, apply_realtime,
-    check_cpu,
+    ConfigError, DriverError, LoopMode, PioneerConfig, PioneerDriver, RunOptions, StartOptions,
+    apply_realtime, check_cpu,
 };
 use limber_services::{Context, Role};
 
@@ -132,7 +132,11 @@ fn serve(args: PioneerArgs, domain: &limber_services::Domain) -> Result<(), Pion
     };
     // Each warning is logged where it arises.
     let _warnings = apply_realtime(args.cpu, args.rt);
-    let mut driver = PioneerDriver::start(&ctx, cfg.clone(), target)?;
+    // The built-in emulator's devices say SIMULATED; a driver on a port never does.
+    let start = StartOptions {
+        simulated: emulator.is_some(),
+    };
+    let mut driver = PioneerDriver::start_with(&ctx, cfg.clone(), target, start)?;
     let hw = driver.hardware().clone();
     eprintln!(
         "limber pioneer: connected to {:?} class {:?} subclass {:?}; domain {}",
@@ -157,8 +161,11 @@ fn serve(args: PioneerArgs, domain: &limber_services::Domain) -> Result<(), Pion
     } else {
         LoopMode::Event
     };
-    driver.run(RunOptions { mode })?;
-    eprintln!("limber pioneer: stopped the arm and closed the link");
+    let ran = driver.run_until(RunOptions { mode }, || false);
+    // What the shutdown could do: a robot that does not listen is not said stopped.
+    let report = driver.shutdown();
+    eprintln!("limber pioneer: {report}");
+    ran?;
     drop(driver);
     if let Some(e) = emulator
         && let Err(err) = e.stop()

@@ -290,3 +290,51 @@ fn setpose_with_a_huge_finite_approach_is_the_unit_approach() {
     assert_eq!(code, Some(0), "{out}");
     assert_eq!(drv.term(), Some(0));
 }
+
+/// The `header.flags` of the first state `limber echo DEVICE --count 1 --json` prints.
+fn echoed_flags(domain: &str, device: &str) -> u64 {
+    let o = limber(domain, &["echo", device, "--count", "1", "--json"]);
+    assert!(o.status.success(), "echo {device}: {}", stderr(&o));
+    let text = stdout(&o);
+    let line = text.lines().next().unwrap_or_default();
+    let v: serde_json::Value = serde_json::from_str(line).unwrap_or_else(|e| panic!("{e}: {text}"));
+    v["header"]["flags"]
+        .as_u64()
+        .unwrap_or_else(|| panic!("no header.flags: {text}"))
+}
+
+/// The devices of an emulated Pioneer (the gripper's and lift's included).
+const PIONEER_DEVICES: [&str; 6] = [
+    "pioneer/actarray/0",
+    "pioneer/actarray/1",
+    "pioneer/limb/0",
+    "pioneer/gripper/0",
+    "pioneer/gripper/1",
+    "pioneer/driver",
+];
+
+/// Issue "One protocol core", item 5: `limber pioneer --emulated` drives its built-in
+/// emulator, and every device's state says SIMULATED (as simarm's do); a driver on a port
+/// (`--port`, here `limber emulator`'s pty, which it cannot tell from a robot) never does.
+#[test]
+fn the_built_in_emulator_is_simulated_and_a_port_is_not() {
+    let d = Domain::unique_for_test();
+    let mut drv = common::pioneer_emulated(d.name());
+    for dev in PIONEER_DEVICES {
+        let flags = echoed_flags(d.name(), dev);
+        assert_ne!(flags & 4, 0, "{dev} under --emulated: flags {flags}");
+    }
+    assert_eq!(drv.term(), Some(0));
+
+    let d = Domain::unique_for_test();
+    let mut emu = Bg::spawn(d.name(), &["emulator", "--pty", "--ignore-stdin"]);
+    let pty = emu.line(|l| l.starts_with("/dev/"));
+    let mut drv = Bg::spawn(d.name(), &["pioneer", "--port", &pty]);
+    drv.line(|l| l.ends_with("ready"));
+    for dev in PIONEER_DEVICES {
+        let flags = echoed_flags(d.name(), dev);
+        assert_eq!(flags & 4, 0, "{dev} on --port: flags {flags}");
+    }
+    assert_eq!(drv.term(), Some(0));
+    assert_eq!(emu.term(), Some(0));
+}

@@ -97,6 +97,21 @@ fn bad_values_and_verbs_of_the_wrong_interface_exit_2() {
     );
     std::fs::write(&cfg, "tick_ms = 0\n").unwrap();
     usage(&["pioneer", "--config", cfg.to_str().unwrap()], "tick_ms");
+    // Issue "Nobody moves the arm who may not", item 16: a zero keep-alive interval (a
+    // PULSE flood) or ARM_INFO wait (nothing of the arm or gripper served) is refused.
+    for (text, says) in [
+        (
+            "pulse_interval_ms = 0\n",
+            "pulse_interval_ms must be >= 100",
+        ),
+        (
+            "arm_info_timeout_ms = 0\n",
+            "arm_info_timeout_ms must be >= 100",
+        ),
+    ] {
+        std::fs::write(&cfg, text).unwrap();
+        usage(&["pioneer", "--config", cfg.to_str().unwrap()], says);
+    }
     // A baud rate P2OS does not speak (0 would hang up a real serial line), from the
     // flag or the file, is refused before any port is opened.
     for b in ["0", "12345"] {

@@ -529,3 +529,63 @@ fn a_gripperless_emulator_gets_no_gripper_command_unless_forced() {
         "{report}"
     );
 }
+
+/// Issue "Nobody moves the arm who may not", item 16: SIGTERM to a driver whose robot is
+/// SIGSTOPped printed "stopped the arm and closed the link" after "cannot stop the arm:
+/// link down". It says what happened: the arm could not be stopped, the link was down.
+#[test]
+fn a_driver_ended_with_its_robot_stopped_does_not_claim_it_stopped_the_arm() {
+    use std::process::{Command, Stdio};
+    let d = Domain::unique_for_test();
+    let (mut emu, port) = emulator(&d, false, &[]);
+    let cfg = config("claim");
+    let log = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("link-claim.stderr");
+    let mut child = Command::new(common::LIMBER)
+        .args([
+            "pioneer",
+            "--port",
+            &port,
+            "--config",
+            cfg.to_str().unwrap(),
+        ])
+        .env("LIMBER_DOMAIN", d.name())
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(std::fs::File::create(&log).unwrap())
+        .spawn()
+        .unwrap();
+    let ctx = Context::new(&d, Role::Client, "link-test").unwrap();
+    let mut arm = ActArrayClient::connect_timeout(&ctx, "pioneer/actarray/0", T).unwrap();
+    assert!(wait_link(&mut arm, true, T), "the link never came up");
+    emu.signal(libc::SIGSTOP);
+    assert!(
+        wait_link(&mut arm, false, T),
+        "the silent robot was not detected"
+    );
+    // SAFETY: kill(2) on our own child; no memory is involved.
+    unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
+    let deadline = Instant::now() + T;
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("the driver did not end within {T:?} of SIGTERM");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    emu.signal(libc::SIGCONT);
+    let text = std::fs::read_to_string(&log).unwrap();
+    assert_eq!(status.code(), Some(0), "{text}");
+    assert!(
+        !text.contains("stopped the arm"),
+        "claims it stopped the arm: {text}"
+    );
+    assert!(
+        text.contains("limber pioneer: could not stop the arm (link to the hardware is down); the link had already closed"),
+        "does not say what happened: {text}"
+    );
+    assert_eq!(emu.term(), Some(0));
+}

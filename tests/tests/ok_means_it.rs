@@ -289,3 +289,38 @@ fn a_speed_request_beyond_the_joint_limit_is_clamped_to_it() {
         cal().speed_to_ms_per_step(j2, limit / 2.0).unwrap()
     );
 }
+
+/// Issue "Nobody moves the arm who may not", item 15: `power off` answered "ok" while the
+/// latest state still said powered (the driver changed `motor_state` only when the robot's
+/// next ARMpac said so). The state sent before a POWER reply shows what was asked; the
+/// robot's ARMpacs then confirm it, and the state keeps saying so.
+#[test]
+fn after_a_power_reply_the_latest_state_already_shows_it() {
+    let domain = Domain::unique_for_test();
+    let emu = Emulator::start_pty(EmulatorConfig::default()).unwrap();
+    let _driver = start(&domain, &emu, "ok-power-state");
+    let c = ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
+    arm.set_request_timeout(T);
+    arm.current(T).unwrap();
+    for (on, speed) in [(false, 0.3), (true, 0.25), (false, 0.2), (true, 0.35)] {
+        arm.power(on).unwrap();
+        // Nothing waited for: what arrived with the reply.
+        let s = arm.state().expect("a state");
+        assert_eq!(
+            s.motor_state, on as u32,
+            "power {on} answered ok, but the latest state says motor_state {}",
+            s.motor_state
+        );
+        let (done, _) = emu.wait_for(T, |s| s.robot.arm_powered == on);
+        assert!(done, "the robot never took power {on}");
+        // A barrier the robot took after the power command: the robot's reports since
+        // then confirm the state.
+        barrier(&mut arm, &emu, speed);
+        let s = arm.state().expect("a state");
+        assert_eq!(
+            s.motor_state, on as u32,
+            "power {on}: after the robot took it"
+        );
+    }
+}

@@ -82,9 +82,11 @@ pub struct PioneerConfig {
     /// doubling from this value up to 30 s (an arm found so late needs a driver restart to
     /// be served; after a reconnect, the arm's ARMpac stream is restarted). Also how long
     /// each CONFIG (the body-gripper probe at start) may go unanswered: asked 3 times with
-    /// `body_gripper = "auto"`, once when it is true or false.
+    /// `body_gripper = "auto"`, once when it is true or false. At least 100 (one controller
+    /// cycle).
     pub arm_info_timeout_ms: u64,
-    /// Send PULSE when nothing was sent for this long, ms.
+    /// Send PULSE when nothing was sent for this long, ms; at least 100 (one controller
+    /// cycle: shorter floods the link).
     pub pulse_interval_ms: u64,
     /// A joint that stays short of its target for this long, not moving, is stalled, ms.
     pub stall_timeout_ms: u64,
@@ -341,6 +343,16 @@ impl PioneerConfig {
         if self.tick_ms == 0 || self.tick_ms > 1000 {
             return bad("tick_ms must be 1..=1000");
         }
+        if self.pulse_interval_ms < 100 {
+            return bad(
+                "pulse_interval_ms must be >= 100: the keep-alive PULSE goes out when nothing was sent for this long, and a shorter interval floods the link (0 would send one at every tick)",
+            );
+        }
+        if self.arm_info_timeout_ms < 100 {
+            return bad(
+                "arm_info_timeout_ms must be >= 100: the robot answers ARM_INFO and CONFIG within its 100 ms cycle, and a shorter wait gives up before the answer (0 would serve neither the arm nor the gripper)",
+            );
+        }
         if self.autopark_s != 0 && u64::from(self.autopark_s) * 1000 <= self.pulse_interval_ms {
             return bad(
                 "autopark_s must be 0 (disabled) or longer than pulse_interval_ms, or a live driver's arm parks",
@@ -441,6 +453,22 @@ mod tests {
         let e = PioneerConfig::from_toml("autopark_s = 1\npulse_interval_ms = 1000").unwrap_err();
         assert!(e.to_string().contains("autopark_s"), "{e}");
         assert!(PioneerConfig::from_toml("autopark_s = 70000").is_err());
+    }
+
+    #[test]
+    fn a_zero_keep_alive_or_arm_info_wait_is_refused_with_its_reason() {
+        for (bad, key) in [
+            ("pulse_interval_ms = 0", "pulse_interval_ms"),
+            ("pulse_interval_ms = 99", "pulse_interval_ms"),
+            ("arm_info_timeout_ms = 0", "arm_info_timeout_ms"),
+            ("arm_info_timeout_ms = 50", "arm_info_timeout_ms"),
+        ] {
+            let e = PioneerConfig::from_toml(bad).unwrap_err();
+            assert!(e.to_string().contains(key), "{bad}: {e}");
+            assert!(e.to_string().contains(">= 100"), "{bad}: {e}");
+        }
+        let c = PioneerConfig::from_toml("pulse_interval_ms = 100\narm_info_timeout_ms = 100");
+        assert!(c.is_ok(), "{c:?}");
     }
 
     #[test]

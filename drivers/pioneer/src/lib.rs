@@ -27,7 +27,10 @@ pub mod robot;
 mod stats;
 
 pub use config::{BodyGripper, ConfigError, GripperGeometry, PioneerConfig};
-pub use driver::{DriverError, Hardware, LoopMode, PioneerDriver, RunOptions, gripper_decision};
+pub use driver::{
+    ArmAtShutdown, DriverError, Hardware, LinkAtShutdown, LoopMode, PioneerDriver, RunOptions,
+    ShutdownReport, StartOptions, gripper_decision,
+};
 pub use realtime::{CpuError, RealtimeWarning, apply_realtime, check_cpu};
 pub use robot::{INTERNAL, Outbox, PacketEffect, Queued, RobotModel};
 pub use stats::{LoopStats, Ring};

@@ -475,3 +475,37 @@ fn an_arm_whose_armpacs_stop_is_stale_and_refuses_commands() {
     assert!(m.arm_reporting(Instant::now()));
     assert_eq!(m.arm_command(&pos, &now_origin()), Status::Ok);
 }
+
+/// Issue "Nobody moves the arm who may not", item 15: the arm's state shows a power
+/// request at once; the robot's ARMpacs confirm it, or (a power-on the robot never takes)
+/// correct it once the grace is over.
+#[test]
+fn motor_state_shows_the_power_asked_until_the_robot_corrects_it() {
+    let (mut m, _) = ready();
+    let motor = |m: &RobotModel| {
+        let mut s = ActArrayData::default();
+        m.arm_state(&mut s, Instant::now());
+        s.motor_state
+    };
+    assert_eq!(motor(&m), 1);
+    m.arm_request(&ActArrayRequest::Power(false), &now_origin())
+        .unwrap();
+    drain(&mut m);
+    assert_eq!(motor(&m), 0, "off at once");
+    m.arm_request(&ActArrayRequest::Power(true), &now_origin())
+        .unwrap();
+    drain(&mut m);
+    assert_eq!(motor(&m), 1, "on at once");
+    // The robot keeps saying "unpowered", well after the power-on: corrected.
+    let later = Instant::now() + Duration::from_secs(1);
+    for _ in 0..3 {
+        m.on_packet(&RobotPacket::Arm(arm_packet(false, 0, home_ticks())), later);
+    }
+    assert_eq!(motor(&m), 0, "the robot's reports correct it");
+    // Confirmed by the robot.
+    m.arm_request(&ActArrayRequest::Power(true), &now_origin())
+        .unwrap();
+    drain(&mut m);
+    m.on_packet(&RobotPacket::Arm(arm_packet(true, 0, home_ticks())), later);
+    assert_eq!(motor(&m), 1);
+}

@@ -102,6 +102,65 @@ pub struct RunOptions {
     pub mode: LoopMode,
 }
 
+/// Options of a driver start.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct StartOptions {
+    /// The robot is an emulator (`limber pioneer --emulated`, the demo): every device's
+    /// state header says [`device_flag::SIMULATED`]. Never set for a real robot's port.
+    pub simulated: bool,
+}
+
+/// What [`PioneerDriver::shutdown`] did to the arm.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ArmAtShutdown {
+    /// ARM_STOP was written to the robot: the arm stops where it is.
+    Stopped,
+    /// The robot has no arm served: nothing to stop.
+    NoArm,
+    /// ARM_STOP could not be written (the link was down or the write failed): the arm was
+    /// not stopped by the driver (the controller's autopark parks it later).
+    NotStopped(Status),
+}
+
+/// What [`PioneerDriver::shutdown`] did to the link.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LinkAtShutdown {
+    /// CLOSE was written and the link closed.
+    Closed,
+    /// CLOSE could not be written; the link was closed anyway (logged).
+    ClosedWithoutClose,
+    /// The link was already down (the robot silent or gone).
+    AlreadyDown,
+}
+
+/// What [`PioneerDriver::shutdown`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ShutdownReport {
+    /// The arm.
+    pub arm: ArmAtShutdown,
+    /// The link.
+    pub link: LinkAtShutdown,
+}
+
+impl core::fmt::Display for ShutdownReport {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self.arm {
+            ArmAtShutdown::Stopped => f.write_str("stopped the arm")?,
+            ArmAtShutdown::NoArm => f.write_str("no arm to stop")?,
+            ArmAtShutdown::NotStopped(status) => {
+                write!(f, "could not stop the arm ({status})")?;
+            }
+        }
+        match self.link {
+            LinkAtShutdown::Closed => f.write_str(" and closed the link"),
+            LinkAtShutdown::ClosedWithoutClose => {
+                f.write_str("; closed the link without telling the robot (CLOSE failed)")
+            }
+            LinkAtShutdown::AlreadyDown => f.write_str("; the link had already closed"),
+        }
+    }
+}
+
 /// The driver's name in device attributes and statistics.
 const DRIVER: &str = "pioneer";
 
@@ -145,6 +204,8 @@ pub struct PioneerDriver {
     /// The body gripper's devices are offered (they stay once offered; a robot that lost
     /// its gripper has their commands refused).
     gripper_offered: bool,
+    /// The robot is an emulator: every state says [`device_flag::SIMULATED`].
+    simulated: bool,
 }
 
 /// A failure the loop survives (it is retried on the next cycle or the next event).
@@ -191,6 +252,17 @@ impl PioneerDriver {
         ctx: &Context,
         cfg: PioneerConfig,
         target: LinkTarget,
+    ) -> Result<Self, DriverError> {
+        Self::start_with(ctx, cfg, target, StartOptions::default())
+    }
+
+    /// [`PioneerDriver::start`] with options (an emulated robot's states flagged
+    /// [`device_flag::SIMULATED`]).
+    pub fn start_with(
+        ctx: &Context,
+        cfg: PioneerConfig,
+        target: LinkTarget,
+        opts: StartOptions,
     ) -> Result<Self, DriverError> {
         Self::check_name_free(ctx, &cfg.robot)?;
         let conn = Connection::open(&target, &options(&cfg, &target)).map_err(|source| {
@@ -275,6 +347,7 @@ impl PioneerDriver {
             devices_added: false,
             malformed_seen,
             gripper_offered,
+            simulated: opts.simulated,
         };
         if d.hardware.arm && !calibrated {
             // The ARMINFOpac was not a calibration (logged): ask again.
@@ -372,7 +445,16 @@ impl PioneerDriver {
         if self.robot.cal.is_some() {
             f |= device_flag::CALIBRATED;
         }
-        f
+        f | self.simulated_flag()
+    }
+
+    /// [`device_flag::SIMULATED`] when the robot is an emulator, else 0.
+    fn simulated_flag(&self) -> u32 {
+        if self.simulated {
+            device_flag::SIMULATED
+        } else {
+            0
+        }
     }
 
     /// Publishes the devices whose state changed, and the statistics once a second.
@@ -413,7 +495,7 @@ impl PioneerDriver {
         if robot.dirty.body {
             robot.lift_from_sip(now);
             if let Some(h) = self.hosts.gripper_mut(0) {
-                h.set_flags(flags & device_flag::LINK_UP);
+                h.set_flags(flags & (device_flag::LINK_UP | device_flag::SIMULATED));
                 robot.gripper_state(h.state_mut());
                 h.state_mut().header.stamp_ns = monotonic_ns();
                 if let Err(e) = h.publish() {
@@ -421,7 +503,7 @@ impl PioneerDriver {
                 }
             }
             if let Some(h) = self.hosts.actarray_mut(1) {
-                h.set_flags(flags & device_flag::LINK_UP);
+                h.set_flags(flags & (device_flag::LINK_UP | device_flag::SIMULATED));
                 robot.lift_state(h.state_mut());
                 h.state_mut().header.stamp_ns = monotonic_ns();
                 if let Err(e) = h.publish() {
@@ -437,13 +519,14 @@ impl PioneerDriver {
     }
 
     fn publish_stats(&mut self) {
+        let simulated = self.simulated_flag();
         let s = &mut self.stats;
         let ls = &self.timing;
         s.header.flags = if self.conn.is_some() {
             device_flag::LINK_UP
         } else {
             0
-        };
+        } | simulated;
         s.loop_mode = match self.mode {
             LoopMode::Event => loop_mode::EVENT,
             LoopMode::Spin => loop_mode::SPIN,
@@ -507,25 +590,37 @@ impl PioneerDriver {
         }
     }
 
-    /// Stops the arm, stops the ARMpac stream and closes the link (STOP, CLOSE).
-    pub fn shutdown(&mut self) {
+    /// Stops the arm, stops the ARMpac stream and closes the link (STOP, CLOSE); says
+    /// what it could do (a robot that does not listen is not stopped).
+    pub fn shutdown(&mut self) -> ShutdownReport {
         // A handshake still running on its thread closes what it opens.
         self.connecting = None;
-        if self.hardware.arm
-            && let Err(status) =
-                self.send_internal(&Command::ArmStop(limber_p2os::JointSelection::All))
-        {
-            tracing::warn!("cannot stop the arm at shutdown: {status}");
-        }
-        if let Some(conn) = self.conn.take()
-            && let Err(e) = conn.close()
-        {
-            tracing::warn!("closing the link: {e}");
-        }
+        let arm = if !self.hardware.arm {
+            ArmAtShutdown::NoArm
+        } else {
+            match self.send_internal(&Command::ArmStop(limber_p2os::JointSelection::All)) {
+                Ok(()) => ArmAtShutdown::Stopped,
+                Err(status) => {
+                    tracing::warn!("cannot stop the arm at shutdown: {status}");
+                    ArmAtShutdown::NotStopped(status)
+                }
+            }
+        };
+        let link = match self.conn.take() {
+            None => LinkAtShutdown::AlreadyDown,
+            Some(conn) => match conn.close() {
+                Ok(()) => LinkAtShutdown::Closed,
+                Err(e) => {
+                    tracing::warn!("closing the link: {e}");
+                    LinkAtShutdown::ClosedWithoutClose
+                }
+            },
+        };
         self.robot.link_down();
         self.robot.dirty.arm = true;
         self.robot.dirty.body = true;
         self.publish_all(Instant::now());
         self.publish_stats();
+        ShutdownReport { arm, link }
     }
 }

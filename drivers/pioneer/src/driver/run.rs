@@ -55,10 +55,13 @@ impl PioneerDriver {
         }
     }
 
-    /// Runs until SIGINT/SIGTERM/SIGHUP; then stops the arm, closes the link and returns.
+    /// Runs until SIGINT/SIGTERM/SIGHUP; then stops the arm, closes the link and returns
+    /// (what the shutdown did is logged; [`PioneerDriver::run_until`] and
+    /// [`PioneerDriver::shutdown`] give it).
     pub fn run(&mut self, opts: RunOptions) -> Result<LoopExit, DriverError> {
         let exit = self.run_until(opts, || false);
-        self.shutdown();
+        let report = self.shutdown();
+        tracing::info!("{report}");
         exit
     }
 

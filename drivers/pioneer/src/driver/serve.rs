@@ -156,14 +156,22 @@ impl DeviceSetHandler for Serve<'_> {
         index: u16,
         req: &ActArrayRequest,
         from: &Origin,
-        _s: &mut ActArrayData,
+        s: &mut ActArrayData,
     ) -> Result<ActArrayReply, Status> {
         let r = if index == 0 {
             self.robot.arm_request(req, from)
         } else {
             self.robot.lift_request(req)
         };
-        self.answered(r)
+        let r = self.answered(r);
+        // The state sent before the reply shows what the request did (a POWER: the motor
+        // state asked for).
+        if index == 0 {
+            self.robot.arm_state(s, Instant::now());
+        } else {
+            self.robot.lift_state(s);
+        }
+        r
     }
     fn limb_command(
         &mut self,
@@ -182,10 +190,12 @@ impl DeviceSetHandler for Serve<'_> {
         _index: u16,
         req: &LimbRequest,
         from: &Origin,
-        _s: &mut LimbData,
+        s: &mut LimbData,
     ) -> Result<LimbReply, Status> {
         let r = self.robot.limb_request(req, from);
-        self.answered(r)
+        let r = self.answered(r);
+        self.robot.limb_state(s, Instant::now());
+        r
     }
     fn gripper_command(
         &mut self,

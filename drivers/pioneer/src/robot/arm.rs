@@ -260,7 +260,9 @@ impl RobotModel {
             .map(|c| c.num_joints().min(ARM_JOINTS))
             .unwrap_or(ARM_JOINTS);
         s.actuators_count = n as u32;
-        s.motor_state = self.arm.powered as u32;
+        // What was last asked at once (the state sent before a POWER request's reply shows
+        // it); the ARMpacs confirm it, or correct it once the grace of a power-on is over.
+        s.motor_state = self.arm.powered_or_pending() as u32;
         let q = self.joint_angles();
         for j in 0..n {
             let a = &mut s.actuators[j];

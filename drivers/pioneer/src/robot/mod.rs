@@ -456,6 +456,7 @@ impl RobotModel {
         }
         if let Command::ArmPower(on) = *cmd {
             self.arm.power_commanded(on);
+            self.dirty.arm = true;
         }
         Ok(())
     }
