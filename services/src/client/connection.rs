@@ -184,8 +184,21 @@ impl<I: Interface> Client<I> {
     fn open_device(ctx: &Context, device: &DeviceName) -> Result<Self, ConnectError> {
         let dev = device.to_string();
         let domain = ctx.domain().name().to_string();
+        // The device's capacity as its driver published it (ordinary, reserved), once read.
+        let capacity: core::cell::Cell<(usize, usize)> = core::cell::Cell::new((0, 0));
+        let full = || {
+            let (max, reserved) = capacity.get();
+            ConnectError::Full {
+                device: dev.clone(),
+                max,
+                reserved,
+                priority: ctx.priority(),
+            }
+        };
         let map = |channel: &'static str, e: Iox2Error| -> ConnectError {
-            if e.is_missing_service() {
+            if e.is_full() {
+                full()
+            } else if e.is_missing_service() {
                 ConnectError::NoDriver {
                     device: dev.clone(),
                     domain: domain.clone(),
@@ -232,6 +245,18 @@ impl<I: Interface> Client<I> {
             .publish_subscribe::<I::Data>()
             .open_with_attributes(&layout)
             .map_err(|e| map("data", e.into()))?;
+        if let Some((max, reserved)) = advertised_capacity(&data_svc) {
+            capacity.set((max, reserved));
+            // The last `reserved` slots are the priority clients' (cooperative: see
+            // `Context::set_priority`). Dead clients' slots are freed before refusing.
+            let taken = || data_svc.dynamic_config().number_of_subscribers();
+            if !ctx.priority() && taken() >= max {
+                ctx.domain().cleanup_dead_nodes(&data_svc);
+                if taken() >= max {
+                    return Err(full());
+                }
+            }
+        }
         let states = data_svc
             .subscriber_builder()
             .create()
@@ -376,6 +401,18 @@ impl<I: Interface> Client<I> {
     pub fn driver_status(&self) -> DriverStatus {
         driver_status_of(&self.data_svc, self.ctx.domain())
     }
+}
+
+/// The capacity a driver published for its device: (ordinary clients, reserved slots);
+/// `None` from a driver that does not say.
+fn advertised_capacity<P: PortFactory<Service = ipc::Service>>(svc: &P) -> Option<(usize, usize)> {
+    let get = |key: &str| -> Option<usize> {
+        svc.attributes()
+            .iter()
+            .find(|a| a.key().as_bytes() == key.as_bytes())
+            .and_then(|a| a.value().to_string().parse().ok())
+    };
+    Some((get(attr::MAX_CLIENTS)?, get(attr::RESERVED_CLIENTS)?))
 }
 
 /// The status of the driver attached to a device's data service.
