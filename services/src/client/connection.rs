@@ -83,6 +83,8 @@ pub struct Client<I: Interface> {
     /// The next command's sample, loaned right after the previous command was sent
     /// (`crate::host::loan_ahead`).
     pub(super) cmd_loan: Option<CmdLoan<I>>,
+    /// The driver's status as [`Client::freshness`] last looked, and when.
+    pub(super) liveness_seen: Option<(Instant, DriverStatus)>,
     /// Last: dropped after the ports, so a test's domain whose last handle this is finds
     /// them gone ([`crate::Domain::unique_for_test`]).
     pub(super) ctx: Context,
@@ -245,6 +247,15 @@ impl<I: Interface> Client<I> {
             .publish_subscribe::<I::Data>()
             .open_with_attributes(&layout)
             .map_err(|e| map("data", e.into()))?;
+        // Services that another client keeps open outlive their driver: a device whose
+        // driver died (or ended) is not offered, whoever still holds its files.
+        if !driver_may_be_alive(&data_svc, ctx.domain()) {
+            return Err(ConnectError::NoDriver {
+                device: dev.clone(),
+                domain: domain.clone(),
+                elsewhere: crate::domain::dir::elsewhere_note(&domain),
+            });
+        }
         if let Some((max, reserved)) = advertised_capacity(&data_svc) {
             capacity.set((max, reserved));
             // The last `reserved` slots are the priority clients' (cooperative: see
@@ -338,6 +349,7 @@ impl<I: Interface> Client<I> {
             spin_budget: crate::qos::default_spin_budget(),
             spin_until: None,
             cmd_loan: None,
+            liveness_seen: None,
         })
     }
 
@@ -401,6 +413,43 @@ impl<I: Interface> Client<I> {
     pub fn driver_status(&self) -> DriverStatus {
         driver_status_of(&self.data_svc, self.ctx.domain())
     }
+}
+
+/// Whether a driver's process may be attached to a device's data service: one is known
+/// alive, or a live node's name cannot be read (in group mode, another member's). A dead
+/// driver found on the way is cleaned up.
+fn driver_may_be_alive<P: PortFactory<Service = ipc::Service>>(
+    svc: &P,
+    domain: &crate::domain::Domain,
+) -> bool {
+    let (mut alive, mut unknown, mut dead) = (false, false, false);
+    if let Err(e) = svc.nodes(|n| {
+        match &n {
+            NodeState::Alive(v) => match v.details() {
+                Some(d) if d.name().as_str().starts_with(DRIVER_NODE_PREFIX) => alive = true,
+                Some(_) => {}
+                None => unknown = true,
+            },
+            NodeState::Dead(v) => {
+                if v.details()
+                    .as_ref()
+                    .is_some_and(|d| d.name().as_str().starts_with(DRIVER_NODE_PREFIX))
+                {
+                    dead = true;
+                }
+            }
+            NodeState::Inaccessible(_) | NodeState::Undefined(_) => unknown = true,
+        }
+        CallbackProgression::Continue
+    }) {
+        // Not known to be dead: let the connection go on (its waits check again).
+        tracing::warn!(error = %e, "cannot list the nodes of a device");
+        return true;
+    }
+    if dead && !alive {
+        domain.cleanup_dead_nodes(svc);
+    }
+    alive || unknown
 }
 
 /// The capacity a driver published for its device: (ordinary clients, reserved slots);
