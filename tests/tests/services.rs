@@ -312,9 +312,18 @@ fn a_killed_driver_reads_dead_and_its_device_refuses_new_connections() {
     arm.wait_state(T).unwrap();
     driver.signal(libc::SIGKILL);
     assert_eq!(driver.wait_timeout(T), None, "killed");
+    // Found dead (and cleaned up on the way): dead it stays for this client, through its
+    // own looks (freshness, waits) as through a monitor's repeated ones, until a driver is
+    // back.
     assert_eq!(arm.driver_status(), DriverStatus::Dead);
-    // `arm` keeps the services open: a new client must not be told it is connected.
+    assert_eq!(arm.freshness(Duration::from_secs(3600)), Freshness::Gone);
+    assert_eq!(
+        arm.driver_status(),
+        DriverStatus::Dead,
+        "until a driver is back"
+    );
     let other = Context::new(&domain, Role::Client, "late").unwrap();
+    // `arm` keeps the services open: a new client must not be told it is connected.
     let err = ActArrayClient::connect(&other, "test/actarray/0").unwrap_err();
     assert!(matches!(err, ConnectError::NoDriver { .. }), "{err}");
     assert!(

@@ -85,6 +85,9 @@ pub struct Client<I: Interface> {
     pub(super) cmd_loan: Option<CmdLoan<I>>,
     /// The driver's status as [`Client::freshness`] last looked, and when.
     pub(super) liveness_seen: Option<(Instant, DriverStatus)>,
+    /// This client found the driver's process dead (and cleaned it up), and no driver is
+    /// alive since: [`Client::driver_status`] says `Dead`, not `Absent`.
+    pub(super) driver_died: core::cell::Cell<bool>,
     /// Last: dropped after the ports, so a test's domain whose last handle this is finds
     /// them gone ([`crate::Domain::unique_for_test`]).
     pub(super) ctx: Context,
@@ -350,6 +353,7 @@ impl<I: Interface> Client<I> {
             spin_until: None,
             cmd_loan: None,
             liveness_seen: None,
+            driver_died: core::cell::Cell::new(false),
         })
     }
 
@@ -408,10 +412,20 @@ impl<I: Interface> Client<I> {
     // ----- liveness ---------------------------------------------------------------------
 
     /// Whether the device's driver process is alive. A dead driver's resources are
-    /// cleaned up on the way, so that a restarted driver is picked up by this client.
-    /// Costs tens of microseconds: not for every control cycle.
+    /// cleaned up on the way, so that a restarted driver is picked up by this client; it
+    /// reads [`DriverStatus::Dead`] all the same until a driver is alive again (a driver
+    /// that another process cleaned up before this client looked reads `Absent`: iceoryx2
+    /// keeps nothing of it to tell). Costs tens of microseconds: not for every control
+    /// cycle.
     pub fn driver_status(&self) -> DriverStatus {
-        driver_status_of(&self.data_svc, self.ctx.domain())
+        let status = driver_status_of(&self.data_svc, self.ctx.domain());
+        match status {
+            DriverStatus::Alive => self.driver_died.set(false),
+            DriverStatus::Dead => self.driver_died.set(true),
+            DriverStatus::Absent if self.driver_died.get() => return DriverStatus::Dead,
+            DriverStatus::Absent => {}
+        }
+        status
     }
 }
 

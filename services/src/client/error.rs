@@ -88,13 +88,14 @@ pub enum ConnectError {
 
 /// The sentence of [`ConnectError::Full`].
 fn full_text(device: &str, max: usize, reserved: usize, priority: bool) -> String {
+    let clients = if max == 1 { "client" } else { "clients" };
     let taken = if priority {
         format!(
-            "its driver admits {max} clients and {reserved} priority clients at once, and all are connected"
+            "its driver admits {max} {clients} and {reserved} priority clients at once, and all are connected"
         )
     } else {
         format!(
-            "its driver admits {max} clients at once and all are connected ({reserved} more slots are kept for priority clients)"
+            "its driver admits {max} {clients} at once and all are connected ({reserved} more slots are kept for priority clients)"
         )
     };
     format!(

@@ -16,7 +16,8 @@ use crate::error::Iox2Error;
 pub enum DriverStatus {
     /// Its process is alive.
     Alive,
-    /// Its process died without cleaning up (found dead and cleaned up now).
+    /// Its process died without cleaning up (found dead by this client and cleaned up;
+    /// so it stays until a driver is alive again).
     Dead,
     /// No driver is attached.
     Absent,
