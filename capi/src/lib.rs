@@ -347,9 +347,9 @@ impl From<ConnectError> for Fail {
             ConnectError::Context(_) => LimberCode::Transport,
             ConnectError::NoDriver { .. } => LimberCode::NoDriver,
             ConnectError::Incompatible { .. } => LimberCode::Incompatible,
-            ConnectError::Transport { .. } | ConnectError::Permission { .. } => {
-                LimberCode::Transport
-            }
+            ConnectError::Transport { .. }
+            | ConnectError::Permission { .. }
+            | ConnectError::Full { .. } => LimberCode::Transport,
         };
         Fail::from_error(code, &e)
     }

@@ -25,6 +25,11 @@ pub struct Common {
     /// with the holder's name if another client holds it. Without it, the last writer wins.
     #[arg(long, global = true)]
     own: bool,
+    /// Connect as a priority client (as LIMBER_PRIORITY=1 does): it may take the slots a
+    /// device keeps beyond its --max-clients for the robot's control program. Cooperative
+    /// among the domain owner's processes, not a protection.
+    #[arg(long, global = true)]
+    priority: bool,
 }
 
 impl Common {
@@ -252,6 +257,8 @@ pub(crate) fn connect_err(e: ConnectError) -> CliError {
     }
     let code = match e {
         ConnectError::NoDriver { .. } => exit::NO_DRIVER,
+        // The device refused one more client: it says how many it admits and what to do.
+        ConnectError::Full { .. } => exit::REFUSED,
         ConnectError::Name(_) => exit::USAGE,
         // A verb of another interface than the device's: a usage error.
         ConnectError::Incompatible {
@@ -295,6 +302,9 @@ pub(crate) fn wait_err(e: WaitError) -> CliError {
 
 fn connect<I: Interface>(device: &str, common: &Common) -> Result<Client<I>, CliError> {
     let ctx = crate::client_context()?;
+    if common.priority {
+        ctx.set_priority(true);
+    }
     let timeout = common.timeout();
     // A driver that is starting gets the whole --timeout to appear.
     let mut c = Client::<I>::connect_timeout(&ctx, device, timeout).map_err(connect_err)?;

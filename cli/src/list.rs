@@ -36,13 +36,19 @@ pub fn run(args: ListArgs) -> Result<(), CliError> {
         }
         return Ok(());
     }
-    if devices.is_empty() {
+    let robots = limber_services::diagnostics::list_drivers(&domain)
+        .map_err(|e| CliError::new(exit::FAILURE, e.to_string()))?;
+    if devices.is_empty() && robots.is_empty() {
         outln!(
             "no devices in domain {} (start a driver, e.g. `limber pioneer --emulated`, or check --domain / LIMBER_DOMAIN){}",
             domain.name(),
             limber_services::domain_dir::elsewhere_note(domain.name())
         )?;
         return Ok(());
+    }
+    if devices.is_empty() {
+        // Drivers that serve only their statistics: a robot without arm or gripper.
+        return print_lacks(&robots, true);
     }
     outln!(
         "{:<28} {:<12} {:<6} {:>9}",
@@ -60,20 +66,22 @@ pub fn run(args: ListArgs) -> Result<(), CliError> {
             d.nodes
         )?;
     }
-    print_lacks(&domain)
+    print_lacks(&robots, false)
 }
 
-/// One line per robot whose running driver found hardware missing: "robot pioneer has no
-/// arm (driver pioneer)".
-fn print_lacks(domain: &limber_services::Domain) -> Result<(), CliError> {
-    let robots = limber_services::diagnostics::list_drivers(domain)
-        .map_err(|e| CliError::new(exit::FAILURE, e.to_string()))?;
+/// One line per robot (of `robots`, whose drivers publish statistics) whose running driver
+/// found hardware missing: "robot pioneer has no arm (driver pioneer)"; with `every`, also
+/// one for each robot that lacks nothing ("robot r: driver d serves no devices").
+fn print_lacks(robots: &[String], every: bool) -> Result<(), CliError> {
     if robots.is_empty() {
         return Ok(());
     }
     let ctx = crate::client_context()?;
     for robot in robots {
-        let Some(l) = crate::lacks::of_robot(&ctx, &robot) else {
+        let Some(l) = crate::lacks::of_robot(&ctx, robot) else {
+            if every {
+                outln!("robot {robot}: its driver serves no devices (no statistics arrived)")?;
+            }
             continue;
         };
         let missing = limber_interfaces::diagnostics::hardware::lacking(l.bits);
@@ -83,6 +91,8 @@ fn print_lacks(domain: &limber_services::Domain) -> Result<(), CliError> {
                 missing.join(", no "),
                 l.driver
             )?;
+        } else if every {
+            outln!("robot {robot}: driver {} serves no devices", l.driver)?;
         }
     }
     Ok(())

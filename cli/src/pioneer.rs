@@ -44,6 +44,10 @@ pub struct PioneerArgs {
     /// CAP_IPC_LOCK; a warning says so when not permitted).
     #[arg(long)]
     pub rt: bool,
+    /// Clients each device admits at once (default 64, or max_clients of --config); a few
+    /// more slots are kept for priority clients (LIMBER_PRIORITY=1, --priority).
+    #[arg(long, value_name = "N")]
+    pub max_clients: Option<usize>,
     /// Print the configuration (defaults merged with --config) as TOML and exit.
     #[arg(long)]
     pub print_config: bool,
@@ -83,6 +87,9 @@ pub fn config_from(args: &PioneerArgs) -> Result<PioneerConfig, PioneerCliError>
     }
     if let Some(r) = &args.robot {
         cfg.robot = r.clone();
+    }
+    if let Some(n) = args.max_clients {
+        cfg.max_clients = n;
     }
     cfg.validate()?;
     Ok(cfg)

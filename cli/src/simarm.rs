@@ -48,6 +48,19 @@ pub struct SimArmArgs {
     /// e.g. `--object 0.45,0.1,0.1,0.04`.
     #[arg(long, value_name = "X,Y,Z,WIDTH", value_parser = parse_object)]
     pub object: Option<SimObject>,
+    /// Clients each device admits at once; a few more slots are kept for priority clients
+    /// (LIMBER_PRIORITY=1, --priority).
+    #[arg(long, value_name = "N", default_value_t = limber_services::qos::DEFAULT_MAX_CLIENTS,
+          value_parser = parse_max_clients)]
+    pub max_clients: usize,
+}
+
+/// `--max-clients`: 1 to `qos::MAX_CLIENTS_LIMIT`.
+pub(crate) fn parse_max_clients(s: &str) -> Result<usize, String> {
+    let n: usize = s.parse().map_err(|e| format!("{s:?}: {e}"))?;
+    limber_services::qos::Capacity::new(n)
+        .map(|c| c.max_clients())
+        .map_err(|e| e.to_string())
 }
 
 impl SimArmArgs {
@@ -111,6 +124,10 @@ pub fn run(args: SimArmArgs) -> Result<(), CliError> {
             format!("cannot join domain {}: {e}", domain.name()),
         )
     })?;
+    match limber_services::qos::Capacity::new(args.max_clients) {
+        Ok(c) => ctx.set_capacity(c),
+        Err(e) => return Err(CliError::new(exit::USAGE, e.to_string())),
+    }
     let robot = options.robot.clone();
     let mut arm = SimArm::new(&ctx, chain, options).map_err(|e| match e {
         // Bad option values (time scale, object, robot name) are usage errors.

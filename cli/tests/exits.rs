@@ -240,3 +240,89 @@ fn bench_only_an_unknown_scenario_is_a_usage_error() {
         "{err}"
     );
 }
+
+/// A device full of clients refuses one more verb with exit 5 and a sentence naming the
+/// device, its limit and what to do; `--priority` (or `LIMBER_PRIORITY=1`) gets in.
+#[test]
+fn a_full_device_refuses_a_verb_with_exit_5_and_priority_gets_in() {
+    use limber_services::prelude::*;
+    use limber_services::qos::Capacity;
+    use limber_services::testing::TestDriver;
+    use std::sync::mpsc;
+
+    let d = Domain::unique_for_test();
+    let (stop_tx, stop_rx) = mpsc::channel::<()>();
+    let (ready_tx, ready_rx) = mpsc::channel();
+    let name = d.name().to_string();
+    let served = std::thread::spawn(move || {
+        let domain = Domain::new(&name).unwrap();
+        let ctx = Context::new(&domain, Role::Driver, "testdriver").unwrap();
+        ctx.set_capacity(Capacity::new(2).unwrap());
+        let mut drv = TestDriver::new(&ctx, "cli", 6).unwrap();
+        ready_tx.send(()).unwrap();
+        let _ = drv.run(Duration::from_millis(10), || {
+            !matches!(stop_rx.try_recv(), Err(mpsc::TryRecvError::Empty))
+        });
+    });
+    ready_rx.recv_timeout(Duration::from_secs(10)).unwrap();
+    let ctx = Context::new(&d, Role::Client, "filler").unwrap();
+    ctx.set_priority(false);
+    let _fill: Vec<_> = (0..2)
+        .map(|_| ActArrayClient::connect(&ctx, "cli/actarray/0").unwrap())
+        .collect();
+    let verb = |args: &[&str], priority: Option<&str>| {
+        let mut cmd = Command::new(LIMBER);
+        cmd.args(args)
+            .env("LIMBER_DOMAIN", d.name())
+            .env_remove("LIMBER_PRIORITY");
+        if let Some(p) = priority {
+            cmd.env("LIMBER_PRIORITY", p);
+        }
+        common::output(&mut cmd)
+    };
+    let o = verb(&["actarray", "cli/actarray/0", "geom"], None);
+    assert_eq!(o.status.code(), Some(5), "{}", stderr(&o));
+    for needle in [
+        "cli/actarray/0 is full",
+        "admits 2 clients",
+        "--max-clients",
+        "LIMBER_PRIORITY=1",
+    ] {
+        assert!(stderr(&o).contains(needle), "{needle:?}: {}", stderr(&o));
+    }
+    assert!(!stderr(&o).contains("ExceedsMax"), "{}", stderr(&o));
+    let o = verb(&["actarray", "cli/actarray/0", "geom", "--priority"], None);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let o = verb(&["actarray", "cli/actarray/0", "geom"], Some("1"));
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    stop_tx.send(()).unwrap();
+    served.join().unwrap();
+}
+
+/// `--max-clients` is the driver's `max_clients`, checked like every value.
+#[test]
+fn max_clients_is_a_setting_of_the_drivers() {
+    let d = Domain::unique_for_test();
+    let o = limber(
+        d.name(),
+        &["pioneer", "--print-config", "--max-clients", "80"],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("max_clients = 80"),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    for args in [
+        &["pioneer", "--print-config", "--max-clients", "0"][..],
+        &["simarm", "--max-clients", "0"][..],
+    ] {
+        let o = limber(d.name(), args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains("max_clients must be between 1 and"),
+            "{args:?}: {}",
+            stderr(&o)
+        );
+    }
+}

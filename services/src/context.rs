@@ -91,6 +91,10 @@ pub(crate) struct Inner {
     pub(crate) domain: Domain,
     pub(crate) role: Role,
     pub(crate) name: String,
+    /// The capacity of the devices this process offers (drivers).
+    pub(crate) capacity: core::cell::Cell<crate::qos::Capacity>,
+    /// Whether this process's clients may take a device's reserved slots.
+    pub(crate) priority: core::cell::Cell<bool>,
 }
 
 impl Drop for Inner {
@@ -187,6 +191,8 @@ impl Context {
                 node,
                 role,
                 name: name.to_string(),
+                capacity: core::cell::Cell::new(crate::qos::Capacity::default()),
+                priority: core::cell::Cell::new(crate::qos::priority_from_env()),
             }),
         })
     }
@@ -226,6 +232,36 @@ impl Context {
     /// own). Other signals never make it true.
     pub fn termination_requested(&self) -> bool {
         self.inner.role == Role::Driver && crate::signals::termination_requested()
+    }
+
+    /// The capacity of the devices this process offers from now on (default
+    /// [`crate::qos::DEFAULT_MAX_CLIENTS`] clients each): a driver sets it before it
+    /// offers its devices. Published as the services' attributes, so that a client refused
+    /// for a full device can say the limit.
+    pub fn set_capacity(&self, capacity: crate::qos::Capacity) {
+        self.inner.capacity.set(capacity);
+    }
+
+    /// The capacity of the devices this process offers.
+    pub fn capacity(&self) -> crate::qos::Capacity {
+        self.inner.capacity.get()
+    }
+
+    /// Makes this process's clients priority clients (or ordinary ones again): the owner's
+    /// control program, which must get in even when a device is full of other clients.
+    /// They may take the [`crate::qos::RESERVED_CLIENTS`] slots that ordinary clients leave
+    /// free. Default: `LIMBER_PRIORITY=1` in the environment.
+    ///
+    /// This is cooperation among one user's processes, not protection: every process of the
+    /// domain's owner (or group) can map the domain's memory anyway, and one that does not
+    /// use limber's client can take any slot.
+    pub fn set_priority(&self, priority: bool) {
+        self.inner.priority.set(priority);
+    }
+
+    /// Whether this process's clients are priority clients ([`Context::set_priority`]).
+    pub fn priority(&self) -> bool {
+        self.inner.priority.get()
     }
 
     /// A new client id, unique in the domain while this process lives: the process id in

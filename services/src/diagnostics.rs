@@ -125,8 +125,8 @@ impl StatsPublisher {
             .history_size(1)
             .subscriber_max_buffer_size(qos::DATA_BUFFER)
             .max_publishers(qos::DATA_PUBLISHERS)
-            .max_subscribers(qos::MAX_CLIENTS)
-            .max_nodes(qos::MAX_NODES)
+            .max_subscribers(ctx.capacity().ports())
+            .max_nodes(ctx.capacity().nodes())
             .open_or_create()
             .map_err(|e| offer(e.into()))?;
         let publisher = svc

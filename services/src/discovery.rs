@@ -55,7 +55,8 @@ pub enum ListError {
 }
 
 /// Every device of `domain`, sorted by name. A device whose driver died is listed as not
-/// alive until its services are cleaned up.
+/// alive until its services are cleaned up; one whose driver ended cleanly is not listed,
+/// even while clients still hold its services open.
 pub fn list_devices(domain: &Domain) -> Result<Vec<DeviceInfo>, ListError> {
     let mut out = Vec::new();
     let config = domain.config().map_err(|e| ListError::Domain {
@@ -81,20 +82,27 @@ pub fn list_devices(domain: &Domain) -> Result<Vec<DeviceInfo>, ListError> {
                 .map(|a| a.value().to_string())
                 .unwrap_or_default()
         };
-        let (mut alive, mut nodes) = (false, 0);
+        let (mut alive, mut dead, mut unknown, mut nodes) = (false, false, false, 0);
         if let Some(dynamic) = &details.dynamic_details {
+            use iceoryx2::node::NodeView;
+            let is_driver = |d: &Option<iceoryx2::node::NodeDetails>| {
+                d.as_ref()
+                    .is_some_and(|d| d.name().as_str().starts_with(DRIVER_NODE_PREFIX))
+            };
             for n in &dynamic.nodes {
                 nodes += 1;
-                if let NodeState::Alive(v) = n {
-                    use iceoryx2::node::NodeView;
-                    if v.details()
-                        .as_ref()
-                        .is_some_and(|d| d.name().as_str().starts_with(DRIVER_NODE_PREFIX))
-                    {
-                        alive = true;
-                    }
+                match n {
+                    NodeState::Alive(v) if v.details().is_none() => unknown = true,
+                    NodeState::Alive(v) => alive |= is_driver(v.details()),
+                    NodeState::Dead(v) => dead |= is_driver(v.details()),
+                    NodeState::Inaccessible(_) | NodeState::Undefined(_) => unknown = true,
                 }
             }
+        }
+        // A driver that ended cleanly left no node behind: the files that clients still
+        // hold are not a device any more (neither alive nor dead: not listed).
+        if !(alive || dead || unknown) {
+            return CallbackProgression::Continue;
         }
         out.push(DeviceInfo {
             name: device,

@@ -167,6 +167,22 @@ impl Iox2Error {
         )
     }
 
+    /// True when a service or port could not be made because every slot of its kind is
+    /// taken (subscribers, publishers, clients, notifiers, listeners, nodes).
+    pub fn is_full(&self) -> bool {
+        matches!(
+            self,
+            Iox2Error::SubscriberCreate(SubscriberCreateError::ExceedsMaxSupportedSubscribers)
+                | Iox2Error::PublisherCreate(PublisherCreateError::ExceedsMaxSupportedPublishers)
+                | Iox2Error::ClientCreate(ClientCreateError::ExceedsMaxSupportedClients)
+                | Iox2Error::NotifierCreate(NotifierCreateError::ExceedsMaxSupportedNotifiers)
+                | Iox2Error::ListenerCreate(ListenerCreateError::ExceedsMaxSupportedListeners)
+                | Iox2Error::PubSubOpen(PublishSubscribeOpenError::ExceedsMaxNumberOfNodes)
+                | Iox2Error::EventOpen(EventOpenError::ExceedsMaxNumberOfNodes)
+                | Iox2Error::ReqRespOpen(RequestResponseOpenError::ExceedsMaxNumberOfNodes)
+        )
+    }
+
     /// True when the service exists with other attributes (another layout version or
     /// driver) or other payload types.
     pub fn is_incompatible_attributes_or_types(&self) -> bool {

@@ -192,6 +192,10 @@ pub mod attr {
     pub const DRIVER: &str = "limber.driver";
     /// The layout version of the wire contract.
     pub const LAYOUT: &str = "limber.layout";
+    /// Ordinary clients the device admits ([`crate::qos::Capacity::max_clients`]).
+    pub const MAX_CLIENTS: &str = "limber.max_clients";
+    /// Slots beyond them kept for priority clients ([`crate::qos::RESERVED_CLIENTS`]).
+    pub const RESERVED_CLIENTS: &str = "limber.reserved_clients";
 }
 
 /// The node name prefix of driver processes (liveness checks look for it).

@@ -3,13 +3,80 @@
 //! Drivers create the services with these values; clients open them with iceoryx2's
 //! defaults, which are below them (iceoryx2 treats the opener's values as minimums).
 
-/// Clients (processes) per device: subscribers of `data`, publishers of `cmd`, clients of
-/// `req`, notifiers of `wake`, listeners of `notify`.
+/// Clients per device that a driver admits unless configured otherwise (the Pioneer
+/// driver's `max_clients`, `limber pioneer --max-clients N`, `limber simarm --max-clients
+/// N`): subscribers of `data` and `outcome`, publishers of `cmd`, clients of `req` and
+/// `lease`, notifiers of `wake`, listeners of `notify`. Enough for a robot PC's control
+/// program, monitors, loggers, bridges and a few shell commands at once.
 /// (Each subscriber slot costs every publish: 64 slots made a 1.3 kB publish 2.4x slower
-/// than 1 slot, measured by `limber bench`.)
-pub const MAX_CLIENTS: usize = 32;
-/// Nodes (processes) that may open one service.
-pub const MAX_NODES: usize = 80;
+/// than 1 slot, measured by `limber bench`. A driver that needs the fastest publish and
+/// few clients says so with a smaller `max_clients`.)
+pub const DEFAULT_MAX_CLIENTS: usize = 64;
+/// The largest `max_clients` a driver accepts.
+pub const MAX_CLIENTS_LIMIT: usize = 1024;
+/// Slots of every device kept beyond `max_clients` for priority clients (the owner's
+/// control program: [`PRIORITY_ENV`], [`crate::Context::set_priority`]): an ordinary
+/// client refuses to take them, so a device full of ordinary clients still admits them.
+pub const RESERVED_CLIENTS: usize = 2;
+/// Nodes (processes) that may open one service beyond its client slots: the driver, a dead
+/// driver not yet cleaned up, observers.
+pub const EXTRA_NODES: usize = 16;
+/// The environment variable that makes a process's clients priority clients (`1`): they
+/// may take the [`RESERVED_CLIENTS`] slots of a device full of ordinary clients.
+pub const PRIORITY_ENV: &str = "LIMBER_PRIORITY";
+
+/// How many clients a driver's devices admit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Capacity {
+    max_clients: usize,
+}
+
+impl Default for Capacity {
+    fn default() -> Self {
+        Capacity {
+            max_clients: DEFAULT_MAX_CLIENTS,
+        }
+    }
+}
+
+/// A capacity out of range.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("max_clients must be between 1 and {MAX_CLIENTS_LIMIT}, not {0}")]
+pub struct CapacityError(pub usize);
+
+impl Capacity {
+    /// `max_clients` ordinary clients per device (1 to [`MAX_CLIENTS_LIMIT`]), plus the
+    /// [`RESERVED_CLIENTS`] slots of priority clients.
+    pub fn new(max_clients: usize) -> Result<Self, CapacityError> {
+        if (1..=MAX_CLIENTS_LIMIT).contains(&max_clients) {
+            Ok(Capacity { max_clients })
+        } else {
+            Err(CapacityError(max_clients))
+        }
+    }
+
+    /// Ordinary clients per device.
+    pub fn max_clients(&self) -> usize {
+        self.max_clients
+    }
+
+    /// Every client slot of a device's services: ordinary and reserved.
+    pub fn ports(&self) -> usize {
+        self.max_clients + RESERVED_CLIENTS
+    }
+
+    /// Nodes (processes) that may open one of a device's services.
+    pub fn nodes(&self) -> usize {
+        self.ports() + EXTRA_NODES
+    }
+}
+
+/// Whether `LIMBER_PRIORITY` asks for priority clients (`1`, `true`, `yes`).
+pub fn priority_from_env() -> bool {
+    std::env::var(PRIORITY_ENV)
+        .map(|v| matches!(v.trim(), "1" | "true" | "yes"))
+        .unwrap_or(false)
+}
 /// Publishers of `data`: the driver, plus one dead driver not yet cleaned up.
 pub const DATA_PUBLISHERS: usize = 2;
 /// Samples buffered per `data` subscriber (history 1; when full the oldest is replaced).

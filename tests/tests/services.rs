@@ -274,3 +274,78 @@ fn many_clients_do_not_make_a_long_lived_client_look_lossy() {
         "{out}"
     );
 }
+
+/// Issue "Nobody moves the arm who may not", item 14: `freshness(max_age)` looks at the
+/// driver's process once the state is older than a short bound, not only after `max_age`:
+/// a SIGKILLed driver is gone long before a generous `max_age` has passed.
+#[test]
+fn freshness_says_gone_soon_after_the_driver_dies_whatever_max_age() {
+    let domain = Domain::unique_for_test();
+    let mut driver = start_driver(&domain, &[]);
+    let ctx = client_ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&ctx, "test/actarray/0", T).unwrap();
+    arm.wait_state(T).unwrap();
+    let generous = Duration::from_secs(3600);
+    assert_eq!(arm.freshness(generous), Freshness::Fresh);
+    driver.signal(libc::SIGKILL);
+    assert_eq!(driver.wait_timeout(T), None, "killed");
+    // The driver is dead: the state only ages. Gone well within max_age (the bound here
+    // is the test's, not a claim of speed).
+    let deadline = Instant::now() + Duration::from_secs(30);
+    let mut seen = arm.freshness(generous);
+    while seen == Freshness::Fresh && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(5));
+        seen = arm.freshness(generous);
+    }
+    assert_eq!(seen, Freshness::Gone);
+}
+
+/// Item 14: a SIGKILLed driver reads DEAD (its node is found dead, then cleaned up), not
+/// ABSENT, and a connection to its device fails even while another client keeps the
+/// device's services open.
+#[test]
+fn a_killed_driver_reads_dead_and_its_device_refuses_new_connections() {
+    let domain = Domain::unique_for_test();
+    let mut driver = start_driver(&domain, &[]);
+    let ctx = client_ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&ctx, "test/actarray/0", T).unwrap();
+    arm.wait_state(T).unwrap();
+    driver.signal(libc::SIGKILL);
+    assert_eq!(driver.wait_timeout(T), None, "killed");
+    // Found dead (and cleaned up on the way): dead it stays for this client, through its
+    // own looks (freshness, waits) as through a monitor's repeated ones, until a driver is
+    // back.
+    assert_eq!(arm.driver_status(), DriverStatus::Dead);
+    assert_eq!(arm.freshness(Duration::from_secs(3600)), Freshness::Gone);
+    assert_eq!(
+        arm.driver_status(),
+        DriverStatus::Dead,
+        "until a driver is back"
+    );
+    let other = Context::new(&domain, Role::Client, "late").unwrap();
+    // `arm` keeps the services open: a new client must not be told it is connected.
+    let err = ActArrayClient::connect(&other, "test/actarray/0").unwrap_err();
+    assert!(matches!(err, ConnectError::NoDriver { .. }), "{err}");
+    assert!(
+        err.to_string().contains("no driver offers test/actarray/0"),
+        "{err}"
+    );
+    drop(arm);
+}
+
+/// Item 14: a driver that ended cleanly (SIGTERM) while a client was attached is not
+/// listed as dead: its devices are simply not offered any more.
+#[test]
+fn a_cleanly_stopped_driver_is_not_listed_dead() {
+    let domain = Domain::unique_for_test();
+    let mut driver = start_driver(&domain, &[]);
+    let ctx = client_ctx(&domain);
+    let mut arm = ActArrayClient::connect_timeout(&ctx, "test/actarray/0", T).unwrap();
+    arm.wait_state(T).unwrap();
+    driver.signal(libc::SIGTERM);
+    assert_eq!(driver.wait_timeout(T), Some(0));
+    let devices = list_devices(&domain).unwrap();
+    assert!(devices.iter().all(|d| d.alive), "{devices:?}");
+    assert_ne!(arm.driver_status(), DriverStatus::Dead);
+    drop(arm);
+}

@@ -365,8 +365,9 @@ impl App {
         }
     }
 
-    /// Reads the device list again: connects to new devices, forgets vanished ones,
-    /// reconnects to devices whose driver came back.
+    /// Reads the device list again: connects to new devices, forgets vanished ones (but
+    /// those it is connected to, whose driver ended cleanly), reconnects to devices whose
+    /// driver came back.
     pub fn discover(&mut self) {
         self.last_discovery = Some(Instant::now());
         let list = match list_devices(self.ctx.domain()) {
@@ -420,6 +421,15 @@ impl App {
                 c.ask_geometry();
             }
             self.devices.push(dev);
+        }
+        // A driver that ended cleanly is not listed any more; the devices this monitor is
+        // connected to stay, not alive, with their last values (a driver that comes back
+        // is listed again and reconnected above).
+        for (_, mut d) in old {
+            if d.conn.is_ok() {
+                d.info.alive = false;
+                self.devices.push(d);
+            }
         }
         self.devices.sort_by(|a, b| a.info.name.cmp(&b.info.name));
         self.selected = selected

@@ -127,6 +127,12 @@ pub struct PioneerConfig {
     /// needs no wake-up (`event_loop::linger`; at most 1 ms of CPU per burst). 0: sleep at
     /// once. Chosen by measurement (`limber bench --only command`, the `event-*` rows).
     pub linger_us: u32,
+    /// Clients each device admits at once (`limber pioneer --max-clients N`; 1 to
+    /// `limber_services::qos::MAX_CLIENTS_LIMIT`): a full device refuses one more with a
+    /// sentence naming the limit. A few more slots are kept for priority clients (the
+    /// robot's control program: `LIMBER_PRIORITY=1`). Every slot costs a little on every
+    /// publish: size it to the programs of the robot PC.
+    pub max_clients: usize,
 }
 
 /// `body_gripper`: whether the robot has the body gripper and its lift.
@@ -244,6 +250,7 @@ impl Default for PioneerConfig {
             // The link timeout (1 s) and a reconnection or two, with room to spare.
             autopark_s: 10,
             linger_us: limber_services::qos::DRIVER_LINGER.as_micros() as u32,
+            max_clients: limber_services::qos::DEFAULT_MAX_CLIENTS,
         }
     }
 }
@@ -276,6 +283,11 @@ impl PioneerConfig {
                 .replacen(
                     "setpose_position_tolerance =",
                     "# SETPOSE: position (m) and approach (degrees) within these; the orientation is the\n# nearest one the five joints can hold (outcome ADJUSTED, the limb state says by how much)\nsetpose_position_tolerance =",
+                    1,
+                )
+                .replacen(
+                    "max_clients =",
+                    "# max_clients: clients each device admits at once (a few more slots are kept for\n# priority clients, LIMBER_PRIORITY=1); every slot costs a little on every publish\nmax_clients =",
                     1,
                 )
                 .replacen(
@@ -312,6 +324,9 @@ impl PioneerConfig {
             || self.arm_links[2] <= 0.0
         {
             return bad("arm_links must be >= 0 (L2 and L4 > 0)");
+        }
+        if let Err(e) = limber_services::qos::Capacity::new(self.max_clients) {
+            return bad(&e.to_string());
         }
         if !(self.lift_stroke > 0.0 && self.lift_stroke.is_finite()) {
             return bad("lift_stroke must be > 0");

@@ -83,6 +83,11 @@ pub struct Client<I: Interface> {
     /// The next command's sample, loaned right after the previous command was sent
     /// (`crate::host::loan_ahead`).
     pub(super) cmd_loan: Option<CmdLoan<I>>,
+    /// The driver's status as [`Client::freshness`] last looked, and when.
+    pub(super) liveness_seen: Option<(Instant, DriverStatus)>,
+    /// This client found the driver's process dead (and cleaned it up), and no driver is
+    /// alive since: [`Client::driver_status`] says `Dead`, not `Absent`.
+    pub(super) driver_died: core::cell::Cell<bool>,
     /// Last: dropped after the ports, so a test's domain whose last handle this is finds
     /// them gone ([`crate::Domain::unique_for_test`]).
     pub(super) ctx: Context,
@@ -184,8 +189,21 @@ impl<I: Interface> Client<I> {
     fn open_device(ctx: &Context, device: &DeviceName) -> Result<Self, ConnectError> {
         let dev = device.to_string();
         let domain = ctx.domain().name().to_string();
+        // The device's capacity as its driver published it (ordinary, reserved), once read.
+        let capacity: core::cell::Cell<(usize, usize)> = core::cell::Cell::new((0, 0));
+        let full = || {
+            let (max, reserved) = capacity.get();
+            ConnectError::Full {
+                device: dev.clone(),
+                max,
+                reserved,
+                priority: ctx.priority(),
+            }
+        };
         let map = |channel: &'static str, e: Iox2Error| -> ConnectError {
-            if e.is_missing_service() {
+            if e.is_full() {
+                full()
+            } else if e.is_missing_service() {
                 ConnectError::NoDriver {
                     device: dev.clone(),
                     domain: domain.clone(),
@@ -232,6 +250,27 @@ impl<I: Interface> Client<I> {
             .publish_subscribe::<I::Data>()
             .open_with_attributes(&layout)
             .map_err(|e| map("data", e.into()))?;
+        // Services that another client keeps open outlive their driver: a device whose
+        // driver died (or ended) is not offered, whoever still holds its files.
+        if !driver_may_be_alive(&data_svc, ctx.domain()) {
+            return Err(ConnectError::NoDriver {
+                device: dev.clone(),
+                domain: domain.clone(),
+                elsewhere: crate::domain::dir::elsewhere_note(&domain),
+            });
+        }
+        if let Some((max, reserved)) = advertised_capacity(&data_svc) {
+            capacity.set((max, reserved));
+            // The last `reserved` slots are the priority clients' (cooperative: see
+            // `Context::set_priority`). Dead clients' slots are freed before refusing.
+            let taken = || data_svc.dynamic_config().number_of_subscribers();
+            if !ctx.priority() && taken() >= max {
+                ctx.domain().cleanup_dead_nodes(&data_svc);
+                if taken() >= max {
+                    return Err(full());
+                }
+            }
+        }
         let states = data_svc
             .subscriber_builder()
             .create()
@@ -313,6 +352,8 @@ impl<I: Interface> Client<I> {
             spin_budget: crate::qos::default_spin_budget(),
             spin_until: None,
             cmd_loan: None,
+            liveness_seen: None,
+            driver_died: core::cell::Cell::new(false),
         })
     }
 
@@ -371,11 +412,70 @@ impl<I: Interface> Client<I> {
     // ----- liveness ---------------------------------------------------------------------
 
     /// Whether the device's driver process is alive. A dead driver's resources are
-    /// cleaned up on the way, so that a restarted driver is picked up by this client.
-    /// Costs tens of microseconds: not for every control cycle.
+    /// cleaned up on the way, so that a restarted driver is picked up by this client; it
+    /// reads [`DriverStatus::Dead`] all the same until a driver is alive again (a driver
+    /// that another process cleaned up before this client looked reads `Absent`: iceoryx2
+    /// keeps nothing of it to tell). Costs tens of microseconds: not for every control
+    /// cycle.
     pub fn driver_status(&self) -> DriverStatus {
-        driver_status_of(&self.data_svc, self.ctx.domain())
+        let status = driver_status_of(&self.data_svc, self.ctx.domain());
+        match status {
+            DriverStatus::Alive => self.driver_died.set(false),
+            DriverStatus::Dead => self.driver_died.set(true),
+            DriverStatus::Absent if self.driver_died.get() => return DriverStatus::Dead,
+            DriverStatus::Absent => {}
+        }
+        status
     }
+}
+
+/// Whether a driver's process may be attached to a device's data service: one is known
+/// alive, or a live node's name cannot be read (in group mode, another member's). A dead
+/// driver found on the way is cleaned up.
+fn driver_may_be_alive<P: PortFactory<Service = ipc::Service>>(
+    svc: &P,
+    domain: &crate::domain::Domain,
+) -> bool {
+    let (mut alive, mut unknown, mut dead) = (false, false, false);
+    if let Err(e) = svc.nodes(|n| {
+        match &n {
+            NodeState::Alive(v) => match v.details() {
+                Some(d) if d.name().as_str().starts_with(DRIVER_NODE_PREFIX) => alive = true,
+                Some(_) => {}
+                None => unknown = true,
+            },
+            NodeState::Dead(v) => {
+                if v.details()
+                    .as_ref()
+                    .is_some_and(|d| d.name().as_str().starts_with(DRIVER_NODE_PREFIX))
+                {
+                    dead = true;
+                }
+            }
+            NodeState::Inaccessible(_) | NodeState::Undefined(_) => unknown = true,
+        }
+        CallbackProgression::Continue
+    }) {
+        // Not known to be dead: let the connection go on (its waits check again).
+        tracing::warn!(error = %e, "cannot list the nodes of a device");
+        return true;
+    }
+    if dead && !alive {
+        domain.cleanup_dead_nodes(svc);
+    }
+    alive || unknown
+}
+
+/// The capacity a driver published for its device: (ordinary clients, reserved slots);
+/// `None` from a driver that does not say.
+fn advertised_capacity<P: PortFactory<Service = ipc::Service>>(svc: &P) -> Option<(usize, usize)> {
+    let get = |key: &str| -> Option<usize> {
+        svc.attributes()
+            .iter()
+            .find(|a| a.key().as_bytes() == key.as_bytes())
+            .and_then(|a| a.value().to_string().parse().ok())
+    };
+    Some((get(attr::MAX_CLIENTS)?, get(attr::RESERVED_CLIENTS)?))
 }
 
 /// The status of the driver attached to a device's data service.

@@ -33,6 +33,20 @@ pub enum ConnectError {
         /// this machine (a domain is its owner's alone: README, Security).
         elsewhere: String,
     },
+    /// Every client slot of the device that this client may take is taken: `max` ordinary
+    /// clients are connected (the driver's `max_clients`), and the `reserved` slots beyond
+    /// them are kept for priority clients (taken too, when `priority`).
+    #[error("{}", full_text(.device, *.max, *.reserved, *.priority))]
+    Full {
+        /// The device.
+        device: String,
+        /// The ordinary clients it admits.
+        max: usize,
+        /// The slots beyond them kept for priority clients.
+        reserved: usize,
+        /// Whether the refused client was a priority client (the reserved slots are taken).
+        priority: bool,
+    },
     /// The device is of another interface, or speaks another layout version.
     #[error("{device} is incompatible: {reason}")]
     Incompatible {
@@ -70,6 +84,26 @@ pub enum ConnectError {
         #[source]
         source: Iox2Error,
     },
+}
+
+/// The sentence of [`ConnectError::Full`].
+fn full_text(device: &str, max: usize, reserved: usize, priority: bool) -> String {
+    let clients = if max == 1 { "client" } else { "clients" };
+    let taken = if priority {
+        format!(
+            "its driver admits {max} {clients} and {reserved} priority clients at once, and all are connected"
+        )
+    } else {
+        format!(
+            "its driver admits {max} {clients} at once and all are connected ({reserved} more slots are kept for priority clients)"
+        )
+    };
+    format!(
+        "{device} is full: {taken}; end a client you do not need (`limber list` counts each \
+         device's processes), restart the driver with a larger --max-clients (max_clients in \
+         its configuration), or connect the robot's control program as a priority client \
+         (LIMBER_PRIORITY=1, or --priority)"
+    )
 }
 
 /// Why a device is incompatible with a client ([`ConnectError::Incompatible`]).

@@ -24,7 +24,7 @@ pub use connection::{ActArrayClient, Client, GripperClient, LimbClient};
 pub use device::{AnyGeom, DeviceClient, connect_device};
 pub use error::{CommandError, ConnectError, Incompatibility, LeaseError, RequestError, WaitError};
 pub use ownership::{LeaseHolder, Outcome};
-pub use waiting::{DriverStatus, Freshness, WaitMode};
+pub use waiting::{DriverStatus, FRESHNESS_CHECK_AGE, Freshness, WaitMode};
 
 /// Default time a request waits for its reply.
 pub const DEFAULT_REQUEST_TIMEOUT: Duration = Duration::from_secs(2);

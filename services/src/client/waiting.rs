@@ -16,7 +16,8 @@ use crate::error::Iox2Error;
 pub enum DriverStatus {
     /// Its process is alive.
     Alive,
-    /// Its process died without cleaning up (found dead and cleaned up now).
+    /// Its process died without cleaning up (found dead by this client and cleaned up;
+    /// so it stays until a driver is alive again).
     Dead,
     /// No driver is attached.
     Absent,
@@ -34,6 +35,11 @@ pub enum Freshness {
     /// No state received yet.
     NoData,
 }
+
+/// A state older than this makes [`Client::freshness`] look at the driver's process,
+/// whatever its `max_age`: a few periods of a driver's loop (the Pioneer driver and simarm
+/// publish every 10 ms).
+pub const FRESHNESS_CHECK_AGE: Duration = Duration::from_millis(50);
 
 /// In spin mode, the waiting loops read the clock on every this many polls.
 const SPIN_CLOCK_EVERY: u32 = 32;
@@ -168,16 +174,42 @@ impl<I: Interface> Client<I> {
     }
 
     /// Fresh (younger than `max_age`), stale (older, driver alive), gone, or no data.
+    ///
+    /// A state older than [`FRESHNESS_CHECK_AGE`] (or `max_age`, if shorter) has the
+    /// driver's process looked at, whatever `max_age`: a driver that died is gone within
+    /// about that bound plus [`LIVENESS_PERIOD`], not only after `max_age`. The look costs
+    /// tens of microseconds and is taken at most once per [`LIVENESS_PERIOD`]; a driver
+    /// that publishes more often than the bound costs none.
     pub fn freshness(&mut self, max_age: Duration) -> Freshness {
         self.refresh_or_log();
-        match self.state_age() {
-            None => Freshness::NoData,
-            Some(a) if a <= max_age => Freshness::Fresh,
-            Some(_) => match self.driver_status() {
-                DriverStatus::Alive => Freshness::Stale,
-                _ => Freshness::Gone,
-            },
+        let Some(age) = self.state_age() else {
+            return Freshness::NoData;
+        };
+        if age <= max_age.min(FRESHNESS_CHECK_AGE) {
+            return Freshness::Fresh;
         }
+        match (
+            self.driver_status_at_most_every(LIVENESS_PERIOD),
+            age <= max_age,
+        ) {
+            (DriverStatus::Alive, true) => Freshness::Fresh,
+            (DriverStatus::Alive, false) => Freshness::Stale,
+            _ => Freshness::Gone,
+        }
+    }
+
+    /// [`Client::driver_status`], looked at again only when the last look is older than
+    /// `period`.
+    fn driver_status_at_most_every(&mut self, period: Duration) -> DriverStatus {
+        let now = Instant::now();
+        if let Some((at, status)) = self.liveness_seen
+            && now.saturating_duration_since(at) < period
+        {
+            return status;
+        }
+        let status = self.driver_status();
+        self.liveness_seen = Some((now, status));
+        status
     }
 
     /// [`Client::refresh`] for the callers that answer with the latest state taken: a

@@ -13,7 +13,11 @@ use crate::error::Iox2Error;
 use crate::naming::{Channel, DeviceName, attr};
 use crate::qos;
 
-fn attribute_verifier(device: &DeviceName, driver: &str) -> Result<AttributeVerifier, HostError> {
+fn attribute_verifier(
+    device: &DeviceName,
+    driver: &str,
+    capacity: qos::Capacity,
+) -> Result<AttributeVerifier, HostError> {
     let err = |e: Iox2Error| HostError::Transport {
         device: device.to_string(),
         channel: "attributes",
@@ -32,6 +36,8 @@ fn attribute_verifier(device: &DeviceName, driver: &str) -> Result<AttributeVeri
         (attr::INDEX, device.index().to_string()),
         (attr::DRIVER, driver.to_string()),
         (attr::LAYOUT, limber_interfaces::LAYOUT_VERSION.to_string()),
+        (attr::MAX_CLIENTS, capacity.max_clients().to_string()),
+        (attr::RESERVED_CLIENTS, qos::RESERVED_CLIENTS.to_string()),
     ] {
         let (k, val) = kv(k, &val)?;
         v = v.require(&k, &val).map_err(|e| err(e.into()))?;
@@ -52,7 +58,11 @@ impl<I: Interface> DeviceHost<I> {
         }
         let node = ctx.node();
         let dev = device.to_string();
-        let verifier = attribute_verifier(device, driver)?;
+        // Every client slot of every channel: the ordinary clients and the reserved ones
+        // (the clients keep count of the ordinary ones: `Client::connect`).
+        let capacity = ctx.capacity();
+        let (ports, nodes) = (capacity.ports(), capacity.nodes());
+        let verifier = attribute_verifier(device, driver, capacity)?;
         let transport = |channel: &'static str, e: Iox2Error| {
             if e.is_incompatible_attributes_or_types() {
                 HostError::Incompatible {
@@ -75,8 +85,8 @@ impl<I: Interface> DeviceHost<I> {
             .subscriber_max_buffer_size(qos::DATA_BUFFER)
             .subscriber_max_borrowed_samples(qos::DATA_BORROWED)
             .max_publishers(qos::DATA_PUBLISHERS)
-            .max_subscribers(qos::MAX_CLIENTS)
-            .max_nodes(qos::MAX_NODES)
+            .max_subscribers(ports)
+            .max_nodes(nodes)
             .enable_safe_overflow(true)
             .open_or_create_with_attributes(&verifier)
             .map_err(|e| transport("data", e.into()))?;
@@ -103,9 +113,9 @@ impl<I: Interface> DeviceHost<I> {
             .history_size(0)
             .subscriber_max_buffer_size(qos::CMD_BUFFER)
             .subscriber_max_borrowed_samples(2)
-            .max_publishers(qos::MAX_CLIENTS)
+            .max_publishers(ports)
             .max_subscribers(qos::CMD_SUBSCRIBERS)
-            .max_nodes(qos::MAX_NODES)
+            .max_nodes(nodes)
             .enable_safe_overflow(true)
             .open_or_create_with_attributes(&verifier)
             .map_err(|e| transport("cmd", e.into()))?;
@@ -118,9 +128,9 @@ impl<I: Interface> DeviceHost<I> {
         let req_svc = node
             .service_builder(&device.service_name(Channel::Req))
             .request_response::<I::ReqMsg, I::ReplyMsg>()
-            .max_clients(qos::MAX_CLIENTS)
+            .max_clients(ports)
             .max_servers(qos::REQ_SERVERS)
-            .max_nodes(qos::MAX_NODES)
+            .max_nodes(nodes)
             .max_active_requests_per_client(qos::MAX_ACTIVE_REQUESTS)
             .max_response_buffer_size(2)
             .enable_fire_and_forget_requests(false)
@@ -135,8 +145,8 @@ impl<I: Interface> DeviceHost<I> {
             .service_builder(&device.service_name(Channel::Wake))
             .event()
             .max_listeners(qos::WAKE_LISTENERS)
-            .max_notifiers(qos::MAX_CLIENTS)
-            .max_nodes(qos::MAX_NODES)
+            .max_notifiers(ports)
+            .max_nodes(nodes)
             .open_or_create_with_attributes(&verifier)
             .map_err(|e| transport("wake", e.into()))?;
         let wake = wake_svc
@@ -147,9 +157,9 @@ impl<I: Interface> DeviceHost<I> {
         let notify_svc = node
             .service_builder(&device.service_name(Channel::Notify))
             .event()
-            .max_listeners(qos::MAX_CLIENTS)
+            .max_listeners(ports)
             .max_notifiers(qos::NOTIFY_NOTIFIERS)
-            .max_nodes(qos::MAX_NODES)
+            .max_nodes(nodes)
             .open_or_create_with_attributes(&verifier)
             .map_err(|e| transport("notify", e.into()))?;
         let notify = notify_svc
@@ -164,8 +174,8 @@ impl<I: Interface> DeviceHost<I> {
             .subscriber_max_buffer_size(qos::OUTCOME_BUFFER)
             .subscriber_max_borrowed_samples(2)
             .max_publishers(qos::DATA_PUBLISHERS)
-            .max_subscribers(qos::MAX_CLIENTS)
-            .max_nodes(qos::MAX_NODES)
+            .max_subscribers(ports)
+            .max_nodes(nodes)
             .enable_safe_overflow(true)
             .open_or_create_with_attributes(&verifier)
             .map_err(|e| transport("outcome", e.into()))?
@@ -177,9 +187,9 @@ impl<I: Interface> DeviceHost<I> {
         let lease_svc = node
             .service_builder(&device.service_name(Channel::Lease))
             .request_response::<LeaseReq, LeaseReply>()
-            .max_clients(qos::MAX_CLIENTS)
+            .max_clients(ports)
             .max_servers(qos::REQ_SERVERS)
-            .max_nodes(qos::MAX_NODES)
+            .max_nodes(nodes)
             .max_active_requests_per_client(qos::MAX_ACTIVE_REQUESTS)
             .max_response_buffer_size(2)
             .enable_fire_and_forget_requests(false)
@@ -200,9 +210,9 @@ impl<I: Interface> DeviceHost<I> {
             commands,
             cmd_svc,
             req_svc,
-            cmd_senders: super::senders::PortNodes::new(),
-            req_senders: super::senders::PortNodes::new(),
-            lease_senders: super::senders::PortNodes::new(),
+            cmd_senders: super::senders::PortNodes::new(ports),
+            req_senders: super::senders::PortNodes::new(ports),
+            lease_senders: super::senders::PortNodes::new(ports),
             server,
             wake: Some(wake),
             notify,

@@ -10,21 +10,20 @@
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::{publish_subscribe, request_response};
 
-/// Entries kept per channel: every port the service admits ([`crate::qos::MAX_CLIENTS`]
-/// clients, and room for the dead ones not yet cleaned up).
-const PORTS: usize = 2 * crate::qos::MAX_CLIENTS;
-
 /// Port id → node id of one channel.
 #[derive(Debug, Clone)]
 pub(crate) struct PortNodes {
-    entries: [(u128, u128); PORTS],
+    /// Allocated once, when the device is offered.
+    entries: Box<[(u128, u128)]>,
     len: usize,
 }
 
 impl PortNodes {
-    pub(crate) const fn new() -> Self {
+    /// A table for a channel of `ports` client slots ([`crate::qos::Capacity::ports`]),
+    /// with room for as many dead ports not yet cleaned up.
+    pub(crate) fn new(ports: usize) -> Self {
         PortNodes {
-            entries: [(0, 0); PORTS],
+            entries: vec![(0, 0); 2 * ports].into_boxed_slice(),
             len: 0,
         }
     }
@@ -45,8 +44,8 @@ impl PortNodes {
         self.len = 0;
         let (entries, len) = (&mut self.entries, &mut self.len);
         fill(&mut |p, n| {
-            if *len < PORTS {
-                entries[*len] = (p, n);
+            if let Some(e) = entries.get_mut(*len) {
+                *e = (p, n);
                 *len += 1;
             }
         });
@@ -92,7 +91,7 @@ mod tests {
 
     #[test]
     fn a_known_port_is_found_and_a_new_one_refills_the_table() {
-        let mut t = PortNodes::new();
+        let mut t = PortNodes::new(4);
         let mut fills = 0;
         let mut registry = vec![(1u128, 10u128), (2, 20)];
         let look = |t: &mut PortNodes, port: u128, registry: &[(u128, u128)], fills: &mut u32| {

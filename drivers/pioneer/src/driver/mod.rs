@@ -264,6 +264,15 @@ impl PioneerDriver {
         target: LinkTarget,
         opts: StartOptions,
     ) -> Result<Self, DriverError> {
+        // The devices admit `max_clients` clients each (checked by `validate`; a value out
+        // of range keeps the context's capacity).
+        match limber_services::qos::Capacity::new(cfg.max_clients) {
+            Ok(c) => ctx.set_capacity(c),
+            Err(e) => tracing::warn!(
+                "{e}: devices admit {} clients",
+                ctx.capacity().max_clients()
+            ),
+        }
         Self::check_name_free(ctx, &cfg.robot)?;
         let conn = Connection::open(&target, &options(&cfg, &target)).map_err(|source| {
             DriverError::Connect {
