@@ -3,6 +3,27 @@
 //! [`DeviceSetHandler`] once for all of them, and its loop processes, publishes and waits
 //! on the whole set.
 //!
+//! ## One lease per set of actuators
+//!
+//! Devices that move the same actuators (an arm's joints, its limb, its gripper) are one
+//! thing to own: [`DeviceSet::share_lease`] makes them share one lease. Each host keeps its
+//! arbiter (which does no I/O) and its copy of the lease; the set keeps the copies equal by
+//! propagation: after each grouped host is processed, what its processing did to the
+//! lease (acquired, renewed, released, ended by the deadman) is copied to the others of its
+//! group before any of them is processed. The hosts are processed one after another on
+//! the driver's one thread, so every host decides on the group's current lease, and the
+//! copy is a few words (no allocation). A host whose holder changed publishes its state
+//! at once (the `LEASED` flag follows); when the deadman ended the lease on one host (its
+//! holder's process died or missed its heartbeat), the set stops the others too (each
+//! handler's stop). Only the host that granted the lease looks up the holder's node (on
+//! its own lease channel, where the holder's port is); every host sees a missed heartbeat.
+//! On the devices of the group other than the one the lease was taken on, the holder is
+//! its process (its node): a program that holds the arm's joints commands the limb and
+//! the gripper through clients of their own. This was chosen over a lease slot that the
+//! set owns and lends to each host: every reader of the lease (the host's own
+//! [`DeviceHost::holder`], its publication, its deadman check) would have to be lent it
+//! too, whereas a propagated copy is always there.
+//!
 //! ```
 //! use limber_services::prelude::*;
 //! use limber_services::{DeviceSet, DeviceSetHandler};
@@ -41,8 +62,8 @@ use thiserror::Error;
 
 use crate::context::Context;
 use crate::host::{
-    Activity, DeviceHandler, DeviceHost, HostError, HostStats, Motion, Origin, ProcessError,
-    PublishError,
+    Activity, DeviceHandler, DeviceHost, Holder, HostError, HostStats, Motion, Origin,
+    ProcessError, PublishError,
 };
 use crate::naming::DeviceName;
 
@@ -240,6 +261,62 @@ pub struct DeviceSet {
     actarrays: Vec<DeviceHost<ActArray>>,
     limbs: Vec<DeviceHost<Limb>>,
     grippers: Vec<DeviceHost<Gripper>>,
+    /// The devices that move the same actuators, each group with one lease
+    /// ([`DeviceSet::share_lease`]).
+    groups: Vec<LeaseGroup>,
+}
+
+/// Devices that move the same actuators, and their one lease as last made known to all of
+/// them.
+#[derive(Debug)]
+struct LeaseGroup {
+    members: Vec<(InterfaceKind, u16)>,
+    lease: Option<Holder>,
+}
+
+/// [`DeviceSet::share_lease`] failed.
+#[derive(Debug, Error)]
+pub enum ShareLeaseError {
+    /// The device is not served by the set.
+    #[error("{kind}/{index} is not served: it cannot share a lease")]
+    NotServed {
+        /// Its interface.
+        kind: InterfaceKind,
+        /// Its index.
+        index: u16,
+    },
+    /// The device already shares a lease with other devices.
+    #[error("{kind}/{index} already shares a lease with other devices")]
+    AlreadyShared {
+        /// Its interface.
+        kind: InterfaceKind,
+        /// Its index.
+        index: u16,
+    },
+    /// The state of a device whose lease changed could not be published.
+    #[error(transparent)]
+    Publish(#[from] DeviceError<PublishError>),
+}
+
+/// What one device of a lease group does after another device of the group was processed.
+#[derive(Debug, Clone, Copy)]
+enum Follow {
+    /// The deadman ended the group's lease (this holder's, for this reason): stop.
+    Stop(Holder, &'static str),
+    /// The group's lease is now this: take it.
+    Lease(Option<Holder>),
+}
+
+/// `follow` on one host: see [`Follow`].
+fn follow_one<I: Interface, D: DeviceHandler<I>>(
+    host: &mut DeviceHost<I>,
+    handler: &mut D,
+    follow: Follow,
+) -> Result<(), ProcessError> {
+    match follow {
+        Follow::Stop(ended, why) => host.stop_with_group(handler, &ended, why),
+        Follow::Lease(lease) => Ok(host.follow_lease(lease)?),
+    }
 }
 
 impl core::fmt::Debug for DeviceSet {
@@ -277,6 +354,7 @@ impl DeviceSet {
             actarrays: Vec::new(),
             limbs: Vec::new(),
             grippers: Vec::new(),
+            groups: Vec::new(),
         };
         set.add(ctx, robot, driver, serve)?;
         Ok(set)
@@ -466,29 +544,35 @@ impl DeviceSet {
         }
         let mut total = Activity::default();
         let mut first = None;
-        for h in &mut self.actarrays {
+        for i in 0..self.actarrays.len() {
+            let h = &mut self.actarrays[i];
             let index = h.device().index();
             let mut at = At {
                 handler: &mut *handler,
                 index,
             };
             one::<ActArray, _>(h, &mut at, drain, &mut total, &mut first);
+            self.spread_lease(InterfaceKind::ActArray, index, handler, &mut first);
         }
-        for h in &mut self.limbs {
+        for i in 0..self.limbs.len() {
+            let h = &mut self.limbs[i];
             let index = h.device().index();
             let mut at = At {
                 handler: &mut *handler,
                 index,
             };
             one::<Limb, _>(h, &mut at, drain, &mut total, &mut first);
+            self.spread_lease(InterfaceKind::Limb, index, handler, &mut first);
         }
-        for h in &mut self.grippers {
+        for i in 0..self.grippers.len() {
+            let h = &mut self.grippers[i];
             let index = h.device().index();
             let mut at = At {
                 handler: &mut *handler,
                 index,
             };
             one::<Gripper, _>(h, &mut at, drain, &mut total, &mut first);
+            self.spread_lease(InterfaceKind::Gripper, index, handler, &mut first);
         }
         first.map_or(Ok(total), Err)
     }
@@ -541,7 +625,8 @@ impl DeviceSet {
             }
         }
         let mut first = None;
-        for h in &mut self.actarrays {
+        for i in 0..self.actarrays.len() {
+            let h = &mut self.actarrays[i];
             let index = h.device().index();
             one::<ActArray, _>(
                 h,
@@ -551,8 +636,10 @@ impl DeviceSet {
                 },
                 &mut first,
             );
+            self.spread_lease(InterfaceKind::ActArray, index, handler, &mut first);
         }
-        for h in &mut self.limbs {
+        for i in 0..self.limbs.len() {
+            let h = &mut self.limbs[i];
             let index = h.device().index();
             one::<Limb, _>(
                 h,
@@ -562,8 +649,10 @@ impl DeviceSet {
                 },
                 &mut first,
             );
+            self.spread_lease(InterfaceKind::Limb, index, handler, &mut first);
         }
-        for h in &mut self.grippers {
+        for i in 0..self.grippers.len() {
+            let h = &mut self.grippers[i];
             let index = h.device().index();
             one::<Gripper, _>(
                 h,
@@ -573,8 +662,151 @@ impl DeviceSet {
                 },
                 &mut first,
             );
+            self.spread_lease(InterfaceKind::Gripper, index, handler, &mut first);
         }
         first.map_or(Ok(()), Err)
+    }
+
+    /// Declares that `devices` (interface and index each, all served) move the same
+    /// actuators (an arm's joints, its limb, its gripper): they share one lease. A lease
+    /// acquired on any of them holds all of them: other clients' commands and requests that
+    /// may change any of them are refused [`Status::Leased`] naming the holder, the
+    /// holder's pass; a renewal, release or query on any of them acts on the one lease; the
+    /// deadman (the holder's process dead or its heartbeat missed) stops every one of them;
+    /// the `LEASED` flag of each one's state follows.
+    ///
+    /// When some of them are already held, the first one's lease (in the order given)
+    /// becomes the group's; a different holder of another one loses its lease (logged).
+    pub fn share_lease(&mut self, devices: &[(InterfaceKind, u16)]) -> Result<(), ShareLeaseError> {
+        for (n, &(kind, index)) in devices.iter().enumerate() {
+            if self.shared_lease_of(kind, index).is_none() {
+                return Err(ShareLeaseError::NotServed { kind, index });
+            }
+            if self.group_of(kind, index).is_some() || devices[..n].contains(&(kind, index)) {
+                return Err(ShareLeaseError::AlreadyShared { kind, index });
+            }
+        }
+        let lease = devices
+            .iter()
+            .find_map(|&(kind, index)| self.shared_lease_of(kind, index).flatten());
+        for &(kind, index) in devices {
+            if let Some(other) = self.shared_lease_of(kind, index).flatten()
+                && lease
+                    .is_some_and(|l| (l.client_id, l.node_id) != (other.client_id, other.node_id))
+            {
+                tracing::warn!(device = %format_args!("{kind}/{index}"), holder = other.name(),
+                    "lease ended: the device now shares the lease of the devices that move the same actuators");
+            }
+            let r = match kind {
+                InterfaceKind::ActArray => self.actarray_mut(index).map(|h| {
+                    let _ = h.take_lease_ended();
+                    h.follow_lease(lease).map_err(|e| (h.device().clone(), e))
+                }),
+                InterfaceKind::Limb => self.limb_mut(index).map(|h| {
+                    let _ = h.take_lease_ended();
+                    h.follow_lease(lease).map_err(|e| (h.device().clone(), e))
+                }),
+                InterfaceKind::Gripper => self.gripper_mut(index).map(|h| {
+                    let _ = h.take_lease_ended();
+                    h.follow_lease(lease).map_err(|e| (h.device().clone(), e))
+                }),
+            };
+            if let Some(Err((device, source))) = r {
+                return Err(DeviceError { device, source }.into());
+            }
+        }
+        self.groups.push(LeaseGroup {
+            members: devices.to_vec(),
+            lease,
+        });
+        Ok(())
+    }
+
+    /// The group of devices that share a lease with `kind`/`index`, if any.
+    fn group_of(&self, kind: InterfaceKind, index: u16) -> Option<usize> {
+        self.groups
+            .iter()
+            .position(|g| g.members.contains(&(kind, index)))
+    }
+
+    /// The lease of `kind`/`index` as its host holds it (`None`: not served).
+    fn shared_lease_of(&self, kind: InterfaceKind, index: u16) -> Option<Option<Holder>> {
+        match kind {
+            InterfaceKind::ActArray => self.actarray(index).map(|h| h.shared_lease()),
+            InterfaceKind::Limb => self.limb(index).map(|h| h.shared_lease()),
+            InterfaceKind::Gripper => self.gripper(index).map(|h| h.shared_lease()),
+        }
+    }
+
+    /// After `kind`/`index` was processed: when it shares a lease, what its processing did
+    /// to the lease reaches the other devices of its group (a deadman's end stops them, a
+    /// new holder, renewal or release is taken by them). No allocation.
+    fn spread_lease<H: DeviceSetHandler + ?Sized>(
+        &mut self,
+        kind: InterfaceKind,
+        index: u16,
+        handler: &mut H,
+        first: &mut Option<DeviceError<ProcessError>>,
+    ) {
+        let Some(g) = self.group_of(kind, index) else {
+            return;
+        };
+        let (lease, ended) = match kind {
+            InterfaceKind::ActArray => self
+                .actarray_mut(index)
+                .map(|h| (h.shared_lease(), h.take_lease_ended())),
+            InterfaceKind::Limb => self
+                .limb_mut(index)
+                .map(|h| (h.shared_lease(), h.take_lease_ended())),
+            InterfaceKind::Gripper => self
+                .gripper_mut(index)
+                .map(|h| (h.shared_lease(), h.take_lease_ended())),
+        }
+        .unwrap_or((None, None));
+        if ended.is_none() && lease == self.groups[g].lease {
+            return;
+        }
+        self.groups[g].lease = lease;
+        for m in 0..self.groups[g].members.len() {
+            let (k, i) = self.groups[g].members[m];
+            if (k, i) == (kind, index) {
+                continue;
+            }
+            if let Some((holder, why)) = ended {
+                self.follow(k, i, handler, Follow::Stop(holder, why), first);
+            }
+            self.follow(k, i, handler, Follow::Lease(lease), first);
+        }
+    }
+
+    /// [`Follow`] on `kind`/`index`; a failure is logged and the first one kept.
+    fn follow<H: DeviceSetHandler + ?Sized>(
+        &mut self,
+        kind: InterfaceKind,
+        index: u16,
+        handler: &mut H,
+        follow: Follow,
+        first: &mut Option<DeviceError<ProcessError>>,
+    ) {
+        let at = &mut At { handler, index };
+        let r = match kind {
+            InterfaceKind::ActArray => self
+                .actarray_mut(index)
+                .map(|h| (follow_one::<ActArray, _>(h, at, follow), h.device())),
+            InterfaceKind::Limb => self
+                .limb_mut(index)
+                .map(|h| (follow_one::<Limb, _>(h, at, follow), h.device())),
+            InterfaceKind::Gripper => self
+                .gripper_mut(index)
+                .map(|h| (follow_one::<Gripper, _>(h, at, follow), h.device())),
+        };
+        if let Some((Err(source), device)) = r {
+            tracing::warn!(device = %device, error = %source, "cannot follow the shared lease");
+            first.get_or_insert_with(|| DeviceError {
+                device: device.clone(),
+                source,
+            });
+        }
     }
 
     /// [`DeviceHost::cleanup_dead`] on every device (a 1 Hz housekeeping tick).

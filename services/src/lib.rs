@@ -96,7 +96,7 @@ pub use client::{
     RequestError, Ticket, WaitError, WaitMode, connect_device,
 };
 pub use context::{Context, ContextError, Role, monotonic_ns};
-pub use device_set::{DeviceError, DeviceSet, DeviceSetHandler, Drain};
+pub use device_set::{DeviceError, DeviceSet, DeviceSetHandler, Drain, ShareLeaseError};
 pub use discovery::{DeviceInfo, ListError, list_devices};
 pub use domain::Domain;
 pub use domain::DomainError;

@@ -13,6 +13,7 @@ use limber_tests::Proc;
 
 const PIONEER: &str = env!("CARGO_BIN_EXE_limber-test-pioneer");
 const CLIENT: &str = env!("CARGO_BIN_EXE_limber-test-client");
+const CLI: &str = env!("CARGO_BIN_EXE_limber-test-cli");
 const T: Duration = Duration::from_secs(5);
 
 /// `limber pioneer --emulated` with the tests' short timeouts, ready.
@@ -228,4 +229,75 @@ fn a_vecmove_stopped_by_another_client_is_told_preempted() {
         (p.status, p.other_client),
         (Status::Preempted, b.client_id())
     );
+}
+
+/// Issue "Nobody moves the arm who may not", item 3: a lease on the arm's joints covers the
+/// arm. While alice holds `pioneer/actarray/0`, another client's limb SETPOSE and arm
+/// gripper CLOSE, and `limber limb ... setpose` from the shell, are refused naming her;
+/// her own process commands the limb; the body gripper (other actuators) stays free.
+#[test]
+fn a_lease_on_the_arms_joints_holds_its_limb_and_its_gripper() {
+    let domain = Domain::unique_for_test();
+    let _d = start(&domain, "own-arm-set");
+    let alice = Context::new(&domain, Role::Client, "alice").unwrap();
+    let mut a = ActArrayClient::connect_timeout(&alice, "pioneer/actarray/0", T).unwrap();
+    a.set_request_timeout(T);
+    a.acquire("alice", Duration::from_secs(30)).unwrap();
+
+    let bob = Context::new(&domain, Role::Client, "bob").unwrap();
+    let mut limb = LimbClient::connect_timeout(&bob, "pioneer/limb/0", T).unwrap();
+    let mut hand = GripperClient::connect_timeout(&bob, "pioneer/gripper/1", T).unwrap();
+    let t = limb
+        .set_pose([0.38, 0.1, 0.22], [0.0, 0.0, -1.0], [0.94, 0.34, 0.0])
+        .unwrap();
+    let o = limb.wait_outcome_detail(t, T).unwrap();
+    assert_eq!(o.status, Status::Leased, "another client's SETPOSE");
+    assert_eq!(o.other_name(), "alice");
+    assert_eq!(o.other_client, a.client_id());
+    let t = hand.close().unwrap();
+    let o = hand.wait_outcome_detail(t, T).unwrap();
+    assert_eq!(
+        o.status,
+        Status::Leased,
+        "another client's arm gripper CLOSE"
+    );
+    assert_eq!(o.other_name(), "alice");
+    assert_eq!(limb.holder().unwrap().map(|h| h.name), Some("alice".into()));
+
+    // From the shell: refused, exit 5, naming the holder.
+    let o = limber_bounded_run::output_within(
+        std::process::Command::new(CLI)
+            .args([
+                "limb",
+                "pioneer/limb/0",
+                "setpose",
+                "0.38",
+                "0.1",
+                "0.22",
+                "--approach",
+                "0",
+                "0",
+                "-1",
+                "--orient",
+                "0.94",
+                "0.34",
+                "0",
+            ])
+            .env("LIMBER_DOMAIN", domain.name()),
+        Duration::from_secs(30),
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(5), "{err}");
+    assert!(
+        err.contains("held by another client (alice)"),
+        "the refusal names the holder: {err}"
+    );
+
+    // The body gripper moves other actuators: not held.
+    let mut body = GripperClient::connect_timeout(&bob, "pioneer/gripper/0", T).unwrap();
+    assert_eq!(body.holder().unwrap(), None);
+    // The holder's process commands the arm's gripper through a client of its own.
+    let mut own_hand = GripperClient::connect_timeout(&alice, "pioneer/gripper/1", T).unwrap();
+    let t = own_hand.close().unwrap();
+    assert!(own_hand.wait_outcome(t, T).unwrap().is_carried_out());
 }

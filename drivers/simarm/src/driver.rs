@@ -7,7 +7,7 @@ use std::time::Instant;
 use limber_interfaces::common::device_flag;
 use limber_services::event_loop::{self, LoopError, LoopExit, Wake};
 use limber_services::prelude::*;
-use limber_services::{DeviceError, HostError, ProcessError, PublishError, qos};
+use limber_services::{DeviceError, HostError, ProcessError, PublishError, ShareLeaseError, qos};
 
 use limber_kinematics::chain::Chain;
 
@@ -31,6 +31,9 @@ pub enum SimArmError {
     /// A state could not be published.
     #[error(transparent)]
     Publish(#[from] DeviceError<PublishError>),
+    /// The arm's devices could not be made to share one lease.
+    #[error(transparent)]
+    ShareLease(#[from] ShareLeaseError),
     /// Commands or requests could not be received.
     #[error(transparent)]
     Process(#[from] DeviceError<ProcessError>),
@@ -173,16 +176,14 @@ impl SimArm {
     pub fn new(ctx: &Context, chain: Chain, options: SimArmOptions) -> Result<Self, SimArmError> {
         let robot = options.robot.clone();
         let model = ArmModel::new(chain, options)?;
-        let mut hosts = DeviceSet::new(
-            ctx,
-            &robot,
-            DRIVER_NAME,
-            &[
-                (InterfaceKind::ActArray, 0),
-                (InterfaceKind::Limb, 0),
-                (InterfaceKind::Gripper, 0),
-            ],
-        )?;
+        let devices = [
+            (InterfaceKind::ActArray, 0),
+            (InterfaceKind::Limb, 0),
+            (InterfaceKind::Gripper, 0),
+        ];
+        let mut hosts = DeviceSet::new(ctx, &robot, DRIVER_NAME, &devices)?;
+        // The joints, the end effector and the gripper are one arm: one lease holds them.
+        hosts.share_lease(&devices)?;
         hosts.set_flags(device_flag::SIMULATED | device_flag::LINK_UP | device_flag::CALIBRATED);
         let mut s = SimArm {
             model,

@@ -35,6 +35,10 @@ pub struct Holder {
     /// When the holder last renewed (`CLOCK_MONOTONIC` ns).
     pub last_renewal_ns: u64,
     pub(crate) name: [u8; 32],
+    /// The tag of the arbiter that granted the lease: of the devices that share it, only
+    /// that one's host looks up the holder's node (on its own lease channel, where the
+    /// holder's client port is).
+    pub(crate) granted_by: u64,
 }
 
 impl Holder {
@@ -106,6 +110,8 @@ pub(crate) enum Deadman {
 /// The arbiter of one device (see the module documentation). Fixed size, no allocation.
 #[derive(Debug, Clone)]
 pub(crate) struct Arbiter {
+    /// Tells this arbiter apart from the others of a lease group (see `Holder::granted_by`).
+    tag: u64,
     lease: Option<Holder>,
     /// When the holder's node is looked up next (`CLOCK_MONOTONIC` ns).
     next_holder_check_ns: u64,
@@ -117,8 +123,15 @@ pub(crate) struct Arbiter {
 
 impl Arbiter {
     /// Nobody holds the device, nothing moves, no client is known.
+    #[cfg(test)]
     pub(crate) fn new() -> Self {
+        Self::with_tag(0)
+    }
+
+    /// As [`Arbiter::new`], told apart from the other arbiters of its lease group by `tag`.
+    pub(crate) fn with_tag(tag: u64) -> Self {
         Arbiter {
+            tag,
             lease: None,
             next_holder_check_ns: 0,
             drivers: [CmdRef::default(); 64],
@@ -136,10 +149,18 @@ impl Arbiter {
     /// the client id its message carries *and* the node the transport says sent it
     /// (`node`, from iceoryx2's registry of the service's ports): a client that writes the
     /// holder's id into its messages from another process is not the holder.
+    ///
+    /// On a device that shares the lease of another (a lease group), the holder is its
+    /// process: any client of the holder's node is the holder there (a program that holds
+    /// the arm's joints commands the arm's limb and gripper through clients of their own).
     pub(crate) fn refusing(&self, client_id: u64, node: u128) -> Option<&Holder> {
-        self.lease
-            .as_ref()
-            .filter(|l| l.client_id != client_id || l.node_id != node)
+        self.lease.as_ref().filter(|l| {
+            if l.granted_by == self.tag {
+                l.client_id != client_id || l.node_id != node
+            } else {
+                l.node_id != node
+            }
+        })
     }
 
     /// A command arrived: returns how many earlier commands of its client provably went
@@ -239,6 +260,7 @@ impl Arbiter {
                     timeout_ns: req.timeout_ns,
                     last_renewal_ns: now_ns,
                     name,
+                    granted_by: self.tag,
                 });
                 (Status::Ok, Some(LeaseEvent::Acquired))
             }
@@ -280,9 +302,30 @@ impl Arbiter {
         reply
     }
 
+    /// The lease as the devices that share it hold it: a copy for the others of the group.
+    pub(crate) fn shared(&self) -> Option<Holder> {
+        self.lease
+    }
+
+    /// Takes the lease of the group (acquired, renewed or released on another device of
+    /// it); returns whether another client (or nobody) holds it now, so the state's
+    /// `LEASED` flag must follow.
+    pub(crate) fn share(&mut self, lease: Option<Holder>) -> bool {
+        let before = self.lease.map(|l| (l.client_id, l.node_id));
+        self.lease = lease;
+        before != lease.map(|l| (l.client_id, l.node_id))
+    }
+
+    /// The deadman ended the group's lease on another device: this one stops too, so no
+    /// command drives anything any more.
+    pub(crate) fn ended_elsewhere(&mut self) {
+        self.end_lease();
+    }
+
     /// The deadman at `now_ns`: ends the lease whose holder missed its heartbeat (more than
     /// its timeout since the last renewal), or asks for the holder's node to be looked up
-    /// (at most every [`HOLDER_CHECK_NS`]).
+    /// (at most every [`HOLDER_CHECK_NS`]; only by the arbiter that granted the lease, when
+    /// several devices share it).
     pub(crate) fn deadman(&mut self, now_ns: u64) -> Deadman {
         let Some(l) = self.lease else {
             return Deadman::Fine;
@@ -291,7 +334,7 @@ impl Arbiter {
             self.end_lease();
             return Deadman::Expired(l);
         }
-        if now_ns >= self.next_holder_check_ns {
+        if l.granted_by == self.tag && now_ns >= self.next_holder_check_ns {
             self.next_holder_check_ns = now_ns.saturating_add(HOLDER_CHECK_NS);
             return Deadman::CheckNode(l.node_id);
         }
@@ -720,5 +763,31 @@ mod tests {
         req.set_node_id(node(HOLDER));
         assert_eq!(b.lease_request(&req, forger, 0).status, Status::Ok);
         assert_eq!(b.holder().map(|h| h.node_id), Some(forger));
+    }
+
+    #[test]
+    fn a_shared_lease_admits_the_holders_process_and_refuses_others_on_every_device() {
+        let mut arm = Arbiter::with_tag(1);
+        let mut limb = Arbiter::with_tag(2);
+        acquire(&mut arm, HOLDER, 100 * MS, 0);
+        assert!(limb.share(arm.shared()), "the limb's holder changed");
+        // On the arm, the holder is its client; on the limb, any client of its process.
+        assert!(arm.refusing(HOLDER + 1, node(HOLDER)).is_some());
+        assert!(limb.refusing(HOLDER + 1, node(HOLDER)).is_none());
+        assert_eq!(
+            limb.refusing(OTHER, node(OTHER)).map(|h| h.name()),
+            Some("holder")
+        );
+        let told = limb.outcome(cmd(OTHER, 1), node(OTHER), Status::Leased);
+        assert_eq!(told.other_client, HOLDER);
+        // Only the arbiter that granted the lease looks up the holder's node; both end it
+        // when its heartbeat is missed.
+        assert_eq!(limb.deadman(0), Deadman::Fine);
+        assert!(matches!(arm.deadman(0), Deadman::CheckNode(_)));
+        assert!(matches!(limb.deadman(101 * MS), Deadman::Expired(_)));
+        assert!(matches!(arm.deadman(101 * MS), Deadman::Expired(_)));
+        // Released: the lease is shared as none.
+        assert!(limb.share(None) || limb.holder().is_none());
+        assert!(limb.holder().is_none());
     }
 }

@@ -7,7 +7,7 @@ use iceoryx2::prelude::*;
 use limber_interfaces::prelude::*;
 
 use super::arbiter::{Deadman, LeaseEvent};
-use super::{DeviceHandler, DeviceHost, ProcessError};
+use super::{DeviceHandler, DeviceHost, Holder, ProcessError, PublishError};
 use crate::context::monotonic_ns;
 use crate::error::Iox2Error;
 use crate::qos;
@@ -35,12 +35,60 @@ impl<I: Interface> DeviceHost<I> {
                 }
             }
         };
+        self.lease_ended = Some((ended, why));
+        self.deadman_stop(handler, &ended, why)
+    }
+
+    /// Stops the device whose lease ended, says so, and publishes the state.
+    fn deadman_stop<H: DeviceHandler<I>>(
+        &mut self,
+        handler: &mut H,
+        ended: &Holder,
+        why: &str,
+    ) -> Result<(), ProcessError> {
         let status = handler.stop(&mut self.state);
         tracing::warn!(device = %self.device, holder = ended.name(), client = ended.client_id,
             stop = %status, "lease ended because {why}: device stopped");
         self.stats.deadman_stops += 1;
         self.publish()?;
         Ok(())
+    }
+
+    /// The lease as this device holds it, for the other devices that share it
+    /// ([`DeviceSet::share_lease`](crate::DeviceSet::share_lease)).
+    pub(crate) fn shared_lease(&self) -> Option<Holder> {
+        self.arbiter.shared()
+    }
+
+    /// The lease the deadman ended on this device since the last call, and why: the other
+    /// devices that shared it must stop too ([`DeviceHost::stop_with_group`]).
+    pub(crate) fn take_lease_ended(&mut self) -> Option<(Holder, &'static str)> {
+        self.lease_ended.take()
+    }
+
+    /// Takes the lease of its group, changed on another device of it (acquired, renewed,
+    /// released); publishes the state when the holder changed, so the `LEASED` flag follows
+    /// at once.
+    pub(crate) fn follow_lease(&mut self, lease: Option<Holder>) -> Result<(), PublishError> {
+        if self.arbiter.shared() == lease {
+            return Ok(());
+        }
+        if self.arbiter.share(lease) {
+            self.publish()?;
+        }
+        Ok(())
+    }
+
+    /// The deadman ended the group's lease on another device (`ended`, because `why`): this
+    /// device stops too ([`DeviceHandler::stop`]) and publishes its state.
+    pub(crate) fn stop_with_group<H: DeviceHandler<I>>(
+        &mut self,
+        handler: &mut H,
+        ended: &Holder,
+        why: &str,
+    ) -> Result<(), ProcessError> {
+        self.arbiter.ended_elsewhere();
+        self.deadman_stop(handler, ended, why)
     }
 
     /// True when the node `id` is dead or no longer attached to the lease channel.

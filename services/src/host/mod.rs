@@ -111,6 +111,9 @@ pub struct DeviceHost<I: Interface> {
     lease_server: Server<ipc::Service, LeaseReq, (), LeaseReply, ()>,
     /// Leases, preemption, the gap table and the outcome rules: no I/O.
     arbiter: Arbiter,
+    /// The lease the deadman ended here and why, until the [`DeviceSet`](crate::DeviceSet)
+    /// stops the other devices that shared it (see `lease.rs`).
+    lease_ended: Option<(Holder, &'static str)>,
     state: I::Data,
     seq: u64,
     outcome: CmdOutcome,

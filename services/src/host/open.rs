@@ -1,6 +1,7 @@
 //! Opening a device's channels: [`DeviceHost::new`].
 
 use core::marker::PhantomData;
+use core::sync::atomic::{AtomicU64, Ordering};
 
 use iceoryx2::prelude::*;
 use iceoryx2::service::attribute::{AttributeKey, AttributeValue};
@@ -12,6 +13,9 @@ use crate::context::Context;
 use crate::error::Iox2Error;
 use crate::naming::{Channel, DeviceName, attr};
 use crate::qos;
+
+/// The next host's arbiter tag (see `Arbiter::with_tag`).
+static NEXT_ARBITER_TAG: AtomicU64 = AtomicU64::new(1);
 
 fn attribute_verifier(
     device: &DeviceName,
@@ -219,7 +223,10 @@ impl<I: Interface> DeviceHost<I> {
             outcomes,
             lease_svc,
             lease_server,
-            arbiter: Arbiter::new(),
+            // A tag of its own: of the hosts that share a lease, the one that granted it
+            // looks up the holder's node.
+            arbiter: Arbiter::with_tag(NEXT_ARBITER_TAG.fetch_add(1, Ordering::Relaxed)),
+            lease_ended: None,
             state: I::Data::default(),
             seq: 0,
             outcome: CmdOutcome::default(),

@@ -80,7 +80,14 @@ pub fn gripper_decision(setting: BodyGripper, probe: &ConfigProbe, robot: &str) 
     }
 }
 
-/// The devices of the arm: `actarray/0`, `limb/0` and the arm gripper `gripper/1`.
+/// The devices of the arm: `actarray/0`, `limb/0` and the arm gripper `gripper/1`. They
+/// move the same actuators (the limb moves the joints; the arm's gripper is its joint 6):
+/// they share one lease ([`DeviceSet::share_lease`](limber_services::DeviceSet::share_lease)).
+///
+/// The body gripper `gripper/0` and its lift `actarray/1` (the [`BODY_DEVICES`]) are left
+/// out, each with a lease of its own: the paddles and the lift are motors of their own,
+/// and no command of one moves the other (the gripper's STORE and RETRIEVE, which would
+/// move both, are refused as unsupported), nor any of the arm's.
 pub(super) const ARM_DEVICES: [(InterfaceKind, u16); 3] = [
     (InterfaceKind::ActArray, 0),
     (InterfaceKind::Limb, 0),

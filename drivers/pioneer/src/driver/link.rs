@@ -201,6 +201,10 @@ impl PioneerDriver {
             );
             return;
         }
+        // The joints, the end effector and the arm's gripper: one lease holds them.
+        if let Err(e) = self.hosts.share_lease(&ARM_DEVICES) {
+            tracing::error!("the arm's devices cannot share one lease: {e}");
+        }
         self.devices_added = true;
         self.hardware.arm = true;
         self.stats.hardware = hardware_bits(&self.hardware);

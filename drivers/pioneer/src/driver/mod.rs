@@ -46,6 +46,9 @@ pub enum DriverError {
     /// A device could not be offered.
     #[error(transparent)]
     Host(#[from] HostError),
+    /// The arm's devices could not be made to share one lease.
+    #[error(transparent)]
+    ShareLease(#[from] limber_services::ShareLeaseError),
     /// A running driver already serves devices of this robot name: refused before the
     /// link is opened, so the other driver's link is left alone.
     #[error(
@@ -320,7 +323,11 @@ impl PioneerDriver {
         }
         model.set_body_gripper(hardware.gripper);
         let gripper_offered = hardware.gripper;
-        let hosts = DeviceSet::new(ctx, robot, DRIVER, &serve)?;
+        let mut hosts = DeviceSet::new(ctx, robot, DRIVER, &serve)?;
+        if hardware.arm {
+            // The joints, the end effector and the arm's gripper: one lease holds them.
+            hosts.share_lease(&ARM_DEVICES)?;
+        }
         let stats_pub = StatsPublisher::new(ctx, robot).map_err(DriverError::Stats)?;
         let mut stats = DriverStats::default();
         diagnostics::put_text(&mut stats.driver, DRIVER);
