@@ -844,6 +844,7 @@ fn a_lease_refuses_the_other_client_by_name_and_preemption_and_the_deadman_are_t
         "holder: alice",
         "bob's move: held by another client: refused: held by another client (alice, client ",
         "bob's acquire: the driver refused the request: held by another client (alice)",
+        "limb held with the arm: alice",
         "bob's move after release: ok",
         "limb holder: lease",
         "gripper lease ok",

@@ -90,10 +90,12 @@ int main(void) {
     if ((c = limber_actarray_power(bob, true, WAIT_MS)) != LIMBER_CODE_REFUSED ||
         limber_last_refusal() != LIMBER_STATUS_LEASED)
         return fail("bob's power request", c);
-    /* A lease covers one device: the limb is free. */
+    /* A lease on the arm's joints holds the arm: its limb names the same holder. */
     limber_lease_holder limb_holder;
-    if ((c = limber_limb_holder(limb, &limb_holder)) != LIMBER_CODE_OK || limb_holder.client_id != 0)
-        return fail("limb holder", c);
+    if ((c = limber_limb_holder(limb, &limb_holder)) != LIMBER_CODE_OK || limb_holder.client_id != alice_id ||
+        strcmp(limb_holder.name, "alice") != 0)
+        return fail("limb holder while alice holds the arm", c);
+    printf("limb held with the arm: %s\n", limb_holder.name);
     /* The holder commands; renews. */
     if ((c = move_and_wait(alice, 2, 0.3, &status)) != LIMBER_CODE_OK || status != LIMBER_STATUS_OK)
         return fail("alice's move", c);
