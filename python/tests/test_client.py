@@ -489,8 +489,9 @@ def test_driver_killed(own_driver):
         arm.refresh()  # samples published before the driver died are still readable
         with pytest.raises(DriverGoneError):
             arm.wait_state(T)
-        # The dead driver was cleaned up on the way: nothing is left to answer.
-        assert arm.driver_status() is DriverStatus.ABSENT
+        # The dead driver was cleaned up on the way, and this client, which found it dead,
+        # says so (DEAD, not ABSENT) until a driver lives again: nothing is left to answer.
+        assert arm.driver_status() is DriverStatus.DEAD
         with pytest.raises(NoDriverError):
             arm.geometry(timeout=T)
     finally:
