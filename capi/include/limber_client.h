@@ -860,6 +860,74 @@ uint64_t limber_default_spin_budget_us(void);
 limber_code limber_set_program_name(const char *name);
 
 /*
+ Lists the devices of `domain` (NULL: `LIMBER_DOMAIN`, or "limber"), sorted by name:
+ writes the first `capacity` into `out[]` and the number found into `*count` (which
+ may exceed `capacity`: call again with a larger array). `out` may be NULL when
+ `capacity` is 0.
+
+ # Safety
+ `domain` is NULL or a NUL-terminated string; `out` points to `capacity` writable
+ entries (or is NULL with `capacity` 0); `count` is NULL or writable.
+ */
+limber_code limber_list_devices(const char *domain,
+                                struct limber_device_info *out,
+                                size_t capacity,
+                                size_t *count);
+
+/*
+ Removes every file of `domain` (NULL: `LIMBER_DOMAIN`, or "limber") once no process runs
+ in it: the files its killed processes left, the node counter in `/dev/shm`, its token;
+ `*removed` (NULL: not written) is how many files and directories went. A domain without
+ files is left as it is. Processes still running in it: `LIMBER_CODE_TRANSPORT`, naming
+ how many.
+
+ # Safety
+ `domain` is NULL or a NUL-terminated string; `removed` is NULL or writable.
+ */
+limber_code limber_remove_domain_files(const char *domain, size_t *removed);
+
+/*
+ CMD OPEN: opens the gripper. `*ticket` (NULL: not written) is for
+ `limber_gripper_wait_outcome`. Returns at once.
+
+ # Safety
+ `h` is NULL or a live handle; `ticket` is NULL or writable.
+ */
+limber_code limber_gripper_open(limber_gripper *h, struct limber_ticket *ticket);
+
+/*
+ CMD CLOSE: closes the gripper (on an object: the state becomes closed, the beams see it).
+
+ # Safety
+ `h` is NULL or a live handle; `ticket` is NULL or writable.
+ */
+limber_code limber_gripper_close(limber_gripper *h, struct limber_ticket *ticket);
+
+/*
+ CMD STOP: stops the gripper where it is.
+
+ # Safety
+ `h` is NULL or a live handle; `ticket` is NULL or writable.
+ */
+limber_code limber_gripper_stop(limber_gripper *h, struct limber_ticket *ticket);
+
+/*
+ CMD STORE: stores the held object.
+
+ # Safety
+ `h` is NULL or a live handle; `ticket` is NULL or writable.
+ */
+limber_code limber_gripper_store(limber_gripper *h, struct limber_ticket *ticket);
+
+/*
+ CMD RETRIEVE: retrieves a stored object.
+
+ # Safety
+ `h` is NULL or a live handle; `ticket` is NULL or writable.
+ */
+limber_code limber_gripper_retrieve(limber_gripper *h, struct limber_ticket *ticket);
+
+/*
  This handle's client id: how the driver, outcomes and `limber_device_holder` name it.
 
  # Safety
@@ -929,74 +997,6 @@ limber_code limber_device_holds_lease(struct limber_device *h, bool *out);
  `h` is NULL or a live handle; `out` is NULL or writable.
  */
 limber_code limber_device_holder(struct limber_device *h, struct limber_lease_holder *out);
-
-/*
- Lists the devices of `domain` (NULL: `LIMBER_DOMAIN`, or "limber"), sorted by name:
- writes the first `capacity` into `out[]` and the number found into `*count` (which
- may exceed `capacity`: call again with a larger array). `out` may be NULL when
- `capacity` is 0.
-
- # Safety
- `domain` is NULL or a NUL-terminated string; `out` points to `capacity` writable
- entries (or is NULL with `capacity` 0); `count` is NULL or writable.
- */
-limber_code limber_list_devices(const char *domain,
-                                struct limber_device_info *out,
-                                size_t capacity,
-                                size_t *count);
-
-/*
- Removes every file of `domain` (NULL: `LIMBER_DOMAIN`, or "limber") once no process runs
- in it: the files its killed processes left, the node counter in `/dev/shm`, its token;
- `*removed` (NULL: not written) is how many files and directories went. A domain without
- files is left as it is. Processes still running in it: `LIMBER_CODE_TRANSPORT`, naming
- how many.
-
- # Safety
- `domain` is NULL or a NUL-terminated string; `removed` is NULL or writable.
- */
-limber_code limber_remove_domain_files(const char *domain, size_t *removed);
-
-/*
- CMD OPEN: opens the gripper. `*ticket` (NULL: not written) is for
- `limber_gripper_wait_outcome`. Returns at once.
-
- # Safety
- `h` is NULL or a live handle; `ticket` is NULL or writable.
- */
-limber_code limber_gripper_open(limber_gripper *h, struct limber_ticket *ticket);
-
-/*
- CMD CLOSE: closes the gripper (on an object: the state becomes closed, the beams see it).
-
- # Safety
- `h` is NULL or a live handle; `ticket` is NULL or writable.
- */
-limber_code limber_gripper_close(limber_gripper *h, struct limber_ticket *ticket);
-
-/*
- CMD STOP: stops the gripper where it is.
-
- # Safety
- `h` is NULL or a live handle; `ticket` is NULL or writable.
- */
-limber_code limber_gripper_stop(limber_gripper *h, struct limber_ticket *ticket);
-
-/*
- CMD STORE: stores the held object.
-
- # Safety
- `h` is NULL or a live handle; `ticket` is NULL or writable.
- */
-limber_code limber_gripper_store(limber_gripper *h, struct limber_ticket *ticket);
-
-/*
- CMD RETRIEVE: retrieves a stored object.
-
- # Safety
- `h` is NULL or a live handle; `ticket` is NULL or writable.
- */
-limber_code limber_gripper_retrieve(limber_gripper *h, struct limber_ticket *ticket);
 
 /*
  CMD HOME: moves the limb to its home pose. `*ticket` (NULL: not written) is for

@@ -3,9 +3,13 @@
 from __future__ import annotations
 
 import os
+import re
+import sys
+import weakref
 from ctypes import byref, c_size_t
 from dataclasses import dataclass
 from typing import (
+    Any,
     Optional,
 )
 
@@ -164,3 +168,13 @@ def remove_domain_files(domain: "Domain | str | None" = None) -> int:
 
 # ----- the generic client ----------------------------------------------------------------
 
+
+#: Every client still open (closed by the atexit hook).
+_open_clients: "weakref.WeakSet[Any]" = weakref.WeakSet()
+
+
+def _default_process_name() -> str:
+    """The script's name (what ``limber list`` shows for this process by default)."""
+    name = os.path.basename(sys.argv[0]) if sys.argv and sys.argv[0] else ""
+    name = re.sub(r"[^A-Za-z0-9_.-]", "_", name) or "python"
+    return name[:60]
