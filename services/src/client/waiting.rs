@@ -185,6 +185,14 @@ impl<I: Interface> Client<I> {
         let Some(age) = self.state_age() else {
             return Freshness::NoData;
         };
+        // A driver this client found dead is gone, however young its last state: the states
+        // it published before it died say nothing of now (looked at again at most every
+        // LIVENESS_PERIOD, so a driver that is back is seen).
+        if self.driver_died.get()
+            && self.driver_status_at_most_every(LIVENESS_PERIOD) != DriverStatus::Alive
+        {
+            return Freshness::Gone;
+        }
         if age <= max_age.min(FRESHNESS_CHECK_AGE) {
             return Freshness::Fresh;
         }
