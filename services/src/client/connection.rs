@@ -122,7 +122,7 @@ impl<I: Interface> Client<I> {
     ///
     /// In group mode (`LIMBER_GROUP`) a service whose files the member who made them has
     /// not opened to the group yet (the instant after they were made) is tried again for up
-    /// to [`GROUP_PERMISSION_WAIT`] before [`ConnectError::Permission`].
+    /// to `GROUP_PERMISSION_WAIT` (2 s) before [`ConnectError::Permission`].
     pub fn connect(ctx: &Context, device: &str) -> Result<Self, ConnectError> {
         Self::connect_within(ctx, device, Instant::now() + GROUP_PERMISSION_WAIT)
     }

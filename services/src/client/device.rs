@@ -3,7 +3,7 @@
 //! consumer (the CLI's `echo` and monitor, discovery, the bridge, the C API and through it
 //! C++ and Python) holds a `Box<dyn DeviceClient>` and needs no per-interface code for
 //! what an interface does not change: states, waits, outcomes, leases, liveness. The typed
-//! commands and requests of one interface are reached with [`DeviceClient::typed`].
+//! commands and requests of one interface are reached with `<dyn DeviceClient>::typed`.
 
 use core::any::Any;
 use core::time::Duration;
@@ -98,7 +98,7 @@ pub trait DeviceClient {
     fn set_request_timeout(&mut self, timeout: Duration);
 
     /// The typed client, to send this interface's commands and requests (downcast it with
-    /// [`DeviceClient::typed`]).
+    /// `<dyn DeviceClient>::typed`).
     fn as_any_mut(&mut self) -> &mut dyn Any;
     /// The typed client, read-only.
     fn as_any(&self) -> &dyn Any;

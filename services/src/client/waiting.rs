@@ -139,7 +139,7 @@ impl<I: Interface> Client<I> {
 
     /// Whether the motion that the command of `ticket` started was cut short by another
     /// client's command (the outcome says which client, and its name if it held the
-    /// device). Looks at what arrived; remembers the last [`OUTCOME_SLOTS`] commands.
+    /// device). Looks at what arrived; remembers the last 16 commands.
     pub fn preempted(&mut self, ticket: Ticket) -> Result<Option<Outcome>, WaitError> {
         self.refresh()?;
         let p = self.preemptions[(ticket.seq as usize) % OUTCOME_SLOTS];
