@@ -4,7 +4,6 @@
 
 use core::ffi::{c_char, c_void};
 use std::ffi::CString;
-use std::fmt::Write as _;
 use std::sync::{Mutex, OnceLock};
 
 use tracing::field::{Field, Visit};
@@ -75,16 +74,16 @@ impl Visit for Line {
     fn record_debug(&mut self, field: &Field, value: &dyn core::fmt::Debug) {
         if field.name() == "message" {
             let rest = core::mem::take(&mut self.0);
-            let _ = write!(self.0, "{value:?}{rest}");
+            self.0.push_str(&format!("{value:?}{rest}"));
         } else {
-            let _ = write!(self.0, " {}={value:?}", field.name());
+            self.0.push_str(&format!(" {}={value:?}", field.name()));
         }
     }
     fn record_str(&mut self, field: &Field, value: &str) {
         if field.name() == "message" {
             self.0.insert_str(0, value);
         } else {
-            let _ = write!(self.0, " {}={value}", field.name());
+            self.0.push_str(&format!(" {}={value}", field.name()));
         }
     }
 }

@@ -78,6 +78,14 @@ fn a_shared_only_install_needs_no_static_library_and_is_stripped() {
         installed < built,
         "installed {installed} bytes, built {built}"
     );
+    // --keep-debug installs the library as built.
+    let kept = dir.join("kept");
+    let o = install(&["--shared-only", "--keep-debug"], &kept, &build);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let kept_size = std::fs::metadata(kept.join("lib/liblimber.so"))
+        .unwrap()
+        .len();
+    assert_eq!(kept_size, built);
 }
 
 #[test]

@@ -4,8 +4,6 @@
 //! so every generic consumer (the CLI, the monitor, a recorder) prints any interface without
 //! naming it.
 
-use core::fmt::Write as _;
-
 use serde_json::{Value, json};
 
 use crate::actarray::{ActArrayData, ActuatorFlags};
@@ -61,10 +59,10 @@ pub fn header_human(h: &StateHeader) -> String {
         match Status::try_from(h.last_cmd.status) {
             // "ok, clamped to the limit", "ok, orientation adjusted": carried out.
             Ok(st) if st.is_carried_out() => {
-                let _ = write!(s, " [last command: {st}]");
+                s.push_str(&format!(" [last command: {st}]"));
             }
             Ok(st) => {
-                let _ = write!(s, " [last command refused: {st}]");
+                s.push_str(&format!(" [last command refused: {st}]"));
             }
             Err(_) => s.push_str(" [last command refused: ?]"),
         }
@@ -87,18 +85,16 @@ pub fn actuator_state_name(bits: u32) -> &'static str {
 impl Describe for ActArrayData {
     fn human(&self) -> String {
         let mut s = header_human(&self.header);
-        let _ = write!(
-            s,
+        s.push_str(&format!(
             " power {}",
             if self.motor_state != 0 { "on " } else { "off" }
-        );
+        ));
         for (i, a) in self.actuators().iter().enumerate() {
-            let _ = write!(
-                s,
+            s.push_str(&format!(
                 " | j{i} {:+.4} {}",
                 a.position,
                 actuator_state_name(a.state)
-            );
+            ));
         }
         s
     }

@@ -10,6 +10,7 @@ from ctypes import byref, c_size_t
 from dataclasses import dataclass
 from typing import (
     Any,
+    TypeVar,
     Optional,
 )
 
@@ -178,3 +179,26 @@ def _default_process_name() -> str:
     name = os.path.basename(sys.argv[0]) if sys.argv and sys.argv[0] else ""
     name = re.sub(r"[^A-Za-z0-9_.-]", "_", name) or "python"
     return name[:60]
+
+
+_O = TypeVar("_O", bound="_Owned")
+
+
+class _Owned:
+    """What owns a liblimber handle: closed by :meth:`close`, at the end of a ``with``, or
+    when it is collected."""
+
+    def close(self) -> None:
+        raise NotImplementedError
+
+    def __enter__(self: _O) -> _O:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __del__(self) -> None:
+        try:
+            self.close()
+        except Exception:
+            pass

@@ -9,7 +9,7 @@ from typing import Optional
 from . import _layout as L
 from . import _lib
 from ._lib import lib as _c
-from ._names import Domain, _default_process_name, _domain_arg, _open_clients
+from ._names import Domain, _default_process_name, _domain_arg, _open_clients, _Owned
 from ._types import DecodeError, LimberError, _check_layout, _error, _ms
 
 def stats_text(field: "ctypes.Array[ctypes.c_uint8]") -> str:
@@ -23,7 +23,7 @@ def stats_text(field: "ctypes.Array[ctypes.c_uint8]") -> str:
         raise DecodeError("undecodable text field in the driver statistics") from None
 
 
-class DriverStatsReader:
+class DriverStatsReader(_Owned):
     """Reads the statistics a driver publishes on ``<robot>/driver/0`` (its loop, link and
     hardware: :class:`DriverStats`), as ``limber echo pioneer/driver`` does
     (``limber_stats_*``). Open with :meth:`open`; close with :meth:`close` or ``with``."""
@@ -99,16 +99,5 @@ class DriverStatsReader:
             _open_clients.discard(self)
             _c.limber_stats_close(h)
 
-    def __enter__(self) -> "DriverStatsReader":
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
-
-    def __del__(self) -> None:
-        try:
-            self.close()
-        except Exception:
-            pass
 
 

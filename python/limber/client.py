@@ -59,7 +59,7 @@ from ._types import (  # noqa: F401
     _tuple_new,
 )
 from ._names import *  # noqa: F401,F403
-from ._names import _default_process_name, _domain_arg, _open_clients  # noqa: F401
+from ._names import _default_process_name, _domain_arg, _open_clients, _Owned  # noqa: F401
 from ._stats import DriverStatsReader, stats_text  # noqa: F401
 
 __all__ = [
@@ -126,7 +126,7 @@ _wait_state = _c.limber_device_wait_state
 _outcome = _c.limber_device_outcome
 
 
-class _Client(Generic[_D]):
+class _Client(_Owned, Generic[_D]):
     """A connection to one device (a liblimber ``limber_device``). Use
     :class:`ActArrayClient`, :class:`LimbClient` or :class:`GripperClient`."""
 
@@ -239,17 +239,6 @@ class _Client(Generic[_D]):
     def closed(self) -> bool:
         return self._h is None
 
-    def __enter__(self: _C) -> _C:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
-
-    def __del__(self) -> None:
-        try:
-            self.close()
-        except Exception:
-            pass
 
     def __repr__(self) -> str:
         state = "closed" if self.__dict__.get("_h") is None else "open"

@@ -57,7 +57,15 @@ impl Conn {
 
     /// Asks for the geometry (a request: waits up to [`REQUEST_TIMEOUT`]).
     fn ask_geometry(&mut self) -> bool {
-        self.geom = self.client.geometry_within(REQUEST_TIMEOUT).ok();
+        self.geom = match self.client.geometry_within(REQUEST_TIMEOUT) {
+            Ok(g) => Some(g),
+            Err(e) => {
+                // Asked again at the next discoveries (GEOMETRY_TRIES); the panel shows
+                // the state meanwhile.
+                tracing::debug!(device = %self.client.device(), error = %e, "no geometry yet");
+                None
+            }
+        };
         self.has_geometry()
     }
 
