@@ -27,14 +27,15 @@ use limber_services::diagnostics::StatsReader;
 use limber_services::relay::{PendingLease, PendingRelay};
 use limber_services::{Client, Context, DeviceName, Domain, Role, list_devices};
 use thiserror::Error;
+use zenoh::Session;
 use zenoh::Wait;
 use zenoh::liveliness::LivelinessToken;
 use zenoh::pubsub::{Publisher, Subscriber};
 use zenoh::query::{Query, Queryable};
 use zenoh::sample::Sample;
-use zenoh::{Session, bytes::ZBytes};
 use zerocopy::{FromBytes, IntoBytes};
 
+use crate::access;
 use crate::allow::Allow;
 use crate::inbox::{Inbox, InboxError, Sender};
 use crate::keys::{self, TypeNames};
@@ -61,20 +62,22 @@ pub struct ExposeConfig {
     pub discovery_period: Duration,
     /// What passes: devices, commands, requests that change a device.
     pub allow: Allow,
+    /// The principals (Zenoh user names or TLS client certificate common names) that may
+    /// send commands and requests, besides every user of the user/password dictionary and
+    /// the owner on the Unix socket ([`crate::access`]).
+    pub peers: Vec<String>,
 }
 
 impl Default for ExposeConfig {
     fn default() -> Self {
         ExposeConfig {
-            net: NetConfig {
-                listen: vec!["tcp/127.0.0.1:7447".into()],
-                ..NetConfig::default()
-            },
+            net: NetConfig::default(),
             request_timeout: Duration::from_millis(1500),
             // Listing a domain reads every service file of iceoryx2's root (those of every
             // domain of the user): the bridge's main cost when idle, so not too often.
             discovery_period: Duration::from_secs(1),
             allow: Allow::default(),
+            peers: Vec::new(),
         }
     }
 }
@@ -86,6 +89,8 @@ pub enum ExposeEvent {
     Ready {
         /// This bridge's Zenoh id.
         zid: String,
+        /// The endpoints it listens on.
+        listen: Vec<String>,
     },
     /// A device is on Zenoh now.
     Exposed(DeviceName),
@@ -132,16 +137,10 @@ enum Event {
     },
 }
 
-/// The origin id of a command or query: its attachment, if it is a valid key chunk.
-fn origin_of(attachment: Option<&ZBytes>) -> Option<String> {
-    match attachment {
-        None => Some(keys::ANONYMOUS_ORIGIN.to_string()),
-        Some(a) => a
-            .try_to_string()
-            .ok()
-            .map(|s| s.into_owned())
-            .filter(|s| keys::valid_chunk(s)),
-    }
+/// The origin (`<principal>/<session>`) of a query on `channel` of `device`: from its key,
+/// which Zenoh's access control lets a session use only under its own principal.
+fn query_origin(query: &Query, device: &DeviceName, channel: &str) -> Option<String> {
+    keys::origin_of(query.key_expr().as_str(), device, channel).map(str::to_string)
 }
 
 /// Replies to `query` with an error carrying `status` (4 bytes, little-endian).
@@ -266,7 +265,7 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
     }
 
     fn query(&mut self, query: Query, timeout: Duration) {
-        let Some(origin) = origin_of(query.attachment()) else {
+        let Some(origin) = query_origin(&query, &self.device, "req") else {
             malformed::note(
                 &self.device,
                 "?",
@@ -313,7 +312,7 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
     }
 
     fn lease(&mut self, query: Query, timeout: Duration) {
-        let Some(origin) = origin_of(query.attachment()) else {
+        let Some(origin) = query_origin(&query, &self.device, "lease") else {
             malformed::note(
                 &self.device,
                 "?",
@@ -499,15 +498,15 @@ fn expose_device<I: Interface>(
         .map_err(|e| e.to_string())?;
     let (d, t) = (device.clone(), tx.clone());
     let commands = session
-        .declare_subscriber(keys::device_key(device, "cmd"))
+        .declare_subscriber(keys::all_senders(device, "cmd"))
         .callback(move |s: Sample| {
-            let Some(origin) = origin_of(s.attachment()) else {
+            let Some(origin) = keys::origin_of(s.key_expr().as_str(), &d, "cmd") else {
                 malformed::note(&d, "?", "a command without a valid origin: dropped");
                 return;
             };
             let ev = Event::Command {
                 device: d.clone(),
-                origin,
+                origin: origin.to_string(),
                 payload: s.payload().to_bytes().into_owned(),
             };
             if t.send(ev).is_err() {
@@ -518,7 +517,7 @@ fn expose_device<I: Interface>(
         .map_err(|e| e.to_string())?;
     let (d, t) = (device.clone(), tx.clone());
     let queries = session
-        .declare_queryable(keys::device_key(device, "req"))
+        .declare_queryable(keys::all_senders(device, "req"))
         .callback(move |query: Query| {
             if let Err(Event::Query { query, .. }) = t.send(Event::Query {
                 device: d.clone(),
@@ -531,7 +530,7 @@ fn expose_device<I: Interface>(
         .map_err(|e| e.to_string())?;
     let (d, t) = (device.clone(), tx.clone());
     let lease_queries = session
-        .declare_queryable(keys::device_key(device, "lease"))
+        .declare_queryable(keys::all_senders(device, "lease"))
         .callback(move |query: Query| {
             if let Err(Event::Lease { query, .. }) = t.send(Event::Lease {
                 device: d.clone(),
@@ -588,9 +587,10 @@ pub fn expose(
             source,
         }
     })?;
-    let session = session::open(&config.net)?;
+    let (session, listen) = open_session(domain, config)?;
     report(ExposeEvent::Ready {
         zid: session.zid().to_string(),
+        listen,
     });
     let (inbox, tx) = Inbox::<Event>::new()?;
     let mut exposer = Exposer {
@@ -609,6 +609,31 @@ pub fn expose(
     drop(exposer);
     session::close(&session);
     result
+}
+
+/// Opens `expose`'s session: listening on the domain's private Unix socket unless told
+/// otherwise, refusing a listener others reach without credentials, and with the access
+/// rules that bind each sender's key to its authenticated principal
+/// ([`crate::access`]).
+fn open_session(
+    domain: &Domain,
+    config: &ExposeConfig,
+) -> Result<(Session, Vec<String>), SessionError> {
+    let mut zconfig = session::base_config(&config.net)?;
+    let listen = if config.net.listen.is_empty() {
+        let runtime = domain.runtime_dir().map_err(access::AccessError::from)?;
+        vec![access::private_socket(runtime, domain.name())?]
+    } else {
+        config.net.listen.clone()
+    };
+    access::check_listeners(&zconfig, &listen)?;
+    let principals = access::principals(&zconfig, &config.peers)?;
+    session::set(
+        &mut zconfig,
+        "access_control",
+        access::expose_acl(&principals),
+    )?;
+    Ok((session::open(&config.net, zconfig, &listen)?, listen))
 }
 
 /// The state of a running `expose`.

@@ -4,12 +4,18 @@
 //! | key | what | payload |
 //! | --- | --- | --- |
 //! | `limber/<robot>/<interface>/<index>/state` | put by `expose` on every state sample | the interface's state struct (e.g. `limber.v2.ActArrayData`) |
-//! | `limber/<robot>/<interface>/<index>/cmd` | put by a remote client | the command envelope (e.g. `limber.v2.ActArrayCmdMsg`); attachment: the sender's origin id |
-//! | `limber/<robot>/<interface>/<index>/outcome/<origin>` | put by `expose` for each command of that origin | `limber.v2.OutcomeMsg` |
-//! | `limber/<robot>/<interface>/<index>/req` | queryable of `expose` | query: the request envelope; reply: the reply envelope |
-//! | `limber/<robot>/<interface>/<index>/lease` | queryable of `expose` | query: `limber.v2.LeaseReq`; reply: `limber.v2.LeaseReply` |
+//! | `limber/<robot>/<interface>/<index>/cmd/<principal>/<session>` | put by a remote client | the command envelope (e.g. `limber.v2.ActArrayCmdMsg`) |
+//! | `limber/<robot>/<interface>/<index>/outcome/<principal>/<session>` | put by `expose` for each command of that sender | `limber.v2.OutcomeMsg` |
+//! | `limber/<robot>/<interface>/<index>/req/<principal>/<session>` | queryable of `expose` | query: the request envelope; reply: the reply envelope |
+//! | `limber/<robot>/<interface>/<index>/lease/<principal>/<session>` | queryable of `expose` | query: `limber.v2.LeaseReq`; reply: `limber.v2.LeaseReply` |
 //! | `limber/<robot>/<interface>/<index>/alive` | liveliness token of `expose` | none |
 //! | `limber/<robot>/driver/0/stats` | put by `expose` about once a second | `limber.v2.DriverStats` |
+//!
+//! `<principal>` is who the sender is as Zenoh's authentication established it (its user
+//! name or certificate common name; `local` on the owner's Unix socket): the exposing
+//! bridge's access-control rules let a session put and ask only under its own principal
+//! ([`crate::access`]). `<session>` is a chunk the sender chooses to tell its sessions
+//! apart (the mirror uses its Zenoh id). Together they are the sender's *origin*.
 //!
 //! A query that the driver does not answer in time (or cannot be relayed) gets an error
 //! reply whose payload is a `Status` code, 4 bytes little-endian (encoding schema
@@ -26,9 +32,6 @@ use limber_services::monotonic_ns;
 /// The first chunk of every key.
 pub const ROOT: &str = "limber";
 
-/// The origin used for a command that carries no attachment.
-pub const ANONYMOUS_ORIGIN: &str = "_";
-
 /// The key of one channel of `device` (`state`, `cmd`, `req`, `alive`).
 pub fn device_key(device: &DeviceName, channel: &str) -> String {
     format!(
@@ -37,6 +40,32 @@ pub fn device_key(device: &DeviceName, channel: &str) -> String {
         device.interface().name(),
         device.index()
     )
+}
+
+/// The key of channel `channel` (`cmd`, `req`, `lease`) of `device` for the sender
+/// `origin` (`<principal>/<session>`).
+pub fn sender_key(device: &DeviceName, channel: &str, origin: &str) -> String {
+    format!("{}/{origin}", device_key(device, channel))
+}
+
+/// The key expression of channel `channel` of `device` for every sender.
+pub fn all_senders(device: &DeviceName, channel: &str) -> String {
+    format!("{}/*/*", device_key(device, channel))
+}
+
+/// The origin (`<principal>/<session>`) of key `key` on channel `channel` of `device`, if
+/// both chunks are valid.
+pub fn origin_of<'k>(key: &'k str, device: &DeviceName, channel: &str) -> Option<&'k str> {
+    let rest = key
+        .strip_prefix(&device_key(device, channel))?
+        .strip_prefix('/')?;
+    let (principal, session) = rest.split_once('/')?;
+    (valid_chunk(principal) && valid_chunk(session)).then_some(rest)
+}
+
+/// The origin of a sender: its principal and a session chunk of its choosing.
+pub fn origin(principal: &str, session: &str) -> String {
+    format!("{principal}/{session}")
 }
 
 /// The key of the outcomes of `device` for the commands of `origin`.
@@ -163,7 +192,24 @@ mod tests {
             parse("limber/pioneer/actarray/0/state"),
             Some((d.clone(), "state"))
         );
-        assert_eq!(parse(&outcome_key(&d, "abc")), Some((d, "outcome/abc")));
+        assert_eq!(
+            parse(&outcome_key(&d, "abc")),
+            Some((d.clone(), "outcome/abc"))
+        );
+        let k = sender_key(&d, "cmd", &origin("alice", "0f3a"));
+        assert_eq!(k, "limber/pioneer/actarray/0/cmd/alice/0f3a");
+        assert_eq!(origin_of(&k, &d, "cmd"), Some("alice/0f3a"));
+        assert_eq!(origin_of(&k, &d, "req"), None);
+        for bad in [
+            "cmd/alice",
+            "cmd/alice/*",
+            "cmd/a/b/c",
+            "cmd/**/x",
+            "cmdx/a/b",
+        ] {
+            let key = format!("limber/pioneer/actarray/0/{bad}");
+            assert_eq!(origin_of(&key, &d, "cmd"), None, "{bad}");
+        }
         assert_eq!(parse("limber/pioneer/arm/0/state"), None);
         assert_eq!(parse("other/pioneer/actarray/0/state"), None);
         assert!(!valid_chunk("a/b") && !valid_chunk("*") && valid_chunk("0f3a"));

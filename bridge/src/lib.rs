@@ -13,6 +13,7 @@
 //! The payloads are the interfaces' fixed layouts as bytes; the key expressions are in
 //! [`keys`] and documented in this crate's README.
 
+pub mod access;
 pub mod allow;
 pub mod expose;
 mod inbox;
@@ -22,6 +23,7 @@ pub mod mirror;
 mod session;
 mod waiting;
 
+pub use access::{AccessError, LOCAL_PRINCIPAL};
 pub use allow::{Allow, AllowError, CommandKind, DevicePattern, RequestKind};
 pub use expose::{ExposeConfig, ExposeError, ExposeEvent, expose};
 pub use inbox::InboxError;

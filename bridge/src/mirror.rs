@@ -3,10 +3,13 @@
 //! Every device whose liveliness token (`.../alive`) a remote `expose` holds is hosted in
 //! this domain under the same name (the robot name prefixed with `--prefix`, if given), as
 //! driver `bridge`: its state is the remote state (stamped with this host's clock when it
-//! arrives), its clients' commands go to `.../cmd` with this bridge's Zenoh id as their
-//! origin, their outcomes (refusals with their reason, preemptions) come back from
-//! `.../outcome/<origin>` to the client that sent the command, and their requests become
-//! queries on `.../req` with a timeout. When the token goes (the remote driver died, or
+//! arrives), its clients' commands go to `.../cmd/<origin>`, their outcomes (refusals with
+//! their reason, preemptions) come back from `.../outcome/<origin>` to the client that sent
+//! the command, and their requests become queries on `.../req/<origin>` with a timeout. The
+//! origin is this mirror's principal (who the exposing bridge's authentication says it is:
+//! [`crate::access`]) and its Zenoh id. It listens on nothing and scouts for nobody: it
+//! talks only to the bridge it connects to, and hosts [`MirrorConfig::max_devices`] devices
+//! at most. When the token goes (the remote driver died, or
 //! the remote bridge, or the network for longer than the Zenoh lease), the device is no
 //! longer hosted here: its clients see its driver gone.
 //!
@@ -35,6 +38,7 @@ use zenoh::sample::{Sample, SampleKind};
 use zenoh::{Session, bytes::ZBytes};
 use zerocopy::{FromBytes, IntoBytes};
 
+use crate::access;
 use crate::expose::MIRROR_DRIVER;
 use crate::inbox::{Inbox, InboxError, Sender};
 use crate::keys::{self, TypeNames};
@@ -54,17 +58,26 @@ pub struct MirrorConfig {
     pub prefix: String,
     /// How long a relayed request may take before its client is told `Timeout`.
     pub request_timeout: Duration,
+    /// Who this mirror is to the exposing bridge: its principal (the certificate common
+    /// name of its TLS client certificate); None: the user of its user/password
+    /// authentication, else `local` (the owner's Unix socket). See [`crate::access`].
+    pub principal: Option<String>,
+    /// The most remote devices hosted at once; more are refused (a peer that announces
+    /// thousands of devices does not make this process take their memory).
+    pub max_devices: usize,
 }
+
+/// The default of [`MirrorConfig::max_devices`].
+pub const DEFAULT_MAX_DEVICES: usize = 64;
 
 impl Default for MirrorConfig {
     fn default() -> Self {
         MirrorConfig {
-            net: NetConfig {
-                connect: vec!["tcp/127.0.0.1:7447".into()],
-                ..NetConfig::default()
-            },
+            net: NetConfig::default(),
             prefix: String::new(),
             request_timeout: Duration::from_millis(1800),
+            principal: None,
+            max_devices: DEFAULT_MAX_DEVICES,
         }
     }
 }
@@ -74,8 +87,10 @@ impl Default for MirrorConfig {
 pub enum MirrorEvent {
     /// The Zenoh session is open.
     Ready {
-        /// This bridge's Zenoh id (the origin of its commands).
+        /// This bridge's Zenoh id.
         zid: String,
+        /// The principal it acts as (see [`crate::access`]).
+        principal: String,
     },
     /// A remote device is hosted here now, under `local`.
     Mirrored {
@@ -195,7 +210,7 @@ trait MirroredDevice {
     fn state(&mut self, payload: &[u8]);
     fn outcome(&mut self, payload: &[u8]);
     /// Relays what the local clients sent: commands, requests, lease requests.
-    fn relay(&mut self, session: &Session, origin: &str, timeout: Duration);
+    fn relay(&mut self, session: &Session, timeout: Duration);
     fn reply(&mut self, exchange: Exchange, id: u64, reply: &Reply);
     fn done(&mut self, exchange: Exchange, id: u64);
     fn listener(&self) -> Rc<Listener<ipc::Service>>;
@@ -238,7 +253,6 @@ fn ask(
     (device, exchange, id): (&DeviceName, Exchange, u64),
     key: &str,
     (payload, type_name): (&[u8], &str),
-    origin: &str,
     timeout: Duration,
 ) -> Result<(), zenoh::Error> {
     let (on_reply, on_done) = (tx.clone(), tx.clone());
@@ -247,7 +261,6 @@ fn ask(
         .get(key)
         .payload(payload.to_vec())
         .encoding(keys::encoding(type_name))
-        .attachment(origin)
         .timeout(timeout)
         // One reply is expected: delivered as it arrives, not held until the query ends.
         .consolidation(ConsolidationMode::None)
@@ -303,7 +316,7 @@ impl<I: Interface> MirroredDevice for Mirrored<I> {
         }
     }
 
-    fn relay(&mut self, session: &Session, origin: &str, timeout: Duration) {
+    fn relay(&mut self, session: &Session, timeout: Duration) {
         self.host.relay_housekeeping();
         let mut commands = Vec::new();
         if let Err(e) = self
@@ -316,7 +329,6 @@ impl<I: Interface> MirroredDevice for Mirrored<I> {
             if let Err(e) = session
                 .put(&self.cmd_key, c)
                 .encoding(keys::encoding(self.names.cmd))
-                .attachment(origin)
                 .wait()
             {
                 tracing::warn!(device = %self.local, error = %e, "cannot relay a command");
@@ -339,7 +351,6 @@ impl<I: Interface> MirroredDevice for Mirrored<I> {
                 (&self.remote, Exchange::Request, id),
                 &self.req_key,
                 (req.message().as_bytes(), self.names.req),
-                origin,
                 timeout,
             ) {
                 Ok(()) => {
@@ -371,7 +382,6 @@ impl<I: Interface> MirroredDevice for Mirrored<I> {
                 (&self.remote, Exchange::Lease, id),
                 &self.lease_key,
                 (req.message().as_bytes(), keys::lease_req_type()),
-                origin,
                 timeout,
             ) {
                 Ok(()) => {
@@ -468,20 +478,21 @@ struct Host<'a> {
     ctx: &'a Context,
     remote: &'a DeviceName,
     local: &'a DeviceName,
+    origin: &'a str,
     tx: &'a Sender<Event>,
 }
 
 impl InterfaceVisitor for Host<'_> {
     type Output = Result<Box<dyn MirroredDevice>, String>;
     fn visit<I: Interface>(self) -> Self::Output {
-        host_device::<I>(self.ctx, self.remote, self.local, self.tx)
+        host_device::<I>(self.ctx, (self.remote, self.local), self.origin, self.tx)
     }
 }
 
 fn host_device<I: Interface>(
     ctx: &Context,
-    remote: &DeviceName,
-    local: &DeviceName,
+    (remote, local): (&DeviceName, &DeviceName),
+    origin: &str,
     tx: &Sender<Event>,
 ) -> Result<Box<dyn MirroredDevice>, String> {
     let mut host = DeviceHost::<I>::new(ctx, local, MIRROR_DRIVER).map_err(|e| e.to_string())?;
@@ -492,9 +503,9 @@ fn host_device<I: Interface>(
         local: local.clone(),
         remote: remote.clone(),
         host,
-        cmd_key: keys::device_key(remote, "cmd"),
-        req_key: keys::device_key(remote, "req"),
-        lease_key: keys::device_key(remote, "lease"),
+        cmd_key: keys::sender_key(remote, "cmd", origin),
+        req_key: keys::sender_key(remote, "req", origin),
+        lease_key: keys::sender_key(remote, "lease", origin),
         names: keys::type_names::<I>(),
         tx: tx.clone(),
         requests: HashMap::new(),
@@ -541,8 +552,13 @@ pub fn mirror(
             source,
         }
     })?;
-    let session = session::open(&config.net)?;
-    let origin = session.zid().to_string();
+    let zconfig = session::base_config(&config.net)?;
+    let principal = access::mirror_principal(&zconfig, config.principal.as_deref())
+        .map_err(SessionError::from)?;
+    // A mirror listens on nothing unless told: it talks to the bridge it connects to.
+    let session = session::open(&config.net, zconfig, &config.net.listen)?;
+    let zid = session.zid().to_string();
+    let origin = keys::origin(&principal, &zid);
     let (inbox, tx) = Inbox::<Event>::new()?;
 
     let t = tx.clone();
@@ -603,9 +619,7 @@ pub fn mirror(
         })
         .wait()
         .map_err(|source| MirrorError::Subscribe { key, source })?;
-    report(MirrorEvent::Ready {
-        zid: origin.clone(),
-    });
+    report(MirrorEvent::Ready { zid, principal });
 
     let mut mirrorer = Mirrorer {
         config,
@@ -664,7 +678,7 @@ impl Mirrorer<'_> {
                         let timeout = self.config.request_timeout;
                         for remote in &woken.devices {
                             if let Some((_, d)) = self.devices.get_mut(remote) {
-                                d.relay(self.session, &self.origin, timeout);
+                                d.relay(self.session, timeout);
                             }
                         }
                         let mut changed = false;
@@ -740,11 +754,24 @@ impl Mirrorer<'_> {
                     });
                     return false;
                 };
+                if self.devices.len() >= self.config.max_devices {
+                    tracing::warn!(remote = %device, max = self.config.max_devices,
+                        "a remote device beyond --max-devices: not hosted");
+                    report(MirrorEvent::Refused {
+                        remote: device,
+                        reason: format!(
+                            "this mirror hosts {} devices at most (--max-devices)",
+                            self.config.max_devices
+                        ),
+                    });
+                    return false;
+                }
                 let (ctx, tx) = (&self.ctx, &self.tx);
                 let made = device.interface().visit(Host {
                     ctx,
                     remote: &device,
                     local: &local,
+                    origin: &self.origin,
                     tx,
                 });
                 match made {

@@ -1,13 +1,18 @@
-//! Opening the Zenoh session: peer mode, TCP on the given endpoints, multicast scouting off.
+//! Opening the Zenoh session: peer mode on the given endpoints, multicast scouting off and
+//! gossip's autoconnect empty (a bridge talks to the endpoints it is given, and to nobody
+//! they tell it of).
 
 use thiserror::Error;
+
+use crate::access::AccessError;
 use zenoh::{Config, Session, Wait};
 
 /// Where a bridge listens and what it connects to (Zenoh endpoints, e.g.
 /// `tcp/127.0.0.1:7447`).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct NetConfig {
-    /// Endpoints to listen on (none: loopback on a port of the system's choosing).
+    /// Endpoints to listen on. For `expose`, none means the domain's private Unix socket
+    /// ([`crate::access::private_socket`]); a mirror listens on none (it only connects).
     pub listen: Vec<String>,
     /// Endpoints to connect to.
     pub connect: Vec<String>,
@@ -42,6 +47,9 @@ pub enum SessionError {
     /// The session could not be opened (an endpoint to listen on is taken, ...).
     #[error("cannot open the Zenoh session: {0}")]
     Open(#[source] zenoh::Error),
+    /// A listener or principal was refused (who may reach the bridge).
+    #[error(transparent)]
+    Access(#[from] AccessError),
 }
 
 fn json_list(items: &[String]) -> String {
@@ -52,25 +60,43 @@ fn json_list(items: &[String]) -> String {
     format!("[{}]", quoted.join(","))
 }
 
-/// Opens a peer session with `net`.
-pub(crate) fn open(net: &NetConfig) -> Result<Session, SessionError> {
-    let mut config = match &net.config_file {
+/// The Zenoh configuration of `net`: its file, or Zenoh's defaults.
+pub(crate) fn base_config(net: &NetConfig) -> Result<Config, SessionError> {
+    match &net.config_file {
         Some(p) => Config::from_file(p).map_err(|source| SessionError::ConfigFile {
             path: p.display().to_string(),
             source,
-        })?,
-        None => Config::default(),
-    };
-    let listen = if net.listen.is_empty() {
-        vec!["tcp/127.0.0.1:0".to_string()]
-    } else {
-        net.listen.clone()
-    };
-    let settings: [(&'static str, String); 6] = [
+        }),
+        None => Ok(Config::default()),
+    }
+}
+
+/// Sets `key` to `value` (JSON5) in `config`.
+pub(crate) fn set(
+    config: &mut Config,
+    key: &'static str,
+    value: String,
+) -> Result<(), SessionError> {
+    config
+        .insert_json5(key, &value)
+        .map_err(|source| SessionError::Setting { key, value, source })
+}
+
+/// Opens a peer session with `config` (from [`base_config`], with what the caller added),
+/// listening on `listen` and connecting to `net`'s endpoints.
+pub(crate) fn open(
+    net: &NetConfig,
+    mut config: Config,
+    listen: &[String],
+) -> Result<Session, SessionError> {
+    let settings: [(&'static str, String); 7] = [
         ("mode", "\"peer\"".into()),
-        ("listen/endpoints", json_list(&listen)),
+        ("listen/endpoints", json_list(listen)),
         ("connect/endpoints", json_list(&net.connect)),
         ("scouting/multicast/enabled", "false".into()),
+        // Gossip stays on (Zenoh's routing among peers needs it) but connects to nobody it
+        // hears of: a peer's gossip must not make a bridge connect elsewhere.
+        ("scouting/gossip/autoconnect", "[]".into()),
         // A peer that vanishes without closing its connection is declared gone after
         // this long (its liveliness tokens with it).
         ("transport/link/tx/lease", "3000".into()),
@@ -78,9 +104,7 @@ pub(crate) fn open(net: &NetConfig) -> Result<Session, SessionError> {
         ("connect/exit_on_failure", "false".into()),
     ];
     for (key, value) in settings {
-        config
-            .insert_json5(key, &value)
-            .map_err(|source| SessionError::Setting { key, value, source })?;
+        set(&mut config, key, value)?;
     }
     zenoh::open(config).wait().map_err(SessionError::Open)
 }

@@ -7,7 +7,8 @@ use clap::{Args, Subcommand};
 use limber_bridge::expose::ExposeEvent;
 use limber_bridge::mirror::MirrorEvent;
 use limber_bridge::{
-    Allow, CommandKind, DevicePattern, ExposeConfig, MirrorConfig, NetConfig, RequestKind,
+    Allow, CommandKind, DevicePattern, ExposeConfig, ExposeError, MirrorConfig, MirrorError,
+    NetConfig, RequestKind, SessionError,
 };
 use limber_services::signals;
 
@@ -24,13 +25,17 @@ pub struct BridgeArgs {
 #[derive(Debug, Subcommand)]
 enum Role {
     /// On the robot's PC: put every device of this domain on Zenoh (state, commands,
-    /// requests, a liveliness token per device). Listens on loopback unless told otherwise.
+    /// requests, a liveliness token per device). Listens on a Unix socket only you can open
+    /// (`<runtime dir>/bridge/<domain>.sock`) unless told otherwise; a TCP or TLS listener
+    /// needs credentials (--zenoh-config: user/password, or TLS client certificates).
     ///
     /// Runs until SIGINT, SIGTERM, SIGHUP (or SIGQUIT); prints "exposed DEVICE" and "gone
     /// DEVICE" as drivers come and go.
     Expose(ExposeArgs),
-    /// On another host: host the devices of a remote `expose` in this domain under the same
-    /// names, so that unchanged clients use them.
+    /// On another host (or in another domain of this one): host the devices of a remote
+    /// `expose` in this domain under the same names, so that unchanged clients use them.
+    /// Connects to --connect ENDPOINT, or to the bridge of domain --from DOMAIN of yours on
+    /// this machine; listens on nothing.
     ///
     /// Runs until SIGINT, SIGTERM, SIGHUP (or SIGQUIT); prints "mirrored DEVICE as NAME" and
     /// "gone NAME" as remote devices come and go.
@@ -40,15 +45,15 @@ enum Role {
 /// The network flags of both roles.
 #[derive(Debug, Args)]
 struct Net {
-    /// A Zenoh endpoint to listen on (repeatable), e.g. tcp/127.0.0.1:7447; use a
-    /// non-loopback address only with TLS and authentication (bridge/README.md).
+    /// A Zenoh endpoint to listen on (repeatable), e.g. tls/192.168.1.10:7447; anything but
+    /// a Unix socket needs credentials in --zenoh-config (bridge/README.md, Security).
     #[arg(long, value_name = "ENDPOINT")]
     listen: Vec<String>,
     /// A Zenoh endpoint to connect to (repeatable), e.g. tcp/192.168.1.10:7447.
     #[arg(long, value_name = "ENDPOINT")]
     connect: Vec<String>,
     /// A Zenoh configuration file (JSON5) for TLS, user/password and the like; the
-    /// endpoints given here apply on top of it.
+    /// endpoints given here apply on top of it (bridge/README.md has examples).
     #[arg(long, value_name = "FILE")]
     zenoh_config: Option<PathBuf>,
 }
@@ -79,6 +84,11 @@ struct ExposeArgs {
     /// speed); the state and read-only requests (geometry) still pass.
     #[arg(long)]
     read_only: bool,
+    /// A principal that may send commands and requests (repeatable): the common name of a
+    /// TLS client certificate, or a user of the user/password dictionary (all of whose
+    /// users are principals anyway). Each principal's leases and commands are its own.
+    #[arg(long = "peer", value_name = "NAME")]
+    peers: Vec<String>,
 }
 
 #[derive(Debug, Args)]
@@ -93,23 +103,34 @@ struct MirrorArgs {
     /// seconds.
     #[arg(long, default_value = "1.8", value_parser = parse_seconds, value_name = "S")]
     request_timeout: f64,
+    /// Connect to the exposing bridge of this domain of yours on this machine (its private
+    /// Unix socket), instead of --connect.
+    #[arg(long, value_name = "DOMAIN", conflicts_with = "connect")]
+    from: Option<String>,
+    /// Who this mirror is to the exposing bridge: the common name of its TLS client
+    /// certificate (default: its user/password user, else "local", the owner's socket).
+    #[arg(long = "as", value_name = "NAME")]
+    principal: Option<String>,
+    /// The most remote devices hosted at once; more are refused.
+    #[arg(long, default_value_t = limber_bridge::mirror::DEFAULT_MAX_DEVICES, value_name = "N")]
+    max_devices: usize,
 }
 
-fn net_config(net: Net, default_listen: &[&str], default_connect: &[&str]) -> NetConfig {
-    let defaults = |v: &[&str]| v.iter().map(|s| s.to_string()).collect();
-    let nothing_given = net.listen.is_empty() && net.connect.is_empty();
+fn net_config(net: Net) -> NetConfig {
     NetConfig {
-        listen: if nothing_given {
-            defaults(default_listen)
-        } else {
-            net.listen
-        },
-        connect: if nothing_given {
-            defaults(default_connect)
-        } else {
-            net.connect
-        },
+        listen: net.listen,
+        connect: net.connect,
         config_file: net.zenoh_config,
+    }
+}
+
+/// The exit code of a bridge that failed: a listener or principal refused is a usage
+/// error (2), anything else a failure (1).
+fn bridge_exit(access_refused: bool) -> u8 {
+    if access_refused {
+        exit::USAGE
+    } else {
+        exit::FAILURE
     }
 }
 
@@ -127,7 +148,7 @@ pub fn run(args: BridgeArgs) -> Result<(), CliError> {
         Role::Expose(a) => {
             let filtered = !a.allow_commands.is_empty() || !a.allow_requests.is_empty();
             let config = ExposeConfig {
-                net: net_config(a.net, &["tcp/127.0.0.1:7447"], &[]),
+                net: net_config(a.net),
                 request_timeout: std::time::Duration::from_secs_f64(a.request_timeout),
                 allow: Allow {
                     devices: a.devices,
@@ -135,29 +156,48 @@ pub fn run(args: BridgeArgs) -> Result<(), CliError> {
                     requests: filtered.then_some(a.allow_requests),
                     read_only: a.read_only,
                 },
+                peers: a.peers,
                 ..ExposeConfig::default()
             };
             let name = domain.name().to_string();
             limber_bridge::expose(&domain, &config, &stop, &mut |ev| match ev {
-                ExposeEvent::Ready { zid } => noteln!(
+                ExposeEvent::Ready { zid, listen } => noteln!(
                     "exposing domain {name} on Zenoh (id {zid}, listening on {})",
-                    config.net.listen.join(", ")
+                    listen.join(", ")
                 ),
                 ExposeEvent::Exposed(d) => noteln!("exposed {d}"),
                 ExposeEvent::Gone(d) => noteln!("gone {d}"),
             })
-            .map_err(|e| CliError::new(exit::FAILURE, e.to_string()))
+            .map_err(|e| {
+                let refused = matches!(
+                    e,
+                    ExposeError::Session(SessionError::Access(_) | SessionError::ConfigFile { .. })
+                );
+                CliError::new(bridge_exit(refused), e.to_string())
+            })
         }
         Role::Mirror(a) => {
+            let mut net = net_config(a.net);
+            if let Some(from) = &a.from {
+                net.connect = vec![from_domain(from)?];
+            }
+            if net.connect.is_empty() {
+                return Err(CliError::new(
+                    exit::USAGE,
+                    "bridge mirror needs --from DOMAIN (a bridge of yours on this machine) or --connect ENDPOINT",
+                ));
+            }
             let config = MirrorConfig {
-                net: net_config(a.net, &[], &["tcp/127.0.0.1:7447"]),
+                net,
                 prefix: a.prefix,
                 request_timeout: std::time::Duration::from_secs_f64(a.request_timeout),
+                principal: a.principal,
+                max_devices: a.max_devices,
             };
             let name = domain.name().to_string();
             limber_bridge::mirror(&domain, &config, &stop, &mut |ev| match ev {
-                MirrorEvent::Ready { zid } => noteln!(
-                    "mirroring into domain {name} (Zenoh id {zid}, connecting to {})",
+                MirrorEvent::Ready { zid, principal } => noteln!(
+                    "mirroring into domain {name} (Zenoh id {zid}, as {principal}, connecting to {})",
                     config.net.connect.join(", ")
                 ),
                 MirrorEvent::Mirrored { remote, local } => {
@@ -168,7 +208,23 @@ pub fn run(args: BridgeArgs) -> Result<(), CliError> {
                     noteln!("cannot mirror {remote}: {reason}")
                 }
             })
-            .map_err(|e| CliError::new(exit::FAILURE, e.to_string()))
+            .map_err(|e| {
+                let refused = matches!(
+                    e,
+                    MirrorError::Session(SessionError::Access(_) | SessionError::ConfigFile { .. })
+                        | MirrorError::Prefix(_)
+                );
+                CliError::new(bridge_exit(refused), e.to_string())
+            })
         }
     }
+}
+
+/// The endpoint of the exposing bridge of this user's domain `name` (its private socket).
+fn from_domain(name: &str) -> Result<String, CliError> {
+    let other = limber_services::Domain::new(name)
+        .map_err(|e| CliError::new(exit::USAGE, e.to_string()))?;
+    let runtime = limber_services::domain_dir::runtime_dir();
+    limber_bridge::access::private_socket(&runtime, other.name())
+        .map_err(|e| CliError::new(exit::FAILURE, e.to_string()))
 }

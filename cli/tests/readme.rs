@@ -360,7 +360,8 @@ impl Session {
                 }
                 name
             };
-            if a == "--domain" {
+            // `bridge mirror --from NAME` names a domain too.
+            if a == "--domain" || a == "--from" {
                 out.push(a);
                 if let Some(n) = it.next() {
                     out.push(own(&n));

@@ -4,10 +4,15 @@ domain on this host, only `eclipse-zenoh` and the wire layouts of `limber/_layou
 (pure ctypes, loaded by path so that the `limber` package and the liblimber it binds are
 not needed).
 
-The robot's PC runs `limber bridge expose` (see bridge/README.md for the keys and payloads):
+The robot's PC runs `limber bridge expose` (see bridge/README.md for the keys and payloads).
+On that PC, as the bridge's owner, through its private Unix socket:
 
-    python3 python/examples/zenoh_remote.py --connect tcp/127.0.0.1:7447 \
-        pioneer/actarray/0 1 0.3
+    python3 python/examples/zenoh_remote.py \
+        --connect unixsock-stream/$LIMBER_RUNTIME_DIR/bridge/robot.sock pioneer/actarray/0 1 0.3
+
+(`$LIMBER_RUNTIME_DIR` defaults to /tmp/limber-<uid>.) From another host, with Zenoh's
+user/password authentication: `--zenoh-config FILE --as USER` (the bridge accepts commands
+only under the principal the session authenticated as).
 
 prints the joints' positions, sends "move joint 1 to 0.3 rad" and prints the driver's
 outcome. Exit status: 0 carried out, 5 refused (the reason is printed), 6 no state or no
@@ -41,8 +46,8 @@ def key(device, channel):
     return f"limber/{device}/{channel}"
 
 
-def open_session(endpoint):
-    conf = zenoh.Config()
+def open_session(endpoint, config_file):
+    conf = zenoh.Config.from_file(config_file) if config_file else zenoh.Config()
     conf.insert_json5("mode", '"client"')
     conf.insert_json5("connect/endpoints", json.dumps([endpoint]))
     conf.insert_json5("scouting/multicast/enabled", "false")
@@ -58,16 +63,21 @@ def first(q, timeout):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--connect", default="tcp/127.0.0.1:7447", help="the bridge's endpoint")
+    p.add_argument("--connect", required=True, help="the bridge's endpoint")
+    p.add_argument("--zenoh-config", help="a Zenoh configuration file (user/password, TLS)")
+    p.add_argument("--as", dest="principal", default="local",
+                   help="who this session is to the bridge: its user/password user or "
+                        "certificate name; 'local' on the owner's Unix socket")
     p.add_argument("--timeout", type=float, default=5.0, help="seconds per wait")
     p.add_argument("device", help="an actarray, e.g. pioneer/actarray/0")
     p.add_argument("joint", type=int)
     p.add_argument("position", type=float, help="radians (metres for a linear joint)")
     a = p.parse_args()
 
-    origin = f"py{random.getrandbits(48):012x}"  # where our outcomes come back
+    # <principal>/<session>: where our commands go and our outcomes come back.
+    origin = f"{a.principal}/py{random.getrandbits(48):012x}"
     client_id = random.getrandbits(63) | 1
-    session = open_session(a.connect)
+    session = open_session(a.connect, a.zenoh_config)
     try:
         states, outcomes = queue.Queue(), queue.Queue()
         session.declare_subscriber(key(a.device, "state"),
@@ -92,7 +102,7 @@ def main():
         msg.meta.stamp_ns = time.monotonic_ns()
         msg.meta.kind = L.ACTARRAY_CMD_POS
         msg.meta.body_len = ctypes.sizeof(body)
-        session.put(key(a.device, "cmd"), bytes(msg), attachment=origin.encode(),
+        session.put(key(a.device, f"cmd/{origin}"), bytes(msg),
                     encoding=zenoh.Encoding("application/octet-stream;" + msg.type_name()))
 
         deadline = time.monotonic() + a.timeout

@@ -8,7 +8,6 @@ Every wait has a timeout.
 import os
 import queue
 import signal
-import socket
 import subprocess
 import sys
 import threading
@@ -37,10 +36,10 @@ def cli_bin():
     return path
 
 
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+def private_socket(domain):
+    """The endpoint of `limber bridge expose`'s default listener for `domain`."""
+    runtime = os.environ.get("LIMBER_RUNTIME_DIR") or f"/tmp/limber-{os.geteuid()}"
+    return f"unixsock-stream/{runtime}/bridge/{domain}.sock"
 
 
 class Job:
@@ -94,13 +93,13 @@ def bridge():
     except ImportError:
         _need(False, "eclipse-zenoh is not installed (pip install eclipse-zenoh==1.10.2)")
     domain = unique_domain()
-    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    endpoint = private_socket(domain)
     driver = Job(domain, "pioneer", "--emulated")
     driver.wait_line(lambda l: l.endswith("ready"))
-    expose = Job(domain, "bridge", "expose", "--listen", endpoint)
+    expose = Job(domain, "bridge", "expose")
     expose.wait_line(lambda l: l == "exposed pioneer/actarray/0")
     mirror_domain = unique_domain()
-    mirror = Job(mirror_domain, "bridge", "mirror", "--connect", endpoint)
+    mirror = Job(mirror_domain, "bridge", "mirror", "--from", domain)
     mirror.wait_line(lambda l: l == "mirrored pioneer/actarray/0 as pioneer/actarray/0")
     yield endpoint, mirror_domain
     assert mirror.stop() == 0
@@ -139,3 +138,12 @@ def test_the_python_client_commands_the_arm_through_a_mirror(bridge):
             assert time.monotonic() < deadline, "joint 2 never reached 0.4"
         t = arm.move_to(1, 9.0)
         assert arm.wait_outcome(t, T) is Status.BEYOND_LIMITS
+
+
+def test_a_session_cannot_command_as_another_principal(bridge):
+    # On the owner's Unix socket the session is `local`: a command put under another
+    # principal's key is dropped by the bridge's access rules, so no outcome ever comes.
+    r = run_example(bridge[0], "--as", "alice", "--timeout", "2", "pioneer/actarray/0", "1", "0.6")
+    assert r.returncode == 6, r.stdout + r.stderr
+    assert r.stdout.startswith("state #"), r.stdout
+    assert "no outcome" in r.stderr, r.stderr

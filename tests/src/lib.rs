@@ -198,3 +198,24 @@ pub fn start_pioneer(bin: &str, domain: &str, port: &str, cfg: &std::path::Path)
     );
     d
 }
+
+/// Writes a Zenoh configuration with user/password authentication to `dir/file` (user
+/// `user`, password `password`; with `dictionary`, the file of the users it accepts, as a
+/// listening bridge has) and returns its path, for the bridge tests.
+pub fn usrpwd_config(
+    dir: &std::path::Path,
+    file: &str,
+    user: &str,
+    password: &str,
+    dictionary: Option<&std::path::Path>,
+) -> String {
+    let path = dir.join(file);
+    let dict = dictionary
+        .map(|d| format!(", dictionary_file: \"{}\"", d.display()))
+        .unwrap_or_default();
+    let text = format!(
+        "{{ transport: {{ auth: {{ usrpwd: {{ user: \"{user}\", password: \"{password}\"{dict} }} }} }} }}\n"
+    );
+    std::fs::write(&path, text).expect("write a Zenoh configuration");
+    path.display().to_string()
+}

@@ -1,9 +1,12 @@
 //! `limber bridge` (issue 17): the emulated Pioneer in domain A, `bridge expose` there,
-//! `bridge mirror` into domain B over TCP loopback, and unchanged clients in domain B
+//! `bridge mirror --from A` into domain B over A's private Unix socket (TCP with
+//! user/password authentication, and between two network namespaces, where it says so),
+//! and unchanged clients in domain B
 //! (the Rust client, the CLI) commanding the arm. Killing the driver or either bridge
 //! makes the mirrored devices gone for B's clients, within a bound, without a hang.
 //!
-//! Each test uses its own two domains and its own port; every wait is bounded.
+//! Each test uses its own two domains (and its own port where it uses TCP); every wait is
+//! bounded. Who may reach a bridge, forged identities and TLS: `bridge_access.rs`.
 
 use std::time::{Duration, Instant};
 
@@ -11,18 +14,11 @@ use limber_services::prelude::*;
 use limber_services::{DriverStatus, RequestError};
 use limber_tests::Proc;
 
-const CLI: &str = env!("CARGO_BIN_EXE_limber-test-cli");
+mod bridging;
+use bridging::{CLI, arm_in, free_port, start_driver, usrpwd_configs, wait_mirrored};
 
 /// How long a mirrored device may take to be gone after its driver or a bridge dies.
 const GONE_BOUND: Duration = Duration::from_secs(10);
-
-/// A TCP port on loopback that was free a moment ago.
-fn free_port() -> u16 {
-    std::net::TcpListener::bind("127.0.0.1:0")
-        .and_then(|l| l.local_addr())
-        .map(|a| a.port())
-        .expect("a free loopback port")
-}
 
 /// The processes first: they end before the domains, which then remove their files.
 struct Setup {
@@ -31,20 +27,11 @@ struct Setup {
     mirror: Proc,
     a: Domain,
     b: Domain,
-    endpoint: String,
 }
 
-fn start_driver(a: &Domain) -> Proc {
-    let mut d = Proc::spawn(CLI, a.name(), &["pioneer", "--emulated"]);
-    assert!(
-        d.read_until(|l| l.ends_with("ready")).is_some(),
-        "the driver did not start"
-    );
-    d
-}
-
-fn start_expose(a: &Domain, endpoint: &str) -> Proc {
-    let mut e = Proc::spawn(CLI, a.name(), &["bridge", "expose", "--listen", endpoint]);
+/// `bridge expose` on its default listener, domain A's private Unix socket.
+fn start_expose(a: &Domain) -> Proc {
+    let mut e = Proc::spawn(CLI, a.name(), &["bridge", "expose"]);
     assert!(
         e.read_until(|l| l == "exposed pioneer/actarray/0")
             .is_some(),
@@ -53,41 +40,26 @@ fn start_expose(a: &Domain, endpoint: &str) -> Proc {
     e
 }
 
-fn start_mirror(b: &Domain, endpoint: &str) -> Proc {
-    let mut m = Proc::spawn(CLI, b.name(), &["bridge", "mirror", "--connect", endpoint]);
+/// `bridge mirror --from A` into domain B.
+fn start_mirror(b: &Domain, a: &Domain) -> Proc {
+    let mut m = Proc::spawn(CLI, b.name(), &["bridge", "mirror", "--from", a.name()]);
     wait_mirrored(&mut m);
     m
-}
-
-fn wait_mirrored(m: &mut Proc) {
-    assert!(
-        m.read_until(|l| l == "mirrored pioneer/actarray/0 as pioneer/actarray/0")
-            .is_some(),
-        "mirror did not host the arm"
-    );
 }
 
 fn setup() -> Setup {
     let a = Domain::unique_for_test();
     let b = Domain::unique_for_test();
-    let endpoint = format!("tcp/127.0.0.1:{}", free_port());
     let driver = start_driver(&a);
-    let expose = start_expose(&a, &endpoint);
-    let mirror = start_mirror(&b, &endpoint);
+    let expose = start_expose(&a);
+    let mirror = start_mirror(&b, &a);
     Setup {
         driver,
         expose,
         mirror,
         a,
         b,
-        endpoint,
     }
-}
-
-fn arm_in(b: &Domain) -> ActArrayClient {
-    let ctx = Context::new(b, Role::Client, "bridge-test").expect("join domain B");
-    ActArrayClient::connect_timeout(&ctx, "pioneer/actarray/0", Duration::from_secs(10))
-        .expect("the mirrored arm")
 }
 
 /// Waits (bounded) until joint `j` of the arm is within 0.02 rad of `target`.
@@ -272,7 +244,7 @@ fn a_dead_driver_or_bridge_makes_the_mirrored_arm_gone() {
     );
 
     // It comes back; then the mirror dies.
-    s.expose = start_expose(&s.a, &s.endpoint);
+    s.expose = start_expose(&s.a);
     wait_mirrored(&mut s.mirror);
     let mut arm = arm_in(&s.b);
     arm.geometry()
@@ -304,15 +276,12 @@ fn the_allow_list_keeps_devices_and_commands_out() {
     let _driver = start_driver(&a);
 
     let b = Domain::unique_for_test();
-    let endpoint = format!("tcp/127.0.0.1:{}", free_port());
     let mut expose = Proc::spawn(
         CLI,
         a.name(),
         &[
             "bridge",
             "expose",
-            "--listen",
-            &endpoint,
             "--device",
             "pioneer/actarray/0",
             "--allow-command",
@@ -326,7 +295,7 @@ fn the_allow_list_keeps_devices_and_commands_out() {
             .read_until(|l| l == "exposed pioneer/actarray/0")
             .is_some()
     );
-    let _mirror = start_mirror(&b, &endpoint);
+    let _mirror = start_mirror(&b, &a);
     let mut arm = arm_in(&b);
     arm.geometry().expect("a read-only request passes");
     let t = arm.move_to(2, 0.4).expect("send");
@@ -359,18 +328,13 @@ fn the_allow_list_keeps_devices_and_commands_out() {
     assert!(!rest.contains("exposed "), "{rest}");
 
     let b = Domain::unique_for_test();
-    let endpoint = format!("tcp/127.0.0.1:{}", free_port());
-    let mut expose = Proc::spawn(
-        CLI,
-        a.name(),
-        &["bridge", "expose", "--listen", &endpoint, "--read-only"],
-    );
+    let mut expose = Proc::spawn(CLI, a.name(), &["bridge", "expose", "--read-only"]);
     assert!(
         expose
             .read_until(|l| l == "exposed pioneer/actarray/0")
             .is_some()
     );
-    let _mirror = start_mirror(&b, &endpoint);
+    let _mirror = start_mirror(&b, &a);
     let mut arm = arm_in(&b);
     arm.geometry().expect("a read-only request passes");
     assert!(
@@ -460,27 +424,7 @@ fn a_remote_holder_that_dies_triggers_the_deadman() {
 /// wrong password gets nothing, one with the right password mirrors the arm.
 #[test]
 fn a_mirror_with_the_wrong_password_gets_nothing() {
-    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("bridge-usrpwd-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("a scratch directory");
-    let users = dir.join("users.txt");
-    std::fs::write(&users, "robot:a long secret\n").expect("write the users");
-    let config = |name: &str, password: &str, dictionary: bool| {
-        let path = dir.join(name);
-        let dict = if dictionary {
-            format!(", dictionary_file: \"{}\"", users.display())
-        } else {
-            String::new()
-        };
-        let text = format!(
-            "{{ transport: {{ auth: {{ usrpwd: {{ user: \"robot\", password: \"{password}\"{dict} }} }} }} }}\n"
-        );
-        std::fs::write(&path, text).expect("write a Zenoh configuration");
-        path.display().to_string()
-    };
-    let robot = config("robot.json5", "a long secret", true);
-    let good = config("good.json5", "a long secret", false);
-    let bad = config("bad.json5", "a guess", false);
+    let (dir, robot, good, bad) = usrpwd_configs("usrpwd");
 
     let a = Domain::unique_for_test();
     let _driver = start_driver(&a);
@@ -644,13 +588,26 @@ fn a_bridge_pair_between_two_network_namespaces_moves_the_arm() {
     let a = Domain::unique_for_test();
     let b = Domain::unique_for_test();
     let endpoint = format!("tcp/{ROBOT_ADDR}:{}", free_port());
+    // A listener another host reaches needs credentials.
+    let (dir, robot, good, _) = usrpwd_configs("netns");
 
     let mut driver = NetnsPair::spawn(&net.robot, &a, &["pioneer", "--emulated"]);
     assert!(
         driver.read_until(|l| l.ends_with("ready")).is_some(),
         "the driver did not start in the robot's namespace"
     );
-    let mut expose = NetnsPair::spawn(&net.robot, &a, &["bridge", "expose", "--listen", &endpoint]);
+    let mut expose = NetnsPair::spawn(
+        &net.robot,
+        &a,
+        &[
+            "bridge",
+            "expose",
+            "--listen",
+            &endpoint,
+            "--zenoh-config",
+            &robot,
+        ],
+    );
     assert!(
         expose
             .read_until(|l| l == "exposed pioneer/actarray/0")
@@ -660,7 +617,14 @@ fn a_bridge_pair_between_two_network_namespaces_moves_the_arm() {
     let mut mirror = NetnsPair::spawn(
         &net.operator,
         &b,
-        &["bridge", "mirror", "--connect", &endpoint],
+        &[
+            "bridge",
+            "mirror",
+            "--connect",
+            &endpoint,
+            "--zenoh-config",
+            &good,
+        ],
     );
     wait_mirrored(&mut mirror);
 
@@ -721,4 +685,5 @@ fn a_bridge_pair_between_two_network_namespaces_moves_the_arm() {
         "{r:?}"
     );
     drop((driver, mirror));
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -1,6 +1,7 @@
 //! The exposing bridge under a flood of malformed messages from the network (commands of
 //! the wrong size, commands and requests without a valid origin): it logs the first one
-//! and then a count, not one line per message, and keeps serving.
+//! and then a count, not one line per message, and keeps serving. The flood comes through
+//! the private Unix socket, as principal `local`, the only one it may act as there.
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -12,13 +13,6 @@ use zenoh::Wait;
 use zenoh::qos::CongestionControl;
 
 const CLI: &str = env!("CARGO_BIN_EXE_limber-test-cli");
-
-fn free_port() -> u16 {
-    std::net::TcpListener::bind("127.0.0.1:0")
-        .and_then(|l| l.local_addr())
-        .map(|a| a.port())
-        .expect("a free loopback port")
-}
 
 /// A Zenoh client session of the test's own, connected to `endpoint` only.
 fn session(endpoint: &str) -> zenoh::Session {
@@ -36,7 +30,11 @@ fn session(endpoint: &str) -> zenoh::Session {
 #[test]
 fn a_flood_of_malformed_messages_is_counted_not_logged_one_by_one() {
     let a = Domain::unique_for_test();
-    let endpoint = format!("tcp/127.0.0.1:{}", free_port());
+    let endpoint = format!(
+        "unixsock-stream/{}/bridge/{}.sock",
+        a.runtime_dir().expect("the runtime directory").display(),
+        a.name()
+    );
     let mut driver = Proc::spawn(CLI, a.name(), &["pioneer", "--emulated"]);
     assert!(driver.read_until(|l| l.ends_with("ready")).is_some());
     let log = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
@@ -44,9 +42,8 @@ fn a_flood_of_malformed_messages_is_counted_not_logged_one_by_one() {
     let mut c = Command::new("sh");
     c.args([
         "-c",
-        "exec \"$0\" bridge expose --listen \"$1\" 2>\"$2\"",
+        "exec \"$0\" bridge expose 2>\"$1\"",
         CLI,
-        &endpoint,
         log.to_str().unwrap(),
     ])
     .env("LIMBER_DOMAIN", a.name());
@@ -57,16 +54,15 @@ fn a_flood_of_malformed_messages_is_counted_not_logged_one_by_one() {
             .is_some()
     );
     let s = session(&endpoint);
-    let cmd = "limber/pioneer/actarray/0/cmd";
     // 1,000 commands of the wrong size, 788 without a valid origin.
     for i in 0..1788 {
-        let origin = if i < 1000 {
+        let session = if i < 1000 {
             "tester"
         } else {
             "not a valid origin!"
         };
+        let cmd = format!("limber/pioneer/actarray/0/cmd/local/{session}");
         s.put(cmd, vec![0u8; 3])
-            .attachment(origin)
             .congestion_control(CongestionControl::Block)
             .wait()
             .unwrap();
@@ -74,9 +70,8 @@ fn a_flood_of_malformed_messages_is_counted_not_logged_one_by_one() {
     // Then a request of the wrong size, refused: its answer comes after the commands
     // before it were handled (one link, handled in order).
     let replies = s
-        .get("limber/pioneer/actarray/0/req")
+        .get("limber/pioneer/actarray/0/req/local/tester")
         .payload(vec![0u8; 5])
-        .attachment("tester")
         .timeout(Duration::from_secs(10))
         .wait()
         .unwrap();

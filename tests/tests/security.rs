@@ -3,9 +3,9 @@
 //! The hostile actions run as a second Unix user, `limber-hostile`, which the tests create
 //! (idempotently) with `useradd`; they need root, and are skipped with the reason otherwise.
 
-use std::os::unix::fs::{MetadataExt, PermissionsExt};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::os::unix::fs::MetadataExt;
+use std::path::PathBuf;
+use std::process::Command;
 use std::time::Duration;
 
 use limber_bounded_run::output_within;
@@ -14,79 +14,11 @@ use limber_services::prelude::*;
 use limber_services::{ContextError, Domain, Role};
 use limber_tests::Proc;
 
+mod hostile;
+use hostile::{LIMIT, Scratch, as_user, hostile_user};
+
 const DRIVER: &str = env!("CARGO_BIN_EXE_limber-test-driver");
 const CLI: &str = env!("CARGO_BIN_EXE_limber-test-cli");
-const HOSTILE: &str = "limber-hostile";
-const LIMIT: Duration = Duration::from_secs(30);
-
-/// Creates the hostile user if needed; None (with the reason printed) when not root.
-fn hostile_user() -> Option<&'static str> {
-    if euid() != 0 {
-        eprintln!(
-            "SKIPPED: creating a second Unix user needs root (these tests run as root in CI)"
-        );
-        return None;
-    }
-    // Tests run in parallel processes: useradd may meet another's lock or find the user
-    // made meanwhile. Bounded retries.
-    for _ in 0..50 {
-        if output_within(Command::new("id").arg("-u").arg(HOSTILE), LIMIT)
-            .status
-            .success()
-        {
-            return Some(HOSTILE);
-        }
-        let _ = output_within(
-            Command::new("useradd").args(["-M", "-r", "-s", "/usr/sbin/nologin", HOSTILE]),
-            LIMIT,
-        );
-        std::thread::sleep(Duration::from_millis(100));
-    }
-    panic!("cannot create the user {HOSTILE}");
-}
-
-/// Runs `script` with `sh -c` as `user`, in `dir`, with `env`.
-fn as_user(user: &str, dir: &Path, env: &[(&str, &str)], script: &str) -> Output {
-    let mut c = Command::new("runuser");
-    c.args(["-u", user, "--", "sh", "-c", script])
-        .current_dir(dir);
-    for (k, v) in env {
-        c.env(k, v);
-    }
-    output_within(c, LIMIT)
-}
-
-/// A directory everybody may enter, for the hostile user's work, removed at the end.
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(name: &str) -> Scratch {
-        let p = std::env::temp_dir().join(format!("limber-sec-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&p);
-        std::fs::create_dir_all(&p).unwrap();
-        std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o1777)).unwrap();
-        Scratch(p)
-    }
-
-    /// A copy of the CLI the hostile user can run (the build directory may be private).
-    fn cli(&self, user: &str) -> String {
-        if as_user(user, &self.0, &[], &format!("test -x '{CLI}'"))
-            .status
-            .success()
-        {
-            return CLI.to_string();
-        }
-        let to = self.0.join("limber");
-        std::fs::copy(CLI, &to).unwrap();
-        to.to_string_lossy().into_owned()
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 fn start_driver(domain: &Domain) -> Proc {
     let mut d = Proc::spawn(DRIVER, domain.name(), &[]);

@@ -1,5 +1,5 @@
 //! `bridge`: the command round trip (`move_to` then a blocking `wait_outcome`, as a client
-//! does) through a `limber bridge expose` + `limber bridge mirror` pair over TCP loopback
+//! does) through a `limber bridge expose` + `limber bridge mirror` pair over the private Unix socket of `expose`
 //! (Zenoh), beside the same client against the driver directly, in the same run.
 //!
 //! The driver is the `command` scenario's event-driven driver child (`cmd-driver-event`,
@@ -40,7 +40,7 @@ impl Scenario for Bridge {
         "bridge"
     }
     fn description(&self) -> &'static str {
-        "command round trip through limber bridge expose + mirror (Zenoh, TCP loopback), beside the same client direct"
+        "command round trip through limber bridge expose + mirror (Zenoh, Unix socket), beside the same client direct"
     }
     fn run(&self, ctx: &mut RunCtx) -> Result<(), BenchError> {
         if !ctx.blocking_enabled() {
@@ -94,14 +94,6 @@ fn limber_exe() -> Result<PathBuf, String> {
     Ok(exe)
 }
 
-/// A TCP port on loopback that was free a moment ago.
-fn free_port() -> Result<u16, BenchError> {
-    std::net::TcpListener::bind("127.0.0.1:0")
-        .and_then(|l| l.local_addr())
-        .map(|a| a.port())
-        .map_err(|e| BenchError::io("a free loopback port", e))
-}
-
 /// `limber --domain <domain> bridge <args>`, started as a child that must print `line`.
 fn start_bridge(
     exe: &Path,
@@ -133,12 +125,12 @@ fn run(ctx: &mut RunCtx, exe: &Path) -> Result<(), BenchError> {
     let mut direct = ActArrayClient::connect_timeout(&cctx_a, DEVICE, READY_TIMEOUT)
         .map_err(|e| err("connect in A", e))?;
     let r = (|| {
-        let endpoint = format!("tcp/127.0.0.1:{}", free_port()?);
+        // The default listener, A's private Unix socket (a TCP listener needs credentials).
         let expose = start_bridge(
             exe,
             "bridge expose",
             &a,
-            &["expose", "--listen", &endpoint],
+            &["expose"],
             &format!("exposed {DEVICE}"),
             deadline,
         )?;
@@ -146,7 +138,7 @@ fn run(ctx: &mut RunCtx, exe: &Path) -> Result<(), BenchError> {
             exe,
             "bridge mirror",
             &b,
-            &["mirror", "--connect", &endpoint],
+            &["mirror", "--from", a.name()],
             &format!("mirrored {DEVICE} as {DEVICE}"),
             deadline,
         )?;
@@ -176,7 +168,7 @@ fn run(ctx: &mut RunCtx, exe: &Path) -> Result<(), BenchError> {
     push(
         ctx,
         "bridge.zenoh.rtt",
-        "command→outcome through bridge expose+mirror (Zenoh, TCP loopback)",
+        "command→outcome through bridge expose+mirror (Zenoh, Unix socket)",
         rtt_bridge,
     );
     Ok(())

@@ -134,6 +134,13 @@ impl Domain {
         Ok(&self.resolved()?.root)
     }
 
+    /// The runtime directory of this domain's files (the parent of [`Domain::root`]: its
+    /// token, its iceoryx2 files, the private sockets of its bridges).
+    pub fn runtime_dir(&self) -> Result<&std::path::Path, DomainError> {
+        let root = self.root()?;
+        Ok(root.parent().unwrap_or(root))
+    }
+
     /// The Unix group that shares this domain (group mode, `LIMBER_GROUP`), or None: the
     /// domain is its user's alone.
     pub fn group(&self) -> Result<Option<&Group>, DomainError> {
