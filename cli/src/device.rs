@@ -18,7 +18,8 @@ pub struct Common {
     #[arg(long, global = true, default_value_t = 2.0, value_name = "S",
           value_parser = crate::parse_seconds)]
     timeout: f64,
-    /// Send commands without waiting for their outcome.
+    /// Send commands without waiting for their outcome ("sent"); the CLI still ends only
+    /// once the driver has taken them.
     #[arg(long, global = true)]
     no_wait: bool,
     /// Take the device for this command (a control lease, released when it ends): refused

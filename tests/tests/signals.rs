@@ -191,29 +191,21 @@ fn the_other_terminating_signals_are_ignored_by_the_spinning_driver() {
     the_other_terminating_signals_are_ignored(&["--spin"], "ignored-spin");
 }
 
-fn free_port() -> u16 {
-    std::net::TcpListener::bind("127.0.0.1:0")
-        .and_then(|l| l.local_addr())
-        .map(|a| a.port())
-        .expect("a free loopback port")
-}
-
 /// Both bridges ignore SIGALRM and SIGUSR1 (and the like): the arm of domain A is still
 /// served in domain B through them; SIGTERM then ends each with exit 0.
 #[test]
 fn bridges_survive_sigalrm_and_sigusr1() {
     let a = Domain::unique_for_test();
     let b = Domain::unique_for_test();
-    let endpoint = format!("tcp/127.0.0.1:{}", free_port());
     let mut driver = Proc::spawn(CLI, a.name(), &["pioneer", "--emulated"]);
     assert!(driver.read_until(|l| l.ends_with("ready")).is_some());
-    let mut expose = Proc::spawn(CLI, a.name(), &["bridge", "expose", "--listen", &endpoint]);
+    let mut expose = Proc::spawn(CLI, a.name(), &["bridge", "expose"]);
     assert!(
         expose
             .read_until(|l| l == "exposed pioneer/actarray/0")
             .is_some()
     );
-    let mut mirror = Proc::spawn(CLI, b.name(), &["bridge", "mirror", "--connect", &endpoint]);
+    let mut mirror = Proc::spawn(CLI, b.name(), &["bridge", "mirror", "--from", a.name()]);
     assert!(
         mirror
             .read_until(|l| l == "mirrored pioneer/actarray/0 as pioneer/actarray/0")

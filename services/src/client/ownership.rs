@@ -10,7 +10,7 @@ use limber_interfaces::control::{get_name, put_name};
 use limber_interfaces::prelude::*;
 
 use super::connection::LeaseSide;
-use super::{Client, DriverStatus, LIVENESS_PERIOD, LeaseError};
+use super::{Client, DriverStatus, LIVENESS_PERIOD, LeaseError, Ticket, WaitError};
 use crate::error::Iox2Error;
 use crate::naming::{Channel, attr};
 use crate::qos;
@@ -287,8 +287,43 @@ fn held_by(reply: &LeaseReply) -> LeaseError {
     }
 }
 
+/// How long a client that goes waits for the driver to take the commands it sent
+/// ([`Client::settle`]); a driver found dead is not waited for.
+pub const SETTLE_ON_DROP: Duration = Duration::from_secs(2);
+
+impl<I: Interface> Client<I> {
+    /// Waits (at most `timeout`) until the driver has taken every command this client sent:
+    /// the outcome of the last one arrived. A command is in the client's publisher until the
+    /// driver reads it; a client that went at once could take it along (a short-lived
+    /// program, `limber ... --no-wait`), so [`Drop`] settles first. Returns whether they
+    /// were all taken (true at once when nothing is outstanding).
+    pub fn settle(&mut self, timeout: Duration) -> Result<bool, WaitError> {
+        if self.cmd_seq == 0 || self.max_seen_seq >= self.cmd_seq {
+            return Ok(true);
+        }
+        let last = Ticket {
+            seq: self.cmd_seq,
+            receivers: 1,
+        };
+        match self.wait_outcome_detail(last, timeout) {
+            Ok(_) => Ok(true),
+            Err(WaitError::Timeout(_)) => Ok(false),
+            Err(e) => Err(e),
+        }
+    }
+}
+
 impl<I: Interface> Drop for Client<I> {
     fn drop(&mut self) {
+        if !self.driver_died.get() {
+            match self.settle(SETTLE_ON_DROP) {
+                Ok(true) => {}
+                Ok(false) => tracing::warn!(device = %self.device, seq = self.cmd_seq,
+                    "closing with commands the driver has not taken after {SETTLE_ON_DROP:?}"),
+                Err(e) => tracing::debug!(device = %self.device, error = %e,
+                    "closing: the driver's outcomes cannot be waited for"),
+            }
+        }
         if self.holds_lease()
             && let Err(e) = self.release()
         {
