@@ -3,10 +3,10 @@
 //! limber is shared memory on one PC. This crate carries devices to other hosts over
 //! [Zenoh](https://zenoh.io) (the `zenoh` crate, 1.x, TCP only), in two roles:
 //!
-//! * [`expose`]: on the robot's PC, joins domain A as a client of every device there and
+//! * [`expose()`]: on the robot's PC, joins domain A as a client of every device there and
 //!   publishes each device's state, takes commands and requests from Zenoh and hands them
 //!   to the driver, and holds a liveliness token per device.
-//! * [`mirror`]: on another host, hosts every remote device in domain B under the same
+//! * [`mirror()`]: on another host, hosts every remote device in domain B under the same
 //!   name (or with a prefix on the robot name), as a driver would, so that unchanged
 //!   clients use it: their commands, requests and outcomes travel to the robot and back.
 //!

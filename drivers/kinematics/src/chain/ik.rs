@@ -40,8 +40,8 @@ impl Chain {
     /// the chain's atlas (256 drawn at load) whose tool poses are nearest the target,
     /// the others at deterministic random configurations. Each
     /// attempt is Levenberg–Marquardt on the damped least-squares step
-    /// `Δq = Jᵀ(JJᵀ + λI)⁻¹e` with λ adapted to the cost (from [`INITIAL_DAMPING`]),
-    /// the step limited to [`MAX_STEP`] rad (or m) per joint, joints pushing against a limit frozen for that step, and the
+    /// `Δq = Jᵀ(JJᵀ + λI)⁻¹e` with λ adapted to the cost (from `INITIAL_DAMPING`),
+    /// the step limited to `MAX_STEP` rad (or m) per joint, joints pushing against a limit frozen for that step, and the
     /// result clamped into the limits. An attempt has stalled when the cost falls by
     /// less than half in 10 iterations, or by less than a fifth in 3 while a joint
     /// sits on a limit. The first time it stalls, rotary joints on a limit whose

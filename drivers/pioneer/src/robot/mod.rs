@@ -5,9 +5,9 @@
 //! it has no link. It takes the robot's packets ([`RobotModel::on_packet`]) and the link's
 //! comings and goings ([`RobotModel::link_up`], [`RobotModel::link_down`]), and every
 //! command it accepts leaves P2OS [`Command`]s in its [`Outbox`], which the driver writes
-//! to the link. Its methods are split by device: [`arm`] (the arm actarray), [`limb`] (the
-//! end effector and its IK), [`grippers`] (the arm gripper and the body gripper) and
-//! [`lift`].
+//! to the link. Its methods are split by device, one private module each: `arm` (the arm
+//! actarray), `limb` (the end effector and its IK), `grippers` (the arm gripper and the body
+//! gripper) and `lift`.
 
 mod arm;
 mod grippers;
@@ -82,10 +82,10 @@ pub struct ArmModel {
     /// are carried out powered.
     pub power_on_pending: u8,
     /// When the last power-on was written: "unpowered" reports before
-    /// [`POWER_ON_SETTLE`] after it are not counted against the grace.
+    /// `POWER_ON_SETTLE` after it are not counted against the grace.
     pub power_on_sent: Option<Instant>,
     /// When the last power-off was written: ARMpacs saying "powered" for
-    /// [`POWER_ON_SETTLE`] after it left the controller before it read the command.
+    /// `POWER_ON_SETTLE` after it left the controller before it read the command.
     pub power_off_sent: Option<Instant>,
     /// Commanded target tick per joint (None: hold wherever it is).
     pub target: [Option<u8>; ARM_JOINTS],
