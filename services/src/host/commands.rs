@@ -32,9 +32,17 @@ impl<I: Interface> DeviceHost<I> {
             let raw: &I::CmdMsg = &sample;
             let meta = *raw.meta();
             // Who sent it, as the transport says: the node of its publisher.
-            let node = self
+            let sender = self
                 .cmd_senders
                 .publisher(sample.header().publisher_id().value(), &self.cmd_svc);
+            let node = sender.node;
+            if !super::senders::client_of_process(meta.client_id, sender.pid) {
+                // Another process's client id: its outcome would go to that client (who
+                // never sent it, and would take it for one of its own). Dropped, counted.
+                drop(sample);
+                self.forged_command(meta.client_id, sender.pid);
+                continue;
+            }
             let origin = Origin {
                 client_id: meta.client_id,
                 seq: meta.seq,
@@ -92,6 +100,18 @@ impl<I: Interface> DeviceHost<I> {
             }
         }
         Ok(n)
+    }
+
+    /// A command whose client id is another process's: counted as refused, and logged
+    /// (at warning level the first time, then once per 1,000).
+    fn forged_command(&mut self, client_id: u64, pid: u32) {
+        self.stats.commands += 1;
+        self.stats.refused += 1;
+        self.forged += 1;
+        if self.forged % 1000 == 1 {
+            tracing::warn!(device = %self.device, client_id, sender_pid = pid, forged = self.forged,
+                "a command with another process's client id: dropped (no outcome to that client)");
+        }
     }
 
     /// Carries out one decoded command of a client allowed to command the device, and

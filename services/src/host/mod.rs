@@ -95,6 +95,8 @@ pub struct DeviceHost<I: Interface> {
     >,
     /// Who sent each command, request and lease request (see `senders.rs`).
     cmd_senders: senders::PortNodes,
+    /// Commands dropped because their client id named another process than their sender.
+    forged: u64,
     req_senders: senders::PortNodes,
     lease_senders: senders::PortNodes,
     server: Server<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()>,

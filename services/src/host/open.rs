@@ -215,6 +215,7 @@ impl<I: Interface> DeviceHost<I> {
             cmd_svc,
             req_svc,
             cmd_senders: super::senders::PortNodes::new(ports),
+            forged: 0,
             req_senders: super::senders::PortNodes::new(ports),
             lease_senders: super::senders::PortNodes::new(ports),
             server,
