@@ -46,4 +46,4 @@ mod driver;
 pub mod model;
 
 pub use driver::{DRIVER_NAME, SimArm, SimArmError, SimArmFailures};
-pub use model::{ArmModel, MotorModel, OptionsError, SimArmOptions, SimObject};
+pub use model::{ArmModel, MAX_STORE_CAPACITY, MotorModel, OptionsError, SimArmOptions, SimObject};

@@ -32,6 +32,7 @@ use gripper::GripperCmd;
 use limb::VecMovePlan;
 use motion::Motion;
 pub use options::{MotorModel, OptionsError, SimArmOptions, SimObject};
+pub use store::MAX_STORE_CAPACITY;
 use store::Store;
 
 /// Most waypoints of one VECMOVE (at [`SimArmOptions::vecmove_step`] apart).
