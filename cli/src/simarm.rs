@@ -48,6 +48,14 @@ pub struct SimArmArgs {
     /// e.g. `--object 0.45,0.1,0.1,0.04`.
     #[arg(long, value_name = "X,Y,Z,WIDTH", value_parser = parse_object)]
     pub object: Option<SimObject>,
+    /// How many objects the gripper can store (STORE swallows the object between the
+    /// fingers, RETRIEVE gives it back); 0, the default: it cannot, both unsupported.
+    #[arg(long, value_name = "N", default_value_t = 0,
+          value_parser = clap::value_parser!(u32).range(0..=i64::from(limber_simarm::MAX_STORE_CAPACITY)))]
+    pub store_capacity: u32,
+    /// The chain's joints have no brakes (BRAKES unsupported, `has_brakes` 0).
+    #[arg(long)]
+    pub no_brakes: bool,
     /// Clients each device admits at once; a few more slots are kept for priority clients
     /// (LIMBER_PRIORITY=1, --priority).
     #[arg(long, value_name = "N", default_value_t = limber_services::qos::DEFAULT_MAX_CLIENTS,
@@ -80,6 +88,8 @@ impl SimArmArgs {
             tick: Duration::from_millis(self.tick_ms),
             time_scale: self.time_scale,
             object: self.object,
+            store_capacity: self.store_capacity,
+            brakes: !self.no_brakes,
             ..SimArmOptions::default()
         }
     }

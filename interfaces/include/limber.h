@@ -40,6 +40,10 @@ extern "C" {
 #define LIMBER_STATUS_PREEMPTED 14 /* the motion was cut short by another client's command */
 #define LIMBER_STATUS_LEASED 15 /* another client holds the device */
 #define LIMBER_STATUS_ADJUSTED 16 /* carried out, the orientation adjusted to one the limb's joints can hold */
+#define LIMBER_STATUS_BRAKED 17 /* the brakes are on: release them before moving */
+#define LIMBER_STATUS_STORE_FULL 18 /* the gripper's store is full */
+#define LIMBER_STATUS_NOTHING_TO_STORE 19 /* nothing between the gripper's fingers to store */
+#define LIMBER_STATUS_NOTHING_STORED 20 /* the gripper's store is empty */
 
 /* Bits of StateHeader.flags */
 #define LIMBER_DEVICE_FLAG_LINK_UP 1 /* link to the hardware up */

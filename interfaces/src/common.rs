@@ -167,11 +167,19 @@ pub enum Status {
     /// `orientation_adjustment` says by how much). Counts as carried out
     /// ([`Status::is_carried_out`]).
     Adjusted = 16,
+    /// The brakes are on: a motion of a braked joint (or of the limb) would not move it.
+    Braked = 17,
+    /// The gripper's store is full: STORE cannot take one more object.
+    StoreFull = 18,
+    /// Nothing is between the gripper's fingers: STORE has nothing to store.
+    NothingToStore = 19,
+    /// The gripper's store is empty: RETRIEVE has nothing to give back.
+    NothingStored = 20,
 }
 
 impl Status {
     /// Every status, in code order.
-    pub const ALL: [Status; 17] = [
+    pub const ALL: [Status; 21] = [
         Status::Ok,
         Status::Unsupported,
         Status::UnknownJoint,
@@ -189,6 +197,10 @@ impl Status {
         Status::Preempted,
         Status::Leased,
         Status::Adjusted,
+        Status::Braked,
+        Status::StoreFull,
+        Status::NothingToStore,
+        Status::NothingStored,
     ];
 
     /// The wire code.
@@ -239,6 +251,10 @@ impl Status {
             Status::Preempted => "preempted by another client",
             Status::Leased => "held by another client",
             Status::Adjusted => "ok, orientation adjusted",
+            Status::Braked => "brakes on",
+            Status::StoreFull => "the gripper's store is full",
+            Status::NothingToStore => "nothing between the fingers to store",
+            Status::NothingStored => "nothing stored to retrieve",
         }
     }
 }
@@ -367,6 +383,26 @@ pub(crate) const STATUS_GROUP: ConstantGroup = ConstantGroup {
             name: "ADJUSTED",
             value: 16,
             doc: "carried out, the orientation adjusted to one the limb's joints can hold",
+        },
+        Constant {
+            name: "BRAKED",
+            value: 17,
+            doc: "the brakes are on: release them before moving",
+        },
+        Constant {
+            name: "STORE_FULL",
+            value: 18,
+            doc: "the gripper's store is full",
+        },
+        Constant {
+            name: "NOTHING_TO_STORE",
+            value: 19,
+            doc: "nothing between the gripper's fingers to store",
+        },
+        Constant {
+            name: "NOTHING_STORED",
+            value: 20,
+            doc: "the gripper's store is empty",
         },
     ],
 };

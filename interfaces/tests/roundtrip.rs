@@ -439,6 +439,10 @@ fn every_status_code_decodes_to_itself_and_names_its_cause() {
     assert_eq!(Status::Preempted.code(), 14);
     assert_eq!(Status::Leased.code(), 15);
     assert_eq!(Status::Adjusted.code(), 16);
+    assert_eq!(Status::Braked.code(), 17);
+    assert_eq!(Status::StoreFull.code(), 18);
+    assert_eq!(Status::NothingToStore.code(), 19);
+    assert_eq!(Status::NothingStored.code(), 20);
     let mut texts: Vec<&str> = Status::ALL.iter().map(|s| s.describe()).collect();
     texts.sort_unstable();
     texts.dedup();

@@ -29,6 +29,10 @@ STATUS_CLAMPED = 13  # carried out, a value clamped to the limit
 STATUS_PREEMPTED = 14  # the motion was cut short by another client's command
 STATUS_LEASED = 15  # another client holds the device
 STATUS_ADJUSTED = 16  # carried out, the orientation adjusted to one the limb's joints can hold
+STATUS_BRAKED = 17  # the brakes are on: release them before moving
+STATUS_STORE_FULL = 18  # the gripper's store is full
+STATUS_NOTHING_TO_STORE = 19  # nothing between the gripper's fingers to store
+STATUS_NOTHING_STORED = 20  # the gripper's store is empty
 
 # Bits of StateHeader.flags
 DEVICE_FLAG_LINK_UP = 1  # link to the hardware up
@@ -153,6 +157,10 @@ DESCRIBE_STATUS = {
     14: "preempted by another client",
     15: "held by another client",
     16: "ok, orientation adjusted",
+    17: "brakes on",
+    18: "the gripper's store is full",
+    19: "nothing between the fingers to store",
+    20: "nothing stored to retrieve",
 }
 
 

@@ -76,10 +76,9 @@ impl RobotModel {
     /// A command of the body gripper drives it (bit 0); moving while the paddles are
     /// between their end switches.
     pub fn gripper_motion(&self) -> Motion {
-        let moving = self
-            .sip
-            .as_ref()
-            .is_some_and(|s| s.gripper_switches().paddles() == PaddleState::Moving);
+        let moving = self.sip.as_ref().is_some_and(|s| {
+            s.gripper_reading(self.cfg.gripper_byte).paddles == PaddleState::Moving
+        });
         Motion::of(1, moving as u64)
     }
 
