@@ -111,6 +111,12 @@ extern "C" {
 #define LIMBER_GRIPPER_STATE_MOVING 3 /* moving */
 #define LIMBER_GRIPPER_STATE_ERROR 4 /* error */
 
+/* ranger request kinds (MsgMeta.kind on the req channel); a ranger has no command */
+#define LIMBER_RANGER_REQ_GET_GEOM 1 /* empty; reply RangerGeom */
+
+/* capacity of RangerData's arrays */
+#define LIMBER_RANGER_LIMITS_MAX_RANGES 361 /* ranges (and intensities) in one scan */
+
 /* DriverStats.hardware bits */
 #define LIMBER_HARDWARE_ARM 1 /* 5-DOF arm present */
 #define LIMBER_HARDWARE_GRIPPER 2 /* body gripper present */
@@ -730,6 +736,99 @@ LIMBER_STATIC_ASSERT(sizeof(limber_gripper_reply_msg) == 136, "limber_gripper_re
 LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_gripper_reply_msg) == 8, "limber_gripper_reply_msg alignment");
 LIMBER_STATIC_ASSERT(offsetof(limber_gripper_reply_msg, meta) == 0, "limber_gripper_reply_msg.meta offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_gripper_reply_msg, body) == 32, "limber_gripper_reply_msg.body offset");
+
+/* limber.v2.RangerData (size 5888, align 8) */
+typedef struct limber_ranger_data {
+    limber_state_header header;
+    double min_angle;
+    double max_angle;
+    double angular_res;
+    double min_range;
+    double max_range;
+    double range_res;
+    double frequency;
+    uint32_t ranges_count;
+    uint32_t intensities_count;
+    double ranges[361];
+    double intensities[361];
+} limber_ranger_data;
+#define LIMBER_RANGER_DATA_TYPE_NAME "limber.v2.RangerData"
+LIMBER_STATIC_ASSERT(sizeof(limber_ranger_data) == 5888, "limber_ranger_data size");
+LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_ranger_data) == 8, "limber_ranger_data alignment");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_data, header) == 0, "limber_ranger_data.header offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_data, min_angle) == 48, "limber_ranger_data.min_angle offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_data, max_angle) == 56, "limber_ranger_data.max_angle offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_data, angular_res) == 64, "limber_ranger_data.angular_res offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_data, min_range) == 72, "limber_ranger_data.min_range offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_data, max_range) == 80, "limber_ranger_data.max_range offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_data, range_res) == 88, "limber_ranger_data.range_res offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_data, frequency) == 96, "limber_ranger_data.frequency offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_data, ranges_count) == 104, "limber_ranger_data.ranges_count offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_data, intensities_count) == 108, "limber_ranger_data.intensities_count offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_data, ranges) == 112, "limber_ranger_data.ranges offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_data, intensities) == 3000, "limber_ranger_data.intensities offset");
+
+/* limber.v2.RangerCmdMsg (size 40, align 8) */
+typedef struct limber_ranger_cmd_msg {
+    limber_msg_meta meta;
+    uint8_t body[8];
+} limber_ranger_cmd_msg;
+#define LIMBER_RANGER_CMD_MSG_TYPE_NAME "limber.v2.RangerCmdMsg"
+LIMBER_STATIC_ASSERT(sizeof(limber_ranger_cmd_msg) == 40, "limber_ranger_cmd_msg size");
+LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_ranger_cmd_msg) == 8, "limber_ranger_cmd_msg alignment");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_cmd_msg, meta) == 0, "limber_ranger_cmd_msg.meta offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_cmd_msg, body) == 32, "limber_ranger_cmd_msg.body offset");
+
+/* limber.v2.RangerReqMsg (size 40, align 8) */
+typedef struct limber_ranger_req_msg {
+    limber_msg_meta meta;
+    uint8_t body[8];
+} limber_ranger_req_msg;
+#define LIMBER_RANGER_REQ_MSG_TYPE_NAME "limber.v2.RangerReqMsg"
+LIMBER_STATIC_ASSERT(sizeof(limber_ranger_req_msg) == 40, "limber_ranger_req_msg size");
+LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_ranger_req_msg) == 8, "limber_ranger_req_msg alignment");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_req_msg, meta) == 0, "limber_ranger_req_msg.meta offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_req_msg, body) == 32, "limber_ranger_req_msg.body offset");
+
+/* limber.v2.RangerGeom (size 136, align 8) */
+typedef struct limber_ranger_geom {
+    limber_pose3 pose;
+    limber_bbox3 size;
+    double min_angle;
+    double max_angle;
+    double angular_res;
+    double min_range;
+    double max_range;
+    double range_res;
+    double frequency;
+    uint32_t ranges_count;
+    uint32_t _pad;
+} limber_ranger_geom;
+#define LIMBER_RANGER_GEOM_TYPE_NAME "limber.v2.RangerGeom"
+LIMBER_STATIC_ASSERT(sizeof(limber_ranger_geom) == 136, "limber_ranger_geom size");
+LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_ranger_geom) == 8, "limber_ranger_geom alignment");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_geom, pose) == 0, "limber_ranger_geom.pose offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_geom, size) == 48, "limber_ranger_geom.size offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_geom, min_angle) == 72, "limber_ranger_geom.min_angle offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_geom, max_angle) == 80, "limber_ranger_geom.max_angle offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_geom, angular_res) == 88, "limber_ranger_geom.angular_res offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_geom, min_range) == 96, "limber_ranger_geom.min_range offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_geom, max_range) == 104, "limber_ranger_geom.max_range offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_geom, range_res) == 112, "limber_ranger_geom.range_res offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_geom, frequency) == 120, "limber_ranger_geom.frequency offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_geom, ranges_count) == 128, "limber_ranger_geom.ranges_count offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_geom, _pad) == 132, "limber_ranger_geom._pad offset");
+
+/* limber.v2.RangerReplyMsg (size 168, align 8) */
+typedef struct limber_ranger_reply_msg {
+    limber_reply_meta meta;
+    uint8_t body[136];
+} limber_ranger_reply_msg;
+#define LIMBER_RANGER_REPLY_MSG_TYPE_NAME "limber.v2.RangerReplyMsg"
+LIMBER_STATIC_ASSERT(sizeof(limber_ranger_reply_msg) == 168, "limber_ranger_reply_msg size");
+LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_ranger_reply_msg) == 8, "limber_ranger_reply_msg alignment");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_reply_msg, meta) == 0, "limber_ranger_reply_msg.meta offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_ranger_reply_msg, body) == 32, "limber_ranger_reply_msg.body offset");
 
 /* limber.v2.DriverStats (size 352, align 8) */
 typedef struct limber_driver_stats {

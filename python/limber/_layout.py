@@ -100,6 +100,12 @@ GRIPPER_STATE_CLOSED = 2  # closed
 GRIPPER_STATE_MOVING = 3  # moving
 GRIPPER_STATE_ERROR = 4  # error
 
+# ranger request kinds (MsgMeta.kind on the req channel); a ranger has no command
+RANGER_REQ_GET_GEOM = 1  # empty; reply RangerGeom
+
+# capacity of RangerData's arrays
+RANGER_LIMITS_MAX_RANGES = 361  # ranges (and intensities) in one scan
+
 # DriverStats.hardware bits
 HARDWARE_ARM = 1  # 5-DOF arm present
 HARDWARE_GRIPPER = 2  # body gripper present
@@ -779,6 +785,90 @@ class GripperReplyMsg(ctypes.Structure):
         return "limber.v2.GripperReplyMsg"
 
 
+class RangerData(ctypes.Structure):
+    """limber.v2.RangerData (size 5888, align 8)."""
+
+    _fields_ = [
+        ("header", StateHeader),
+        ("min_angle", ctypes.c_double),
+        ("max_angle", ctypes.c_double),
+        ("angular_res", ctypes.c_double),
+        ("min_range", ctypes.c_double),
+        ("max_range", ctypes.c_double),
+        ("range_res", ctypes.c_double),
+        ("frequency", ctypes.c_double),
+        ("ranges_count", ctypes.c_uint32),
+        ("intensities_count", ctypes.c_uint32),
+        ("ranges", ctypes.c_double * 361),
+        ("intensities", ctypes.c_double * 361),
+    ]
+
+    @staticmethod
+    def type_name() -> str:
+        return "limber.v2.RangerData"
+
+
+class RangerCmdMsg(ctypes.Structure):
+    """limber.v2.RangerCmdMsg (size 40, align 8)."""
+
+    _fields_ = [
+        ("meta", MsgMeta),
+        ("body", ctypes.c_uint8 * 8),
+    ]
+
+    @staticmethod
+    def type_name() -> str:
+        return "limber.v2.RangerCmdMsg"
+
+
+class RangerReqMsg(ctypes.Structure):
+    """limber.v2.RangerReqMsg (size 40, align 8)."""
+
+    _fields_ = [
+        ("meta", MsgMeta),
+        ("body", ctypes.c_uint8 * 8),
+    ]
+
+    @staticmethod
+    def type_name() -> str:
+        return "limber.v2.RangerReqMsg"
+
+
+class RangerGeom(ctypes.Structure):
+    """limber.v2.RangerGeom (size 136, align 8)."""
+
+    _fields_ = [
+        ("pose", Pose3),
+        ("size", Bbox3),
+        ("min_angle", ctypes.c_double),
+        ("max_angle", ctypes.c_double),
+        ("angular_res", ctypes.c_double),
+        ("min_range", ctypes.c_double),
+        ("max_range", ctypes.c_double),
+        ("range_res", ctypes.c_double),
+        ("frequency", ctypes.c_double),
+        ("ranges_count", ctypes.c_uint32),
+        ("_pad", ctypes.c_uint32),
+    ]
+
+    @staticmethod
+    def type_name() -> str:
+        return "limber.v2.RangerGeom"
+
+
+class RangerReplyMsg(ctypes.Structure):
+    """limber.v2.RangerReplyMsg (size 168, align 8)."""
+
+    _fields_ = [
+        ("meta", ReplyMeta),
+        ("body", ctypes.c_uint8 * 136),
+    ]
+
+    @staticmethod
+    def type_name() -> str:
+        return "limber.v2.RangerReplyMsg"
+
+
 class DriverStats(ctypes.Structure):
     """limber.v2.DriverStats (size 352, align 8)."""
 
@@ -919,6 +1009,11 @@ STRUCTS = [
     GripperReqMsg,
     GripperGeom,
     GripperReplyMsg,
+    RangerData,
+    RangerCmdMsg,
+    RangerReqMsg,
+    RangerGeom,
+    RangerReplyMsg,
     DriverStats,
     OutcomeMsg,
     LeaseReq,
