@@ -3,13 +3,13 @@
 //!
 //! | key | what | payload |
 //! | --- | --- | --- |
-//! | `limber/<robot>/<interface>/<index>/state` | put by `expose` on every state sample | the interface's state struct (e.g. `limber.v2.ActArrayData`) |
-//! | `limber/<robot>/<interface>/<index>/cmd` | put by a remote client | the command envelope (e.g. `limber.v2.ActArrayCmdMsg`); attachment: the sender's origin id |
-//! | `limber/<robot>/<interface>/<index>/outcome/<origin>` | put by `expose` for each command of that origin | `limber.v2.OutcomeMsg` |
+//! | `limber/<robot>/<interface>/<index>/state` | put by `expose` on every state sample | the interface's state struct (e.g. `limber.v3.ActArrayData`) |
+//! | `limber/<robot>/<interface>/<index>/cmd` | put by a remote client | the command envelope (e.g. `limber.v3.ActArrayCmdMsg`); attachment: the sender's origin id |
+//! | `limber/<robot>/<interface>/<index>/outcome/<origin>` | put by `expose` for each command of that origin | `limber.v3.OutcomeMsg` |
 //! | `limber/<robot>/<interface>/<index>/req` | queryable of `expose` | query: the request envelope; reply: the reply envelope |
-//! | `limber/<robot>/<interface>/<index>/lease` | queryable of `expose` | query: `limber.v2.LeaseReq`; reply: `limber.v2.LeaseReply` |
+//! | `limber/<robot>/<interface>/<index>/lease` | queryable of `expose` | query: `limber.v3.LeaseReq`; reply: `limber.v3.LeaseReply` |
 //! | `limber/<robot>/<interface>/<index>/alive` | liveliness token of `expose` | none |
-//! | `limber/<robot>/driver/0/stats` | put by `expose` about once a second | `limber.v2.DriverStats` |
+//! | `limber/<robot>/driver/0/stats` | put by `expose` about once a second | `limber.v3.DriverStats` |
 //!
 //! A query that the driver does not answer in time (or cannot be relayed) gets an error
 //! reply whose payload is a `Status` code, 4 bytes little-endian (encoding schema
@@ -44,7 +44,7 @@ pub fn outcome_key(device: &DeviceName, origin: &str) -> String {
     format!("{}/{origin}", device_key(device, "outcome"))
 }
 
-/// The key of the driver statistics of `robot` (`limber.v2.DriverStats`, put by `expose`
+/// The key of the driver statistics of `robot` (`limber.v3.DriverStats`, put by `expose`
 /// about once a second).
 pub fn driver_stats_key(robot: &str) -> String {
     format!("{ROOT}/{robot}/driver/0/stats")

@@ -938,23 +938,6 @@ limber_code limber_gripper_store(limber_gripper *h, struct limber_ticket *ticket
 limber_code limber_gripper_retrieve(limber_gripper *h, struct limber_ticket *ticket);
 
 /*
- The bearing of range `index` of `scan` (rad, counter-clockwise from the sensor's x
- axis: `min_angle + index * angular_res`) and the point it hit (`x`, `y` in the
- sensor's frame, m; Player's `GetBearing` and `GetPoint`). `bearing`, `x`, `y` may be
- NULL (not written). An index at or beyond `ranges_count` is
- `LIMBER_CODE_INVALID_VALUE`.
-
- # Safety
- `scan` is NULL or points to a readable `limber_ranger_data`; `bearing`, `x` and `y`
- are NULL or writable.
- */
-limber_code limber_ranger_point(const limber_ranger_data *scan,
-                                size_t index,
-                                double *bearing,
-                                double *x,
-                                double *y);
-
-/*
  This handle's client id: how the driver, outcomes and `limber_device_holder` name it.
 
  # Safety
@@ -1131,6 +1114,23 @@ limber_code limber_limb_can_reach(limber_limb *h,
  set; `user` is what it expects.
  */
 limber_code limber_set_logger(limber_log_fn callback, void *user, limber_log_level min_level);
+
+/*
+ The bearing of range `index` of `scan` (rad, counter-clockwise from the sensor's x
+ axis: `min_angle + index * angular_res`) and the point it hit (`x`, `y` in the
+ sensor's frame, m; Player's `GetBearing` and `GetPoint`). `bearing`, `x`, `y` may be
+ NULL (not written). An index at or beyond `ranges_count` is
+ `LIMBER_CODE_INVALID_VALUE`.
+
+ # Safety
+ `scan` is NULL or points to a readable `limber_ranger_data`; `bearing`, `x` and `y`
+ are NULL or writable.
+ */
+limber_code limber_ranger_point(const limber_ranger_data *scan,
+                                size_t index,
+                                double *bearing,
+                                double *x,
+                                double *y);
 
 /*
  Opens the statistics of the driver of `robot` (e.g. "pioneer") in `domain` (NULL:

@@ -7,7 +7,7 @@
 //! * Wire structs are `#[repr(C)]`, have no implicit padding (explicit `_pad` fields,
 //!   checked at compile time), derive zerocopy's `FromBytes`/`IntoBytes`/`KnownLayout`/
 //!   `Immutable` and iceoryx2's `ZeroCopySend`, and carry a versioned type name
-//!   (`limber.v2.ActArrayData`). iceoryx2 only compares name, size and alignment when a
+//!   (`limber.v3.ActArrayData`). iceoryx2 only compares name, size and alignment when a
 //!   service is opened, so the version in the name changes whenever a layout changes.
 //! * Units are SI: m, rad, s, m/s, rad/s, A. No `bool` or Rust enum on the wire: `u32`
 //!   codes, decoded by typed views that reject unknown values with a [`DecodeError`].
@@ -70,9 +70,10 @@ pub use wire::{WireField, WireStruct};
 ///
 /// Version 2 added the `outcome` and `lease` channels ([`control::OutcomeMsg`],
 /// [`control::LeaseReq`], [`control::LeaseReply`]), the statuses `PREEMPTED`, `LEASED` and
-/// `ADJUSTED`, the limb state's `orientation_adjustment` and the limb's REACH request;
+/// `ADJUSTED`, the limb state's `orientation_adjustment` and the limb's REACH request.
+/// Version 3 added the `ranger` interface ([`ranger::RangerData`] and its envelopes);
 /// every type name carries the version.
-pub const LAYOUT_VERSION: u32 = 2;
+pub const LAYOUT_VERSION: u32 = 3;
 
 /// Everything a driver or client author needs, in one `use`.
 pub mod prelude {
