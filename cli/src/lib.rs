@@ -25,6 +25,7 @@ mod monitor;
 mod out;
 pub mod pioneer;
 pub mod simarm;
+pub mod world;
 
 /// limber: Player's generic limb interfaces (actarray, limb, gripper) over zero-copy
 /// shared memory, with a real-time driver for the Pioneer arm.

@@ -51,6 +51,9 @@ pub struct PioneerArgs {
     /// Print the configuration (defaults merged with --config) as TOML and exit.
     #[arg(long)]
     pub print_config: bool,
+    /// With --emulated: the world its laser scans and its arm picks blocks from.
+    #[command(flatten)]
+    pub world: crate::world::WorldArgs,
 }
 
 /// `limber pioneer` failed.
@@ -143,6 +146,15 @@ fn serve(args: PioneerArgs, domain: &limber_services::Domain) -> Result<(), Pion
     let start = StartOptions {
         simulated: emulator.is_some(),
     };
+    let world = if args.emulated {
+        Some(
+            args.world
+                .world()
+                .map_err(|e| PioneerCliError::Setup(e.to_string()))?,
+        )
+    } else {
+        None
+    };
     let mut driver = PioneerDriver::start_with(&ctx, cfg.clone(), target, start)?;
     let hw = driver.hardware().clone();
     eprintln!(
@@ -162,6 +174,24 @@ fn serve(args: PioneerArgs, domain: &limber_services::Domain) -> Result<(), Pion
     }
     // Served or not, and why (the robot's CONFIGpac, or `body_gripper`).
     noteln!("{}", hw.gripper_note);
+    // The emulated robot's world in this process: its laser and the blocks its arm moves.
+    let _world = match world {
+        Some(w) => {
+            let blocks = crate::world::describe(&w.blocks);
+            let running = crate::world::RunningWorld::start(
+                domain,
+                r,
+                &format!("{r}/limb/0"),
+                &format!("{r}/gripper/1"),
+                w,
+                args.world.laser(),
+            )
+            .map_err(|e| PioneerCliError::Setup(e.to_string()))?;
+            noteln!("serving {r}/ranger/0 (simulated laser; {blocks})");
+            Some(running)
+        }
+        None => None,
+    };
     noteln!("serving {r}/driver/0 (statistics); ready");
     let mode = if args.spin {
         LoopMode::Spin

@@ -73,7 +73,12 @@ impl Carrier {
             && let Some(b) = world.blocks.get_mut(h.block)
         {
             b.lifted = 0.0;
-            tracing::info!(block = h.block, x = b.x, y = b.y, "world: a block was put down");
+            tracing::info!(
+                block = h.block,
+                x = b.x,
+                y = b.y,
+                "world: a block was put down"
+            );
         }
         if let Some(h) = self.held
             && let Some(b) = world.blocks.get_mut(h.block)

@@ -70,7 +70,11 @@ impl LaserConfig {
 
     /// Checks the values.
     pub fn validate(&self) -> Result<(), LaserConfigError> {
-        let finite = self.position.iter().chain(self.size.iter()).all(|v| v.is_finite())
+        let finite = self
+            .position
+            .iter()
+            .chain(self.size.iter())
+            .all(|v| v.is_finite())
             && [self.yaw, self.min_angle, self.angular_res, self.min_range]
                 .iter()
                 .all(|v| v.is_finite());

@@ -31,11 +31,17 @@ fn the_lms200_has_181_beams_over_180_degrees_to_8_m() {
     assert_eq!(s.ranges().len(), 181);
     assert!((s.min_angle + 90f64.to_radians()).abs() < 1e-12);
     assert!((s.max_angle - 90f64.to_radians()).abs() < 1e-12);
-    assert!(s.ranges().iter().all(|r| *r == 8.0), "an empty world reads the max range");
+    assert!(
+        s.ranges().iter().all(|r| *r == 8.0),
+        "an empty world reads the max range"
+    );
     let g = c.geometry();
     assert_eq!(g.ranges_count, 181);
     assert_eq!(g.pose.position.to_array(), [0.16, 0.0, 0.20]);
-    assert_eq!(LaserConfig::lms200_half_degree().geometry().ranges_count, 361);
+    assert_eq!(
+        LaserConfig::lms200_half_degree().geometry().ranges_count,
+        361
+    );
 }
 
 #[test]
@@ -63,7 +69,10 @@ fn listing_2_finds_the_centre_of_a_block_from_the_closest_point() {
         let b = s.bearing(i);
         let (cx, cy) = (pre * b.cos() + 0.16, pre * b.sin());
         let err = (cx - x).hypot(cy - y);
-        assert!(err < 0.005, "block at ({x}, {y}) found at ({cx}, {cy}): {err} m off");
+        assert!(
+            err < 0.005,
+            "block at ({x}, {y}) found at ({cx}, {cy}): {err} m off"
+        );
     }
 }
 
@@ -80,7 +89,10 @@ fn noise_moves_the_ranges_and_zero_noise_does_not() {
     let hit: Vec<usize> = (0..181).filter(|&i| a.ranges()[i] < 8.0).collect();
     assert!(!hit.is_empty());
     assert!(hit.iter().any(|&i| n.ranges()[i] != a.ranges()[i]));
-    assert!(hit.iter().all(|&i| (n.ranges()[i] - a.ranges()[i]).abs() < 0.02));
+    assert!(
+        hit.iter()
+            .all(|&i| (n.ranges()[i] - a.ranges()[i]).abs() < 0.02)
+    );
 }
 
 #[test]
@@ -107,7 +119,10 @@ fn the_world_file_refuses_what_it_does_not_know() {
     ));
     assert!(matches!(
         World::from_toml("[[block]]\nx = 0.4\ny = 0.1\nsize = -1.0\n"),
-        Err(WorldError::Value { what: "block", index: 0 })
+        Err(WorldError::Value {
+            what: "block",
+            index: 0
+        })
     ));
     assert!(matches!(
         World::load(std::path::Path::new("/nonexistent/world.toml")),
