@@ -40,12 +40,22 @@ fn demo_on_the_emulated_pioneer_finds_the_block_with_the_laser_and_moves_it() {
     let d = Domain::unique_for_test();
     let o = limber(
         d.name(),
-        &["demo", "--fast", "--block", "0.40", "0.07", "--laser-noise", "0"],
+        &[
+            "demo",
+            "--fast",
+            "--block",
+            "0.40",
+            "0.07",
+            "--laser-noise",
+            "0",
+        ],
     );
     let out = stdout(&o);
     assert!(o.status.success(), "{out}\n{}", stderr(&o));
     assert!(
-        out.contains("placed a block of 40 mm at (0.400, 0.070); the laser pioneer/ranger/0 will find it"),
+        out.contains(
+            "placed a block of 40 mm at (0.400, 0.070); the laser pioneer/ranger/0 will find it"
+        ),
         "{out}"
     );
     assert!(out.contains("[ 0/11] the laser's closest point"), "{out}");
@@ -79,7 +89,16 @@ fn the_same_program_runs_on_simarm_with_a_block_at_a_seeded_random_place() {
     let d = Domain::unique_for_test();
     let o = limber(
         d.name(),
-        &["demo", "--on", "simarm", "--fast", "--seed", "7", "--laser-noise", "0"],
+        &[
+            "demo",
+            "--on",
+            "simarm",
+            "--fast",
+            "--seed",
+            "7",
+            "--laser-noise",
+            "0",
+        ],
     );
     let out = stdout(&o);
     assert!(o.status.success(), "{out}\n{}", stderr(&o));

@@ -234,7 +234,9 @@ fn the_laser_crosses_the_bridge_as_every_interface_does() {
     let mut laser =
         RangerClient::connect_timeout(&ctx, "pioneer/ranger/0", Duration::from_secs(10))
             .expect("the mirrored laser");
-    let g = laser.geometry().expect("the laser's geometry through the bridge");
+    let g = laser
+        .geometry()
+        .expect("the laser's geometry through the bridge");
     assert_eq!((g.ranges_count, g.max_range), (181, 8.0));
     assert_eq!(g.pose.position.to_array(), [0.16, 0.0, 0.20]);
     let scan = *laser
@@ -249,7 +251,10 @@ fn the_laser_crosses_the_bridge_as_every_interface_does() {
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .expect("ranges");
     let expected = (0.38f64 - 0.16).hypot(0.10) - 0.02;
-    assert!((closest - expected).abs() < 0.015, "closest {closest} m, not {expected}");
+    assert!(
+        (closest - expected).abs() < 0.015,
+        "closest {closest} m, not {expected}"
+    );
     assert!((scan.bearing(i) - (0.10f64).atan2(0.22)).abs() < 0.04);
     let (code, out) = cli_in(&s.b, &["ranger", "pioneer/ranger/0", "geom"]);
     assert_eq!(code, Some(0), "{out}");
