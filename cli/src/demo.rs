@@ -268,6 +268,7 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
         world_args.seed = Some(1);
     }
     let world = world_args.world()?;
+    let laser_config = world_args.laser()?;
     let placed = world.blocks.first().copied();
     let mut running = match a.on {
         Robot::Pioneer => start_pioneer(&domain)?,
@@ -280,7 +281,7 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
         &running.limb,
         &running.gripper,
         world,
-        world_args.laser(),
+        laser_config,
     )?);
     if let Some(b) = placed {
         outln!(

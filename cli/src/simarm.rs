@@ -122,6 +122,7 @@ pub fn run(args: SimArmArgs) -> Result<(), CliError> {
         .map_err(|e| CliError::new(exit::USAGE, e.to_string()))?;
     let mut options = args.options();
     let world = args.world.world()?;
+    args.world.laser()?;
     // The first block is the object the simulated fingers close on (and the beams see),
     // its grasp point at the paper's HandleHeight, unless --object names another.
     if options.object.is_none()
@@ -176,7 +177,7 @@ pub fn run(args: SimArmArgs) -> Result<(), CliError> {
         &format!("{robot}/limb/0"),
         &format!("{robot}/gripper/0"),
         world,
-        args.world.laser(),
+        args.world.laser()?,
     )?;
     noteln!(
         "serving {robot}/actarray/0, {robot}/limb/0, {robot}/gripper/0, {robot}/ranger/0 (laser; {blocks}); ready"

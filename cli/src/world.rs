@@ -70,12 +70,20 @@ impl WorldArgs {
         Ok(w)
     }
 
-    /// The laser the flags describe.
-    pub fn laser(&self) -> LaserConfig {
-        LaserConfig {
+    /// The laser the flags describe (a negative or non-finite noise is a usage error).
+    pub fn laser(&self) -> Result<LaserConfig, CliError> {
+        let c = LaserConfig {
             noise: self.laser_noise,
             ..LaserConfig::lms200()
-        }
+        };
+        c.validate()
+            .map_err(|e| CliError::new(exit::USAGE, format!("--laser-noise: {e}")))?;
+        Ok(c)
+    }
+
+    /// True when a flag describes a world (`--world`, `--block`, `--seed`).
+    pub fn given(&self) -> bool {
+        self.world.is_some() || !self.block.is_empty() || self.seed.is_some()
     }
 }
 

@@ -92,7 +92,7 @@ impl DeviceSetHandler for Serve<'_> {
 }
 
 /// The clients that watch the limb and the gripper (connected once their driver offers
-/// them).
+/// them), on the world's own node.
 struct Watch {
     ctx: Context,
     limb_name: Option<String>,
@@ -161,8 +161,9 @@ impl WorldDriver {
             &[(InterfaceKind::Ranger, 0)],
         )?;
         hosts.set_flags(device_flag::SIMULATED | device_flag::LINK_UP | device_flag::CALIBRATED);
+        // One node for the ranger and the clients that watch the limb and the gripper.
         let watch = Watch {
-            ctx: Context::new(domain, Role::Client, "world-watch")?,
+            ctx: ctx.clone(),
             limb_name: options.limb,
             gripper_name: options.gripper,
             limb: None,
