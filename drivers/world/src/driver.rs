@@ -107,12 +107,17 @@ impl Watch {
     fn look(&mut self) -> Option<([f64; 3], bool)> {
         if (self.limb.is_none() || self.gripper.is_none()) && Instant::now() >= self.next_try {
             self.next_try = Instant::now() + Duration::from_secs(1);
+            // Not there yet (the arm answers late): asked again in a second.
             let quick = Duration::from_millis(1);
             if let (None, Some(n)) = (&self.limb, &self.limb_name) {
-                self.limb = LimbClient::connect_timeout(&self.ctx, n, quick).ok();
+                self.limb = LimbClient::connect_timeout(&self.ctx, n, quick)
+                    .inspect_err(|e| tracing::debug!(device = n, error = %e, "world: no limb yet"))
+                    .ok();
             }
             if let (None, Some(n)) = (&self.gripper, &self.gripper_name) {
-                self.gripper = GripperClient::connect_timeout(&self.ctx, n, quick).ok();
+                self.gripper = GripperClient::connect_timeout(&self.ctx, n, quick)
+                    .inspect_err(|e| tracing::debug!(device = n, error = %e, "world: no gripper yet"))
+                    .ok();
             }
         }
         let l = self.limb.as_mut()?.state().copied()?;
