@@ -5,7 +5,7 @@
  * ticket), send requests (each with a timeout), wait for a command's outcome, ask whether
  * the driver lives, list the devices of a domain. The states and geometries are the wire
  * structs of limber.h (limber_actarray_data, limber_limb_data, limber_gripper_data,
- * limber_*_geom, limber_vec3), which this header includes.
+ * limber_ranger_data, limber_*_geom, limber_vec3), which this header includes.
  *
  * Errors: every function returns a limber_code; LIMBER_CODE_OK (0) means done. Anything
  * else says why it failed: limber_strerror(code) gives the code's message and
@@ -170,6 +170,10 @@ enum limber_interface
    A gripper (`limber_gripper_connect`).
    */
   LIMBER_INTERFACE_GRIPPER = 2,
+  /*
+   A ranger (`limber_ranger_connect`).
+   */
+  LIMBER_INTERFACE_RANGER = 3,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -417,6 +421,12 @@ typedef void (*limber_log_fn)(limber_log_level level,
                               const char *target,
                               const char *message,
                               void *user);
+
+/*
+ A connection to a ranger: a `limber_device` of this interface (the same type, so every
+ `limber_device_*` call takes it).
+ */
+typedef struct limber_device limber_ranger;
 
 #ifdef __cplusplus
 extern "C" {
@@ -1106,6 +1116,23 @@ limber_code limber_limb_can_reach(limber_limb *h,
 limber_code limber_set_logger(limber_log_fn callback, void *user, limber_log_level min_level);
 
 /*
+ The bearing of range `index` of `scan` (rad, counter-clockwise from the sensor's x
+ axis: `min_angle + index * angular_res`) and the point it hit (`x`, `y` in the
+ sensor's frame, m; Player's `GetBearing` and `GetPoint`). `bearing`, `x`, `y` may be
+ NULL (not written). An index at or beyond `ranges_count` is
+ `LIMBER_CODE_INVALID_VALUE`.
+
+ # Safety
+ `scan` is NULL or points to a readable `limber_ranger_data`; `bearing`, `x` and `y`
+ are NULL or writable.
+ */
+limber_code limber_ranger_point(const limber_ranger_data *scan,
+                                size_t index,
+                                double *bearing,
+                                double *x,
+                                double *y);
+
+/*
  Opens the statistics of the driver of `robot` (e.g. "pioneer") in `domain` (NULL:
  `LIMBER_DOMAIN`, or "limber"); `LIMBER_CODE_NO_DRIVER` if no driver publishes them.
  Free the reader with `limber_stats_close`.
@@ -1149,7 +1176,7 @@ limber_code limber_stats_wait(struct limber_stats *h,
 
 #endif  /* LIMBER_CLIENT_H */
 
-/* Typed calls, the same for every interface X (actarray, limb, gripper), each a one-line
+/* Typed calls, the same for every interface X (actarray, limb, gripper, ranger), each a one-line
  * inline function over the limber_device_* call of the same name: it passes the program's
  * own state or geometry struct with its size, so that a program compiled against another
  * limber.h is refused (LIMBER_CODE_INCOMPATIBLE) instead of misreading shared memory.
@@ -1248,5 +1275,6 @@ static inline limber_code limber_device_connect(const char *device, const char *
 LIMBER_TYPED_CLIENT_(actarray, LIMBER_INTERFACE_ACTARRAY)
 LIMBER_TYPED_CLIENT_(limb, LIMBER_INTERFACE_LIMB)
 LIMBER_TYPED_CLIENT_(gripper, LIMBER_INTERFACE_GRIPPER)
+LIMBER_TYPED_CLIENT_(ranger, LIMBER_INTERFACE_RANGER)
 
 #endif  /* LIMBER_CLIENT_TYPED_H */

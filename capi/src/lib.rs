@@ -42,6 +42,7 @@ mod gripper;
 mod lease;
 mod limb;
 mod log;
+mod ranger;
 mod stats;
 
 pub use actarray::*;
@@ -51,6 +52,7 @@ pub use gripper::*;
 pub use lease::*;
 pub use limb::*;
 pub use log::*;
+pub use ranger::*;
 pub use stats::*;
 
 /// What a call returned: `LIMBER_CODE_OK` (0), or why it failed. The detail of a failure is
@@ -534,6 +536,7 @@ impl LimberInterface {
             InterfaceKind::ActArray => LimberInterface::Actarray,
             InterfaceKind::Limb => LimberInterface::Limb,
             InterfaceKind::Gripper => LimberInterface::Gripper,
+            InterfaceKind::Ranger => LimberInterface::Ranger,
         }
     }
 

@@ -1,9 +1,10 @@
-//! `limber actarray|limb|gripper <device> <command>`: every command and request of each
+//! `limber actarray|limb|gripper|ranger <device> <command>`: every command and request of each
 //! interface from the shell, and `limber echo <device>`: the live state.
 
 use std::time::Duration;
 
 use clap::{Args, Subcommand, ValueEnum};
+use limber_interfaces::Describe;
 use limber_services::prelude::*;
 use limber_services::{CommandError, ConnectError, LeaseError, RequestError, WaitError};
 
@@ -591,4 +592,70 @@ pub fn gripper(a: GripperArgs) -> Result<(), CliError> {
         }
     };
     finish(&mut c, sent, &a.common)
+}
+
+/// Arguments of `limber ranger`.
+#[derive(Debug, Args)]
+pub struct RangerArgs {
+    /// The device, e.g. pioneer/ranger/0.
+    device: String,
+    #[command(subcommand)]
+    cmd: RangerVerb,
+    #[command(flatten)]
+    common: Common,
+}
+
+/// What to read from a ranger (it has no command).
+#[derive(Debug, Subcommand)]
+pub enum RangerVerb {
+    /// Print the latest scan: one line per range (index, bearing in degrees, range in m),
+    /// then the closest one; `--json` prints the scan as `limber echo --json` does.
+    Scan {
+        /// One JSON object (the schema of `limber echo --json`).
+        #[arg(long)]
+        json: bool,
+    },
+    /// Print the geometry: the sensor's pose on the robot and its configuration (request).
+    Geom,
+}
+
+/// Runs `limber ranger`.
+pub fn ranger(a: RangerArgs) -> Result<(), CliError> {
+    let mut c = connect::<Ranger>(&a.device, &a.common)?;
+    match a.cmd {
+        RangerVerb::Scan { json } => {
+            let s = *c.current(a.common.timeout()).map_err(wait_err)?;
+            if json {
+                outln!("{}", s.json())?;
+                return Ok(());
+            }
+            for (i, r) in s.ranges().iter().enumerate() {
+                outln!("{i:3} {:+7.2} deg {r:.3} m", s.bearing(i).to_degrees())?;
+            }
+            outln!("{}", s.human())?;
+        }
+        RangerVerb::Geom => {
+            let g = c.geometry().map_err(request_err)?;
+            let (p, o) = (g.pose.position, g.pose.orientation);
+            outln!(
+                "pose ({:.4}, {:.4}, {:.4}) m yaw {:.2} deg; size {:.3} x {:.3} x {:.3} m; {} ranges over {:+.1}..{:+.1} deg every {:.2} deg; range {:.3} to {:.3} m (resolution {:.3} m); {:.1} Hz",
+                p.x,
+                p.y,
+                p.z,
+                o.yaw.to_degrees(),
+                g.size.width,
+                g.size.length,
+                g.size.height,
+                g.ranges_count,
+                g.min_angle.to_degrees(),
+                g.max_angle.to_degrees(),
+                g.angular_res.to_degrees(),
+                g.min_range,
+                g.max_range,
+                g.range_res,
+                g.frequency
+            )?;
+        }
+    }
+    Ok(())
 }

@@ -25,6 +25,7 @@ mod monitor;
 mod out;
 pub mod pioneer;
 pub mod simarm;
+pub mod world;
 
 /// limber: Player's generic limb interfaces (actarray, limb, gripper) over zero-copy
 /// shared memory, with a real-time driver for the Pioneer arm.
@@ -96,6 +97,11 @@ enum Command {
     ///
     /// Example: limber gripper pioneer/gripper/0 open
     Gripper(device::GripperArgs),
+    /// Read a ranger (a laser scanner): scan (the latest ranges with their bearings),
+    /// geom (its pose on the robot and configuration).
+    ///
+    /// Example: limber ranger simarm/ranger/0 geom
+    Ranger(device::RangerArgs),
     /// Run the Pioneer driver: the arm, limb, grippers and lift over P2OS (serial, pty or
     /// tcp://host:port). `--emulated` drives the built-in emulator.
     Pioneer(pioneer::PioneerArgs),
@@ -153,6 +159,7 @@ where
         Command::Actarray(args) => device::actarray(args),
         Command::Limb(args) => device::limb(args),
         Command::Gripper(args) => device::gripper(args),
+        Command::Ranger(args) => device::ranger(args),
         Command::Pioneer(args) => pioneer::run(args),
         Command::Emulator(args) => emulator::run(args),
         Command::Simarm(args) => simarm::run(args),

@@ -61,6 +61,9 @@ pub struct SimArmArgs {
     #[arg(long, value_name = "N", default_value_t = limber_services::qos::DEFAULT_MAX_CLIENTS,
           value_parser = parse_max_clients)]
     pub max_clients: usize,
+    /// The world the laser scans and the gripper picks blocks from.
+    #[command(flatten)]
+    pub world: crate::world::WorldArgs,
 }
 
 /// `--max-clients`: 1 to `qos::MAX_CLIENTS_LIMIT`.
@@ -120,13 +123,26 @@ fn parse_object(s: &str) -> Result<SimObject, String> {
 
 /// Runs `limber simarm` until a termination signal ([`limber_services::signals`]): joins
 /// the domain of `LIMBER_DOMAIN`, prints `serving <robot>/actarray/0, <robot>/limb/0,
-/// <robot>/gripper/0; ready` and serves.
+/// <robot>/gripper/0, <robot>/ranger/0 (laser; ...); ready` and serves, with the world
+/// (the laser, the blocks) on a thread.
 pub fn run(args: SimArmArgs) -> Result<(), CliError> {
     let fail = |e: SimArmError| CliError::new(exit::FAILURE, e.to_string());
     let chain = args
         .chain()
         .map_err(|e| CliError::new(exit::USAGE, e.to_string()))?;
-    let options = args.options();
+    let mut options = args.options();
+    let world = args.world.world()?;
+    args.world.laser()?;
+    // The first block is the object the simulated fingers close on (and the beams see),
+    // its grasp point at the paper's HandleHeight, unless --object names another.
+    if options.object.is_none()
+        && let Some(b) = world.blocks.first()
+    {
+        options.object = Some(SimObject::block(
+            [b.x, b.y, crate::world::HANDLE_HEIGHT],
+            b.size,
+        ));
+    }
     let domain = crate::domain()?;
     let ctx = Context::new(&domain, Role::Driver, "simarm").map_err(|e| {
         CliError::new(
@@ -164,7 +180,18 @@ pub fn run(args: SimArmArgs) -> Result<(), CliError> {
         args.time_scale,
         domain.name()
     );
-    noteln!("serving {robot}/actarray/0, {robot}/limb/0, {robot}/gripper/0; ready");
+    let blocks = crate::world::describe(&world.blocks);
+    let _world = crate::world::RunningWorld::start(
+        &domain,
+        &robot,
+        &format!("{robot}/limb/0"),
+        &format!("{robot}/gripper/0"),
+        world,
+        args.world.laser()?,
+    )?;
+    noteln!(
+        "serving {robot}/actarray/0, {robot}/limb/0, {robot}/gripper/0, {robot}/ranger/0 (laser; {blocks}); ready"
+    );
     let ended = arm.run(|| false).map_err(fail)?;
     if ended == LoopExit::Signal {
         eprintln!("limber simarm: stopped");

@@ -107,6 +107,7 @@ CODE_LEASE_LOST = 15
 INTERFACE_ACTARRAY = 0
 INTERFACE_LIMB = 1
 INTERFACE_GRIPPER = 2
+INTERFACE_RANGER = 3
 
 LIVENESS_ALIVE = 0
 LIVENESS_STALE = 1
@@ -195,6 +196,11 @@ PROTOTYPES: "dict[str, Tuple[Any, List[Any]]]" = {
     "limber_gripper_stop": (_CODE, [_H, _P_TICKET]),
     "limber_gripper_store": (_CODE, [_H, _P_TICKET]),
     "limber_gripper_retrieve": (_CODE, [_H, _P_TICKET]),
+    # ranger
+    "limber_ranger_point": (
+        _CODE,
+        [POINTER(L.RangerData), c_size_t, POINTER(c_double), POINTER(c_double), POINTER(c_double)],
+    ),
     # driver statistics
     "limber_stats_open": (_CODE, [c_char_p, c_char_p, POINTER(_H)]),
     "limber_stats_close": (None, [_H]),

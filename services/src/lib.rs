@@ -92,8 +92,8 @@ pub use domain::dir as domain_dir;
 
 pub use client::{
     ActArrayClient, AnyGeom, Client, CommandError, ConnectError, DeviceClient, DriverStatus,
-    Freshness, GripperClient, Incompatibility, LeaseError, LeaseHolder, LimbClient, Outcome,
-    RequestError, Ticket, WaitError, WaitMode, connect_device,
+    Freshness, GripperClient, Incompatibility, LaserClient, LeaseError, LeaseHolder, LimbClient,
+    Outcome, RangerClient, RequestError, Ticket, WaitError, WaitMode, connect_device,
 };
 pub use context::{Context, ContextError, Role, monotonic_ns};
 pub use device_set::{DeviceError, DeviceSet, DeviceSetHandler, Drain, ShareLeaseError};
@@ -112,7 +112,8 @@ pub use relay::{AnswerError, PendingLease, PendingRelay, RelayedLease, RelayedRe
 pub mod prelude {
     pub use crate::client::{
         ActArrayClient, Client, CommandError, ConnectError, DeviceClient, DriverStatus, Freshness,
-        GripperClient, LimbClient, RequestError, Ticket, WaitError, WaitMode, connect_device,
+        GripperClient, LaserClient, LimbClient, RangerClient, RequestError, Ticket, WaitError,
+        WaitMode, connect_device,
     };
     pub use crate::context::{Context, Role, monotonic_ns};
     pub use crate::device_set::{DeviceSet, DeviceSetHandler};

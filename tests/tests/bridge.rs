@@ -195,6 +195,44 @@ fn the_remote_drivers_statistics_reach_the_other_domain() {
     );
 }
 
+/// A fourth interface crosses the bridge with no code of its own in the bridge (expose
+/// and mirror reach every interface through `InterfaceKind::visit`): the emulated
+/// Pioneer's laser, in domain B, answers its geometry and gives its scans, in which the
+/// world's block (0.38, 0.10 by default) is the closest thing; the CLI reads it too.
+#[test]
+fn the_laser_crosses_the_bridge_as_every_interface_does() {
+    let s = setup();
+    let ctx = Context::new(&s.b, Role::Client, "bridge-test").expect("join domain B");
+    let mut laser =
+        RangerClient::connect_timeout(&ctx, "pioneer/ranger/0", Duration::from_secs(10))
+            .expect("the mirrored laser");
+    let g = laser
+        .geometry()
+        .expect("the laser's geometry through the bridge");
+    assert_eq!((g.ranges_count, g.max_range), (181, 8.0));
+    assert_eq!(g.pose.position.to_array(), [0.16, 0.0, 0.20]);
+    let scan = *laser
+        .wait_state(Duration::from_secs(5))
+        .expect("a scan through the bridge");
+    let r = scan.ranges();
+    assert_eq!(r.len(), 181);
+    let (i, closest) = r
+        .iter()
+        .copied()
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .expect("ranges");
+    let expected = (0.38f64 - 0.16).hypot(0.10) - 0.02;
+    assert!(
+        (closest - expected).abs() < 0.015,
+        "closest {closest} m, not {expected}"
+    );
+    assert!((scan.bearing(i) - (0.10f64).atan2(0.22)).abs() < 0.04);
+    let (code, out) = cli_in(&s.b, &["ranger", "pioneer/ranger/0", "geom"]);
+    assert_eq!(code, Some(0), "{out}");
+    assert!(out.contains("181 ranges over -90.0..+90.0 deg"), "{out}");
+}
+
 /// Kill the driver in A, then (after a restart) the exposing bridge, then the mirror:
 /// each time B's clients learn the arm is gone within a bound, and never hang.
 #[test]

@@ -84,6 +84,7 @@ fn pick_params(which: Which) -> PickParams {
     };
     PickParams {
         block,
+        block_radius: 0.02,
         drop,
         grasp_height: 0.15,
         clearance: 0.05,

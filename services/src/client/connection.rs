@@ -115,6 +115,10 @@ pub type ActArrayClient = Client<ActArray>;
 pub type LimbClient = Client<Limb>;
 /// A client of a gripper.
 pub type GripperClient = Client<Gripper>;
+/// A client of a ranger (a laser scanner).
+pub type RangerClient = Client<Ranger>;
+/// Player's name for a planar laser's client: a [`RangerClient`].
+pub type LaserClient = RangerClient;
 
 impl<I: Interface> Client<I> {
     /// Connects to `device` ("robot/interface/index") in the context's domain. Fails with
