@@ -22,7 +22,8 @@ pub mod ptype {
     pub const ARM: u8 = 0xA0;
     /// ARMINFOpac.
     pub const ARM_INFO: u8 = 0xA1;
-    /// ARIA's gripper packet.
+    /// The GRIPPERpac (the Pioneer Gripper manual; ARIA's gripper packet), answering
+    /// GRIPREQUEST (37).
     pub const GRIPPER: u8 = 0xE0;
 }
 

@@ -105,43 +105,36 @@ impl Motion {
         }
     }
 
-    /// One step of the trapezoidal profile: the velocity moves toward the move's speed
-    /// by at most `a dt` until the distance left is the one it needs to stop at the
-    /// limit (`v² / 2a`); from there it brakes at the rate that stops it exactly at the
-    /// target. The position follows the mean velocity of the step.
+    /// One step of the trapezoidal profile. The speed toward the target changes by at
+    /// most `a dt` per step, toward the move's speed but never above the largest speed
+    /// from which the joint still stops at the target at `a`, counted from where this
+    /// step ends (`v² <= 2 a d'`): it ramps up, cruises, and brakes at `a` to rest on the
+    /// target, the acceleration never above the limit. The position follows the mean
+    /// velocity of the step.
     fn step_limited(&mut self, dt: f64) {
         let a = self.accel;
         let d = self.target - self.pos;
         let dir = d.signum();
-        let v = self.velocity;
-        let (v_new, rate) = if v * dir > 0.0 && v * v >= 2.0 * a * d.abs() {
-            // Braking: constant deceleration to rest at the target.
-            let rate = v * v / (2.0 * d.abs());
-            let v_new = v - (rate * dt).copysign(v);
-            if v_new * v <= 0.0 {
-                // At rest within this step: there.
-                self.pos = self.target;
-                self.moving = false;
-                self.velocity = 0.0;
-                self.accel_now = rate;
-                return;
-            }
-            (v_new, rate)
-        } else {
-            let wanted = self.speed.min((2.0 * a * d.abs()).sqrt()) * dir;
-            let dv = (wanted - v).clamp(-a * dt, a * dt);
-            (v + dv, if dt > 0.0 { dv.abs() / dt } else { 0.0 })
-        };
+        let left = d.abs();
+        // Speed toward the target (negative: moving away from it).
+        let v = self.velocity * dir;
+        // v_new² <= 2a (left - (v + v_new) dt / 2), solved for v_new.
+        let room = (left - 0.5 * v * dt).max(0.0);
+        let stoppable = 0.5 * (-a * dt + (a * a * dt * dt + 8.0 * a * room).sqrt());
+        let wanted = self.speed.min(stoppable.max(0.0));
+        let dv = (wanted - v).clamp(-a * dt, a * dt);
+        let v_new = v + dv;
+        self.accel_now = if dt > 0.0 { dv.abs() / dt } else { 0.0 };
         let ds = 0.5 * (v + v_new) * dt;
-        self.accel_now = rate;
-        if ds * dir >= d.abs() {
+        if (v >= 0.0 && v_new <= 0.0) || ds >= left {
+            // At rest on the target within this step.
             self.pos = self.target;
             self.moving = false;
             self.velocity = 0.0;
-        } else {
-            self.pos += ds;
-            self.velocity = v_new;
+            return;
         }
+        self.pos += ds * dir;
+        self.velocity = v_new * dir;
     }
 }
 
@@ -175,6 +168,31 @@ mod tests {
         assert_eq!(m.pos, 1.0);
         assert!((peak - 1.0).abs() < 1e-9);
         assert!((t - 1.5).abs() < 0.005, "arrived after {t} s");
+    }
+
+    #[test]
+    fn coarse_steps_never_exceed_the_limit_and_arrive() {
+        // 1 rad at 0.5 rad/s² in 0.1 s steps (a 10 ms tick at 10x time): a triangle of
+        // 2 * sqrt(2) s, the speed never above the limit's.
+        for (dt, dist) in [(0.1, 1.0), (0.1, -0.3), (0.05, 0.01), (0.001, 2.0)] {
+            let mut m = Motion::at(0.0);
+            m.go_accel(dist, 3.15, 0.5);
+            let mut t = 0.0;
+            let mut prev = 0.0f64;
+            while m.moving && t < 100.0 {
+                m.step(dt);
+                t += dt;
+                assert!(m.accel_now <= 0.5 + 1e-9, "{dt} {dist}: {}", m.accel_now);
+                assert!((m.velocity - prev).abs() <= 0.5 * dt + 1e-9);
+                prev = m.velocity;
+            }
+            assert_eq!(m.pos, dist);
+            let ideal = 2.0 * (dist.abs() / 0.5f64).sqrt();
+            assert!(
+                t >= ideal - 1e-9 && t <= ideal + 2.0 * dt + 1e-9,
+                "{dt} {dist}: {t} s"
+            );
+        }
     }
 
     #[test]
