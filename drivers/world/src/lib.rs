@@ -8,7 +8,7 @@
 //!   seed ([`World::random_block`]).
 //! * [`Laser`]: a SICK LMS200-like planar laser ([`LaserConfig::lms200`]: 181 beams over
 //!   180°, 8 m, 10 scans a second) at a pose on the robot; [`Laser::scan`] ray-casts the
-//!   world into a [`RangerData`], with Gaussian noise that can be switched off.
+//!   world into a [`RangerData`](limber_interfaces::ranger::RangerData), with Gaussian noise that can be switched off.
 //! * [`Carrier`]: blocks move with the gripper: a block whose centre is within the capture
 //!   radius of the tool point when the gripper closes is carried (it follows the tool)
 //!   until the gripper opens, where it is put down.

@@ -5,7 +5,7 @@ use limber_interfaces::prelude::*;
 
 use crate::host::{DeviceHandler, Motion, Origin};
 
-/// What a driver implements to serve a [`DeviceSet`]: the [`DeviceHandler`] methods of
+/// What a driver implements to serve a [`DeviceSet`](super::DeviceSet): the [`DeviceHandler`] methods of
 /// each interface, with the index of the device (`gripper/0` or `gripper/1`). A device
 /// the set serves but the handler does not override answers [`Status::Unsupported`].
 pub trait DeviceSetHandler {
