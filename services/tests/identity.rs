@@ -5,7 +5,7 @@
 //! held arm, and a forged RELEASE freed it).
 
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use limber_interfaces::message::Message as _;
@@ -16,22 +16,35 @@ use limber_services::{LeaseError, RequestError};
 const T: Duration = Duration::from_secs(5);
 const DEVICE: &str = "ident/actarray/0";
 
-#[test]
-fn a_client_that_writes_the_holders_id_is_not_the_holder() {
-    let domain = Domain::unique_for_test();
-    let stop = Arc::new(AtomicBool::new(false));
-    let (driver_stop, driver_domain) = (Arc::clone(&stop), domain.clone());
-    let driver = std::thread::spawn(move || {
-        let ctx = Context::new(&driver_domain, Role::Driver, "ident").unwrap();
+/// A driver of a 2-joint test arm on a thread of this process until `stop`; with `refused`,
+/// it keeps the count of commands it refused there.
+fn test_driver(
+    domain: &Domain,
+    stop: &Arc<AtomicBool>,
+    refused: Option<Arc<AtomicU64>>,
+) -> std::thread::JoinHandle<()> {
+    let (stop, domain) = (Arc::clone(stop), domain.clone());
+    std::thread::spawn(move || {
+        let ctx = Context::new(&domain, Role::Driver, "ident").unwrap();
         let mut host = DeviceHost::<ActArray>::new(&ctx, &DEVICE.parse().unwrap(), "t").unwrap();
         host.state_mut().actuators_count = 2;
         host.publish().unwrap();
         let mut arm = TestArm::new(2);
-        while !driver_stop.load(Ordering::Relaxed) {
+        while !stop.load(Ordering::Relaxed) {
             host.process_spin(&mut arm).unwrap();
+            if let Some(r) = &refused {
+                r.store(host.stats().refused, Ordering::Relaxed);
+            }
             std::thread::yield_now();
         }
-    });
+    })
+}
+
+#[test]
+fn a_client_that_writes_the_holders_id_is_not_the_holder() {
+    let domain = Domain::unique_for_test();
+    let stop = Arc::new(AtomicBool::new(false));
+    let driver = test_driver(&domain, &stop, None);
     // The holder and the forger: two processes as far as iceoryx2 knows (a node each).
     let hctx = Context::new(&domain, Role::Client, "alice").unwrap();
     let mut holder = ActArrayClient::connect_timeout(&hctx, DEVICE, T).unwrap();
@@ -161,21 +174,8 @@ fn forger_process() {
 fn a_command_with_another_processs_client_id_is_dropped() {
     let domain = Domain::unique_for_test();
     let stop = Arc::new(AtomicBool::new(false));
-    let refused = Arc::new(std::sync::atomic::AtomicU64::new(0));
-    let (driver_stop, driver_domain, driver_refused) =
-        (Arc::clone(&stop), domain.clone(), Arc::clone(&refused));
-    let driver = std::thread::spawn(move || {
-        let ctx = Context::new(&driver_domain, Role::Driver, "ident").unwrap();
-        let mut host = DeviceHost::<ActArray>::new(&ctx, &DEVICE.parse().unwrap(), "t").unwrap();
-        host.state_mut().actuators_count = 2;
-        host.publish().unwrap();
-        let mut arm = TestArm::new(2);
-        while !driver_stop.load(Ordering::Relaxed) {
-            host.process_spin(&mut arm).unwrap();
-            driver_refused.store(host.stats().refused, Ordering::Relaxed);
-            std::thread::yield_now();
-        }
-    });
+    let refused = Arc::new(AtomicU64::new(0));
+    let driver = test_driver(&domain, &stop, Some(Arc::clone(&refused)));
     let vctx = Context::new(&domain, Role::Client, "victim").unwrap();
     let mut victim = ActArrayClient::connect_timeout(&vctx, DEVICE, T).unwrap();
     let before = victim.wait_state(T).unwrap().actuators[1].position;

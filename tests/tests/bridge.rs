@@ -15,7 +15,10 @@ use limber_services::{DriverStatus, RequestError};
 use limber_tests::Proc;
 
 mod bridging;
-use bridging::{CLI, arm_in, free_port, start_driver, usrpwd_configs, wait_mirrored};
+use bridging::{
+    CLI, arm_in, expose_with, free_port, mirror_with, mirrored_nothing, start_driver,
+    usrpwd_configs, wait_mirrored,
+};
 
 /// How long a mirrored device may take to be gone after its driver or a bridge dies.
 const GONE_BOUND: Duration = Duration::from_secs(10);
@@ -467,63 +470,17 @@ fn a_mirror_with_the_wrong_password_gets_nothing() {
     let a = Domain::unique_for_test();
     let _driver = start_driver(&a);
     let endpoint = format!("tcp/127.0.0.1:{}", free_port());
-    let mut expose = Proc::spawn(
-        CLI,
-        a.name(),
-        &[
-            "bridge",
-            "expose",
-            "--listen",
-            &endpoint,
-            "--zenoh-config",
-            &robot,
-        ],
-    );
-    assert!(
-        expose
-            .read_until(|l| l == "exposed pioneer/actarray/0")
-            .is_some()
-    );
+    let _expose = expose_with(&a, &["--listen", &endpoint, "--zenoh-config", &robot]);
     let b_bad = Domain::unique_for_test();
-    let mut intruder = Proc::spawn(
-        CLI,
-        b_bad.name(),
-        &[
-            "bridge",
-            "mirror",
-            "--connect",
-            &endpoint,
-            "--zenoh-config",
-            &bad,
-        ],
-    );
-    assert!(
-        intruder
-            .read_until(|l| l.starts_with("mirroring into"))
-            .is_some()
-    );
+    let intruder = mirror_with(&b_bad, &["--connect", &endpoint, "--zenoh-config", &bad]);
     let b = Domain::unique_for_test();
-    let mut mirror = Proc::spawn(
-        CLI,
-        b.name(),
-        &[
-            "bridge",
-            "mirror",
-            "--connect",
-            &endpoint,
-            "--zenoh-config",
-            &good,
-        ],
-    );
+    let mut mirror = mirror_with(&b, &["--connect", &endpoint, "--zenoh-config", &good]);
     wait_mirrored(&mut mirror);
     let mut arm = arm_in(&b);
     arm.geometry()
         .expect("the geometry with the right password");
     // The intruder started first and had as long: it mirrored nothing.
-    intruder.signal(libc::SIGTERM);
-    assert_eq!(intruder.wait_timeout(Duration::from_secs(20)), Some(0));
-    let rest = intruder.rest_of_stdout();
-    assert!(!rest.contains("mirrored"), "{rest}");
+    mirrored_nothing(intruder);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
