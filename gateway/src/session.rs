@@ -3,13 +3,15 @@
 //! it takes is its own), reading Player messages from its socket and writing replies and
 //! data back. Everything it holds goes with it when it ends.
 
-use std::collections::HashSet;
+use std::collections::{HashSet, VecDeque};
 use std::io::{Read, Write};
 use std::net::TcpStream;
 use std::time::Duration;
 
 use limber_interfaces::prelude::*;
-use limber_services::{ConnectError, Context, ContextError, Role, connect_device, list_devices};
+use limber_services::{
+    ConnectError, Context, ContextError, Role, Ticket, WaitError, connect_device, list_devices,
+};
 use thiserror::Error;
 
 use crate::header::{DevAddr, HEADER_SIZE, HeaderError, MsgHeader, message, msg_type, now};
@@ -76,7 +78,13 @@ struct Sub {
     last_seq: u64,
     /// `(type, subtype)` the driver refused as unsupported to this session.
     unsupported: HashSet<(u8, u8)>,
+    /// Commands sent whose outcome has not been seen yet, oldest first.
+    pending: VecDeque<(Ticket, u8)>,
 }
+
+/// The most commands whose outcomes a session follows per device (as many as a limber
+/// client remembers).
+const PENDING_MAX: usize = 16;
 
 /// A session.
 pub(crate) struct Session<'a> {
@@ -333,6 +341,7 @@ impl<'a> Session<'a> {
             dev,
             last_seq: 0,
             unsupported: HashSet::new(),
+            pending: VecDeque::new(),
         });
         Ok(m.info.driver)
     }
@@ -447,16 +456,25 @@ impl<'a> Session<'a> {
             );
             return;
         }
-        if let Err(e) = self.subs[i].dev.command(h.subtype, body) {
-            tracing::warn!(session = self.id, subtype = h.subtype, error = %e, "command not sent");
+        let sub = &mut self.subs[i];
+        match sub.dev.command(h.subtype, body) {
+            Ok(t) => {
+                if sub.pending.len() >= PENDING_MAX {
+                    sub.pending.pop_front();
+                }
+                sub.pending.push_back((t, h.subtype));
+            }
+            Err(e) => {
+                tracing::warn!(session = self.id, subtype = h.subtype, error = %e, "command not sent")
+            }
         }
     }
 
-    /// Takes the devices' new states into the queue; renews leases.
+    /// Takes the devices' new states into the queue, and the outcomes of the commands
+    /// sent (a refusal as unsupported is remembered for the capability query); renews
+    /// leases.
     fn poll_devices(&mut self) {
-        let own = |s: &Sub| s.dev.client_ref().client_id();
         for s in &mut self.subs {
-            let id = own(s);
             let c = s.dev.client();
             if let Err(e) = c.refresh() {
                 tracing::debug!(device = %c.device(), error = %e, "no state");
@@ -466,6 +484,17 @@ impl<'a> Session<'a> {
             {
                 tracing::warn!(device = %c.device(), error = %e, "the lease was lost");
             }
+            while let Some(&(t, subtype)) = s.pending.front() {
+                match c.wait_outcome_detail(t, Duration::ZERO) {
+                    Err(WaitError::Timeout(_)) => break,
+                    Ok(o) if o.status == Status::Unsupported => {
+                        s.unsupported.insert((msg_type::CMD, subtype));
+                    }
+                    Ok(_) => {}
+                    Err(e) => tracing::debug!(device = %c.device(), error = %e, "no outcome"),
+                }
+                s.pending.pop_front();
+            }
             let Some(hd) = c.header().copied() else {
                 continue;
             };
@@ -473,12 +502,6 @@ impl<'a> Session<'a> {
                 continue;
             }
             s.last_seq = hd.seq;
-            if hd.last_cmd.client_id == id
-                && hd.last_cmd.status == Status::Unsupported.code()
-                && let Ok(k) = u8::try_from(hd.last_cmd.kind)
-            {
-                s.unsupported.insert((msg_type::CMD, k));
-            }
             let Some(body) = s.dev.data() else { continue };
             let age = limber_services::monotonic_ns().saturating_sub(hd.stamp_ns);
             let h = MsgHeader {

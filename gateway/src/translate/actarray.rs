@@ -9,7 +9,7 @@
 
 use limber_interfaces::actarray::{cmd, req};
 use limber_interfaces::prelude::*;
-use limber_services::DeviceClient;
+use limber_services::{DeviceClient, Ticket};
 
 use super::{
     Conventions, MessageError, PlayerDevice, Translator, empty, in_tables, on_off, typed, unknown,
@@ -227,10 +227,9 @@ impl PlayerDevice for ActArrayDevice {
         let c = self.dev.typed_ref::<ActArray>()?;
         c.last_state().map(|d| data_body(d, self.scale))
     }
-    fn command(&mut self, subtype: u8, body: &[u8]) -> Result<(), MessageError> {
+    fn command(&mut self, subtype: u8, body: &[u8]) -> Result<Ticket, MessageError> {
         let c = command_of(subtype, body, self.scale)?;
-        typed::<ActArray>(self.dev.as_mut())?.send(&c)?;
-        Ok(())
+        Ok(typed::<ActArray>(self.dev.as_mut())?.send(&c)?)
     }
     fn request(&mut self, subtype: u8, body: &[u8]) -> Result<Vec<u8>, MessageError> {
         let q = request_of(subtype, body, self.scale)?;

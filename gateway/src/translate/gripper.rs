@@ -3,7 +3,7 @@
 
 use limber_interfaces::gripper::{cmd, req};
 use limber_interfaces::prelude::*;
-use limber_services::DeviceClient;
+use limber_services::{DeviceClient, Ticket};
 
 use super::{
     Conventions, MessageError, PlayerDevice, Translator, empty, in_tables, typed, unknown,
@@ -83,10 +83,9 @@ impl PlayerDevice for GripperDevice {
         let c = self.dev.typed_ref::<Gripper>()?;
         c.last_state().map(data_body)
     }
-    fn command(&mut self, subtype: u8, body: &[u8]) -> Result<(), MessageError> {
+    fn command(&mut self, subtype: u8, body: &[u8]) -> Result<Ticket, MessageError> {
         let c = command_of(subtype, body)?;
-        typed::<Gripper>(self.dev.as_mut())?.send(&c)?;
-        Ok(())
+        Ok(typed::<Gripper>(self.dev.as_mut())?.send(&c)?)
     }
     fn request(&mut self, subtype: u8, body: &[u8]) -> Result<Vec<u8>, MessageError> {
         if u32::from(subtype) != req::GET_GEOM {

@@ -5,7 +5,7 @@
 
 use limber_interfaces::limb::{cmd, req};
 use limber_interfaces::prelude::*;
-use limber_services::DeviceClient;
+use limber_services::{DeviceClient, Ticket};
 
 use super::{
     Conventions, MessageError, PlayerDevice, Translator, empty, in_tables, on_off, read_vec3,
@@ -98,10 +98,9 @@ impl PlayerDevice for LimbDevice {
         let c = self.dev.typed_ref::<Limb>()?;
         c.last_state().map(data_body)
     }
-    fn command(&mut self, subtype: u8, body: &[u8]) -> Result<(), MessageError> {
+    fn command(&mut self, subtype: u8, body: &[u8]) -> Result<Ticket, MessageError> {
         let c = command_of(subtype, body)?;
-        typed::<Limb>(self.dev.as_mut())?.send(&c)?;
-        Ok(())
+        Ok(typed::<Limb>(self.dev.as_mut())?.send(&c)?)
     }
     fn request(&mut self, subtype: u8, body: &[u8]) -> Result<Vec<u8>, MessageError> {
         let q = request_of(subtype, body)?;

@@ -7,7 +7,7 @@
 //! new interface (the ranger of a simulated world) is one more module and one more entry.
 
 use limber_interfaces::prelude::*;
-use limber_services::{Client, CommandError, DeviceClient, RequestError};
+use limber_services::{Client, CommandError, DeviceClient, RequestError, Ticket};
 use thiserror::Error;
 
 use crate::header::msg_type;
@@ -59,8 +59,8 @@ pub trait PlayerDevice {
     fn client_ref(&self) -> &dyn DeviceClient;
     /// The DATA (subtype STATE = 1) body of the latest state taken, if any.
     fn data(&self) -> Option<Vec<u8>>;
-    /// Sends a Player command.
-    fn command(&mut self, subtype: u8, body: &[u8]) -> Result<(), MessageError>;
+    /// Sends a Player command; its ticket, to see its outcome.
+    fn command(&mut self, subtype: u8, body: &[u8]) -> Result<Ticket, MessageError>;
     /// Sends a Player request; the ACK's body, or why it is NACKed.
     fn request(&mut self, subtype: u8, body: &[u8]) -> Result<Vec<u8>, MessageError>;
     /// Whether the gateway translates this `(type, subtype)` (CMD or REQ).
