@@ -487,10 +487,14 @@ impl<'a> Session<'a> {
             while let Some(&(t, subtype)) = s.pending.front() {
                 match c.wait_outcome_detail(t, Duration::ZERO) {
                     Err(WaitError::Timeout(_)) => break,
-                    Ok(o) if o.status == Status::Unsupported => {
-                        s.unsupported.insert((msg_type::CMD, subtype));
+                    Ok(o) if o.status.is_carried_out() => {}
+                    Ok(o) => {
+                        tracing::info!(device = %c.device(), subtype, status = %o.status,
+                            "command refused");
+                        if o.status == Status::Unsupported {
+                            s.unsupported.insert((msg_type::CMD, subtype));
+                        }
                     }
-                    Ok(_) => {}
                     Err(e) => tracing::debug!(device = %c.device(), error = %e, "no outcome"),
                 }
                 s.pending.pop_front();
