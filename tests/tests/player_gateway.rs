@@ -434,3 +434,50 @@ fn the_lift_mapped_to_actarray_0_moves_from_0_down_to_1_up() {
         near(joint(b, 0).into(), 1.0, 0.02)
     });
 }
+
+/// simarm beside the Pioneer in one domain: its `simarm/actarray/0` collides with the
+/// Pioneer's arm and lift and takes the lowest free index, `actarray:2`, with its driver's
+/// name; two Player clients at once, one in PULL commanding it, one in PUSH watching it
+/// move.
+#[test]
+fn two_player_clients_share_simarm_beside_the_pioneer() {
+    let s = setup(&[]);
+    let mut simarm = Proc::spawn(CLI, s.domain.name(), &["simarm"]);
+    assert!(
+        simarm.read_until(|l| l.ends_with("ready")).is_some(),
+        "simarm did not start"
+    );
+    let mut a = libplayerc_like(s.port);
+    let (mut b, _) = PlayerClient::connect(s.port);
+    let info = a.ack(
+        PLAYER,
+        0,
+        2,
+        &Body::default()
+            .u32(0)
+            .u32(s.port.into())
+            .u32(ACTARRAY)
+            .u32(2)
+            .count(0)
+            .0,
+    );
+    assert_eq!(&info[24..30], b"simarm", "{info:?}");
+    assert!(a.subscribe(ACTARRAY, 2).is_some());
+    assert!(b.subscribe(ACTARRAY, 2).is_some());
+    let n = Words(&a.ack(ACTARRAY, 2, 3, &[]), 0).u32();
+    assert!(n >= 5, "{n} actuators");
+    a.ack(ACTARRAY, 2, 1, &Body::default().u32(1).0);
+    a.send(ACTARRAY, 2, CMD, 1, &Body::default().i32(1).f32(0.4).0);
+    // B reads in PUSH mode (the server's default): data comes without asking.
+    let deadline = Instant::now() + Duration::from_secs(30);
+    loop {
+        let m = b.read();
+        if m.mtype == DATA && m.index == 2 && near(joint(&m.body, 1).into(), 0.4, 0.02) {
+            break;
+        }
+        assert!(Instant::now() < deadline, "B never saw joint 1 at 0.4");
+    }
+    a.pull_until(ACTARRAY, 2, "A sees joint 1 at 0.4", |b| {
+        near(joint(b, 1).into(), 0.4, 0.02)
+    });
+}
