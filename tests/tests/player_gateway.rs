@@ -316,6 +316,30 @@ fn a_lease_taken_through_the_gateway_ends_with_its_session() {
             .expect("outcome"),
         Status::Ok
     );
+
+    // The other way round: while a limber client holds the arm, a Player client's
+    // changing request is NACKed and its command refused as LEASED (in the driver's state,
+    // under the session's own client id).
+    arm.acquire("tester", Duration::from_secs(5))
+        .expect("the lease");
+    let mut c = libplayerc_like(s.port);
+    assert!(c.subscribe(ACTARRAY, 0).is_some());
+    c.nack(ACTARRAY, 0, 1, &Body::default().u32(1).0);
+    c.send(ACTARRAY, 0, CMD, 1, &Body::default().i32(2).f32(0.1).0);
+    let deadline = Instant::now() + Duration::from_secs(10);
+    loop {
+        let st = arm.wait_state(Duration::from_secs(5)).expect("a state");
+        let last = st.header.last_cmd;
+        if last.client_id != arm.client_id() && last.kind == 1 {
+            assert_eq!(last.status, Status::Leased.code());
+            break;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "the Player command never reached the driver"
+        );
+        arm.renew().expect("renew");
+    }
 }
 
 /// `--read-only`: states, the list and the geometry pass; commands, changing requests
