@@ -24,6 +24,7 @@ mod logging;
 mod monitor;
 mod out;
 pub mod pioneer;
+mod player_gateway;
 pub mod simarm;
 pub mod world;
 
@@ -121,6 +122,13 @@ enum Command {
     /// bridge/README.md.
     #[cfg(feature = "bridge")]
     Bridge(bridge::BridgeArgs),
+    /// Serve Player's TCP protocol (Player 3) for every device of the domain, so that
+    /// Player's own programs (libplayerc, libplayerc++, playerv, playerprint, playerjoy)
+    /// use limber devices unchanged: point them at this address. Loopback by default.
+    ///
+    /// Runs until SIGINT, SIGTERM, SIGHUP (or SIGQUIT); prints "session N from ADDR" and
+    /// "session N ended" as clients come and go (a session's leases end with it).
+    PlayerGateway(player_gateway::PlayerGatewayArgs),
 }
 
 /// Runs the `limber` command line with the process's arguments.
@@ -165,6 +173,7 @@ where
         Command::Simarm(args) => simarm::run(args),
         #[cfg(feature = "bridge")]
         Command::Bridge(args) => bridge::run(args),
+        Command::PlayerGateway(args) => player_gateway::run(args),
         Command::Bench(args) => limber_bench::run_cli(args).map_err(|e| {
             let code = if e.is_usage() {
                 exit::USAGE
