@@ -17,6 +17,7 @@ mod gripper;
 mod limb;
 mod ownership;
 mod ranger;
+mod done;
 mod requests;
 mod waiting;
 
@@ -26,6 +27,7 @@ pub use connection::{
     ActArrayClient, Client, GripperClient, LaserClient, LimbClient, RangerClient,
 };
 pub use device::{AnyGeom, DeviceClient, connect_device};
+pub use done::{Done, DoneError};
 pub use error::{CommandError, ConnectError, Incompatibility, LeaseError, RequestError, WaitError};
 pub use ownership::{LeaseHolder, Outcome};
 pub use waiting::{DriverStatus, FRESHNESS_CHECK_AGE, Freshness, WaitMode};
