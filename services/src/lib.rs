@@ -92,9 +92,8 @@ pub use domain::dir as domain_dir;
 
 pub use client::{
     ActArrayClient, AnyGeom, Client, CommandError, ConnectError, DeviceClient, Done, DoneError,
-    DriverStatus,
-    Freshness, GripperClient, Incompatibility, LaserClient, LeaseError, LeaseHolder, LimbClient,
-    Outcome, RangerClient, RequestError, Ticket, WaitError, WaitMode, connect_device,
+    DriverStatus, Freshness, GripperClient, Incompatibility, LaserClient, LeaseError, LeaseHolder,
+    LimbClient, Outcome, RangerClient, RequestError, Ticket, WaitError, WaitMode, connect_device,
 };
 pub use context::{Context, ContextError, Role, monotonic_ns};
 pub use device_set::{DeviceError, DeviceSet, DeviceSetHandler, Drain, ShareLeaseError};
@@ -103,8 +102,8 @@ pub use domain::Domain;
 pub use domain::DomainError;
 pub use error::Iox2Error;
 pub use host::{
-    Activity, CLIENT_SLOTS, DeviceHandler, DeviceHost, Holder, HostError, HostStats,
-    MAX_TRACKED, Motion, Origin, ProcessError, Progress, PublishError,
+    Activity, CLIENT_SLOTS, DeviceHandler, DeviceHost, Holder, HostError, HostStats, MAX_TRACKED,
+    Motion, Origin, ProcessError, Progress, PublishError,
 };
 pub use naming::{Channel, DeviceName, NameError};
 pub use relay::{AnswerError, PendingLease, PendingRelay, RelayedLease, RelayedRequest};
@@ -113,9 +112,8 @@ pub use relay::{AnswerError, PendingLease, PendingRelay, RelayedLease, RelayedRe
 pub mod prelude {
     pub use crate::client::{
         ActArrayClient, Client, CommandError, ConnectError, DeviceClient, Done, DoneError,
-        DriverStatus, Freshness,
-        GripperClient, LaserClient, LimbClient, RangerClient, RequestError, Ticket, WaitError,
-        WaitMode, connect_device,
+        DriverStatus, Freshness, GripperClient, LaserClient, LimbClient, RangerClient,
+        RequestError, Ticket, WaitError, WaitMode, connect_device,
     };
     pub use crate::context::{Context, Role, monotonic_ns};
     pub use crate::device_set::{DeviceSet, DeviceSetHandler};

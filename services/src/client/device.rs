@@ -13,9 +13,8 @@ use limber_interfaces::{InterfaceVisitor, WireBytes};
 use zerocopy::IntoBytes;
 
 use super::{
-    Done, DoneError,
-    Client, ConnectError, DriverStatus, Freshness, LeaseError, LeaseHolder, Outcome, RequestError,
-    Ticket, WaitError, WaitMode,
+    Client, ConnectError, Done, DoneError, DriverStatus, Freshness, LeaseError, LeaseHolder,
+    Outcome, RequestError, Ticket, WaitError, WaitMode,
 };
 use crate::context::Context;
 use crate::naming::DeviceName;

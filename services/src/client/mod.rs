@@ -12,12 +12,12 @@ mod actarray;
 mod commands;
 mod connection;
 mod device;
+mod done;
 mod error;
 mod gripper;
 mod limb;
 mod ownership;
 mod ranger;
-mod done;
 mod requests;
 mod waiting;
 

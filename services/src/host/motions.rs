@@ -153,7 +153,13 @@ impl Motions {
     }
 
     /// Ends every running part of `parts` with `result` (by `cause`, client `other`).
-    pub(crate) fn end_parts(&mut self, parts: u64, result: MotionResult, cause: Status, other: u64) {
+    pub(crate) fn end_parts(
+        &mut self,
+        parts: u64,
+        result: MotionResult,
+        cause: Status,
+        other: u64,
+    ) {
         for t in self.slots.iter_mut().flatten() {
             for part in 0..64 {
                 if t.left & parts & (1 << part) != 0 {
@@ -182,7 +188,12 @@ impl Motions {
                 let mut old = self.slots[oldest].take();
                 if let Some(t) = old.as_mut() {
                     for part in 0..64 {
-                        t.end(part, MotionResult::Preempted, Status::Preempted, cmd.client_id);
+                        t.end(
+                            part,
+                            MotionResult::Preempted,
+                            Status::Preempted,
+                            cmd.client_id,
+                        );
                     }
                 }
                 (oldest, old)
@@ -318,7 +329,10 @@ mod tests {
         assert_eq!((t.cmd, t.result), (cmd(1, 1), MotionResult::Preempted));
         m.start(cmd(2, 1), Motion::of(0b1, 0b1).stopping());
         let t = m.take_ended().unwrap();
-        assert_eq!((t.cmd, t.result, t.other), (cmd(1, 2), MotionResult::Stopped, 2));
+        assert_eq!(
+            (t.cmd, t.result, t.other),
+            (cmd(1, 2), MotionResult::Stopped, 2)
+        );
         // The stop itself ends at once.
         assert_eq!(m.running(), 0);
         assert_eq!(m.take_ended().unwrap().cmd, cmd(2, 1));
@@ -331,9 +345,15 @@ mod tests {
         m.end_parts(0b01, MotionResult::Reached, Status::Ok, 0);
         m.end_parts(0b10, MotionResult::Aborted, Status::LinkDown, 0);
         let t = m.take_ended().unwrap();
-        assert_eq!((t.result, t.cause), (MotionResult::Aborted, Status::LinkDown));
+        assert_eq!(
+            (t.result, t.cause),
+            (MotionResult::Aborted, Status::LinkDown)
+        );
         m.start(cmd(1, 2), Motion::NONE);
         let t = m.take_ended().unwrap();
-        assert_eq!((t.result, t.message().max_error), (MotionResult::Reached, 0.0));
+        assert_eq!(
+            (t.result, t.message().max_error),
+            (MotionResult::Reached, 0.0)
+        );
     }
 }
