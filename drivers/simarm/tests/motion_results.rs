@@ -161,3 +161,25 @@ fn limb_and_gripper_motions_end_with_a_result() {
     let t = grip.open().unwrap();
     assert!(grip.wait_done(t, TIMEOUT).unwrap().reached());
 }
+
+#[test]
+fn the_deadman_stops_a_motion_whose_holder_missed_its_heartbeat() {
+    let d = Domain::unique_for_test();
+    // Real time: the long move is still running when the lease ends.
+    let _drv = start(&d, 1.0);
+    let ctx = Context::new(&d, Role::Client, "results").unwrap();
+    let mut a = arm(&ctx);
+    let far = target(&a.geometry().unwrap(), 0, 0.9);
+    let t = a.move_to(0, far).unwrap();
+    assert_eq!(a.wait_outcome(t, TIMEOUT).unwrap(), Status::Ok);
+    // Mid-way, a lease with the shortest heartbeat, never renewed: the deadman ends it and
+    // stops the arm.
+    a.acquire("silent", Duration::from_millis(10)).unwrap();
+    let done = a.wait_done(t, TIMEOUT).unwrap();
+    assert_eq!(
+        (done.result(), done.cause()),
+        (MotionResult::Stopped, Status::Leased),
+        "{done}"
+    );
+    assert!(done.errors()[0].abs() > TOLERANCE, "stopped short: {done}");
+}
