@@ -370,6 +370,36 @@ typedef struct limber_outcome {
 } limber_outcome;
 
 /*
+ One device found by `limber_list_devices`.
+ */
+typedef struct limber_device_info {
+  /*
+   Its name, `robot/interface/index`, NUL-terminated.
+   */
+  char name[LIMBER_DEVICE_NAME_CAPACITY];
+  /*
+   The driver that offers it, NUL-terminated (cut to fit).
+   */
+  char driver[LIMBER_DRIVER_NAME_CAPACITY];
+  /*
+   Its interface.
+   */
+  limber_interface interface;
+  /*
+   True while the driver's process lives.
+   */
+  bool alive;
+  /*
+   Processes attached to its state channel (the driver and the clients).
+   */
+  uint32_t nodes;
+  /*
+   The layout version it speaks (`LIMBER_LAYOUT_VERSION`); 0 if it does not say.
+   */
+  uint32_t layout;
+} limber_device_info;
+
+/*
  How a motion ended ([`limber_device_wait_done`]).
  */
 typedef struct limber_done {
@@ -424,36 +454,6 @@ typedef struct limber_done {
    */
   char sentence[160];
 } limber_done;
-
-/*
- One device found by `limber_list_devices`.
- */
-typedef struct limber_device_info {
-  /*
-   Its name, `robot/interface/index`, NUL-terminated.
-   */
-  char name[LIMBER_DEVICE_NAME_CAPACITY];
-  /*
-   The driver that offers it, NUL-terminated (cut to fit).
-   */
-  char driver[LIMBER_DRIVER_NAME_CAPACITY];
-  /*
-   Its interface.
-   */
-  limber_interface interface;
-  /*
-   True while the driver's process lives.
-   */
-  bool alive;
-  /*
-   Processes attached to its state channel (the driver and the clients).
-   */
-  uint32_t nodes;
-  /*
-   The layout version it speaks (`LIMBER_LAYOUT_VERSION`); 0 if it does not say.
-   */
-  uint32_t layout;
-} limber_device_info;
 
 /*
  A connection to a gripper: a `limber_device` of this interface (the same type, so every
@@ -926,22 +926,6 @@ uint64_t limber_default_spin_budget_us(void);
 limber_code limber_set_program_name(const char *name);
 
 /*
- Waits up to `timeout_ms` until the motion that the command of `ticket` started has
- ended, and writes how to `*out`: reached within the device's tolerance, stalled,
- stopped, preempted, aborted or timed out, with each part's final position and error
- against the goal and a sentence. A command that starts nothing that runs on is reached
- when carried out. A refused command is `LIMBER_CODE_REFUSED` (its status in
- `limber_last_refusal()`); `LIMBER_CODE_TIMEOUT` when the motion has not ended in time.
-
- # Safety
- `h` is NULL or a live handle; `out` is NULL or writable.
- */
-limber_code limber_device_wait_done(struct limber_device *h,
-                                    struct limber_ticket ticket,
-                                    uint64_t timeout_ms,
-                                    struct limber_done *out);
-
-/*
  Lists the devices of `domain` (NULL: `LIMBER_DOMAIN`, or "limber"), sorted by name:
  writes the first `capacity` into `out[]` and the number found into `*count` (which
  may exceed `capacity`: call again with a larger array). `out` may be NULL when
@@ -967,6 +951,22 @@ limber_code limber_list_devices(const char *domain,
  `domain` is NULL or a NUL-terminated string; `removed` is NULL or writable.
  */
 limber_code limber_remove_domain_files(const char *domain, size_t *removed);
+
+/*
+ Waits up to `timeout_ms` until the motion that the command of `ticket` started has
+ ended, and writes how to `*out`: reached within the device's tolerance, stalled,
+ stopped, preempted, aborted or timed out, with each part's final position and error
+ against the goal and a sentence. A command that starts nothing that runs on is reached
+ when carried out. A refused command is `LIMBER_CODE_REFUSED` (its status in
+ `limber_last_refusal()`); `LIMBER_CODE_TIMEOUT` when the motion has not ended in time.
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_device_wait_done(struct limber_device *h,
+                                    struct limber_ticket ticket,
+                                    uint64_t timeout_ms,
+                                    struct limber_done *out);
 
 /*
  CMD OPEN: opens the gripper. `*ticket` (NULL: not written) is for
