@@ -233,6 +233,16 @@ public:
         detail::Check(limber_device_outcome(h_, ticket, detail::Millis(timeout), &o));
         return o;
     }
+    /// Waits up to `timeout` until the motion that the command of `ticket` started has
+    /// ended: how (`result`, a LIMBER_RESULT_*; `cause`, a LIMBER_STATUS_*), each part's
+    /// final position and error against the goal, the device's tolerance and a sentence.
+    /// Throws for a refused command (LIMBER_CODE_REFUSED) and when it has not ended in
+    /// time (LIMBER_CODE_TIMEOUT).
+    limber_done WaitDone(limber_ticket ticket, Duration timeout) {
+        limber_done d{};
+        detail::Check(limber_device_wait_done(h_, ticket, detail::Millis(timeout), &d));
+        return d;
+    }
     /// Alive (a state younger than `max_age`), stale, gone, or no data yet.
     limber_liveness Liveness(Duration max_age) {
         limber_liveness l = LIMBER_LIVENESS_NO_DATA;

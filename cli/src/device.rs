@@ -23,6 +23,14 @@ pub struct Common {
     /// once the driver has taken them.
     #[arg(long, global = true)]
     no_wait: bool,
+    /// After the outcome, wait up to S seconds (default 60) until the command's motion
+    /// has ended, and say how (reached within the tolerance, stalled, stopped, preempted,
+    /// aborted, timed out) with the largest final error; exit 1 when it did not reach its
+    /// goal.
+    #[arg(long, global = true, value_name = "S", num_args = 0..=1,
+          default_missing_value = "60", value_parser = crate::parse_seconds,
+          conflicts_with = "no_wait")]
+    wait: Option<f64>,
     /// Take the device for this command (a control lease, released when it ends): refused
     /// with the holder's name if another client holds it. Without it, the last writer wins.
     #[arg(long, global = true)]
@@ -357,7 +365,10 @@ fn finish<I: Interface>(
         // "ok", or "ok, clamped to the limit": carried out either way.
         Ok(o) if o.status.is_carried_out() => {
             outln!("{}", o.status)?;
-            Ok(())
+            match common.wait {
+                Some(s) => wait_done(c, ticket, s),
+                None => Ok(()),
+            }
         }
         // Another client holds the device: "refused: held by another client (its name)".
         Ok(o) if o.status == Status::Leased => Err(held_by(o.other_name())),
@@ -371,6 +382,25 @@ fn finish<I: Interface>(
             Ok(())
         }
         Err(e) => Err(wait_err(e)),
+    }
+}
+
+/// `--wait`: how the motion of `ticket`'s command ended, in the core's sentence ("done:
+/// reached the goal within the tolerance; largest final error ..."); exit 1 when it did
+/// not reach its goal.
+fn wait_done<I: Interface>(
+    c: &mut Client<I>,
+    ticket: Ticket,
+    seconds: f64,
+) -> Result<(), CliError> {
+    match c.wait_done(ticket, Duration::from_secs_f64(seconds)) {
+        Ok(d) if d.reached() => {
+            outln!("done: {d}")?;
+            Ok(())
+        }
+        Ok(d) => Err(CliError::new(exit::FAILURE, format!("done: {d}"))),
+        Err(DoneError::Refused(s)) => Err(CliError::new(exit::REFUSED, format!("refused: {s}"))),
+        Err(DoneError::Wait(e)) => Err(wait_err(e)),
     }
 }
 

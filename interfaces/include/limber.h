@@ -73,6 +73,7 @@ extern "C" {
 #define LIMBER_ACTSTATE_MOVING 2 /* moving */
 #define LIMBER_ACTSTATE_BRAKED 4 /* brakes applied */
 #define LIMBER_ACTSTATE_STALLED 8 /* stopped short of its target */
+#define LIMBER_ACTSTATE_SPEED_ESTIMATED 16 /* speed estimated from successive positions, not measured */
 
 /* ActuatorGeom.kind */
 #define LIMBER_ACTUATOR_KIND_LINEAR 1 /* linear, m */
@@ -138,6 +139,14 @@ extern "C" {
 #define LIMBER_LEASE_OP_RENEW 2 /* heartbeat of the holder */
 #define LIMBER_LEASE_OP_RELEASE 3 /* give the device back */
 #define LIMBER_LEASE_OP_QUERY 4 /* who holds the device */
+
+/* OutcomeMsg.result codes: how a motion ended (0: the sample is the command's outcome) */
+#define LIMBER_RESULT_REACHED 1 /* every part reached its goal within the tolerance */
+#define LIMBER_RESULT_STALLED 2 /* a part stopped short of its goal */
+#define LIMBER_RESULT_STOPPED 3 /* a STOP (or the deadman) stopped it */
+#define LIMBER_RESULT_PREEMPTED 4 /* another command took over its parts */
+#define LIMBER_RESULT_ABORTED 5 /* link lost, powered off, brakes, collision (status says which) */
+#define LIMBER_RESULT_TIMED_OUT 6 /* the device's time limit for the motion passed */
 
 /* Name limits (domain and robot names are [A-Za-z0-9_-]+) */
 #define LIMBER_NAME_MAX_DOMAIN_LEN 48 /* longest domain name */
@@ -897,7 +906,7 @@ LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, refused) == 328, "limber_driv
 LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, requests) == 336, "limber_driver_stats.requests offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_driver_stats, cmd_overflows) == 344, "limber_driver_stats.cmd_overflows offset");
 
-/* limber.v3.OutcomeMsg (size 72, align 8) */
+/* limber.v3.OutcomeMsg (size 608, align 8) */
 typedef struct limber_outcome_msg {
     uint64_t client_id;
     uint64_t cmd_seq;
@@ -906,9 +915,15 @@ typedef struct limber_outcome_msg {
     uint32_t kind;
     uint32_t status;
     uint8_t other_name[32];
+    uint32_t result;
+    uint32_t parts;
+    double max_error;
+    double tolerance;
+    double position[32];
+    double error[32];
 } limber_outcome_msg;
 #define LIMBER_OUTCOME_MSG_TYPE_NAME "limber.v3.OutcomeMsg"
-LIMBER_STATIC_ASSERT(sizeof(limber_outcome_msg) == 72, "limber_outcome_msg size");
+LIMBER_STATIC_ASSERT(sizeof(limber_outcome_msg) == 608, "limber_outcome_msg size");
 LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_outcome_msg) == 8, "limber_outcome_msg alignment");
 LIMBER_STATIC_ASSERT(offsetof(limber_outcome_msg, client_id) == 0, "limber_outcome_msg.client_id offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_outcome_msg, cmd_seq) == 8, "limber_outcome_msg.cmd_seq offset");
@@ -917,6 +932,12 @@ LIMBER_STATIC_ASSERT(offsetof(limber_outcome_msg, stamp_ns) == 24, "limber_outco
 LIMBER_STATIC_ASSERT(offsetof(limber_outcome_msg, kind) == 32, "limber_outcome_msg.kind offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_outcome_msg, status) == 36, "limber_outcome_msg.status offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_outcome_msg, other_name) == 40, "limber_outcome_msg.other_name offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_outcome_msg, result) == 72, "limber_outcome_msg.result offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_outcome_msg, parts) == 76, "limber_outcome_msg.parts offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_outcome_msg, max_error) == 80, "limber_outcome_msg.max_error offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_outcome_msg, tolerance) == 88, "limber_outcome_msg.tolerance offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_outcome_msg, position) == 96, "limber_outcome_msg.position offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_outcome_msg, error) == 352, "limber_outcome_msg.error offset");
 
 /* limber.v3.LeaseReq (size 80, align 8) */
 typedef struct limber_lease_req {

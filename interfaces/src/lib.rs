@@ -71,8 +71,9 @@ pub use wire::{WireField, WireStruct};
 /// Version 2 added the `outcome` and `lease` channels ([`control::OutcomeMsg`],
 /// [`control::LeaseReq`], [`control::LeaseReply`]), the statuses `PREEMPTED`, `LEASED` and
 /// `ADJUSTED`, the limb state's `orientation_adjustment` and the limb's REACH request.
-/// Version 3 added the `ranger` interface ([`ranger::RangerData`] and its envelopes);
-/// every type name carries the version.
+/// Version 3 added the `ranger` interface ([`ranger::RangerData`] and its envelopes), and
+/// the motion results on the `outcome` channel ([`control::OutcomeMsg::result`],
+/// [`control::MotionResult`]); every type name carries the version.
 pub const LAYOUT_VERSION: u32 = 3;
 
 /// Everything a driver or client author needs, in one `use`.
@@ -86,7 +87,7 @@ pub mod prelude {
         Bbox3, CmdOutcome, MAX_ACTUATORS, MsgMeta, Orientation3, Pose3, ReplyMeta, StateHeader,
         Status, Vec3, device_flag,
     };
-    pub use crate::control::{LeaseReply, LeaseReq, OutcomeMsg, lease_op};
+    pub use crate::control::{LeaseReply, LeaseReq, MotionResult, OutcomeMsg, lease_op};
     pub use crate::describe::Describe;
     pub use crate::diagnostics::DriverStats;
     pub use crate::error::{DecodeError, ValueError};
@@ -188,6 +189,7 @@ pub fn manifest() -> Manifest {
     constants.extend_from_slice(ranger::GROUPS);
     constants.extend_from_slice(diagnostics::GROUPS);
     constants.push(control::LEASE_OP_GROUP);
+    constants.push(control::RESULT_GROUP);
     constants.extend_from_slice(&[
         protocol::NAME_GROUP,
         protocol::WAKE_GROUP,

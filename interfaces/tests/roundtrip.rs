@@ -261,12 +261,12 @@ fn unknown_kinds_are_named_errors() {
 fn unknown_codes_in_state_are_named_errors() {
     let mut d = ActArrayData::default();
     d.actuators_count = 1;
-    d.actuators[0].state = 16;
+    d.actuators[0].state = 32;
     assert_eq!(
         d.validate(),
         Err(DecodeError::UnknownBits {
             field: "actuator state",
-            bits: 16
+            bits: 32
         })
     );
     d.actuators_count = 33;

@@ -66,6 +66,10 @@ from .client import (
     remove_domain_files as remove_domain_files,
     stats_text as stats_text,
 )
+from .done import (
+    Done as Done,
+    MotionResult as MotionResult,
+)
 from .ranger import (
     LaserClient as LaserClient,
     RangerClient as RangerClient,

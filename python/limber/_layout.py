@@ -62,6 +62,7 @@ ACTSTATE_IDLE = 1  # at its target
 ACTSTATE_MOVING = 2  # moving
 ACTSTATE_BRAKED = 4  # brakes applied
 ACTSTATE_STALLED = 8  # stopped short of its target
+ACTSTATE_SPEED_ESTIMATED = 16  # speed estimated from successive positions, not measured
 
 # ActuatorGeom.kind
 ACTUATOR_KIND_LINEAR = 1  # linear, m
@@ -127,6 +128,14 @@ LEASE_OP_ACQUIRE = 1  # take the device, or refresh one's own lease
 LEASE_OP_RENEW = 2  # heartbeat of the holder
 LEASE_OP_RELEASE = 3  # give the device back
 LEASE_OP_QUERY = 4  # who holds the device
+
+# OutcomeMsg.result codes: how a motion ended (0: the sample is the command's outcome)
+RESULT_REACHED = 1  # every part reached its goal within the tolerance
+RESULT_STALLED = 2  # a part stopped short of its goal
+RESULT_STOPPED = 3  # a STOP (or the deadman) stopped it
+RESULT_PREEMPTED = 4  # another command took over its parts
+RESULT_ABORTED = 5  # link lost, powered off, brakes, collision (status says which)
+RESULT_TIMED_OUT = 6  # the device's time limit for the motion passed
 
 # Name limits (domain and robot names are [A-Za-z0-9_-]+)
 NAME_MAX_DOMAIN_LEN = 48  # longest domain name
@@ -917,7 +926,7 @@ class DriverStats(ctypes.Structure):
 
 
 class OutcomeMsg(ctypes.Structure):
-    """limber.v3.OutcomeMsg (size 72, align 8)."""
+    """limber.v3.OutcomeMsg (size 608, align 8)."""
 
     _fields_ = [
         ("client_id", ctypes.c_uint64),
@@ -927,6 +936,12 @@ class OutcomeMsg(ctypes.Structure):
         ("kind", ctypes.c_uint32),
         ("status", ctypes.c_uint32),
         ("other_name", ctypes.c_uint8 * 32),
+        ("result", ctypes.c_uint32),
+        ("parts", ctypes.c_uint32),
+        ("max_error", ctypes.c_double),
+        ("tolerance", ctypes.c_double),
+        ("position", ctypes.c_double * 32),
+        ("error", ctypes.c_double * 32),
     ]
 
     @staticmethod

@@ -70,6 +70,7 @@ use crate::host::{
 use crate::naming::DeviceName;
 
 mod handler;
+mod motions;
 use handler::At;
 pub use handler::DeviceSetHandler;
 

@@ -71,6 +71,8 @@ pub struct Client<I: Interface> {
     pub(crate) outcome_sub: Subscriber<ipc::Service, OutcomeMsg, ()>,
     pub(super) outcomes: [Outcome; OUTCOME_SLOTS],
     pub(super) preemptions: [Outcome; OUTCOME_SLOTS],
+    /// The motion results of this client's last commands (by sequence number).
+    pub(super) results: [Option<super::Done>; OUTCOME_SLOTS],
     pub(super) max_seen_seq: u64,
     pub(super) lease: Option<LeaseSide>,
     pub(super) wake_driver: bool,
@@ -348,6 +350,7 @@ impl<I: Interface> Client<I> {
             outcome_sub,
             outcomes: [Outcome::NONE; OUTCOME_SLOTS],
             preemptions: [Outcome::NONE; OUTCOME_SLOTS],
+            results: [None; OUTCOME_SLOTS],
             max_seen_seq: 0,
             lease: None,
             wake_driver: true,

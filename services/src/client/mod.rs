@@ -12,6 +12,7 @@ mod actarray;
 mod commands;
 mod connection;
 mod device;
+mod done;
 mod error;
 mod gripper;
 mod limb;
@@ -26,6 +27,7 @@ pub use connection::{
     ActArrayClient, Client, GripperClient, LaserClient, LimbClient, RangerClient,
 };
 pub use device::{AnyGeom, DeviceClient, connect_device};
+pub use done::{Done, DoneError};
 pub use error::{CommandError, ConnectError, Incompatibility, LeaseError, RequestError, WaitError};
 pub use ownership::{LeaseHolder, Outcome};
 pub use waiting::{DriverStatus, FRESHNESS_CHECK_AGE, Freshness, WaitMode};

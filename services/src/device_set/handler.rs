@@ -3,7 +3,7 @@
 
 use limber_interfaces::prelude::*;
 
-use crate::host::{DeviceHandler, Motion, Origin};
+use crate::host::{DeviceHandler, Motion, Origin, Progress};
 
 /// What a driver implements to serve a [`DeviceSet`](super::DeviceSet): the [`DeviceHandler`] methods of
 /// each interface, with the index of the device (`gripper/0` or `gripper/1`). A device
@@ -30,6 +30,12 @@ pub trait DeviceSetHandler {
     ) -> Motion {
         let _ = (index, cmd, state);
         Motion::NONE
+    }
+    /// How part `part` of a motion of `actarray/<index>` is doing; see
+    /// [`DeviceHandler::progress`]. Default: not known.
+    fn actarray_progress(&mut self, index: u16, part: u32, state: &ActArrayData) -> Progress {
+        let _ = (index, part, state);
+        Progress::UNKNOWN
     }
     /// Stops every motion of `actarray/<index>` (the deadman); see [`DeviceHandler::stop`].
     fn actarray_stop(&mut self, index: u16, state: &mut ActArrayData) -> Status {
@@ -64,6 +70,12 @@ pub trait DeviceSetHandler {
         let _ = (index, cmd, state);
         Motion::NONE
     }
+    /// How part `part` of a motion of `limb/<index>` is doing; see
+    /// [`DeviceHandler::progress`]. Default: not known.
+    fn limb_progress(&mut self, index: u16, part: u32, state: &LimbData) -> Progress {
+        let _ = (index, part, state);
+        Progress::UNKNOWN
+    }
     /// Stops every motion of `limb/<index>` (the deadman); see [`DeviceHandler::stop`].
     fn limb_stop(&mut self, index: u16, state: &mut LimbData) -> Status {
         let _ = (index, state);
@@ -96,6 +108,12 @@ pub trait DeviceSetHandler {
     fn gripper_motion(&mut self, index: u16, cmd: &GripperCommand, state: &GripperData) -> Motion {
         let _ = (index, cmd, state);
         Motion::NONE
+    }
+    /// How part `part` of a motion of `gripper/<index>` is doing; see
+    /// [`DeviceHandler::progress`]. Default: not known.
+    fn gripper_progress(&mut self, index: u16, part: u32, state: &GripperData) -> Progress {
+        let _ = (index, part, state);
+        Progress::UNKNOWN
     }
     /// Stops every motion of `gripper/<index>` (the deadman); see [`DeviceHandler::stop`].
     fn gripper_stop(&mut self, index: u16, state: &mut GripperData) -> Status {
@@ -134,6 +152,9 @@ pub(super) struct At<'a, H: ?Sized> {
 }
 
 impl<H: DeviceSetHandler + ?Sized> DeviceHandler<ActArray> for At<'_, H> {
+    fn progress(&mut self, part: u32, s: &ActArrayData) -> Progress {
+        self.handler.actarray_progress(self.index, part, s)
+    }
     fn motion(&mut self, cmd: &ActArrayCommand, s: &ActArrayData) -> Motion {
         self.handler.actarray_motion(self.index, cmd, s)
     }
@@ -154,6 +175,9 @@ impl<H: DeviceSetHandler + ?Sized> DeviceHandler<ActArray> for At<'_, H> {
 }
 
 impl<H: DeviceSetHandler + ?Sized> DeviceHandler<Limb> for At<'_, H> {
+    fn progress(&mut self, part: u32, s: &LimbData) -> Progress {
+        self.handler.limb_progress(self.index, part, s)
+    }
     fn motion(&mut self, cmd: &LimbCommand, s: &LimbData) -> Motion {
         self.handler.limb_motion(self.index, cmd, s)
     }
@@ -174,6 +198,9 @@ impl<H: DeviceSetHandler + ?Sized> DeviceHandler<Limb> for At<'_, H> {
 }
 
 impl<H: DeviceSetHandler + ?Sized> DeviceHandler<Gripper> for At<'_, H> {
+    fn progress(&mut self, part: u32, s: &GripperData) -> Progress {
+        self.handler.gripper_progress(self.index, part, s)
+    }
     fn motion(&mut self, cmd: &GripperCommand, s: &GripperData) -> Motion {
         self.handler.gripper_motion(self.index, cmd, s)
     }

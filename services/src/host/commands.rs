@@ -94,6 +94,9 @@ impl<I: Interface> DeviceHost<I> {
                 sent?;
                 self.state_sent();
             }
+            // A command that drives nothing that runs on has its result now, after its
+            // outcome (so do the motions it preempted or stopped).
+            self.publish_results();
             // The next command's outcome sample, loaned now rather than on its path.
             if self.outcome_loan.is_none() {
                 self.outcome_loan = loan_ahead(&self.outcomes, &self.device, "outcome");
@@ -124,10 +127,12 @@ impl<I: Interface> DeviceHost<I> {
         cmd: CmdRef,
     ) -> Status {
         let motion = handler.motion(decoded, &self.state);
+        self.record_before(handler, motion);
         let status = handler.command(decoded, origin, &mut self.state);
         if !status.is_carried_out() {
             return status;
         }
+        self.motion_started(cmd, motion);
         let (outcomes, loan, stats, device) = (
             &self.outcomes,
             &mut self.outcome_loan,
@@ -152,34 +157,44 @@ fn publish_outcome(
     device: &DeviceName,
     told: Told,
 ) {
+    let mut msg = OutcomeMsg {
+        client_id: told.cmd.client_id,
+        cmd_seq: told.cmd.seq,
+        other_client: told.other_client,
+        kind: told.cmd.kind,
+        status: told.status.code(),
+        ..OutcomeMsg::default()
+    };
+    if let Some(n) = told.other_name {
+        msg.other_name = n;
+    }
+    publish_message(outcomes, loan_ahead, stats, device, msg);
+}
+
+/// Publishes one sample on the `outcome` channel (an outcome or a motion's result),
+/// stamped now; see [`publish_outcome`].
+pub(super) fn publish_message(
+    outcomes: &Publisher<ipc::Service, OutcomeMsg, ()>,
+    loan_ahead: &mut Option<SampleMutUninit<ipc::Service, MaybeUninit<OutcomeMsg>, ()>>,
+    stats: &mut HostStats,
+    device: &DeviceName,
+    mut msg: OutcomeMsg,
+) {
     let loan = match loan_ahead.take() {
         Some(l) => Ok(l),
         None => outcomes.loan_uninit(),
     };
+    msg.stamp_ns = monotonic_ns();
     let sent = match loan {
-        Ok(loan) => {
-            let mut msg = OutcomeMsg {
-                client_id: told.cmd.client_id,
-                cmd_seq: told.cmd.seq,
-                other_client: told.other_client,
-                stamp_ns: monotonic_ns(),
-                kind: told.cmd.kind,
-                status: told.status.code(),
-                ..OutcomeMsg::default()
-            };
-            if let Some(n) = told.other_name {
-                msg.other_name = n;
-            }
-            loan.write_payload(msg).send().map_err(Iox2Error::from)
-        }
+        Ok(loan) => loan.write_payload(msg).send().map_err(Iox2Error::from),
         Err(e) => Err(e.into()),
     };
     match sent {
         Ok(_) => stats.outcomes += 1,
         Err(e) => {
             stats.failed_outcomes += 1;
-            tracing::warn!(device = %device, client = told.cmd.client_id, seq = told.cmd.seq,
-                error = %e, "cannot publish an outcome");
+            tracing::warn!(device = %device, client = msg.client_id, seq = msg.cmd_seq,
+                result = msg.result, error = %e, "cannot publish an outcome");
         }
     }
 }

@@ -32,6 +32,7 @@ use gripper::GripperCmd;
 use limb::VecMovePlan;
 use motion::Motion;
 pub use options::{MotorModel, OptionsError, SimArmOptions, SimObject};
+pub use preemption::TOLERANCE;
 pub use store::MAX_STORE_CAPACITY;
 use store::Store;
 

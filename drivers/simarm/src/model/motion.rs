@@ -26,6 +26,9 @@ pub(super) struct Motion {
     pub(super) accel_now: f64,
     /// Current mode: the commanded current, A (`None`: position or speed mode).
     pub(super) current: Option<f64>,
+    /// The goal of the last motion commanded (kept by a stop: the error of a motion cut
+    /// short is against it).
+    pub(super) goal: f64,
 }
 
 impl Motion {
@@ -41,6 +44,7 @@ impl Motion {
             accel: f64::INFINITY,
             accel_now: 0.0,
             current: None,
+            goal: pos,
         }
     }
 
@@ -61,6 +65,7 @@ impl Motion {
     /// re-aims a current-driven joint every step).
     pub(super) fn drive(&mut self, target: f64, speed: f64, accel: f64) {
         self.target = target;
+        self.goal = target;
         self.speed = speed;
         self.accel = if accel > 0.0 { accel } else { f64::INFINITY };
         self.stalled = false;
