@@ -116,7 +116,9 @@ impl Watch {
             }
             if let (None, Some(n)) = (&self.gripper, &self.gripper_name) {
                 self.gripper = GripperClient::connect_timeout(&self.ctx, n, quick)
-                    .inspect_err(|e| tracing::debug!(device = n, error = %e, "world: no gripper yet"))
+                    .inspect_err(
+                        |e| tracing::debug!(device = n, error = %e, "world: no gripper yet"),
+                    )
                     .ok();
             }
         }
