@@ -23,7 +23,10 @@
 //! Power off stops everything; motion commands are then refused with BUSY until power
 //! is on again. Unsupported: CURRENT/MULTI_CURRENT, BRAKES, ACCEL, gripper STORE and
 //! RETRIEVE. An unreachable limb target is refused with OUT_OF_REACH and the limb
-//! state is OUT_OF_REACH until the next valid limb command.
+//! state is OUT_OF_REACH until the next valid limb command. A limb motion that brings a
+//! joint frame or the tool point below the floor or into an obstacle
+//! ([`SimArmOptions::obstacles`]) stops there, and the limb state is COLLISION until the
+//! next limb command.
 //!
 //! In steady state nothing allocates: the states are written in place, the IK works
 //! on the stack, the VECMOVE plan has a fixed capacity ([`model::MAX_WAYPOINTS`]).
@@ -32,4 +35,6 @@ mod driver;
 pub mod model;
 
 pub use driver::{DRIVER_NAME, SimArm, SimArmError, SimArmFailures};
-pub use model::{ArmModel, OptionsError, SimArmOptions, SimObject};
+pub use model::{
+    ArmModel, Contact, Obstacles, OptionsError, SimArmOptions, SimObject, SimObstacle,
+};

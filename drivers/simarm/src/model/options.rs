@@ -46,6 +46,8 @@ pub struct SimArmOptions {
     /// SETPOSE on a chain that cannot hold the requested frame: position and approach
     /// tolerances (1 mm, 1°), the orientation the nearest one the joints can hold.
     pub setpose: NearestOptions,
+    /// The floor and obstacles the limb stops at (state COLLISION); default none.
+    pub obstacles: super::collision::Obstacles,
 }
 
 impl Default for SimArmOptions {
@@ -58,6 +60,7 @@ impl Default for SimArmOptions {
             object: None,
             ik: NumericIkOptions::default(),
             setpose: NearestOptions::default(),
+            obstacles: Default::default(),
         }
     }
 }
