@@ -493,18 +493,20 @@ fn two_player_clients_share_simarm_beside_the_pioneer() {
     let n = Words(&a.ack(ACTARRAY, 2, 3, &[]), 0).u32();
     assert!(n >= 5, "{n} actuators");
     a.ack(ACTARRAY, 2, 1, &Body::default().u32(1).0);
-    a.send(ACTARRAY, 2, CMD, 1, &Body::default().i32(1).f32(0.4).0);
+    // -0.4: since simarm stops at the floor or an obstacle (COLLISION), joint 1 sent to
+    // +0.4 stops near 0.12 in the default world.
+    a.send(ACTARRAY, 2, CMD, 1, &Body::default().i32(1).f32(-0.4).0);
     // B reads in PUSH mode (the server's default): data comes without asking.
     let deadline = Instant::now() + Duration::from_secs(30);
     loop {
         let m = b.read();
-        if m.mtype == DATA && m.index == 2 && near(joint(&m.body, 1).into(), 0.4, 0.02) {
+        if m.mtype == DATA && m.index == 2 && near(joint(&m.body, 1).into(), -0.4, 0.02) {
             break;
         }
-        assert!(Instant::now() < deadline, "B never saw joint 1 at 0.4");
+        assert!(Instant::now() < deadline, "B never saw joint 1 at -0.4");
     }
-    a.pull_until(ACTARRAY, 2, "A sees joint 1 at 0.4", |b| {
-        near(joint(b, 1).into(), 0.4, 0.02)
+    a.pull_until(ACTARRAY, 2, "A sees joint 1 at -0.4", |b| {
+        near(joint(b, 1).into(), -0.4, 0.02)
     });
 }
 
