@@ -230,7 +230,9 @@ fn the_laser_crosses_the_bridge_as_every_interface_does() {
         (closest - expected).abs() < 0.015,
         "closest {closest} m, not {expected}"
     );
-    assert!((scan.bearing(i) - (0.10f64).atan2(0.22)).abs() < 0.04);
+    // The closest beam hits the block (radius 0.02 m at 0.24 m: within 0.085 rad of its
+    // centre's bearing); which beam it is moves with the laser's 2 mm noise.
+    assert!((scan.bearing(i) - (0.10f64).atan2(0.22)).abs() < 0.085);
     let (code, out) = cli_in(&s.b, &["ranger", "pioneer/ranger/0", "geom"]);
     assert_eq!(code, Some(0), "{out}");
     assert!(out.contains("181 ranges over -90.0..+90.0 deg"), "{out}");
