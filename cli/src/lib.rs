@@ -24,6 +24,7 @@ mod logging;
 mod monitor;
 mod out;
 pub mod pioneer;
+mod record;
 pub mod simarm;
 
 /// limber: Player's generic limb interfaces (actarray, limb, gripper) over zero-copy
@@ -115,6 +116,17 @@ enum Command {
     /// bridge/README.md.
     #[cfg(feature = "bridge")]
     Bridge(bridge::BridgeArgs),
+    /// Record every state, outcome and driver statistics of the domain (or of the devices
+    /// named) into an MCAP file, with a progress line on stderr; `--info FILE` summarises a
+    /// recorded file. Foxglove and the `mcap` tools open the files (record/README.md).
+    ///
+    /// Example: limber record -o run.mcap --duration 10
+    Record(record::RecordArgs),
+    /// Republish a recorded file into the domain as if its devices were live: `limber
+    /// echo`, `limber monitor` and clients work on it; commands are dropped.
+    ///
+    /// Example: limber replay run.mcap --rate 2 --loop
+    Replay(record::ReplayArgs),
 }
 
 /// Runs the `limber` command line with the process's arguments.
@@ -158,6 +170,8 @@ where
         Command::Simarm(args) => simarm::run(args),
         #[cfg(feature = "bridge")]
         Command::Bridge(args) => bridge::run(args),
+        Command::Record(args) => record::record(args),
+        Command::Replay(args) => record::replay(args),
         Command::Bench(args) => limber_bench::run_cli(args).map_err(|e| {
             let code = if e.is_usage() {
                 exit::USAGE

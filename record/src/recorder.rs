@@ -1,0 +1,643 @@
+//! `limber record`: every state, outcome and driver statistics of a domain into an MCAP
+//! file.
+//!
+//! The recorder is a client like any other, in a process of its own: drivers never wait
+//! for it. Its main thread takes what the devices published (woken by their
+//! notifications) and hands each message to a writer thread through a bounded queue; when
+//! the disk is slower than the devices, messages beyond the queue are dropped and counted,
+//! never buffered without bound. A state missed before it reached the recorder (the
+//! subscriber's buffer overflowed) shows as a gap in the state header's sequence numbers,
+//! counted as `missed`.
+
+use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
+use std::time::{Duration, Instant};
+
+use iceoryx2::port::listener::Listener;
+use iceoryx2::prelude::*;
+use limber_interfaces::actarray::ActArrayData;
+use limber_interfaces::control::OutcomeMsg;
+use limber_interfaces::diagnostics::DriverStats;
+use limber_interfaces::prelude::*;
+use limber_interfaces::{HasHeader, Interface, InterfaceVisitor, Message, ReplyBody, WireStruct};
+use limber_services::diagnostics::{StatsReader, list_drivers};
+use limber_services::{Client, Context, DeviceName, Domain, Role, list_devices, monotonic_ns};
+use thiserror::Error;
+use zerocopy::IntoBytes;
+
+use crate::mcap::{Compression, LAYOUT_SCHEMA_ENCODING, McapWriter, WIRE_ENCODING, WriteError};
+use crate::schema;
+
+/// How `record` runs.
+#[derive(Debug, Clone)]
+pub struct RecordConfig {
+    /// The devices to record (`robot/interface/index`); empty: every device of the domain,
+    /// as they come.
+    pub devices: Vec<String>,
+    /// Stop after this long (None: until `stop`).
+    pub duration: Option<Duration>,
+    /// How chunks are compressed.
+    pub compression: Compression,
+    /// Uncompressed bytes per chunk.
+    pub chunk_size: usize,
+    /// Messages the writer thread may have waiting at most.
+    pub queue: usize,
+}
+
+impl Default for RecordConfig {
+    fn default() -> Self {
+        RecordConfig {
+            devices: Vec::new(),
+            duration: None,
+            compression: Compression::Lz4,
+            chunk_size: 1 << 20,
+            queue: 4096,
+        }
+    }
+}
+
+/// Recording failed.
+#[derive(Debug, Error)]
+pub enum RecordError {
+    /// The domain could not be joined or listed.
+    #[error("cannot join domain {domain}: {reason}")]
+    Domain {
+        /// The domain.
+        domain: String,
+        /// Why.
+        reason: String,
+    },
+    /// A device named on the command line is not a device name.
+    #[error(transparent)]
+    Name(#[from] limber_services::NameError),
+    /// The output file could not be created.
+    #[error("cannot create {path}: {source}")]
+    Create {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// Writing the file failed.
+    #[error(transparent)]
+    Write(#[from] WriteError),
+    /// The writer thread could not be started or died.
+    #[error("the writer thread failed: {0}")]
+    Thread(String),
+    /// Waiting for the devices failed.
+    #[error("cannot wait for the devices: {0}")]
+    Wait(String),
+}
+
+/// How far a recording is (for the progress line and the final report).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Progress {
+    /// Messages written to the file.
+    pub messages: u64,
+    /// Bytes written to the file.
+    pub bytes: u64,
+    /// Messages dropped because the writer fell behind.
+    pub dropped: u64,
+    /// States that never reached the recorder (gaps in their sequence numbers).
+    pub missed: u64,
+    /// Channels.
+    pub channels: u64,
+    /// Time since the recording began.
+    pub elapsed: Duration,
+}
+
+#[derive(Default)]
+struct Counters {
+    messages: AtomicU64,
+    bytes: AtomicU64,
+    dropped: AtomicU64,
+    missed: AtomicU64,
+    channels: AtomicU64,
+}
+
+/// What the receiving side hands to the writer thread.
+enum Item {
+    Channel {
+        key: u32,
+        topic: String,
+        schema: (String, String, String),
+        encoding: &'static str,
+        metadata: Vec<(String, String)>,
+    },
+    Message {
+        key: u32,
+        log_time: u64,
+        publish_time: u64,
+        data: Vec<u8>,
+    },
+}
+
+/// The receiving side's end of the queue, and the clock.
+struct Sink {
+    tx: SyncSender<Item>,
+    counters: Arc<Counters>,
+    next_key: u32,
+    /// CLOCK_REALTIME minus CLOCK_MONOTONIC when the recording began.
+    offset_ns: i128,
+}
+
+impl Sink {
+    fn epoch_ns(&self, mono: u64) -> u64 {
+        u64::try_from(i128::from(mono) + self.offset_ns).unwrap_or(0)
+    }
+
+    /// Declares a channel of limber's wire struct `L`.
+    fn wire_channel<L: WireStruct>(&mut self, topic: String, meta: &[(&str, &str)]) -> Option<u32> {
+        let mut metadata: Vec<(String, String)> = meta
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect();
+        metadata.push(("type_name".into(), L::LAYOUT.type_name.into()));
+        self.channel(
+            topic,
+            (
+                L::LAYOUT.type_name.to_string(),
+                LAYOUT_SCHEMA_ENCODING.to_string(),
+                schema::layout_schema(&L::LAYOUT),
+            ),
+            WIRE_ENCODING,
+            metadata,
+        )
+    }
+
+    fn channel(
+        &mut self,
+        topic: String,
+        schema: (String, String, String),
+        encoding: &'static str,
+        metadata: Vec<(String, String)>,
+    ) -> Option<u32> {
+        let key = self.next_key;
+        self.next_key += 1;
+        let item = Item::Channel {
+            key,
+            topic,
+            schema,
+            encoding,
+            metadata,
+        };
+        // A channel is never dropped: its messages would have nowhere to go.
+        match self.tx.send(item) {
+            Ok(()) => Some(key),
+            Err(_) => {
+                tracing::warn!("the writer thread ended: channel not recorded");
+                None
+            }
+        }
+    }
+
+    fn message(&self, key: Option<u32>, received: u64, acquired: u64, data: Vec<u8>) {
+        let Some(key) = key else { return };
+        let item = Item::Message {
+            key,
+            log_time: self.epoch_ns(received),
+            publish_time: self.epoch_ns(if acquired == 0 { received } else { acquired }),
+            data,
+        };
+        match self.tx.try_send(item) {
+            Ok(()) => {}
+            Err(TrySendError::Full(_)) | Err(TrySendError::Disconnected(_)) => {
+                self.counters.dropped.fetch_add(1, Ordering::Relaxed);
+            }
+        }
+    }
+}
+
+/// One recorded device, whatever its interface.
+trait Recorded {
+    fn drain(&mut self, sink: &Sink);
+    fn listener(&self) -> Rc<Listener<ipc::Service>>;
+    fn alive(&self) -> bool;
+}
+
+struct Dev<I: Interface> {
+    client: Client<I>,
+    listener: Rc<Listener<ipc::Service>>,
+    state: Option<u32>,
+    outcome: Option<u32>,
+    joints: Option<u32>,
+    last_seq: Option<u64>,
+}
+
+impl<I: Interface> Recorded for Dev<I> {
+    fn drain(&mut self, sink: &Sink) {
+        let received = monotonic_ns();
+        let mut states = Vec::new();
+        if let Err(e) = self.client.relay_states(|d| states.push(*d)) {
+            tracing::warn!(device = %self.client.device(), error = %e, "cannot take the states");
+        }
+        for d in states {
+            let h = d.header();
+            if let Some(last) = self.last_seq
+                && h.seq > last + 1
+            {
+                sink.counters
+                    .missed
+                    .fetch_add(h.seq - last - 1, Ordering::Relaxed);
+            }
+            self.last_seq = Some(h.seq);
+            if let Some(a) = (&d as &dyn core::any::Any).downcast_ref::<ActArrayData>() {
+                let js = schema::joint_states(a, sink.epoch_ns(h.stamp_ns));
+                sink.message(
+                    self.joints,
+                    received,
+                    h.stamp_ns,
+                    js.to_string().into_bytes(),
+                );
+            }
+            sink.message(self.state, received, h.stamp_ns, d.as_bytes().to_vec());
+        }
+        let mut outcomes = Vec::new();
+        if let Err(e) = self.client.relay_outcomes(|o| outcomes.push(*o)) {
+            tracing::warn!(device = %self.client.device(), error = %e, "cannot take the outcomes");
+        }
+        for o in outcomes {
+            sink.message(self.outcome, received, o.stamp_ns, o.as_bytes().to_vec());
+        }
+        if let Err(e) = self.listener.try_wait(|_| {}) {
+            tracing::debug!(device = %self.client.device(), error = %e, "cannot consume notifications");
+        }
+    }
+    fn listener(&self) -> Rc<Listener<ipc::Service>> {
+        Rc::clone(&self.listener)
+    }
+    fn alive(&self) -> bool {
+        self.client.relay_driver_alive()
+    }
+}
+
+struct Open<'a> {
+    ctx: &'a Context,
+    name: &'a DeviceName,
+    sink: &'a mut Sink,
+}
+
+impl InterfaceVisitor for Open<'_> {
+    type Output = Result<Box<dyn Recorded>, String>;
+    fn visit<I: Interface>(self) -> Self::Output {
+        let dev = self.name.to_string();
+        // No wait: a named device that is not there yet is looked for again next round.
+        let mut client = Client::<I>::connect(self.ctx, &dev).map_err(|e| e.to_string())?;
+        let listener = client.relay_listener().map_err(|e| e.to_string())?;
+        let iface = I::KIND.name();
+        let meta = |kind: &'static str| {
+            [
+                ("device", dev.as_str()),
+                ("interface", iface),
+                ("channel", kind),
+            ]
+        };
+        // The geometry first (its reply as the driver sent it): what replay answers with
+        // and what a URDF is made from.
+        match client.request_with_timeout(&I::GEOMETRY, Duration::from_millis(1500)) {
+            Ok(reply) => {
+                let mut raw = I::ReplyMsg::default();
+                I::Reply::write(I::GEOMETRY.kind(), Ok(&reply), &mut raw);
+                let key = self
+                    .sink
+                    .wire_channel::<I::ReplyMsg>(format!("/{dev}/geometry"), &meta("geometry"));
+                let now = monotonic_ns();
+                self.sink.message(key, now, now, raw.as_bytes().to_vec());
+            }
+            Err(e) => tracing::warn!(device = dev, error = %e, "no geometry recorded"),
+        }
+        let state = self
+            .sink
+            .wire_channel::<I::Data>(format!("/{dev}/state"), &meta("state"));
+        let outcome = self
+            .sink
+            .wire_channel::<OutcomeMsg>(format!("/{dev}/outcome"), &meta("outcome"));
+        let joints = if I::KIND == InterfaceKind::ActArray {
+            self.sink.channel(
+                format!("/{dev}/joint_states"),
+                (
+                    schema::JOINT_STATES.into(),
+                    "jsonschema".into(),
+                    schema::joint_states_schema(),
+                ),
+                "json",
+                meta("joint_states")
+                    .iter()
+                    .map(|(k, v)| (k.to_string(), v.to_string()))
+                    .collect(),
+            )
+        } else {
+            None
+        };
+        Ok(Box::new(Dev::<I> {
+            client,
+            listener: Rc::new(listener),
+            state,
+            outcome,
+            joints,
+            last_seq: None,
+        }))
+    }
+}
+
+/// The writer thread: channels as they are declared, messages as they come, until the
+/// queue closes; then the summary.
+fn write_all(
+    path: &Path,
+    rx: Receiver<Item>,
+    config: &RecordConfig,
+    counters: &Counters,
+    metadata: Vec<(String, String)>,
+) -> Result<(), RecordError> {
+    let file = File::create(path).map_err(|source| RecordError::Create {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let library = format!("limber {}", env!("CARGO_PKG_VERSION"));
+    let mut w = McapWriter::new(
+        BufWriter::new(file),
+        &library,
+        config.compression,
+        config.chunk_size,
+    )?;
+    w.add_metadata("limber", &metadata)?;
+    let mut schemas: HashMap<(String, String), u16> = HashMap::new();
+    let mut channels: HashMap<u32, u16> = HashMap::new();
+    for item in rx {
+        match item {
+            Item::Channel {
+                key,
+                topic,
+                schema: (name, encoding, data),
+                encoding: message_encoding,
+                metadata,
+            } => {
+                let id = match schemas.get(&(name.clone(), encoding.clone())) {
+                    Some(id) => *id,
+                    None => {
+                        let id = w.add_schema(&name, &encoding, data.as_bytes())?;
+                        schemas.insert((name, encoding), id);
+                        id
+                    }
+                };
+                let ch = w.add_channel(id, &topic, message_encoding, &metadata)?;
+                channels.insert(key, ch);
+                counters.channels.fetch_add(1, Ordering::Relaxed);
+            }
+            Item::Message {
+                key,
+                log_time,
+                publish_time,
+                data,
+            } => {
+                if let Some(ch) = channels.get(&key) {
+                    w.write_message(*ch, log_time, publish_time, &data)?;
+                    counters.messages.fetch_add(1, Ordering::Relaxed);
+                    counters
+                        .bytes
+                        .store(w.written() + data.len() as u64, Ordering::Relaxed);
+                }
+            }
+        }
+    }
+    let mut out = w.finish()?;
+    std::io::Write::flush(&mut out).map_err(WriteError::Io)?;
+    let written = out
+        .into_inner()
+        .map_err(|e| WriteError::Io(e.into_error()))?;
+    written.sync_all().map_err(WriteError::Io)?;
+    counters.bytes.store(
+        written.metadata().map(|m| m.len()).unwrap_or(0),
+        Ordering::Relaxed,
+    );
+    Ok(())
+}
+
+fn realtime_minus_monotonic() -> i128 {
+    let rt = rustix::time::clock_gettime(rustix::time::ClockId::Realtime);
+    let mono = monotonic_ns();
+    i128::from(rt.tv_sec) * 1_000_000_000 + i128::from(rt.tv_nsec) - i128::from(mono)
+}
+
+/// Records `domain` into `path` until `stop` returns true or the configured duration has
+/// passed; `progress` hears how far it is about once a second, and once at the end.
+pub fn record(
+    domain: &Domain,
+    path: &Path,
+    config: &RecordConfig,
+    stop: &dyn Fn() -> bool,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<Progress, RecordError> {
+    let named: Vec<DeviceName> = config
+        .devices
+        .iter()
+        .map(|d| d.parse())
+        .collect::<Result<_, _>>()?;
+    let ctx =
+        Context::new(domain, Role::Client, "limber-record").map_err(|e| RecordError::Domain {
+            domain: domain.name().to_string(),
+            reason: e.to_string(),
+        })?;
+    let counters = Arc::new(Counters::default());
+    let (tx, rx) = sync_channel::<Item>(config.queue.max(16));
+    let offset_ns = realtime_minus_monotonic();
+    let metadata = vec![
+        ("domain".to_string(), domain.name().to_string()),
+        (
+            "layout_version".to_string(),
+            limber_interfaces::LAYOUT_VERSION.to_string(),
+        ),
+        (
+            "realtime_minus_monotonic_ns".to_string(),
+            offset_ns.to_string(),
+        ),
+    ];
+    let writer = {
+        let (path, config, counters) = (path.to_path_buf(), config.clone(), Arc::clone(&counters));
+        std::thread::Builder::new()
+            .name("limber-record-writer".into())
+            .spawn(move || write_all(&path, rx, &config, &counters, metadata))
+            .map_err(|e| RecordError::Thread(e.to_string()))?
+    };
+    let mut sink = Sink {
+        tx,
+        counters: Arc::clone(&counters),
+        next_key: 0,
+        offset_ns,
+    };
+    let started = Instant::now();
+    let result = receive(&ctx, domain, &named, config, &mut sink, stop, &mut || {
+        let p = snapshot(&counters, started);
+        progress(&p);
+    });
+    drop(sink);
+    let written = writer
+        .join()
+        .map_err(|_| RecordError::Thread("it panicked".into()))?;
+    result?;
+    written?;
+    let p = snapshot(&counters, started);
+    progress(&p);
+    Ok(p)
+}
+
+fn snapshot(c: &Counters, started: Instant) -> Progress {
+    Progress {
+        messages: c.messages.load(Ordering::Relaxed),
+        bytes: c.bytes.load(Ordering::Relaxed),
+        dropped: c.dropped.load(Ordering::Relaxed),
+        missed: c.missed.load(Ordering::Relaxed),
+        channels: c.channels.load(Ordering::Relaxed),
+        elapsed: started.elapsed(),
+    }
+}
+
+/// The longest the loop waits for a notification: driver statistics have none, and are
+/// looked at this often.
+const POLL: Duration = Duration::from_millis(100);
+/// How often the domain is looked at for new devices and drivers.
+const DISCOVERY: Duration = Duration::from_secs(1);
+
+/// The receiving loop (this thread: iceoryx2's ports stay on the thread that made them).
+fn receive(
+    ctx: &Context,
+    domain: &Domain,
+    named: &[DeviceName],
+    config: &RecordConfig,
+    sink: &mut Sink,
+    stop: &dyn Fn() -> bool,
+    progress: &mut dyn FnMut(),
+) -> Result<(), RecordError> {
+    let started = Instant::now();
+    let end = config.duration.map(|d| started + d);
+    let over = || stop() || end.is_some_and(|e| Instant::now() >= e);
+    let mut devices: BTreeMap<DeviceName, Box<dyn Recorded>> = BTreeMap::new();
+    let mut drivers: BTreeMap<String, (StatsReader, Option<u32>)> = BTreeMap::new();
+    let mut refused: BTreeSet<DeviceName> = BTreeSet::new();
+    let mut last_progress = Instant::now();
+    while !over() {
+        discover(ctx, domain, named, sink, &mut devices, &mut refused)?;
+        let robots: BTreeSet<String> = devices.keys().map(|d| d.robot().to_string()).collect();
+        match list_drivers(domain) {
+            Ok(list) => {
+                for robot in list.into_iter().filter(|r| robots.contains(r)) {
+                    if drivers.contains_key(&robot) {
+                        continue;
+                    }
+                    if let Ok(r) = StatsReader::open(ctx, &robot) {
+                        let key = sink.wire_channel::<DriverStats>(
+                            format!("/{robot}/driver"),
+                            &[("robot", robot.as_str()), ("channel", "driver")],
+                        );
+                        drivers.insert(robot, (r, key));
+                    }
+                }
+            }
+            Err(e) => tracing::warn!(error = %e, "cannot list the drivers"),
+        }
+        let ws = WaitSetBuilder::new()
+            .signal_handling_mode(SignalHandlingMode::Disabled)
+            .create::<ipc::Service>()
+            .map_err(|e| RecordError::Wait(e.to_string()))?;
+        let listeners: Vec<Rc<Listener<ipc::Service>>> =
+            devices.values().map(|d| d.listener()).collect();
+        let mut guards = Vec::new();
+        for l in &listeners {
+            guards.push(
+                ws.attach_notification(l.as_ref())
+                    .map_err(|e| RecordError::Wait(e.to_string()))?,
+            );
+        }
+        let next_discovery = Instant::now() + DISCOVERY;
+        while !over() && Instant::now() < next_discovery {
+            ws.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, POLL)
+                .map_err(|e| RecordError::Wait(e.to_string()))?;
+            for d in devices.values_mut() {
+                d.drain(sink);
+            }
+            for (robot, (r, key)) in drivers.iter_mut() {
+                match r.refresh() {
+                    Ok(true) => {
+                        if let Some(s) = r.latest() {
+                            let now = monotonic_ns();
+                            sink.message(*key, now, s.header.stamp_ns, s.as_bytes().to_vec());
+                        }
+                    }
+                    Ok(false) => {}
+                    Err(e) => tracing::debug!(robot, error = %e, "cannot read driver statistics"),
+                }
+            }
+            if last_progress.elapsed() >= Duration::from_secs(1) {
+                last_progress = Instant::now();
+                progress();
+            }
+        }
+        drop(guards);
+        // Devices whose driver is gone are closed (a new driver is found again).
+        devices.retain(|name, d| {
+            let alive = d.alive();
+            if !alive {
+                tracing::info!(device = %name, "driver gone: no longer recorded");
+            }
+            alive
+        });
+    }
+    // What arrived since the last wake-up.
+    for d in devices.values_mut() {
+        d.drain(sink);
+    }
+    Ok(())
+}
+
+/// Connects to the devices not recorded yet: the named ones, or every live one.
+fn discover(
+    ctx: &Context,
+    domain: &Domain,
+    named: &[DeviceName],
+    sink: &mut Sink,
+    devices: &mut BTreeMap<DeviceName, Box<dyn Recorded>>,
+    refused: &mut BTreeSet<DeviceName>,
+) -> Result<(), RecordError> {
+    let wanted: Vec<DeviceName> = if named.is_empty() {
+        list_devices(domain)
+            .map_err(|e| RecordError::Domain {
+                domain: domain.name().to_string(),
+                reason: e.to_string(),
+            })?
+            .into_iter()
+            .filter(|d| d.alive)
+            .map(|d| d.name)
+            .collect()
+    } else {
+        named.to_vec()
+    };
+    for name in wanted {
+        if devices.contains_key(&name) {
+            continue;
+        }
+        match name.interface().visit(Open {
+            ctx,
+            name: &name,
+            sink,
+        }) {
+            Ok(d) => {
+                tracing::info!(device = %name, "recording");
+                refused.remove(&name);
+                devices.insert(name, d);
+            }
+            Err(e) => {
+                if refused.insert(name.clone()) {
+                    tracing::warn!(device = %name, error = %e, "cannot record the device");
+                }
+            }
+        }
+    }
+    Ok(())
+}
