@@ -7,7 +7,9 @@ use std::time::Duration;
 
 use clap::{Args, ValueEnum};
 use limber_record::mcap::Compression;
-use limber_record::{Progress, RecordConfig, RecordError, ReplayConfig, ReplayError, ReplayEvent};
+use limber_record::{
+    Progress, RecordConfig, RecordError, RecordEvent, ReplayConfig, ReplayError, ReplayEvent,
+};
 use limber_services::signals;
 
 use crate::out::outln;
@@ -103,14 +105,21 @@ pub fn record(a: RecordArgs) -> Result<(), CliError> {
         ..RecordConfig::default()
     };
     let tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
-    let mut progress = |p: &Progress| {
+    let mut report = |ev: RecordEvent| {
+        let p = match ev {
+            RecordEvent::Recording(d) => {
+                crate::out::note(format_args!("recording {d}\n"));
+                return;
+            }
+            RecordEvent::Progress(p) => p,
+        };
         // A progress line on stderr: rewritten in place on a terminal, one per second
         // otherwise.
         let mut err = std::io::stderr();
         let shown = if tty {
-            write!(err, "\r{:<100}", progress_line(p))
+            write!(err, "\r{:<100}", progress_line(&p))
         } else {
-            writeln!(err, "recording: {}", progress_line(p))
+            writeln!(err, "recording: {}", progress_line(&p))
         };
         if let Err(e) = shown {
             tracing::debug!(error = %e, "cannot print the progress");
@@ -122,7 +131,7 @@ pub fn record(a: RecordArgs) -> Result<(), CliError> {
         output,
         &config,
         &signals::termination_requested,
-        &mut progress,
+        &mut report,
     )
     .map_err(|e| {
         let code = match e {

@@ -21,5 +21,5 @@ pub mod replay;
 pub mod schema;
 
 pub use info::{Info, InfoError, info};
-pub use recorder::{Progress, RecordConfig, RecordError, record};
+pub use recorder::{Progress, RecordConfig, RecordError, RecordEvent, record};
 pub use replay::{ReplayConfig, ReplayError, ReplayEvent, replay};

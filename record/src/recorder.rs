@@ -96,6 +96,15 @@ pub enum RecordError {
     Wait(String),
 }
 
+/// What `record` reports as it runs.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum RecordEvent {
+    /// A device is recorded from now on (its channels are declared, its geometry taken).
+    Recording(DeviceName),
+    /// How far it is (about once a second, and once at the end).
+    Progress(Progress),
+}
+
 /// How far a recording is (for the progress line and the final report).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Progress {
@@ -427,13 +436,13 @@ fn realtime_minus_monotonic() -> i128 {
 }
 
 /// Records `domain` into `path` until `stop` returns true or the configured duration has
-/// passed; `progress` hears how far it is about once a second, and once at the end.
+/// passed; `report` hears of each device recorded and of the progress.
 pub fn record(
     domain: &Domain,
     path: &Path,
     config: &RecordConfig,
     stop: &dyn Fn() -> bool,
-    progress: &mut dyn FnMut(&Progress),
+    report: &mut dyn FnMut(RecordEvent),
 ) -> Result<Progress, RecordError> {
     let named: Vec<DeviceName> = config
         .devices
@@ -473,9 +482,8 @@ pub fn record(
         offset_ns,
     };
     let started = Instant::now();
-    let result = receive(&ctx, domain, &named, config, &mut sink, stop, &mut || {
-        let p = snapshot(&counters, started);
-        progress(&p);
+    let result = receive(&ctx, domain, &named, config, &mut sink, stop, &mut |ev| {
+        report(ev.unwrap_or_else(|| RecordEvent::Progress(snapshot(&counters, started))))
     });
     drop(sink);
     let written = writer
@@ -484,7 +492,7 @@ pub fn record(
     result?;
     written?;
     let p = snapshot(&counters, started);
-    progress(&p);
+    report(RecordEvent::Progress(p));
     Ok(p)
 }
 
@@ -513,7 +521,7 @@ fn receive(
     config: &RecordConfig,
     sink: &mut Sink,
     stop: &dyn Fn() -> bool,
-    progress: &mut dyn FnMut(),
+    report: &mut dyn FnMut(Option<RecordEvent>),
 ) -> Result<(), RecordError> {
     let started = Instant::now();
     let end = config.duration.map(|d| started + d);
@@ -523,7 +531,9 @@ fn receive(
     let mut refused: BTreeSet<DeviceName> = BTreeSet::new();
     let mut last_progress = Instant::now();
     while !over() {
-        discover(ctx, domain, named, sink, &mut devices, &mut refused)?;
+        for name in discover(ctx, domain, named, sink, &mut devices, &mut refused)? {
+            report(Some(RecordEvent::Recording(name)));
+        }
         let robots: BTreeSet<String> = devices.keys().map(|d| d.robot().to_string()).collect();
         match list_drivers(domain) {
             Ok(list) => {
@@ -576,7 +586,7 @@ fn receive(
             }
             if last_progress.elapsed() >= Duration::from_secs(1) {
                 last_progress = Instant::now();
-                progress();
+                report(None);
             }
         }
         drop(guards);
@@ -596,7 +606,8 @@ fn receive(
     Ok(())
 }
 
-/// Connects to the devices not recorded yet: the named ones, or every live one.
+/// Connects to the devices not recorded yet: the named ones, or every live one; returns
+/// those it connected to.
 fn discover(
     ctx: &Context,
     domain: &Domain,
@@ -604,7 +615,8 @@ fn discover(
     sink: &mut Sink,
     devices: &mut BTreeMap<DeviceName, Box<dyn Recorded>>,
     refused: &mut BTreeSet<DeviceName>,
-) -> Result<(), RecordError> {
+) -> Result<Vec<DeviceName>, RecordError> {
+    let mut added = Vec::new();
     let wanted: Vec<DeviceName> = if named.is_empty() {
         list_devices(domain)
             .map_err(|e| RecordError::Domain {
@@ -630,6 +642,7 @@ fn discover(
             Ok(d) => {
                 tracing::info!(device = %name, "recording");
                 refused.remove(&name);
+                added.push(name.clone());
                 devices.insert(name, d);
             }
             Err(e) => {
@@ -639,5 +652,5 @@ fn discover(
             }
         }
     }
-    Ok(())
+    Ok(added)
 }

@@ -79,8 +79,9 @@ pub fn joint_name(i: usize) -> String {
     format!("j{i}")
 }
 
-/// An actuator array's state as `foxglove.JointStates` (`stamp_ns` since the Unix epoch;
-/// the current is given as the effort, in A: limber knows no torques).
+/// An actuator array's state as `foxglove.JointStates` (`stamp_ns` since the Unix epoch):
+/// positions and speeds (limber's currents are no efforts, and -1 means "unknown" in its
+/// accelerations: both are left out, as the schema allows).
 pub fn joint_states(d: &ActArrayData, stamp_ns: u64) -> Value {
     json!({
         "timestamp": {"sec": stamp_ns / 1_000_000_000, "nsec": stamp_ns % 1_000_000_000},
@@ -88,8 +89,6 @@ pub fn joint_states(d: &ActArrayData, stamp_ns: u64) -> Value {
             "name": joint_name(i),
             "position": a.position,
             "velocity": a.speed,
-            "acceleration": a.acceleration,
-            "effort": a.current,
         })).collect::<Vec<_>>(),
     })
 }
