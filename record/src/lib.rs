@@ -6,6 +6,8 @@
 //! * [`info`](info::info): what a file holds (channels, counts, time span).
 //! * [`replay`](replay::replay): a recorded file republished into a domain, its devices
 //!   hosted as if their drivers were live.
+//! * [`view`](view::view): the devices live in Foxglove (the `foxglove.websocket.v1`
+//!   protocol over [`ws`]), with a URDF of each arm whose chain limber knows ([`urdf`]).
 //!
 //! The file format is MCAP ([`mcap`]), written and read by this crate from the
 //! specification. Each device has the channels `/<device>/state` and `/<device>/outcome`
@@ -19,7 +21,11 @@ pub mod mcap;
 pub mod recorder;
 pub mod replay;
 pub mod schema;
+pub mod urdf;
+pub mod view;
+pub mod ws;
 
 pub use info::{Info, InfoError, info};
 pub use recorder::{Progress, RecordConfig, RecordError, RecordEvent, record};
 pub use replay::{ReplayConfig, ReplayError, ReplayEvent, replay};
+pub use view::{ViewConfig, ViewError, ViewEvent, view};

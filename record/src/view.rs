@@ -1,0 +1,582 @@
+//! `limber view`: the domain's devices live in Foxglove, over the `foxglove.websocket.v1`
+//! protocol (<https://github.com/foxglove/ws-protocol>, docs/spec.md).
+//!
+//! Read-only: the server offers no client publishing, parameters or services. Channels,
+//! all JSON: per device `/<device>/state` (the state as `limber echo --json` prints it,
+//! schema name its wire struct's type name), per actuator array `/<device>/joint_states`
+//! (`foxglove.JointStates`) and, for an arm whose chain limber knows, `/<device>/
+//! robot_description` (`std_msgs/String` holding its URDF, sent to each new subscriber).
+//!
+//! Threads: this one takes the devices' states (iceoryx2 ports stay on the thread that made
+//! them) and hands each message to every connection's writer through a bounded queue (a
+//! client that reads slowly loses messages, never slows the others); one thread per
+//! connection reads the client's subscriptions and one writes its frames.
+
+use std::collections::{BTreeMap, HashMap};
+use std::io::Write as _;
+use std::net::{Shutdown, SocketAddr, TcpListener, TcpStream};
+use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::{Duration, Instant};
+
+use limber_interfaces::actarray::ActArrayData;
+use limber_interfaces::prelude::*;
+use limber_interfaces::{HasHeader, Interface, InterfaceVisitor, WireStruct};
+use limber_kinematics::chain::Chain;
+use limber_services::{Client, Context, DeviceName, Domain, Role, list_devices, monotonic_ns};
+use serde_json::{Value, json};
+use thiserror::Error;
+
+use crate::schema;
+use crate::urdf::urdf_of_chain;
+use crate::ws::{self, Incoming, MessageReader, opcode};
+
+/// How `view` runs.
+#[derive(Debug, Clone)]
+pub struct ViewConfig {
+    /// Where to listen (default 127.0.0.1:8765, Foxglove's default port).
+    pub listen: SocketAddr,
+    /// The most clients at once; more are refused.
+    pub max_clients: usize,
+    /// The chain of simarm's arms, when not a built-in one (`simarm --chain FILE`).
+    pub simarm_chain: Option<Chain>,
+}
+
+impl Default for ViewConfig {
+    fn default() -> Self {
+        ViewConfig {
+            listen: SocketAddr::from(([127, 0, 0, 1], 8765)),
+            max_clients: 16,
+            simarm_chain: None,
+        }
+    }
+}
+
+/// `view` failed.
+#[derive(Debug, Error)]
+pub enum ViewError {
+    /// The listener could not be opened.
+    #[error("cannot listen on {addr}: {source}")]
+    Listen {
+        /// The address.
+        addr: SocketAddr,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The domain could not be joined or listed.
+    #[error("cannot join domain {domain}: {reason}")]
+    Domain {
+        /// The domain.
+        domain: String,
+        /// Why.
+        reason: String,
+    },
+}
+
+/// What `view` reports as it runs.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ViewEvent {
+    /// Listening.
+    Listening(SocketAddr),
+    /// A device's channels are advertised.
+    Device(DeviceName),
+    /// A client connected.
+    Client(SocketAddr),
+}
+
+/// A message for one connection's writer.
+enum Out {
+    Text(String),
+    /// A message of channel `channel`, for each subscription of it.
+    Data {
+        channel: u32,
+        stamp: u64,
+        payload: Arc<Vec<u8>>,
+    },
+    /// A message for subscription `sub` only (the latched URDF on subscribing).
+    ForSub {
+        sub: u32,
+        stamp: u64,
+        payload: Arc<Vec<u8>>,
+    },
+    Pong(Vec<u8>),
+}
+
+struct Conn {
+    tx: SyncSender<Out>,
+    /// Subscription id -> channel id.
+    subs: Arc<Mutex<HashMap<u32, u32>>>,
+}
+
+/// What every thread shares: the channels advertised, the latched messages, the clients.
+#[derive(Default)]
+struct Shared {
+    channels: BTreeMap<u32, Value>,
+    latched: HashMap<u32, Arc<Vec<u8>>>,
+    conns: Vec<Conn>,
+}
+
+fn lock(m: &Mutex<Shared>) -> MutexGuard<'_, Shared> {
+    // A thread that panicked holding it left plain data behind: use it.
+    m.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+impl Shared {
+    fn broadcast(&mut self, make: impl Fn() -> Out) {
+        self.conns.retain(|c| match c.tx.try_send(make()) {
+            Ok(()) | Err(TrySendError::Full(_)) => true,
+            Err(TrySendError::Disconnected(_)) => false,
+        });
+    }
+}
+
+fn status(level: u8, message: &str) -> Out {
+    Out::Text(json!({"op": "status", "level": level, "message": message}).to_string())
+}
+
+/// One connection's writer: frames out until the queue closes or the client goes.
+fn write_loop(mut s: TcpStream, rx: Receiver<Out>, subs: Arc<Mutex<HashMap<u32, u32>>>) {
+    let data = |sub: u32, stamp: u64, payload: &[u8]| {
+        let mut b = Vec::with_capacity(13 + payload.len());
+        b.push(1u8); // Message Data
+        b.extend_from_slice(&sub.to_le_bytes());
+        b.extend_from_slice(&stamp.to_le_bytes());
+        b.extend_from_slice(payload);
+        b
+    };
+    for out in rx {
+        let written = match out {
+            Out::Text(t) => ws::write_frame(&mut s, opcode::TEXT, t.as_bytes()),
+            Out::Pong(p) => ws::write_frame(&mut s, opcode::PONG, &p),
+            Out::ForSub {
+                sub,
+                stamp,
+                payload,
+            } => ws::write_frame(&mut s, opcode::BINARY, &data(sub, stamp, &payload)),
+            Out::Data {
+                channel,
+                stamp,
+                payload,
+            } => {
+                let ids: Vec<u32> = subs
+                    .lock()
+                    .map(|m| {
+                        m.iter()
+                            .filter(|(_, c)| **c == channel)
+                            .map(|(s, _)| *s)
+                            .collect()
+                    })
+                    .unwrap_or_default();
+                ids.into_iter().try_for_each(|sub| {
+                    ws::write_frame(&mut s, opcode::BINARY, &data(sub, stamp, &payload))
+                })
+            }
+        };
+        if let Err(e) = written.and_then(|()| s.flush()) {
+            tracing::info!(error = %e, "a viewer went away");
+            break;
+        }
+    }
+    if let Err(e) = s.shutdown(Shutdown::Both) {
+        tracing::debug!(error = %e, "cannot shut a viewer's connection down");
+    }
+}
+
+/// One connection: the handshake, then the client's requests until it closes.
+fn serve_client(mut s: TcpStream, shared: Arc<Mutex<Shared>>, max_clients: usize) {
+    let peer = s.peer_addr().ok();
+    if let Err(e) = ws::handshake(&mut s) {
+        tracing::info!(?peer, error = %e, "a viewer's handshake was refused");
+        return;
+    }
+    // A client that stops reading is dropped after this long rather than holding a writer.
+    if let Err(e) = s.set_write_timeout(Some(Duration::from_secs(5))) {
+        tracing::warn!(error = %e, "cannot set a write timeout");
+    }
+    let Ok(write_half) = s.try_clone() else {
+        tracing::warn!(?peer, "cannot clone a viewer's connection");
+        return;
+    };
+    let (tx, rx) = sync_channel::<Out>(1024);
+    let subs: Arc<Mutex<HashMap<u32, u32>>> = Arc::default();
+    let writer = {
+        let subs = Arc::clone(&subs);
+        std::thread::Builder::new()
+            .name("limber-view-write".into())
+            .spawn(move || write_loop(write_half, rx, subs))
+    };
+    if let Err(e) = writer {
+        tracing::warn!(error = %e, "cannot start a viewer's writer");
+        return;
+    }
+    {
+        let mut sh = lock(&shared);
+        if sh.conns.len() >= max_clients {
+            if tx
+                .try_send(status(2, "too many viewers connected"))
+                .is_err()
+            {
+                tracing::debug!("a refused viewer is gone already");
+            }
+            drop(sh);
+            drop(tx);
+            return;
+        }
+        let info = json!({
+            "op": "serverInfo",
+            "name": "limber view",
+            "capabilities": [],
+            "metadata": {"layout_version": limber_interfaces::LAYOUT_VERSION.to_string()},
+            "sessionId": monotonic_ns().to_string(),
+        });
+        let adv = json!({"op": "advertise", "channels": sh.channels.values().cloned().collect::<Vec<_>>()});
+        if tx.try_send(Out::Text(info.to_string())).is_err()
+            || tx.try_send(Out::Text(adv.to_string())).is_err()
+        {
+            return;
+        }
+        sh.conns.push(Conn {
+            tx: tx.clone(),
+            subs: Arc::clone(&subs),
+        });
+    }
+    let mut reader = MessageReader::default();
+    loop {
+        let msg = match reader.read(&mut s) {
+            Ok(m) => m,
+            Err(e) => {
+                tracing::info!(?peer, error = %e, "a viewer's connection ended");
+                break;
+            }
+        };
+        let reply = match msg {
+            Incoming::Close => break,
+            Incoming::Ping(p) => Some(Out::Pong(p)),
+            Incoming::Binary(_) => Some(status(2, "this server is read-only")),
+            Incoming::Text(t) => handle_op(&t, &shared, &subs, &tx),
+        };
+        if let Some(r) = reply
+            && tx.try_send(r).is_err()
+        {
+            break;
+        }
+    }
+    // Dropping the sender ends the writer once the shared list lets its copy go.
+    lock(&shared).conns.retain(|c| !Arc::ptr_eq(&c.subs, &subs));
+    if let Err(e) = s.shutdown(Shutdown::Both) {
+        tracing::debug!(error = %e, "cannot shut a viewer's connection down");
+    }
+}
+
+/// A client's JSON request; the status to answer it with, if any.
+fn handle_op(
+    text: &str,
+    shared: &Mutex<Shared>,
+    subs: &Mutex<HashMap<u32, u32>>,
+    tx: &SyncSender<Out>,
+) -> Option<Out> {
+    let Ok(v) = serde_json::from_str::<Value>(text) else {
+        return Some(status(2, "not a JSON object"));
+    };
+    let Ok(mut subs) = subs.lock() else {
+        return Some(status(2, "internal error"));
+    };
+    match v["op"].as_str() {
+        Some("subscribe") => {
+            let Some(list) = v["subscriptions"].as_array() else {
+                return Some(status(2, "subscribe: no subscriptions array"));
+            };
+            for s in list {
+                let (Some(id), Some(channel)) = (s["id"].as_u64(), s["channelId"].as_u64()) else {
+                    return Some(status(2, "subscribe: id and channelId are numbers"));
+                };
+                let (Ok(id), Ok(channel)) = (u32::try_from(id), u32::try_from(channel)) else {
+                    return Some(status(2, "subscribe: id out of range"));
+                };
+                let sh = lock(shared);
+                if !sh.channels.contains_key(&channel) {
+                    return Some(status(1, &format!("no channel {channel}")));
+                }
+                subs.insert(id, channel);
+                if let Some(p) = sh.latched.get(&channel) {
+                    let latched = Out::ForSub {
+                        sub: id,
+                        stamp: 0,
+                        payload: Arc::clone(p),
+                    };
+                    if tx.try_send(latched).is_err() {
+                        tracing::debug!("a viewer's queue is full: latched message dropped");
+                    }
+                }
+            }
+            None
+        }
+        Some("unsubscribe") => {
+            for id in v["subscriptionIds"].as_array().into_iter().flatten() {
+                if let Some(id) = id.as_u64().and_then(|i| u32::try_from(i).ok()) {
+                    subs.remove(&id);
+                }
+            }
+            None
+        }
+        Some(op) => Some(status(
+            1,
+            &format!("{op} is not supported: this server is read-only"),
+        )),
+        None => Some(status(2, "a message without op")),
+    }
+}
+
+/// One device shown, whatever its interface.
+trait Shown {
+    /// Sends what arrived to the clients.
+    fn forward(&mut self, shared: &Mutex<Shared>, epoch: &dyn Fn(u64) -> u64);
+    fn alive(&self) -> bool;
+}
+
+struct Dev<I: Interface> {
+    client: Client<I>,
+    state: u32,
+    joints: Option<u32>,
+}
+
+impl<I: Interface> Shown for Dev<I> {
+    fn forward(&mut self, shared: &Mutex<Shared>, epoch: &dyn Fn(u64) -> u64) {
+        let mut states = Vec::new();
+        if let Err(e) = self.client.relay_states(|d| states.push(*d)) {
+            tracing::warn!(device = %self.client.device(), error = %e, "cannot take the states");
+        }
+        if states.is_empty() {
+            return;
+        }
+        let mut sh = lock(shared);
+        for d in states {
+            let stamp = epoch(d.header().stamp_ns);
+            let mut v = d.json();
+            v["device"] = json!(self.client.device().to_string());
+            let payload = Arc::new(v.to_string().into_bytes());
+            let channel = self.state;
+            sh.broadcast(|| Out::Data {
+                channel,
+                stamp,
+                payload: Arc::clone(&payload),
+            });
+            if let (Some(channel), Some(a)) = (
+                self.joints,
+                (&d as &dyn core::any::Any).downcast_ref::<ActArrayData>(),
+            ) {
+                let payload = Arc::new(schema::joint_states(a, stamp).to_string().into_bytes());
+                sh.broadcast(|| Out::Data {
+                    channel,
+                    stamp,
+                    payload: Arc::clone(&payload),
+                });
+            }
+        }
+    }
+    fn alive(&self) -> bool {
+        self.client.relay_driver_alive()
+    }
+}
+
+/// Advertises channel `topic` to every client; its id.
+fn advertise(sh: &mut Shared, topic: String, schema_name: &str, schema: String) -> u32 {
+    let id = sh.channels.keys().next_back().map_or(1, |k| k + 1);
+    let ch = json!({
+        "id": id,
+        "topic": topic,
+        "encoding": "json",
+        "schemaName": schema_name,
+        "schema": schema,
+        "schemaEncoding": "jsonschema",
+    });
+    sh.channels.insert(id, ch.clone());
+    let text = json!({"op": "advertise", "channels": [ch]}).to_string();
+    sh.broadcast(|| Out::Text(text.clone()));
+    id
+}
+
+struct Open<'a> {
+    ctx: &'a Context,
+    name: &'a DeviceName,
+    shared: &'a Mutex<Shared>,
+    urdf: Option<String>,
+}
+
+impl InterfaceVisitor for Open<'_> {
+    type Output = Result<Box<dyn Shown>, String>;
+    fn visit<I: Interface>(self) -> Self::Output {
+        let dev = self.name.to_string();
+        let client = Client::<I>::connect(self.ctx, &dev).map_err(|e| e.to_string())?;
+        let mut sh = lock(self.shared);
+        let state = advertise(
+            &mut sh,
+            format!("/{dev}/state"),
+            I::Data::LAYOUT.type_name,
+            json!({"type": "object", "description": "the state as `limber echo --json` prints it (docs/echo-json.md)"}).to_string(),
+        );
+        let joints = (I::KIND == InterfaceKind::ActArray).then(|| {
+            advertise(
+                &mut sh,
+                format!("/{dev}/joint_states"),
+                schema::JOINT_STATES,
+                schema::joint_states_schema(),
+            )
+        });
+        if let Some(urdf) = self.urdf {
+            let id = advertise(
+                &mut sh,
+                format!("/{dev}/robot_description"),
+                "std_msgs/String",
+                json!({"type": "object", "properties": {"data": {"type": "string"}}}).to_string(),
+            );
+            let payload = json!({ "data": urdf }).to_string().into_bytes();
+            sh.latched.insert(id, Arc::new(payload));
+        }
+        Ok(Box::new(Dev::<I> {
+            client,
+            state,
+            joints,
+        }))
+    }
+}
+
+/// The URDF of an actuator array offered by `driver` with `joints` actuators, if limber
+/// knows its chain: the Pioneer arm's; simarm's built-in arms, or the chain given.
+fn urdf_for(driver: &str, device: &DeviceName, config: &ViewConfig) -> Option<String> {
+    if device.interface() != InterfaceKind::ActArray || device.index() != 0 {
+        return None;
+    }
+    let chain = match driver {
+        "pioneer" => Chain::pioneer5(),
+        "simarm" => config
+            .simarm_chain
+            .clone()
+            .unwrap_or_else(Chain::default_6dof),
+        _ => return None,
+    };
+    Some(urdf_of_chain(&chain, device.robot()))
+}
+
+/// Serves the domain's devices to Foxglove until `stop` returns true.
+pub fn view(
+    domain: &Domain,
+    config: &ViewConfig,
+    stop: &dyn Fn() -> bool,
+    report: &mut dyn FnMut(ViewEvent),
+) -> Result<(), ViewError> {
+    let listener = TcpListener::bind(config.listen).map_err(|source| ViewError::Listen {
+        addr: config.listen,
+        source,
+    })?;
+    let local = listener.local_addr().map_err(|source| ViewError::Listen {
+        addr: config.listen,
+        source,
+    })?;
+    let ctx = Context::new(domain, Role::Client, "limber-view").map_err(|e| ViewError::Domain {
+        domain: domain.name().to_string(),
+        reason: e.to_string(),
+    })?;
+    let shared: Arc<Mutex<Shared>> = Arc::default();
+    {
+        let accepted = Arc::clone(&shared);
+        let max = config.max_clients;
+        let (tx, rx) = sync_channel::<SocketAddr>(16);
+        std::thread::Builder::new()
+            .name("limber-view-accept".into())
+            .spawn(move || {
+                for s in listener.incoming() {
+                    match s {
+                        Ok(s) => {
+                            if let Ok(p) = s.peer_addr()
+                                && tx.try_send(p).is_err()
+                            {
+                                tracing::debug!(peer = %p, "a viewer not reported");
+                            }
+                            let shared = Arc::clone(&accepted);
+                            if let Err(e) = std::thread::Builder::new()
+                                .name("limber-view-read".into())
+                                .spawn(move || serve_client(s, shared, max))
+                            {
+                                tracing::warn!(error = %e, "cannot serve a viewer");
+                            }
+                        }
+                        Err(e) => tracing::warn!(error = %e, "cannot accept a viewer"),
+                    }
+                }
+            })
+            .map_err(|source| ViewError::Listen {
+                addr: local,
+                source,
+            })?;
+        report(ViewEvent::Listening(local));
+        run(
+            &ctx,
+            domain,
+            config,
+            &shared,
+            stop,
+            &mut |ev| report(ev),
+            &rx,
+        )
+    }
+}
+
+/// The loop: new devices every second, their states as they come (looked at every 20 ms).
+fn run(
+    ctx: &Context,
+    domain: &Domain,
+    config: &ViewConfig,
+    shared: &Mutex<Shared>,
+    stop: &dyn Fn() -> bool,
+    report: &mut dyn FnMut(ViewEvent),
+    clients: &Receiver<SocketAddr>,
+) -> Result<(), ViewError> {
+    let offset = {
+        let rt = rustix::time::clock_gettime(rustix::time::ClockId::Realtime);
+        i128::from(rt.tv_sec) * 1_000_000_000 + i128::from(rt.tv_nsec) - i128::from(monotonic_ns())
+    };
+    let epoch = move |mono: u64| u64::try_from(i128::from(mono) + offset).unwrap_or(0);
+    let mut devices: BTreeMap<DeviceName, Box<dyn Shown>> = BTreeMap::new();
+    let mut next_discovery = Instant::now();
+    while !stop() {
+        if Instant::now() >= next_discovery {
+            next_discovery = Instant::now() + Duration::from_secs(1);
+            let found = list_devices(domain).map_err(|e| ViewError::Domain {
+                domain: domain.name().to_string(),
+                reason: e.to_string(),
+            })?;
+            for info in found.into_iter().filter(|d| d.alive) {
+                if devices.contains_key(&info.name) {
+                    continue;
+                }
+                let urdf = urdf_for(&info.driver, &info.name, config);
+                match info.name.interface().visit(Open {
+                    ctx,
+                    name: &info.name,
+                    shared,
+                    urdf,
+                }) {
+                    Ok(d) => {
+                        report(ViewEvent::Device(info.name.clone()));
+                        devices.insert(info.name, d);
+                    }
+                    Err(e) => tracing::warn!(device = %info.name, error = %e, "cannot show"),
+                }
+            }
+            devices.retain(|_, d| d.alive());
+        }
+        for d in devices.values_mut() {
+            d.forward(shared, &epoch);
+        }
+        while let Ok(peer) = clients.try_recv() {
+            report(ViewEvent::Client(peer));
+        }
+        std::thread::sleep(FORWARD_PERIOD);
+    }
+    Ok(())
+}
+
+/// How often the states that arrived are forwarded to the viewers.
+const FORWARD_PERIOD: Duration = Duration::from_millis(20);
