@@ -127,6 +127,12 @@ enum Command {
     ///
     /// Example: limber replay run.mcap --rate 2 --loop
     Replay(record::ReplayArgs),
+    /// Show the domain's devices live in Foxglove: a read-only foxglove.websocket.v1
+    /// server (loopback by default) with every state as JSON, the actuator arrays as
+    /// foxglove.JointStates and a URDF of each arm whose chain limber knows.
+    ///
+    /// Example: limber view --listen 127.0.0.1:8765
+    View(record::ViewArgs),
 }
 
 /// Runs the `limber` command line with the process's arguments.
@@ -172,6 +178,7 @@ where
         Command::Bridge(args) => bridge::run(args),
         Command::Record(args) => record::record(args),
         Command::Replay(args) => record::replay(args),
+        Command::View(args) => record::view(args),
         Command::Bench(args) => limber_bench::run_cli(args).map_err(|e| {
             let code = if e.is_usage() {
                 exit::USAGE

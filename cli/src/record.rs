@@ -186,3 +186,48 @@ pub fn replay(a: ReplayArgs) -> Result<(), CliError> {
     outln!("replayed {n} messages")?;
     Ok(())
 }
+
+/// Arguments of `limber view`.
+#[derive(Debug, Args)]
+pub struct ViewArgs {
+    /// Where to listen (Foxglove's default port on loopback; another address exposes the
+    /// domain's states, read-only, to whoever reaches it).
+    #[arg(long, default_value = "127.0.0.1:8765", value_name = "ADDR:PORT")]
+    listen: std::net::SocketAddr,
+    /// The chain of simarm's arm when it runs with `--chain FILE` (default: its built-in
+    /// 6-joint arm), for the URDF served.
+    #[arg(long, value_name = "FILE")]
+    simarm_chain: Option<PathBuf>,
+}
+
+/// Runs `limber view`.
+pub fn view(a: ViewArgs) -> Result<(), CliError> {
+    install_signals()?;
+    let domain = domain()?;
+    let simarm_chain = match &a.simarm_chain {
+        Some(p) => Some(
+            limber_kinematics::chain::Chain::from_file(p)
+                .map_err(|e| CliError::new(exit::USAGE, e.to_string()))?,
+        ),
+        None => None,
+    };
+    let config = limber_record::ViewConfig {
+        listen: a.listen,
+        simarm_chain,
+        ..limber_record::ViewConfig::default()
+    };
+    let mut report = |ev: limber_record::ViewEvent| match ev {
+        limber_record::ViewEvent::Listening(addr) => crate::out::note(format_args!(
+            "serving foxglove.websocket.v1 on ws://{addr}; ready\n"
+        )),
+        limber_record::ViewEvent::Device(d) => crate::out::note(format_args!("showing {d}\n")),
+        limber_record::ViewEvent::Client(p) => crate::out::note(format_args!("viewer {p}\n")),
+    };
+    limber_record::view(
+        &domain,
+        &config,
+        &signals::termination_requested,
+        &mut report,
+    )
+    .map_err(|e| CliError::new(exit::FAILURE, e.to_string()))
+}
