@@ -120,18 +120,17 @@ enum Command {
     /// named) into an MCAP file, with a progress line on stderr; `--info FILE` summarises a
     /// recorded file. Foxglove and the `mcap` tools open the files (record/README.md).
     ///
-    /// Example: limber record -o run.mcap --duration 10
+    /// Example: limber record pioneer/actarray/0 -o /tmp/limber-help.mcap --duration 2
     Record(record::RecordArgs),
     /// Republish a recorded file into the domain as if its devices were live: `limber
     /// echo`, `limber monitor` and clients work on it; commands are dropped.
     ///
-    /// Example: limber replay run.mcap --rate 2 --loop
+    /// Example: limber replay /tmp/limber-help.mcap --rate 4
     Replay(record::ReplayArgs),
     /// Show the domain's devices live in Foxglove: a read-only foxglove.websocket.v1
     /// server (loopback by default) with every state as JSON, the actuator arrays as
-    /// foxglove.JointStates and a URDF of each arm whose chain limber knows.
-    ///
-    /// Example: limber view --listen 127.0.0.1:8765
+    /// foxglove.JointStates and a URDF of each arm whose chain limber knows. Foxglove
+    /// connects to ws://127.0.0.1:8765 (record/README.md).
     View(record::ViewArgs),
 }
 
