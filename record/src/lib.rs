@@ -1,12 +1,12 @@
 //! # limber-record: record, replay and see
 //!
-//! * [`record`](recorder::record): every state, outcome and driver statistics of a
+//! * [`record`]: every state, outcome and driver statistics of a
 //!   domain (or of the devices named) into an MCAP file, with its acquisition and receive
 //!   times, in a process and thread of its own and in bounded memory.
-//! * [`info`](info::info): what a file holds (channels, counts, time span).
-//! * [`replay`](replay::replay): a recorded file republished into a domain, its devices
+//! * [`info()`]: what a file holds (channels, counts, time span).
+//! * [`replay()`]: a recorded file republished into a domain, its devices
 //!   hosted as if their drivers were live.
-//! * [`view`](view::view): the devices live in Foxglove (the `foxglove.websocket.v1`
+//! * [`view()`]: the devices live in Foxglove (the `foxglove.websocket.v1`
 //!   protocol over [`ws`]), with a URDF of each arm whose chain limber knows ([`urdf`]).
 //!
 //! The file format is MCAP ([`mcap`]), written and read by this crate from the

@@ -14,7 +14,7 @@
 mod read;
 mod write;
 
-pub use read::{Channel, McapReader, ReadError, Record, Schema};
+pub use read::{Channel, MAX_RECORD, McapReader, ReadError, Record, Schema};
 pub use write::{Compression, McapWriter, WriteError};
 
 /// The magic at the start and at the end of every MCAP file (format version 0).
