@@ -22,6 +22,7 @@ pub mod recorder;
 pub mod replay;
 pub mod schema;
 pub mod urdf;
+pub mod urdf_in;
 pub mod view;
 pub mod ws;
 
