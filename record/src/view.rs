@@ -459,6 +459,22 @@ fn urdf_for(driver: &str, device: &DeviceName, config: &ViewConfig) -> Option<St
     Some(urdf_of_chain(&chain, device.robot()))
 }
 
+/// No URDF for a device ([`urdf_of_device`]).
+#[derive(Debug, Error)]
+#[error("no URDF for {0}: limber knows the chains of actarray/0 of the pioneer and simarm drivers")]
+pub struct NoUrdf(pub String);
+
+/// The URDF `limber view` serves for `device`: its driver's (found in `domain`) arm chain, or
+/// when no driver runs, the one its robot name suggests (`pioneer`, `simarm`).
+pub fn urdf_of_device(domain: &Domain, device: &DeviceName) -> Result<String, NoUrdf> {
+    let driver = list_devices(domain)
+        .ok()
+        .and_then(|l| l.into_iter().find(|d| &d.name == device))
+        .map(|d| d.driver)
+        .unwrap_or_else(|| device.robot().to_string());
+    urdf_for(&driver, device, &ViewConfig::default()).ok_or_else(|| NoUrdf(device.to_string()))
+}
+
 /// Serves the domain's devices to Foxglove until `stop` returns true.
 pub fn view(
     domain: &Domain,
