@@ -39,8 +39,14 @@ pub struct RecordArgs {
     /// How chunks are compressed.
     #[arg(long, value_enum, default_value = "lz4")]
     compression: CompressionArg,
+    /// Start a new file every this many megabytes (files FILE_0.mcap, FILE_1.mcap...).
+    #[arg(long, value_name = "MB", value_parser = parse_megabytes)]
+    split_size: Option<u64>,
+    /// Start a new file every this many seconds (files FILE_0.mcap, FILE_1.mcap...).
+    #[arg(long, value_name = "S", value_parser = crate::parse_seconds)]
+    split_time: Option<f64>,
     /// Summarise a recorded file instead (channels, message counts, time span).
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["output", "devices", "duration"])]
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["output", "devices", "duration", "split_size", "split_time"])]
     info: Option<PathBuf>,
 }
 
@@ -55,6 +61,16 @@ pub struct ReplayArgs {
     /// Start again at the end, until Ctrl-C or SIGTERM.
     #[arg(long = "loop")]
     looped: bool,
+}
+
+/// `--split-size`: a whole number of megabytes, at least 1; in bytes.
+fn parse_megabytes(s: &str) -> Result<u64, String> {
+    match s.parse::<u64>() {
+        Ok(mb @ 1..=1_000_000) => Ok(mb * 1_000_000),
+        _ => Err(format!(
+            "{s:?}: a whole number of megabytes from 1 to 1000000"
+        )),
+    }
 }
 
 fn install_signals() -> Result<(), CliError> {
@@ -102,6 +118,8 @@ pub fn record(a: RecordArgs) -> Result<(), CliError> {
             CompressionArg::Lz4 => Compression::Lz4,
             CompressionArg::None => Compression::None,
         },
+        split_bytes: a.split_size,
+        split_time: a.split_time.map(Duration::from_secs_f64),
         ..RecordConfig::default()
     };
     let tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
@@ -194,8 +212,8 @@ pub struct ViewArgs {
     /// domain's states, read-only, to whoever reaches it).
     #[arg(long, default_value = "127.0.0.1:8765", value_name = "ADDR:PORT")]
     listen: std::net::SocketAddr,
-    /// The chain of simarm's arm when it runs with `--chain FILE` (default: its built-in
-    /// 6-joint arm), for the URDF served.
+    /// The chain of simarm's arm when it runs with `--chain FILE` or `--urdf FILE.urdf`
+    /// (default: its built-in 6-joint arm), for the URDF served.
     #[arg(long, value_name = "FILE")]
     simarm_chain: Option<PathBuf>,
 }
@@ -205,6 +223,10 @@ pub fn view(a: ViewArgs) -> Result<(), CliError> {
     install_signals()?;
     let domain = domain()?;
     let simarm_chain = match &a.simarm_chain {
+        Some(p) if p.extension().is_some_and(|e| e == "urdf") => Some(
+            limber_record::urdf_in::chain_from_urdf_file(p)
+                .map_err(|e| CliError::new(exit::USAGE, format!("{}: {e}", p.display())))?,
+        ),
         Some(p) => Some(
             limber_kinematics::chain::Chain::from_file(p)
                 .map_err(|e| CliError::new(exit::USAGE, e.to_string()))?,

@@ -307,3 +307,59 @@ fn a_replayed_run_drives_echo_and_a_client_with_the_recorded_states() {
     assert!(stdout(&o).contains("pioneer/actarray/0"), "{}", stdout(&o));
     assert_eq!(replay.term(), Some(0));
 }
+
+#[test]
+fn a_split_recording_is_a_series_of_whole_files_without_a_gap_between_them() {
+    let Some(py) = python() else { return };
+    let d = Domain::unique_for_test();
+    let _pioneer = pioneer_emulated(d.name());
+    let base = scratch("split");
+    let mut rec = Bg::spawn(
+        d.name(),
+        &[
+            "record",
+            "pioneer/actarray/0",
+            "-o",
+            base.to_str().unwrap(),
+            "--duration",
+            "3.5",
+            "--split-time",
+            "1",
+        ],
+    );
+    let done = rec.line(|l| l.starts_with("recorded "));
+    assert!(done.ends_with(", 0 dropped, 0 missed"), "{done}");
+    assert_eq!(exit_of(&mut rec), Some(0));
+    assert!(!base.exists(), "a series has no file of the name given");
+    let mut seqs = Vec::new();
+    let mut files = 0;
+    for i in 0.. {
+        let file = limber_record::files::series_path(&base, i);
+        if !file.exists() {
+            break;
+        }
+        files += 1;
+        let o = output(
+            Command::new(&py)
+                .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/record/check_mcap.py"))
+                .arg(&file),
+        );
+        assert!(o.status.success(), "{}: {}", file.display(), stderr(&o));
+        let v: Value = serde_json::from_str(&stdout(&o)).unwrap();
+        // Each file is whole: its channels declared again, its geometry only in the first.
+        let t = &v["topics"]["/pioneer/actarray/0/state"];
+        seqs.extend(
+            t["seqs"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|s| s.as_u64().unwrap()),
+        );
+    }
+    assert!((3..=5).contains(&files), "{files} files");
+    assert!(seqs.len() >= 10, "{seqs:?}");
+    assert!(
+        seqs.windows(2).all(|w| w[1] == w[0] + 1),
+        "a gap between the files: {seqs:?}"
+    );
+}

@@ -16,6 +16,7 @@
 //! array also `/<device>/joint_states` (Foxglove's `foxglove.JointStates`, JSON); each
 //! robot `/<robot>/driver` (its driver's statistics). See README.md.
 
+pub mod files;
 pub mod info;
 pub mod mcap;
 pub mod recorder;

@@ -9,14 +9,12 @@
 //! subscriber's buffer overflowed) shows as a gap in the state header's sequence numbers,
 //! counted as `missed`.
 
-use std::collections::{BTreeMap, BTreeSet, HashMap};
-use std::fs::File;
-use std::io::BufWriter;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
+use std::sync::mpsc::{SyncSender, TrySendError, sync_channel};
 use std::time::{Duration, Instant};
 
 use iceoryx2::port::listener::Listener;
@@ -31,7 +29,7 @@ use limber_services::{Client, Context, DeviceName, Domain, Role, list_devices, m
 use thiserror::Error;
 use zerocopy::IntoBytes;
 
-use crate::mcap::{Compression, LAYOUT_SCHEMA_ENCODING, McapWriter, WIRE_ENCODING, WriteError};
+use crate::mcap::{Compression, LAYOUT_SCHEMA_ENCODING, WIRE_ENCODING, WriteError};
 use crate::schema;
 
 /// How `record` runs.
@@ -48,6 +46,11 @@ pub struct RecordConfig {
     pub chunk_size: usize,
     /// Messages the writer thread may have waiting at most.
     pub queue: usize,
+    /// Start a new file when this one has this many bytes (files `<stem>_0.mcap`,
+    /// `<stem>_1.mcap`... once either split is set).
+    pub split_bytes: Option<u64>,
+    /// Start a new file when this one is this old.
+    pub split_time: Option<Duration>,
 }
 
 impl Default for RecordConfig {
@@ -58,6 +61,8 @@ impl Default for RecordConfig {
             compression: Compression::Lz4,
             chunk_size: 1 << 20,
             queue: 4096,
+            split_bytes: None,
+            split_time: None,
         }
     }
 }
@@ -123,16 +128,16 @@ pub struct Progress {
 }
 
 #[derive(Default)]
-struct Counters {
-    messages: AtomicU64,
-    bytes: AtomicU64,
+pub(crate) struct Counters {
+    pub(crate) messages: AtomicU64,
+    pub(crate) bytes: AtomicU64,
     dropped: AtomicU64,
     missed: AtomicU64,
-    channels: AtomicU64,
+    pub(crate) channels: AtomicU64,
 }
 
 /// What the receiving side hands to the writer thread.
-enum Item {
+pub(crate) enum Item {
     Channel {
         key: u32,
         topic: String,
@@ -356,79 +361,6 @@ impl InterfaceVisitor for Open<'_> {
     }
 }
 
-/// The writer thread: channels as they are declared, messages as they come, until the
-/// queue closes; then the summary.
-fn write_all(
-    path: &Path,
-    rx: Receiver<Item>,
-    config: &RecordConfig,
-    counters: &Counters,
-    metadata: Vec<(String, String)>,
-) -> Result<(), RecordError> {
-    let file = File::create(path).map_err(|source| RecordError::Create {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let library = format!("limber {}", env!("CARGO_PKG_VERSION"));
-    let mut w = McapWriter::new(
-        BufWriter::new(file),
-        &library,
-        config.compression,
-        config.chunk_size,
-    )?;
-    w.add_metadata("limber", &metadata)?;
-    let mut schemas: HashMap<(String, String), u16> = HashMap::new();
-    let mut channels: HashMap<u32, u16> = HashMap::new();
-    for item in rx {
-        match item {
-            Item::Channel {
-                key,
-                topic,
-                schema: (name, encoding, data),
-                encoding: message_encoding,
-                metadata,
-            } => {
-                let id = match schemas.get(&(name.clone(), encoding.clone())) {
-                    Some(id) => *id,
-                    None => {
-                        let id = w.add_schema(&name, &encoding, data.as_bytes())?;
-                        schemas.insert((name, encoding), id);
-                        id
-                    }
-                };
-                let ch = w.add_channel(id, &topic, message_encoding, &metadata)?;
-                channels.insert(key, ch);
-                counters.channels.fetch_add(1, Ordering::Relaxed);
-            }
-            Item::Message {
-                key,
-                log_time,
-                publish_time,
-                data,
-            } => {
-                if let Some(ch) = channels.get(&key) {
-                    w.write_message(*ch, log_time, publish_time, &data)?;
-                    counters.messages.fetch_add(1, Ordering::Relaxed);
-                    counters
-                        .bytes
-                        .store(w.written() + data.len() as u64, Ordering::Relaxed);
-                }
-            }
-        }
-    }
-    let mut out = w.finish()?;
-    std::io::Write::flush(&mut out).map_err(WriteError::Io)?;
-    let written = out
-        .into_inner()
-        .map_err(|e| WriteError::Io(e.into_error()))?;
-    written.sync_all().map_err(WriteError::Io)?;
-    counters.bytes.store(
-        written.metadata().map(|m| m.len()).unwrap_or(0),
-        Ordering::Relaxed,
-    );
-    Ok(())
-}
-
 fn realtime_minus_monotonic() -> i128 {
     let rt = rustix::time::clock_gettime(rustix::time::ClockId::Realtime);
     let mono = monotonic_ns();
@@ -472,7 +404,7 @@ pub fn record(
         let (path, config, counters) = (path.to_path_buf(), config.clone(), Arc::clone(&counters));
         std::thread::Builder::new()
             .name("limber-record-writer".into())
-            .spawn(move || write_all(&path, rx, &config, &counters, metadata))
+            .spawn(move || crate::files::write_all(&path, rx, &config, &counters, &metadata))
             .map_err(|e| RecordError::Thread(e.to_string()))?
     };
     let mut sink = Sink {
