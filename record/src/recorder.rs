@@ -25,6 +25,7 @@ use limber_interfaces::diagnostics::DriverStats;
 use limber_interfaces::prelude::*;
 use limber_interfaces::{HasHeader, Interface, InterfaceVisitor, Message, ReplyBody, WireStruct};
 use limber_services::diagnostics::{StatsReader, list_drivers};
+use limber_services::event_loop::LoopError;
 use limber_services::{Client, Context, DeviceName, Domain, Role, list_devices, monotonic_ns};
 use thiserror::Error;
 use zerocopy::IntoBytes;
@@ -70,14 +71,18 @@ impl Default for RecordConfig {
 /// Recording failed.
 #[derive(Debug, Error)]
 pub enum RecordError {
-    /// The domain could not be joined or listed.
-    #[error("cannot join domain {domain}: {reason}")]
+    /// The domain could not be joined.
+    #[error("cannot join domain {domain}: {source}")]
     Domain {
         /// The domain.
         domain: String,
         /// Why.
-        reason: String,
+        #[source]
+        source: limber_services::ContextError,
     },
+    /// The domain's devices could not be listed.
+    #[error(transparent)]
+    List(#[from] limber_services::ListError),
     /// A device named on the command line is not a device name.
     #[error(transparent)]
     Name(#[from] limber_services::NameError),
@@ -93,12 +98,15 @@ pub enum RecordError {
     /// Writing the file failed.
     #[error(transparent)]
     Write(#[from] WriteError),
-    /// The writer thread could not be started or died.
-    #[error("the writer thread failed: {0}")]
-    Thread(String),
+    /// The writer thread could not be started.
+    #[error("cannot start the writer thread: {0}")]
+    Thread(#[source] std::io::Error),
+    /// The writer thread panicked (a bug).
+    #[error("the writer thread panicked")]
+    WriterPanicked,
     /// Waiting for the devices failed.
     #[error("cannot wait for the devices: {0}")]
-    Wait(String),
+    Wait(#[from] LoopError),
 }
 
 /// What `record` reports as it runs.
@@ -381,11 +389,12 @@ pub fn record(
         .iter()
         .map(|d| d.parse())
         .collect::<Result<_, _>>()?;
-    let ctx =
-        Context::new(domain, Role::Client, "limber-record").map_err(|e| RecordError::Domain {
+    let ctx = Context::new(domain, Role::Client, "limber-record").map_err(|source| {
+        RecordError::Domain {
             domain: domain.name().to_string(),
-            reason: e.to_string(),
-        })?;
+            source,
+        }
+    })?;
     let counters = Arc::new(Counters::default());
     let (tx, rx) = sync_channel::<Item>(config.queue.max(16));
     let offset_ns = realtime_minus_monotonic();
@@ -405,7 +414,7 @@ pub fn record(
         std::thread::Builder::new()
             .name("limber-record-writer".into())
             .spawn(move || crate::files::write_all(&path, rx, &config, &counters, &metadata))
-            .map_err(|e| RecordError::Thread(e.to_string()))?
+            .map_err(RecordError::Thread)?
     };
     let mut sink = Sink {
         tx,
@@ -418,9 +427,7 @@ pub fn record(
         report(ev.unwrap_or_else(|| RecordEvent::Progress(snapshot(&counters, started))))
     });
     drop(sink);
-    let written = writer
-        .join()
-        .map_err(|_| RecordError::Thread("it panicked".into()))?;
+    let written = writer.join().map_err(|_| RecordError::WriterPanicked)?;
     result?;
     written?;
     let p = snapshot(&counters, started);
@@ -487,20 +494,20 @@ fn receive(
         let ws = WaitSetBuilder::new()
             .signal_handling_mode(SignalHandlingMode::Disabled)
             .create::<ipc::Service>()
-            .map_err(|e| RecordError::Wait(e.to_string()))?;
+            .map_err(|e| LoopError::WaitSet(e.into()))?;
         let listeners: Vec<Rc<Listener<ipc::Service>>> =
             devices.values().map(|d| d.listener()).collect();
         let mut guards = Vec::new();
         for l in &listeners {
             guards.push(
                 ws.attach_notification(l.as_ref())
-                    .map_err(|e| RecordError::Wait(e.to_string()))?,
+                    .map_err(|e| LoopError::WaitSet(e.into()))?,
             );
         }
         let next_discovery = Instant::now() + DISCOVERY;
         while !over() && Instant::now() < next_discovery {
             ws.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, POLL)
-                .map_err(|e| RecordError::Wait(e.to_string()))?;
+                .map_err(LoopError::Wait)?;
             for d in devices.values_mut() {
                 d.drain(sink);
             }
@@ -550,11 +557,7 @@ fn discover(
 ) -> Result<Vec<DeviceName>, RecordError> {
     let mut added = Vec::new();
     let wanted: Vec<DeviceName> = if named.is_empty() {
-        list_devices(domain)
-            .map_err(|e| RecordError::Domain {
-                domain: domain.name().to_string(),
-                reason: e.to_string(),
-            })?
+        list_devices(domain)?
             .into_iter()
             .filter(|d| d.alive)
             .map(|d| d.name)

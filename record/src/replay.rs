@@ -20,8 +20,10 @@ use limber_interfaces::prelude::*;
 use limber_interfaces::{
     Envelope, HasHeader, Interface, InterfaceVisitor, Message, ReplyBody, ReplyEnvelope, WireStruct,
 };
-use limber_services::diagnostics::StatsPublisher;
-use limber_services::{Context, DeviceHost, DeviceName, Domain, Role, monotonic_ns};
+use limber_services::diagnostics::{DiagnosticsError, StatsPublisher};
+use limber_services::{
+    Context, DeviceHost, DeviceName, Domain, HostError, PublishError, Role, monotonic_ns,
+};
 use thiserror::Error;
 use zerocopy::FromBytes;
 
@@ -84,20 +86,31 @@ pub enum ReplayError {
         source: ReadError,
     },
     /// The domain could not be joined.
-    #[error("cannot join domain {domain}: {reason}")]
+    #[error("cannot join domain {domain}: {source}")]
     Domain {
         /// The domain.
         domain: String,
         /// Why.
-        reason: String,
+        #[source]
+        source: limber_services::ContextError,
     },
     /// A recorded device could not be hosted (a live driver offers it?).
-    #[error("cannot host {device}: {reason}")]
+    #[error("cannot host {device}: {source}")]
     Host {
         /// The device.
         device: String,
         /// Why.
-        reason: String,
+        #[source]
+        source: HostError,
+    },
+    /// A robot's driver statistics could not be offered or published.
+    #[error("driver statistics of {robot}: {source}")]
+    Stats {
+        /// The robot.
+        robot: String,
+        /// Why.
+        #[source]
+        source: DiagnosticsError,
     },
     /// A channel was recorded with another layout than this limber's.
     #[error("channel {topic} holds {found:?}, this limber speaks {expected:?}")]
@@ -119,13 +132,14 @@ pub enum ReplayError {
         /// Its struct's size.
         expected: usize,
     },
-    /// Publishing failed.
-    #[error("cannot publish on {topic}: {reason}")]
+    /// Publishing a state or an outcome failed.
+    #[error("cannot publish on {topic}: {source}")]
     Publish {
         /// The channel's topic.
         topic: String,
         /// Why.
-        reason: String,
+        #[source]
+        source: PublishError,
     },
 }
 
@@ -176,9 +190,9 @@ impl<I: Interface> Replayed for Hosted<I> {
         d.header_mut().stamp_ns = monotonic_ns();
         self.host
             .relay_publish(&d)
-            .map_err(|e| ReplayError::Publish {
+            .map_err(|source| ReplayError::Publish {
                 topic: topic.to_string(),
-                reason: e.to_string(),
+                source,
             })
     }
     fn outcome(&mut self, topic: &str, data: &[u8]) -> Result<(), ReplayError> {
@@ -186,9 +200,9 @@ impl<I: Interface> Replayed for Hosted<I> {
         o.stamp_ns = monotonic_ns();
         self.host
             .relay_outcome(&o)
-            .map_err(|e| ReplayError::Publish {
+            .map_err(|source| ReplayError::Publish {
                 topic: topic.to_string(),
-                reason: e.to_string(),
+                source,
             })
     }
     fn geometry(&mut self, topic: &str, data: &[u8]) -> Result<(), ReplayError> {
@@ -266,10 +280,9 @@ struct Host<'a> {
 }
 
 impl InterfaceVisitor for Host<'_> {
-    type Output = Result<Box<dyn Replayed>, String>;
+    type Output = Result<Box<dyn Replayed>, HostError>;
     fn visit<I: Interface>(self) -> Self::Output {
-        let host =
-            DeviceHost::<I>::new(self.ctx, self.name, REPLAY_DRIVER).map_err(|e| e.to_string())?;
+        let host = DeviceHost::<I>::new(self.ctx, self.name, REPLAY_DRIVER)?;
         Ok(Box::new(Hosted::<I> {
             host,
             geometry: None,
@@ -310,10 +323,11 @@ impl Replayer<'_> {
                 return Ok(Target::Ignored);
             };
             if !self.drivers.contains_key(robot) {
-                let p = StatsPublisher::new(&self.ctx, robot).map_err(|e| ReplayError::Host {
-                    device: format!("{robot}/driver"),
-                    reason: e.to_string(),
-                })?;
+                let p =
+                    StatsPublisher::new(&self.ctx, robot).map_err(|source| ReplayError::Stats {
+                        robot: robot.to_string(),
+                        source,
+                    })?;
                 self.drivers.insert(robot.to_string(), p);
                 (self.report)(ReplayEvent::Driver(robot.to_string()));
             }
@@ -335,9 +349,9 @@ impl Replayer<'_> {
                     ctx: &self.ctx,
                     name: &name,
                 })
-                .map_err(|reason| ReplayError::Host {
+                .map_err(|source| ReplayError::Host {
                     device: name.to_string(),
-                    reason,
+                    source,
                 })?;
             self.devices.insert(name.clone(), d);
             (self.report)(ReplayEvent::Hosting(name.clone()));
@@ -369,9 +383,9 @@ impl Replayer<'_> {
             Target::Driver(robot) => {
                 let mut s: DriverStats = read_exact(topic, data)?;
                 if let Some(p) = self.drivers.get_mut(robot) {
-                    p.publish(&mut s).map_err(|e| ReplayError::Publish {
-                        topic: topic.to_string(),
-                        reason: e.to_string(),
+                    p.publish(&mut s).map_err(|source| ReplayError::Stats {
+                        robot: robot.to_string(),
+                        source,
                     })?;
                 }
                 Ok(())
@@ -423,11 +437,12 @@ pub fn replay(
     };
     // The file is checked before anything is offered in the domain.
     let mut reader = open()?;
-    let ctx =
-        Context::new(domain, Role::Driver, "limber-replay").map_err(|e| ReplayError::Domain {
+    let ctx = Context::new(domain, Role::Driver, "limber-replay").map_err(|source| {
+        ReplayError::Domain {
             domain: domain.name().to_string(),
-            reason: e.to_string(),
-        })?;
+            source,
+        }
+    })?;
     let mut r = Replayer {
         ctx,
         devices: BTreeMap::new(),

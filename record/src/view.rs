@@ -15,6 +15,7 @@
 use std::collections::{BTreeMap, HashMap};
 use std::io::Write as _;
 use std::net::{Shutdown, SocketAddr, TcpListener, TcpStream};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
@@ -64,14 +65,18 @@ pub enum ViewError {
         #[source]
         source: std::io::Error,
     },
-    /// The domain could not be joined or listed.
-    #[error("cannot join domain {domain}: {reason}")]
+    /// The domain could not be joined.
+    #[error("cannot join domain {domain}: {source}")]
     Domain {
         /// The domain.
         domain: String,
         /// Why.
-        reason: String,
+        #[source]
+        source: limber_services::ContextError,
     },
+    /// The domain's devices could not be listed.
+    #[error(transparent)]
+    List(#[from] limber_services::ListError),
 }
 
 /// What `view` reports as it runs.
@@ -475,6 +480,22 @@ pub fn urdf_of_device(domain: &Domain, device: &DeviceName) -> Result<String, No
     urdf_for(&driver, device, &ViewConfig::default()).ok_or_else(|| NoUrdf(device.to_string()))
 }
 
+/// One connection counted while its thread lives.
+struct Live(Arc<AtomicUsize>);
+
+impl Live {
+    fn new(count: &Arc<AtomicUsize>) -> Live {
+        count.fetch_add(1, Ordering::Relaxed);
+        Live(Arc::clone(count))
+    }
+}
+
+impl Drop for Live {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::Relaxed);
+    }
+}
+
 /// Serves the domain's devices to Foxglove until `stop` returns true.
 pub fn view(
     domain: &Domain,
@@ -490,20 +511,27 @@ pub fn view(
         addr: config.listen,
         source,
     })?;
-    let ctx = Context::new(domain, Role::Client, "limber-view").map_err(|e| ViewError::Domain {
-        domain: domain.name().to_string(),
-        reason: e.to_string(),
-    })?;
+    let ctx =
+        Context::new(domain, Role::Client, "limber-view").map_err(|source| ViewError::Domain {
+            domain: domain.name().to_string(),
+            source,
+        })?;
     let shared: Arc<Mutex<Shared>> = Arc::default();
     {
         let accepted = Arc::clone(&shared);
         let max = config.max_clients;
         let (tx, rx) = sync_channel::<SocketAddr>(16);
+        // Connections being served or shaking hands: beyond twice the viewers admitted, a
+        // new one is closed at once (a flood of idle connections costs no thread each).
+        let live = Arc::new(AtomicUsize::new(0));
         std::thread::Builder::new()
             .name("limber-view-accept".into())
             .spawn(move || {
                 for s in listener.incoming() {
                     match s {
+                        Ok(s) if live.load(Ordering::Relaxed) >= 2 * max => {
+                            tracing::warn!(peer = ?s.peer_addr().ok(), "too many connections: closed");
+                        }
                         Ok(s) => {
                             if let Ok(p) = s.peer_addr()
                                 && tx.try_send(p).is_err()
@@ -511,9 +539,13 @@ pub fn view(
                                 tracing::debug!(peer = %p, "a viewer not reported");
                             }
                             let shared = Arc::clone(&accepted);
+                            let guard = Live::new(&live);
                             if let Err(e) = std::thread::Builder::new()
                                 .name("limber-view-read".into())
-                                .spawn(move || serve_client(s, shared, max))
+                                .spawn(move || {
+                                    serve_client(s, shared, max);
+                                    drop(guard);
+                                })
                             {
                                 tracing::warn!(error = %e, "cannot serve a viewer");
                             }
@@ -559,10 +591,7 @@ fn run(
     while !stop() {
         if Instant::now() >= next_discovery {
             next_discovery = Instant::now() + Duration::from_secs(1);
-            let found = list_devices(domain).map_err(|e| ViewError::Domain {
-                domain: domain.name().to_string(),
-                reason: e.to_string(),
-            })?;
+            let found = list_devices(domain)?;
             for info in found.into_iter().filter(|d| d.alive) {
                 if devices.contains_key(&info.name) {
                     continue;
