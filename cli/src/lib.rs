@@ -123,7 +123,7 @@ enum Command {
     /// Example: limber record pioneer/actarray/0 -o /tmp/limber-help.mcap --duration 2
     Record(record::RecordArgs),
     /// Republish a recorded file into the domain as if its devices were live: `limber
-    /// echo`, `limber monitor` and clients work on it; commands are dropped.
+    /// echo`, `limber monitor` and clients work on it; commands are refused.
     ///
     /// Example: limber replay /tmp/limber-help.mcap --rate 4
     Replay(record::ReplayArgs),

@@ -233,10 +233,8 @@ fn unstamped(mut v: Value) -> Value {
 fn a_replayed_run_drives_echo_and_a_client_with_the_recorded_states() {
     let d = Domain::unique_for_test();
     let file = scratch("replay");
-    {
-        let _pioneer = pioneer_emulated(d.name());
-        record_pioneer(&d, &file, "2");
-    }
+    let _pioneer = pioneer_emulated(d.name());
+    record_pioneer(&d, &file, "2");
     let recorded = recorded_states(&file, "/pioneer/actarray/0/state");
     assert!(recorded.len() >= 5, "{} states", recorded.len());
     let index_of = |seq: u64| {
@@ -302,9 +300,23 @@ fn a_replayed_run_drives_echo_and_a_client_with_the_recorded_states() {
         last = Some(i);
     }
     assert_eq!(stdout(&o).lines().count(), 8);
-    // The monitor and `limber list` see the replayed device as live.
+    // `limber list`, the recorded geometry and the monitor see the replayed device as live.
     let o = limber(r.name(), &["list"]);
     assert!(stdout(&o).contains("pioneer/actarray/0"), "{}", stdout(&o));
+    let live = limber(d.name(), &["actarray", "pioneer/actarray/0", "geom"]);
+    let replayed = limber(r.name(), &["actarray", "pioneer/actarray/0", "geom"]);
+    assert!(replayed.status.success(), "{}", stderr(&replayed));
+    assert_eq!(stdout(&replayed), stdout(&live));
+    let o = limber(r.name(), &["monitor", "--once"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("pioneer/actarray/0"), "{}", stdout(&o));
+    // Commands are refused at once: nothing moves in a recording.
+    let o = limber(
+        r.name(),
+        &["actarray", "pioneer/actarray/0", "pos", "0", "0.5"],
+    );
+    assert_eq!(o.status.code(), Some(5), "{}{}", stdout(&o), stderr(&o));
+    assert!(stderr(&o).contains("unsupported"), "{}", stderr(&o));
     assert_eq!(replay.term(), Some(0));
 }
 

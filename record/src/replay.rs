@@ -4,9 +4,9 @@
 //! hosts a remote device: its states are published as recorded (header included, the stamp
 //! made this host's time of publication, so that clients judge their age as a live
 //! state's), its outcomes too, its recorded geometry answers geometry requests, and each
-//! robot's driver statistics are published on its `driver` channel. Commands are taken and
-//! dropped (a recording is not an arm: nothing moves), other requests refused as
-//! unsupported, lease requests refused. Messages keep their recorded spacing, scaled by
+//! robot's driver statistics are published on its `driver` channel. Commands are refused
+//! `UNSUPPORTED` (a recording is not an arm: nothing moves), other requests too, lease
+//! requests likewise. Messages keep their recorded spacing, scaled by
 //! `rate`.
 
 use std::collections::BTreeMap;
@@ -212,10 +212,23 @@ impl<I: Interface> Replayed for Hosted<I> {
     fn serve(&mut self) {
         let device = self.host.device().clone();
         self.host.relay_housekeeping();
-        match self.host.relay_commands(|_| {}) {
-            Ok(0) => {}
-            Ok(n) => tracing::info!(device = %device, n, "commands to a replayed device dropped"),
-            Err(e) => tracing::warn!(device = %device, error = %e, "cannot take the commands"),
+        let mut commands = Vec::new();
+        if let Err(e) = self.host.relay_commands(|c| commands.push(*c.meta())) {
+            tracing::warn!(device = %device, error = %e, "cannot take the commands");
+        }
+        // A recording does not move: each command is refused, so its client is told at once.
+        for meta in commands {
+            let refusal = OutcomeMsg {
+                client_id: meta.client_id,
+                cmd_seq: meta.seq,
+                stamp_ns: monotonic_ns(),
+                kind: meta.kind,
+                status: Status::Unsupported.code(),
+                ..OutcomeMsg::default()
+            };
+            if let Err(e) = self.host.relay_outcome(&refusal) {
+                tracing::warn!(device = %device, error = %e, "cannot refuse a command");
+            }
         }
         loop {
             let req = match self.host.relay_take_request() {
