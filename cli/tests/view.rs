@@ -100,7 +100,7 @@ fn text(s: &mut TcpStream) -> Value {
 #[test]
 fn a_protocol_client_receives_joint_states_and_the_urdf() {
     let d = Domain::unique_for_test();
-    let _pioneer = pioneer_emulated(d.name());
+    let mut pioneer = pioneer_emulated(d.name());
     let (_view, addr) = start_view(&d);
 
     let mut s = connect(&addr);
@@ -174,6 +174,22 @@ fn a_protocol_client_receives_joint_states_and_the_urdf() {
         let (op, p) = recv(&mut s).unwrap();
         if op == 1 && serde_json::from_slice::<Value>(&p).unwrap()["op"] == "status" {
             statuses += 1;
+        }
+    }
+
+    // The driver ends: its channels are withdrawn.
+    assert_eq!(pioneer.term(), Some(0));
+    let deadline = Instant::now() + Duration::from_secs(30);
+    loop {
+        assert!(Instant::now() < deadline, "no unadvertise within 30 s");
+        let (op, p) = recv(&mut s).unwrap();
+        let v: Value = if op == 1 {
+            serde_json::from_slice(&p).unwrap()
+        } else {
+            continue;
+        };
+        if v["op"] == "unadvertise" && v["channelIds"].as_array().unwrap().contains(&joints["id"]) {
+            break;
         }
     }
 }

@@ -15,15 +15,19 @@
 use std::collections::{BTreeMap, HashMap};
 use std::io::Write as _;
 use std::net::{Shutdown, SocketAddr, TcpListener, TcpStream};
+use std::rc::Rc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
+use iceoryx2::port::listener::Listener;
+use iceoryx2::prelude::*;
 use limber_interfaces::actarray::ActArrayData;
 use limber_interfaces::prelude::*;
 use limber_interfaces::{HasHeader, Interface, InterfaceVisitor, WireStruct};
 use limber_kinematics::chain::Chain;
+use limber_services::event_loop::LoopError;
 use limber_services::{Client, Context, DeviceName, Domain, Role, list_devices, monotonic_ns};
 use serde_json::{Value, json};
 use thiserror::Error;
@@ -77,6 +81,9 @@ pub enum ViewError {
     /// The domain's devices could not be listed.
     #[error(transparent)]
     List(#[from] limber_services::ListError),
+    /// Waiting for the devices failed.
+    #[error("cannot wait for the devices: {0}")]
+    Wait(#[from] LoopError),
 }
 
 /// What `view` reports as it runs.
@@ -338,16 +345,25 @@ trait Shown {
     /// Sends what arrived to the clients.
     fn forward(&mut self, shared: &Mutex<Shared>, epoch: &dyn Fn(u64) -> u64);
     fn alive(&self) -> bool;
+    /// Notified when the driver published.
+    fn listener(&self) -> Rc<Listener<ipc::Service>>;
+    /// Its channels' ids.
+    fn channels(&self) -> &[u32];
 }
 
 struct Dev<I: Interface> {
     client: Client<I>,
+    listener: Rc<Listener<ipc::Service>>,
     state: u32,
     joints: Option<u32>,
+    channels: Vec<u32>,
 }
 
 impl<I: Interface> Shown for Dev<I> {
     fn forward(&mut self, shared: &Mutex<Shared>, epoch: &dyn Fn(u64) -> u64) {
+        if let Err(e) = self.listener.try_wait(|_| {}) {
+            tracing::debug!(device = %self.client.device(), error = %e, "cannot consume notifications");
+        }
         let mut states = Vec::new();
         if let Err(e) = self.client.relay_states(|d| states.push(*d)) {
             tracing::warn!(device = %self.client.device(), error = %e, "cannot take the states");
@@ -383,6 +399,12 @@ impl<I: Interface> Shown for Dev<I> {
     fn alive(&self) -> bool {
         self.client.relay_driver_alive()
     }
+    fn listener(&self) -> Rc<Listener<ipc::Service>> {
+        Rc::clone(&self.listener)
+    }
+    fn channels(&self) -> &[u32] {
+        &self.channels
+    }
 }
 
 /// Advertises channel `topic` to every client; its id.
@@ -414,6 +436,7 @@ impl InterfaceVisitor for Open<'_> {
     fn visit<I: Interface>(self) -> Self::Output {
         let dev = self.name.to_string();
         let client = Client::<I>::connect(self.ctx, &dev).map_err(|e| e.to_string())?;
+        let listener = Rc::new(client.relay_listener().map_err(|e| e.to_string())?);
         let mut sh = lock(self.shared);
         let state = advertise(
             &mut sh,
@@ -429,6 +452,7 @@ impl InterfaceVisitor for Open<'_> {
                 schema::joint_states_schema(),
             )
         });
+        let mut channels: Vec<u32> = [Some(state), joints].into_iter().flatten().collect();
         if let Some(urdf) = self.urdf {
             let id = advertise(
                 &mut sh,
@@ -438,11 +462,14 @@ impl InterfaceVisitor for Open<'_> {
             );
             let payload = json!({ "data": urdf }).to_string().into_bytes();
             sh.latched.insert(id, Arc::new(payload));
+            channels.push(id);
         }
         Ok(Box::new(Dev::<I> {
             client,
+            listener,
             state,
             joints,
+            channels,
         }))
     }
 }
@@ -571,7 +598,7 @@ pub fn view(
     }
 }
 
-/// The loop: new devices every second, their states as they come (looked at every 20 ms).
+/// The loop: new devices every second, their states as they come.
 fn run(
     ctx: &Context,
     domain: &Domain,
@@ -587,41 +614,70 @@ fn run(
     };
     let epoch = move |mono: u64| u64::try_from(i128::from(mono) + offset).unwrap_or(0);
     let mut devices: BTreeMap<DeviceName, Box<dyn Shown>> = BTreeMap::new();
-    let mut next_discovery = Instant::now();
     while !stop() {
-        if Instant::now() >= next_discovery {
-            next_discovery = Instant::now() + Duration::from_secs(1);
-            let found = list_devices(domain)?;
-            for info in found.into_iter().filter(|d| d.alive) {
-                if devices.contains_key(&info.name) {
-                    continue;
-                }
-                let urdf = urdf_for(&info.driver, &info.name, config);
-                match info.name.interface().visit(Open {
-                    ctx,
-                    name: &info.name,
-                    shared,
-                    urdf,
-                }) {
-                    Ok(d) => {
-                        report(ViewEvent::Device(info.name.clone()));
-                        devices.insert(info.name, d);
-                    }
-                    Err(e) => tracing::warn!(device = %info.name, error = %e, "cannot show"),
-                }
+        for info in list_devices(domain)?.into_iter().filter(|d| d.alive) {
+            if devices.contains_key(&info.name) {
+                continue;
             }
-            devices.retain(|_, d| d.alive());
+            let urdf = urdf_for(&info.driver, &info.name, config);
+            match info.name.interface().visit(Open {
+                ctx,
+                name: &info.name,
+                shared,
+                urdf,
+            }) {
+                Ok(d) => {
+                    report(ViewEvent::Device(info.name.clone()));
+                    devices.insert(info.name, d);
+                }
+                Err(e) => tracing::warn!(device = %info.name, error = %e, "cannot show"),
+            }
         }
-        for d in devices.values_mut() {
-            d.forward(shared, &epoch);
+        // A device whose driver is gone: its channels are withdrawn.
+        devices.retain(|name, d| {
+            if d.alive() {
+                return true;
+            }
+            tracing::info!(device = %name, "driver gone: no longer shown");
+            let mut sh = lock(shared);
+            for id in d.channels() {
+                sh.channels.remove(id);
+                sh.latched.remove(id);
+            }
+            let text = json!({"op": "unadvertise", "channelIds": d.channels()}).to_string();
+            sh.broadcast(|| Out::Text(text.clone()));
+            false
+        });
+        // Until the next look at the domain: woken by the drivers' notifications.
+        let ws = WaitSetBuilder::new()
+            .signal_handling_mode(SignalHandlingMode::Disabled)
+            .create::<ipc::Service>()
+            .map_err(|e| LoopError::WaitSet(e.into()))?;
+        let listeners: Vec<_> = devices.values().map(|d| d.listener()).collect();
+        let mut guards = Vec::with_capacity(listeners.len());
+        for l in &listeners {
+            guards.push(
+                ws.attach_notification(l.as_ref())
+                    .map_err(|e| LoopError::WaitSet(e.into()))?,
+            );
         }
-        while let Ok(peer) = clients.try_recv() {
-            report(ViewEvent::Client(peer));
+        let next_discovery = Instant::now() + DISCOVERY;
+        while !stop() && Instant::now() < next_discovery {
+            ws.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, IDLE_WAIT)
+                .map_err(LoopError::Wait)?;
+            for d in devices.values_mut() {
+                d.forward(shared, &epoch);
+            }
+            while let Ok(peer) = clients.try_recv() {
+                report(ViewEvent::Client(peer));
+            }
         }
-        std::thread::sleep(FORWARD_PERIOD);
+        drop(guards);
     }
     Ok(())
 }
 
-/// How often the states that arrived are forwarded to the viewers.
-const FORWARD_PERIOD: Duration = Duration::from_millis(20);
+/// How often the domain is looked at for new devices and drivers gone.
+const DISCOVERY: Duration = Duration::from_secs(1);
+/// The longest the loop waits without a notification (to look at `stop`).
+const IDLE_WAIT: Duration = Duration::from_millis(100);
