@@ -130,15 +130,18 @@ fn a_protocol_client_receives_joint_states_and_the_urdf() {
     assert_eq!(joints["schemaName"], "foxglove.JointStates");
     assert_eq!(joints["encoding"], "json");
     let urdf = channel("/pioneer/actarray/0/robot_description");
+    let tf = channel("/pioneer/actarray/0/tf");
+    assert_eq!(tf["schemaName"], "foxglove.FrameTransforms");
     let sub = json!({"op": "subscribe", "subscriptions": [
         {"id": 7, "channelId": joints["id"]},
         {"id": 9, "channelId": urdf["id"]},
+        {"id": 11, "channelId": tf["id"]},
     ]});
     send(&mut s, 1, sub.to_string().as_bytes());
 
-    let (mut states, mut description) = (Vec::new(), None);
+    let (mut states, mut description, mut transforms) = (Vec::new(), None, None);
     let deadline = Instant::now() + Duration::from_secs(30);
-    while states.len() < 3 || description.is_none() {
+    while states.len() < 3 || description.is_none() || transforms.is_none() {
         assert!(Instant::now() < deadline, "not everything within 30 s");
         let (op, p) = recv(&mut s).unwrap();
         if op != 2 {
@@ -150,6 +153,7 @@ fn a_protocol_client_receives_joint_states_and_the_urdf() {
         match sub {
             7 => states.push(v),
             9 => description = Some(v),
+            11 => transforms = Some(v),
             other => panic!("a message for subscription {other}"),
         }
     }
@@ -159,6 +163,33 @@ fn a_protocol_client_receives_joint_states_and_the_urdf() {
         assert_eq!(joints[0]["name"], "j0");
         assert!(joints.iter().all(|j| j["position"].is_f64()), "{st}");
         assert!(st["timestamp"]["sec"].as_u64().unwrap() > 0);
+    }
+    // The URDF's frames, base_link to tool, each a unit rotation.
+    let transforms = transforms.unwrap();
+    let frames = transforms["transforms"].as_array().unwrap();
+    let children: Vec<&str> = frames
+        .iter()
+        .map(|t| t["child_frame_id"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        children,
+        [
+            "chain_base",
+            "link1",
+            "link2",
+            "link3",
+            "link4",
+            "link5",
+            "tool"
+        ]
+    );
+    for t in frames {
+        let r = &t["rotation"];
+        let n: f64 = ["x", "y", "z", "w"]
+            .iter()
+            .map(|k| r[k].as_f64().unwrap().powi(2))
+            .sum();
+        assert!((n - 1.0).abs() < 1e-9, "{t}");
     }
     let description = description.unwrap();
     let urdf = description["data"].as_str().unwrap();

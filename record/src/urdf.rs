@@ -10,7 +10,8 @@
 use std::fmt::Write as _;
 
 use limber_kinematics::chain::{Chain, JointKind};
-use nalgebra::{Rotation3, Vector3};
+use nalgebra::{Rotation3, UnitQuaternion, Vector3};
+use serde_json::{Value, json};
 
 use crate::schema::joint_name;
 
@@ -70,6 +71,19 @@ fn link(out: &mut String, name: &str, next: Option<&Vector3<f64>>) {
 
 /// The URDF of `chain`, the robot named `name`.
 pub fn urdf_of_chain(chain: &Chain, name: &str) -> String {
+    urdf_with_signs(chain, name, &[])
+}
+
+/// The sign of joint `i`'s device value against the chain's variable (1 where `signs`
+/// does not say).
+fn sign(signs: &[f64], i: usize) -> f64 {
+    signs.get(i).copied().unwrap_or(1.0)
+}
+
+/// The URDF of `chain` whose joint `i` takes the device's value `signs[i]` times the
+/// chain's variable (the Pioneer arm's actarray angles against its kinematic θ), so that
+/// the joint states of the device drive it as they are.
+pub fn urdf_with_signs(chain: &Chain, name: &str, signs: &[f64]) -> String {
     let joints = chain.joints();
     let mut out = String::new();
     let _ = writeln!(
@@ -111,10 +125,19 @@ pub fn urdf_of_chain(chain: &Chain, name: &str) -> String {
             child
         );
         origin(&mut out, &j.origin, &j.rest);
+        let k = sign(signs, i);
+        let (lo, hi) = if k < 0.0 {
+            (-j.max, -j.min)
+        } else {
+            (j.min, j.max)
+        };
         let _ = writeln!(
             out,
-            "    <axis xyz=\"{} {} {}\"/>\n    <limit lower=\"{}\" upper=\"{}\" velocity=\"{}\" effort=\"0\"/>\n  </joint>",
-            j.axis.x, j.axis.y, j.axis.z, j.min, j.max, j.max_speed
+            "    <axis xyz=\"{} {} {}\"/>\n    <limit lower=\"{lo}\" upper=\"{hi}\" velocity=\"{}\" effort=\"0\"/>\n  </joint>",
+            k * j.axis.x,
+            k * j.axis.y,
+            k * j.axis.z,
+            j.max_speed
         );
         let next = joints
             .get(i + 1)
@@ -134,6 +157,51 @@ pub fn urdf_of_chain(chain: &Chain, name: &str) -> String {
     out
 }
 
+/// The transforms of the URDF's frames (`base_link` -> `chain_base` -> `link1` ... ->
+/// `tool`) for the device's joint values `q` (as in [`urdf_with_signs`]), as Foxglove's
+/// `foxglove.FrameTransforms` (`stamp_ns` since the Unix epoch): what its 3D panel places
+/// the URDF's links with. Joints beyond `q` stay at 0.
+pub fn frame_transforms(chain: &Chain, signs: &[f64], q: &[f64], stamp_ns: u64) -> Value {
+    let stamp = json!({"sec": stamp_ns / 1_000_000_000, "nsec": stamp_ns % 1_000_000_000});
+    let tf = |parent: &str, child: &str, p: &Vector3<f64>, r: &Rotation3<f64>| {
+        let q = UnitQuaternion::from_rotation_matrix(r);
+        json!({
+            "timestamp": stamp,
+            "parent_frame_id": parent,
+            "child_frame_id": child,
+            "translation": {"x": p.x, "y": p.y, "z": p.z},
+            "rotation": {"x": q.i, "y": q.j, "z": q.k, "w": q.w},
+        })
+    };
+    let joints = chain.joints();
+    let mut out = vec![tf(
+        "base_link",
+        "chain_base",
+        &chain.base().position,
+        &chain.base().rotation,
+    )];
+    for (i, j) in joints.iter().enumerate() {
+        let v = sign(signs, i) * q.get(i).copied().unwrap_or(0.0);
+        let (p, r) = match j.kind {
+            JointKind::Rotary => (j.origin, j.rest * Rotation3::from_axis_angle(&j.axis, v)),
+            JointKind::Linear => (j.origin + j.rest * (j.axis.into_inner() * v), j.rest),
+        };
+        let parent = if i == 0 {
+            "chain_base".to_string()
+        } else {
+            format!("link{i}")
+        };
+        out.push(tf(&parent, &format!("link{}", i + 1), &p, &r));
+    }
+    out.push(tf(
+        &format!("link{}", joints.len()),
+        "tool",
+        &chain.tool().position,
+        &chain.tool().rotation,
+    ));
+    json!({ "transforms": out })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -148,5 +216,42 @@ mod tests {
         }
         assert!(u.contains("<child link=\"tool\"/>"));
         assert_eq!(u.matches("<link ").count(), 1 + 1 + 5 + 1);
+    }
+
+    /// The transforms, composed from base_link to tool, are the chain's forward kinematics.
+    #[test]
+    fn the_frame_transforms_compose_to_the_forward_kinematics() {
+        use limber_kinematics::Pose;
+        let chain = Chain::default_6dof();
+        let q = [0.3, -1.2, 0.8, 0.1, 0.5, -0.4];
+        let v = frame_transforms(&chain, &[], &q, 1);
+        let mut at = Pose::identity();
+        for t in v["transforms"].as_array().unwrap() {
+            let f = |k: &str, c: &str| t[k][c].as_f64().unwrap();
+            let p = Vector3::new(
+                f("translation", "x"),
+                f("translation", "y"),
+                f("translation", "z"),
+            );
+            let r = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+                f("rotation", "w"),
+                f("rotation", "x"),
+                f("rotation", "y"),
+                f("rotation", "z"),
+            ))
+            .to_rotation_matrix();
+            at = Pose::new(at.position + at.rotation * p, at.rotation * r);
+        }
+        let fk = chain.fk(&q).unwrap();
+        assert!(at.position_error(&fk) < 1e-9);
+        assert!(at.orientation_error(&fk) < 1e-9);
+        // The Pioneer arm's actarray angles against its kinematic θ: the same pose.
+        use limber_kinematics::pioneer::DRIVER_SIGNS;
+        let arm = Chain::pioneer5();
+        let theta = [0.2, 0.3, -0.4, 0.5, 0.1];
+        let driver: Vec<f64> = theta.iter().zip(DRIVER_SIGNS).map(|(t, s)| t * s).collect();
+        let a = frame_transforms(&arm, &DRIVER_SIGNS, &driver, 1);
+        let b = frame_transforms(&arm, &[], &theta, 1);
+        assert_eq!(a, b);
     }
 }

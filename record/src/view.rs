@@ -5,7 +5,8 @@
 //! all JSON: per device `/<device>/state` (the state as `limber echo --json` prints it,
 //! schema name its wire struct's type name), per actuator array `/<device>/joint_states`
 //! (`foxglove.JointStates`) and, for an arm whose chain limber knows, `/<device>/
-//! robot_description` (`std_msgs/String` holding its URDF, sent to each new subscriber).
+//! robot_description` (`std_msgs/String` holding its URDF, sent to each new subscriber) and
+//! `/<device>/tf` (`foxglove.FrameTransforms` of the URDF's links at each state).
 //!
 //! Threads: this one takes the devices' states (iceoryx2 ports stay on the thread that made
 //! them) and hands each message to every connection's writer through a bounded queue (a
@@ -33,7 +34,7 @@ use serde_json::{Value, json};
 use thiserror::Error;
 
 use crate::schema;
-use crate::urdf::urdf_of_chain;
+use crate::urdf::{frame_transforms, urdf_with_signs};
 use crate::ws::{self, Incoming, MessageReader, opcode};
 
 /// How `view` runs.
@@ -356,7 +357,17 @@ struct Dev<I: Interface> {
     listener: Rc<Listener<ipc::Service>>,
     state: u32,
     joints: Option<u32>,
+    /// The arm's frame transforms: their channel, its chain and its joints' signs.
+    tf: Option<(u32, Arm)>,
     channels: Vec<u32>,
+}
+
+/// An arm limber knows the chain of: the chain and the sign of each device joint against
+/// the chain's variable.
+#[derive(Clone)]
+struct Arm {
+    chain: Chain,
+    signs: Vec<f64>,
 }
 
 impl<I: Interface> Shown for Dev<I> {
@@ -393,6 +404,16 @@ impl<I: Interface> Shown for Dev<I> {
                     stamp,
                     payload: Arc::clone(&payload),
                 });
+                if let Some((channel, arm)) = &self.tf {
+                    let q: Vec<f64> = a.actuators().iter().map(|x| x.position).collect();
+                    let v = frame_transforms(&arm.chain, &arm.signs, &q, stamp);
+                    let payload = Arc::new(v.to_string().into_bytes());
+                    sh.broadcast(|| Out::Data {
+                        channel: *channel,
+                        stamp,
+                        payload: Arc::clone(&payload),
+                    });
+                }
             }
         }
     }
@@ -428,7 +449,7 @@ struct Open<'a> {
     ctx: &'a Context,
     name: &'a DeviceName,
     shared: &'a Mutex<Shared>,
-    urdf: Option<String>,
+    arm: Option<Arm>,
 }
 
 impl InterfaceVisitor for Open<'_> {
@@ -453,7 +474,18 @@ impl InterfaceVisitor for Open<'_> {
             )
         });
         let mut channels: Vec<u32> = [Some(state), joints].into_iter().flatten().collect();
-        if let Some(urdf) = self.urdf {
+        let mut tf = None;
+        if let Some(arm) = self.arm {
+            let urdf = urdf_with_signs(&arm.chain, self.name.robot(), &arm.signs);
+            let id = advertise(
+                &mut sh,
+                format!("/{dev}/tf"),
+                "foxglove.FrameTransforms",
+                json!({"type": "object", "description": "the URDF's frames, base_link to tool"})
+                    .to_string(),
+            );
+            channels.push(id);
+            tf = Some((id, arm));
             let id = advertise(
                 &mut sh,
                 format!("/{dev}/robot_description"),
@@ -469,26 +501,34 @@ impl InterfaceVisitor for Open<'_> {
             listener,
             state,
             joints,
+            tf,
             channels,
         }))
     }
 }
 
-/// The URDF of an actuator array offered by `driver` with `joints` actuators, if limber
-/// knows its chain: the Pioneer arm's; simarm's built-in arms, or the chain given.
-fn urdf_for(driver: &str, device: &DeviceName, config: &ViewConfig) -> Option<String> {
+/// The arm of actuator array `device` offered by `driver`, if limber knows its chain: the
+/// Pioneer arm's (its actarray angles against the kinematic θ:
+/// [`limber_kinematics::pioneer::DRIVER_SIGNS`]); simarm's built-in arm, or the chain
+/// given.
+fn arm_of(driver: &str, device: &DeviceName, config: &ViewConfig) -> Option<Arm> {
     if device.interface() != InterfaceKind::ActArray || device.index() != 0 {
         return None;
     }
-    let chain = match driver {
-        "pioneer" => Chain::pioneer5(),
-        "simarm" => config
-            .simarm_chain
-            .clone()
-            .unwrap_or_else(Chain::default_6dof),
+    Some(match driver {
+        "pioneer" => Arm {
+            chain: Chain::pioneer5(),
+            signs: limber_kinematics::pioneer::DRIVER_SIGNS.to_vec(),
+        },
+        "simarm" => Arm {
+            chain: config
+                .simarm_chain
+                .clone()
+                .unwrap_or_else(Chain::default_6dof),
+            signs: Vec::new(),
+        },
         _ => return None,
-    };
-    Some(urdf_of_chain(&chain, device.robot()))
+    })
 }
 
 /// No URDF for a device ([`urdf_of_device`]).
@@ -504,7 +544,9 @@ pub fn urdf_of_device(domain: &Domain, device: &DeviceName) -> Result<String, No
         .and_then(|l| l.into_iter().find(|d| &d.name == device))
         .map(|d| d.driver)
         .unwrap_or_else(|| device.robot().to_string());
-    urdf_for(&driver, device, &ViewConfig::default()).ok_or_else(|| NoUrdf(device.to_string()))
+    arm_of(&driver, device, &ViewConfig::default())
+        .map(|a| urdf_with_signs(&a.chain, device.robot(), &a.signs))
+        .ok_or_else(|| NoUrdf(device.to_string()))
 }
 
 /// One connection counted while its thread lives.
@@ -619,12 +661,12 @@ fn run(
             if devices.contains_key(&info.name) {
                 continue;
             }
-            let urdf = urdf_for(&info.driver, &info.name, config);
+            let arm = arm_of(&info.driver, &info.name, config);
             match info.name.interface().visit(Open {
                 ctx,
                 name: &info.name,
                 shared,
-                urdf,
+                arm,
             }) {
                 Ok(d) => {
                     report(ViewEvent::Device(info.name.clone()));
