@@ -4,9 +4,11 @@
 
 mod common;
 
+use std::path::{Path, PathBuf};
+use std::process::Command;
 use std::time::{Duration, Instant};
 
-use common::{Bg, limber, stderr, stdout};
+use common::{Bg, limber, output, stderr, stdout};
 use limber_services::Domain;
 use serde_json::Value;
 
@@ -69,17 +71,16 @@ fn write(name: &str, text: &str) -> String {
     p.display().to_string()
 }
 
-#[test]
-fn simarm_simulates_a_urdf_arm_and_reaches_a_pose_with_its_ik() {
+/// Simulates the arm of URDF `file` and moves its limb to the pose its forward kinematics
+/// gives for `q` (a configuration within its limits): the numeric IK finds it.
+fn reaches_a_pose(file: &str, q: &[f64]) {
     let d = Domain::unique_for_test();
-    let file = write("testarm.urdf", ARM);
-    // A pose the arm can take: the forward kinematics of a configuration in its limits.
-    let chain = limber_record::urdf_in::chain_from_urdf(ARM).unwrap();
-    assert_eq!(chain.dof(), 6);
-    let pose = chain.fk(&[0.3, 0.5, 0.7, 0.2, 0.6, 0.1]).unwrap();
+    let chain = limber_record::urdf_in::chain_from_urdf_file(Path::new(file)).unwrap();
+    assert_eq!(chain.dof(), q.len());
+    let pose = chain.fk(q).unwrap();
     let (p, a, o) = (pose.position, pose.approach(), pose.orientation());
 
-    let mut sim = Bg::spawn(d.name(), &["simarm", "--urdf", &file, "--time-scale", "4"]);
+    let mut sim = Bg::spawn(d.name(), &["simarm", "--urdf", file, "--time-scale", "4"]);
     sim.line(|l| l.ends_with("ready"));
     let n = |v: f64| format!("{v:.6}");
     let args: Vec<String> = ["limb", "simarm/limb/0", "setpose"]
@@ -115,6 +116,34 @@ fn simarm_simulates_a_urdf_arm_and_reaches_a_pose_with_its_ik() {
         assert!(Instant::now() < deadline, "the limb is {err} m away: {v}");
     }
     assert_eq!(sim.term(), Some(0));
+}
+
+#[test]
+fn simarm_simulates_a_urdf_arm_and_reaches_a_pose_with_its_ik() {
+    let file = write("testarm.urdf", ARM);
+    reaches_a_pose(&file, &[0.3, 0.5, 0.7, 0.2, 0.6, 0.1]);
+}
+
+/// The Panda of the PyPI package example-robot-data (which `.ci/run` installs in its venv,
+/// `LIMBER_PYTHON`): a real arm's URDF, 7 joints, fixed joints and a two-finger hand.
+#[test]
+fn simarm_simulates_the_panda_of_a_urdf_package() {
+    let py = std::env::var_os("LIMBER_PYTHON").map_or_else(
+        || Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/py-venv/bin/python"),
+        PathBuf::from,
+    );
+    let found = output(Command::new(&py).args([
+        "-c",
+        "import importlib.metadata as m; print([str(f.locate()) for f in m.files('example-robot-data') if str(f).endswith('panda_description/urdf/panda.urdf')][0])",
+    ]));
+    if !found.status.success() {
+        let reason = format!("no example-robot-data in {py:?}: {}", stderr(&found));
+        assert!(std::env::var("CI").as_deref() != Ok("true"), "{reason}");
+        eprintln!("skipped: {reason}");
+        return;
+    }
+    let file = stdout(&found).trim().to_string();
+    reaches_a_pose(&file, &[0.2, -0.3, 0.1, -1.8, 0.2, 1.6, 0.5]);
 }
 
 #[test]
