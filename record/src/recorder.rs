@@ -19,10 +19,8 @@ use std::time::{Duration, Instant};
 
 use iceoryx2::port::listener::Listener;
 use iceoryx2::prelude::*;
-use limber_interfaces::actarray::ActArrayData;
 use limber_interfaces::control::OutcomeMsg;
 use limber_interfaces::diagnostics::DriverStats;
-use limber_interfaces::prelude::*;
 use limber_interfaces::{HasHeader, Interface, InterfaceVisitor, Message, ReplyBody, WireStruct};
 use limber_services::diagnostics::{StatsReader, list_drivers};
 use limber_services::event_loop::LoopError;
@@ -270,8 +268,8 @@ impl<I: Interface> Recorded for Dev<I> {
                     .fetch_add(h.seq - last - 1, Ordering::Relaxed);
             }
             self.last_seq = Some(h.seq);
-            if let Some(a) = (&d as &dyn core::any::Any).downcast_ref::<ActArrayData>() {
-                let js = schema::joint_states(a, sink.epoch_ns(h.stamp_ns));
+            if let Some(joints) = schema::joints_of(&d) {
+                let js = schema::joint_states(&joints, sink.epoch_ns(h.stamp_ns));
                 sink.message(
                     self.joints,
                     received,
@@ -341,7 +339,7 @@ impl InterfaceVisitor for Open<'_> {
         let outcome = self
             .sink
             .wire_channel::<OutcomeMsg>(format!("/{dev}/outcome"), &meta("outcome"));
-        let joints = if I::KIND == InterfaceKind::ActArray {
+        let joints = if schema::has_joints::<I::Data>() {
             self.sink.channel(
                 format!("/{dev}/joint_states"),
                 (

@@ -1,6 +1,8 @@
 //! The schemas written with each channel: limber's wire structs described by the layout
 //! manifest, and Foxglove's well-known `foxglove.JointStates` (JSON) for actuator arrays.
 
+use core::any::{Any, TypeId};
+
 use limber_interfaces::actarray::ActArrayData;
 use limber_interfaces::manifest::StructLayout;
 use serde_json::{Value, json};
@@ -79,16 +81,33 @@ pub fn joint_name(i: usize) -> String {
     format!("j{i}")
 }
 
-/// An actuator array's state as `foxglove.JointStates` (`stamp_ns` since the Unix epoch):
-/// positions and speeds (limber's currents are no efforts, and -1 means "unknown" in its
-/// accelerations: both are left out, as the schema allows).
-pub fn joint_states(d: &ActArrayData, stamp_ns: u64) -> Value {
+/// The joints of a state, as (position, speed) per joint: an actuator array's actuators;
+/// `None` for a state without joints. The one place that tells the interface with joints
+/// apart, so that the recorder and the viewer stay generic over the interface.
+pub fn joints_of<D: 'static>(d: &D) -> Option<Vec<(f64, f64)>> {
+    (d as &dyn Any).downcast_ref::<ActArrayData>().map(|a| {
+        a.actuators()
+            .iter()
+            .map(|x| (x.position, x.speed))
+            .collect()
+    })
+}
+
+/// Whether states of type `D` have joints ([`joints_of`]).
+pub fn has_joints<D: 'static>() -> bool {
+    TypeId::of::<D>() == TypeId::of::<ActArrayData>()
+}
+
+/// Joints as `foxglove.JointStates` (`stamp_ns` since the Unix epoch): positions and
+/// speeds (limber's currents are no efforts, and -1 means "unknown" in its accelerations:
+/// both are left out, as the schema allows).
+pub fn joint_states(joints: &[(f64, f64)], stamp_ns: u64) -> Value {
     json!({
         "timestamp": {"sec": stamp_ns / 1_000_000_000, "nsec": stamp_ns % 1_000_000_000},
-        "joints": d.actuators().iter().enumerate().map(|(i, a)| json!({
+        "joints": joints.iter().enumerate().map(|(i, (position, speed))| json!({
             "name": joint_name(i),
-            "position": a.position,
-            "velocity": a.speed,
+            "position": position,
+            "velocity": speed,
         })).collect::<Vec<_>>(),
     })
 }

@@ -24,7 +24,6 @@ use std::time::{Duration, Instant};
 
 use iceoryx2::port::listener::Listener;
 use iceoryx2::prelude::*;
-use limber_interfaces::actarray::ActArrayData;
 use limber_interfaces::prelude::*;
 use limber_interfaces::{HasHeader, Interface, InterfaceVisitor, WireStruct};
 use limber_kinematics::chain::Chain;
@@ -394,18 +393,19 @@ impl<I: Interface> Shown for Dev<I> {
                 stamp,
                 payload: Arc::clone(&payload),
             });
-            if let (Some(channel), Some(a)) = (
-                self.joints,
-                (&d as &dyn core::any::Any).downcast_ref::<ActArrayData>(),
-            ) {
-                let payload = Arc::new(schema::joint_states(a, stamp).to_string().into_bytes());
+            if let (Some(channel), Some(joints)) = (self.joints, schema::joints_of(&d)) {
+                let payload = Arc::new(
+                    schema::joint_states(&joints, stamp)
+                        .to_string()
+                        .into_bytes(),
+                );
                 sh.broadcast(|| Out::Data {
                     channel,
                     stamp,
                     payload: Arc::clone(&payload),
                 });
                 if let Some((channel, arm)) = &self.tf {
-                    let q: Vec<f64> = a.actuators().iter().map(|x| x.position).collect();
+                    let q: Vec<f64> = joints.iter().map(|(p, _)| *p).collect();
                     let v = frame_transforms(&arm.chain, &arm.signs, &q, stamp);
                     let payload = Arc::new(v.to_string().into_bytes());
                     sh.broadcast(|| Out::Data {
@@ -465,7 +465,7 @@ impl InterfaceVisitor for Open<'_> {
             I::Data::LAYOUT.type_name,
             json!({"type": "object", "description": "the state as `limber echo --json` prints it (docs/echo-json.md)"}).to_string(),
         );
-        let joints = (I::KIND == InterfaceKind::ActArray).then(|| {
+        let joints = schema::has_joints::<I::Data>().then(|| {
             advertise(
                 &mut sh,
                 format!("/{dev}/joint_states"),
