@@ -249,6 +249,20 @@ pub const RATIOS: &[RatioDef] = &[
         goal: None,
     },
     RatioDef {
+        label: "GET_GEOM through the Player gateway / direct (gateway)",
+        num: "gateway.player.rtt",
+        den: "request.pioneer.rtt",
+        pct: Pct::P50,
+        goal: None,
+    },
+    RatioDef {
+        label: "GET_GEOM through the Player gateway / TCP loopback blocking round trip",
+        num: "gateway.player.rtt",
+        den: "peers.tcp.blocking.rtt",
+        pct: Pct::P50,
+        goal: None,
+    },
+    RatioDef {
         label: "spinning driver's cost (arrival → bytes on the pty) / bare pty write(2)",
         num: "loop.spin.driver",
         den: "loop.spin.pty_write",

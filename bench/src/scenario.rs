@@ -10,6 +10,7 @@
 pub mod bridge;
 pub mod command;
 pub mod floor;
+pub mod gateway;
 pub mod ik;
 pub mod lang;
 pub mod peers;
@@ -59,6 +60,7 @@ pub fn registry() -> Vec<Box<dyn Scenario>> {
         Box::new(pty_loop::Loop),
         Box::new(lang::Lang),
         Box::new(bridge::Bridge),
+        Box::new(gateway::Gateway),
     ]
 }
 

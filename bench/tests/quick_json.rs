@@ -297,6 +297,18 @@ fn bridge_measures_through_a_bridge_pair_or_says_why_not() {
     std::fs::remove_dir_all(&dir).expect("remove the test's directory");
 }
 
+/// `--only gateway`: a GET_GEOM's round trip through the Player gateway, with its ratio to
+/// the direct request and Player's own figure in the notes.
+#[test]
+fn gateway_measures_a_request_through_the_player_gateway() {
+    let dir = std::env::temp_dir().join(format!("limber-bench-gateway-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (s, ids, _, _) = run_only("gateway", &dir.join("gateway.json"), None);
+    assert_eq!(ids, ["gateway.player.rtt"]);
+    assert!(s["detail"].as_str().unwrap().contains("162 ms p50"), "{s}");
+    std::fs::remove_dir_all(&dir).expect("remove the test's directory");
+}
+
 /// What a `--quick --scale 0.2 --only <scenario>` run gave: its one scenario's status
 /// entry, the ids of its measurements (each checked to have samples), the whole report,
 /// and its stderr. `env`, if given, is set for the run.

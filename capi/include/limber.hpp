@@ -1,8 +1,9 @@
 /* limber.hpp: the limber client API for C++17, header-only, over the C API of
  * limber_client.h (link with `pkg-config --cflags --libs limber`).
  *
- * RAII proxies named like Player's: limber::ActArrayProxy, limber::LimbProxy and
- * limber::GripperProxy connect in their constructor and disconnect in their destructor.
+ * RAII proxies named like Player's: limber::ActArrayProxy, limber::LimbProxy,
+ * limber::GripperProxy and limber::RangerProxy (limber::LaserProxy) connect in their
+ * constructor and disconnect in their destructor.
  * Every failure throws limber::Error, which carries the limber_code (code()), its message
  * with the detail (what()) and, for a request the driver refused, the driver's
  * LIMBER_STATUS_* (refusal()). Timeouts are std::chrono durations.
@@ -137,6 +138,7 @@ inline void Check(limber_code code) {
 LIMBER_HPP_TRAITS(ActArrayTraits, actarray, limber_actarray_data, limber_actarray_geom);
 LIMBER_HPP_TRAITS(LimbTraits, limb, limber_limb_data, limber_limb_geom);
 LIMBER_HPP_TRAITS(GripperTraits, gripper, limber_gripper_data, limber_gripper_geom);
+LIMBER_HPP_TRAITS(RangerTraits, ranger, limber_ranger_data, limber_ranger_geom);
 #undef LIMBER_HPP_TRAITS
 }  // namespace detail
 
@@ -230,6 +232,16 @@ public:
         limber_outcome o{};
         detail::Check(limber_device_outcome(h_, ticket, detail::Millis(timeout), &o));
         return o;
+    }
+    /// Waits up to `timeout` until the motion that the command of `ticket` started has
+    /// ended: how (`result`, a LIMBER_RESULT_*; `cause`, a LIMBER_STATUS_*), each part's
+    /// final position and error against the goal, the device's tolerance and a sentence.
+    /// Throws for a refused command (LIMBER_CODE_REFUSED) and when it has not ended in
+    /// time (LIMBER_CODE_TIMEOUT).
+    limber_done WaitDone(limber_ticket ticket, Duration timeout) {
+        limber_done d{};
+        detail::Check(limber_device_wait_done(h_, ticket, detail::Millis(timeout), &d));
+        return d;
     }
     /// Alive (a state younger than `max_age`), stale, gone, or no data yet.
     limber_liveness Liveness(Duration max_age) {
@@ -458,6 +470,73 @@ private:
         return t;
     }
 };
+
+/// A point in a plane, m (Player's player_point_2d_t).
+struct Point2d {
+    double px;
+    double py;
+};
+
+/// Player's RangerProxy (and LaserProxy): a range sensor such as a planar laser. Read()
+/// takes the latest scan and keeps it; the getters read that scan (Player's proxies read
+/// the last scan the client thread received). RequestGeometry() (RequestGeom()) asks for
+/// the sensor's pose and configuration, GetPose() returns the pose.
+class RangerProxy : public BasicProxy<detail::RangerTraits> {
+public:
+    using BasicProxy::BasicProxy;
+    /// Takes the latest scan (waiting up to `timeout` for a first one) and keeps it.
+    const Data& Read(Duration timeout = kStateTimeout) {
+        scan_ = GetData(timeout);
+        return scan_;
+    }
+    /// Waits up to `timeout` for a scan newer than the latest one taken, and keeps it.
+    const Data& ReadNext(Duration timeout) {
+        scan_ = WaitForData(timeout);
+        return scan_;
+    }
+    /// The scan kept by the last Read().
+    const Data& GetScan() const noexcept { return scan_; }
+    /// REQ GET_GEOM (Player's name for RequestGeometry()).
+    const Geom& RequestGeom(Duration timeout = kRequestTimeout) { return RequestGeometry(timeout); }
+    /// The sensor's pose on the robot (from the last RequestGeom()).
+    limber_pose3 GetPose() const noexcept { return GetGeom().pose; }
+    /// Ranges in the kept scan.
+    uint32_t GetCount() const noexcept { return scan_.ranges_count; }
+    /// Range `i` of the kept scan, m (throws LIMBER_CODE_INVALID_VALUE beyond the count).
+    double GetRange(uint32_t i) const {
+        Bearing(i);
+        return scan_.ranges[i];
+    }
+    /// Range `i` of the kept scan, m.
+    double operator[](uint32_t i) const { return GetRange(i); }
+    /// The bearing of range `i`, rad, in the sensor's frame.
+    double GetBearing(uint32_t i) const { return Bearing(i); }
+    /// The point range `i` hit, in the sensor's frame, m.
+    Point2d GetPoint(uint32_t i) const {
+        Point2d p{};
+        detail::Check(limber_ranger_point(&scan_, i, nullptr, &p.px, &p.py));
+        return p;
+    }
+    /// Bearing of the first range, rad.
+    double GetMinAngle() const noexcept { return scan_.min_angle; }
+    /// Bearing of the last range, rad.
+    double GetMaxAngle() const noexcept { return scan_.max_angle; }
+    /// Angle between two ranges, rad (Player's LaserProxy::GetScanRes).
+    double GetScanRes() const noexcept { return scan_.angular_res; }
+    /// Longest range, m.
+    double GetMaxRange() const noexcept { return scan_.max_range; }
+
+private:
+    double Bearing(uint32_t i) const {
+        double b = 0.0;
+        detail::Check(limber_ranger_point(&scan_, i, &b, nullptr, nullptr));
+        return b;
+    }
+    Data scan_{};
+};
+
+/// Player's name for a planar laser's proxy.
+using LaserProxy = RangerProxy;
 
 /// A proxy's control lease for the lifetime of this object: acquired in the constructor
 /// (throws as Acquire()), released in the destructor, which cannot throw: a failure there

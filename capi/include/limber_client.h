@@ -5,7 +5,7 @@
  * ticket), send requests (each with a timeout), wait for a command's outcome, ask whether
  * the driver lives, list the devices of a domain. The states and geometries are the wire
  * structs of limber.h (limber_actarray_data, limber_limb_data, limber_gripper_data,
- * limber_*_geom, limber_vec3), which this header includes.
+ * limber_ranger_data, limber_*_geom, limber_vec3), which this header includes.
  *
  * Errors: every function returns a limber_code; LIMBER_CODE_OK (0) means done. Anything
  * else says why it failed: limber_strerror(code) gives the code's message and
@@ -170,6 +170,10 @@ enum limber_interface
    A gripper (`limber_gripper_connect`).
    */
   LIMBER_INTERFACE_GRIPPER = 2,
+  /*
+   A ranger (`limber_ranger_connect`).
+   */
+  LIMBER_INTERFACE_RANGER = 3,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -396,6 +400,62 @@ typedef struct limber_device_info {
 } limber_device_info;
 
 /*
+ How a motion ended ([`limber_device_wait_done`]).
+ */
+typedef struct limber_done {
+  /*
+   The command's sequence number (its ticket's `seq`).
+   */
+  uint64_t seq;
+  /*
+   A `LIMBER_RESULT_*` of limber.h: reached, stalled, stopped, preempted, aborted,
+   timed out.
+   */
+  uint32_t result;
+  /*
+   Why, a `LIMBER_STATUS_*`: OK when reached; the cause of an abort (LINK_DOWN,
+   POWERED_OFF, BRAKED); PREEMPTED; LEASED for the deadman's stop.
+   */
+  uint32_t cause;
+  /*
+   The client whose command preempted or stopped it (0: none or the driver).
+   */
+  uint64_t other_client;
+  /*
+   When the driver published it (`CLOCK_MONOTONIC` ns).
+   */
+  uint64_t stamp_ns;
+  /*
+   The valid entries of `position` and `error` (part i: joint i).
+   */
+  uint32_t parts;
+  /*
+   Explicit padding (zero).
+   */
+  uint32_t _pad;
+  /*
+   The largest |final error| against the goal (rad or m); NaN if not known.
+   */
+  double max_error;
+  /*
+   The device's tolerance for "reached".
+   */
+  double tolerance;
+  /*
+   Each part's final position; NaN where not known.
+   */
+  double position[32];
+  /*
+   Each part's final error against the goal (position − goal); NaN where not known.
+   */
+  double error[32];
+  /*
+   The result in one sentence, NUL-terminated.
+   */
+  char sentence[160];
+} limber_done;
+
+/*
  A connection to a gripper: a `limber_device` of this interface (the same type, so every
  `limber_device_*` call takes it).
  */
@@ -417,6 +477,12 @@ typedef void (*limber_log_fn)(limber_log_level level,
                               const char *target,
                               const char *message,
                               void *user);
+
+/*
+ A connection to a ranger: a `limber_device` of this interface (the same type, so every
+ `limber_device_*` call takes it).
+ */
+typedef struct limber_device limber_ranger;
 
 #ifdef __cplusplus
 extern "C" {
@@ -887,6 +953,22 @@ limber_code limber_list_devices(const char *domain,
 limber_code limber_remove_domain_files(const char *domain, size_t *removed);
 
 /*
+ Waits up to `timeout_ms` until the motion that the command of `ticket` started has
+ ended, and writes how to `*out`: reached within the device's tolerance, stalled,
+ stopped, preempted, aborted or timed out, with each part's final position and error
+ against the goal and a sentence. A command that starts nothing that runs on is reached
+ when carried out. A refused command is `LIMBER_CODE_REFUSED` (its status in
+ `limber_last_refusal()`); `LIMBER_CODE_TIMEOUT` when the motion has not ended in time.
+
+ # Safety
+ `h` is NULL or a live handle; `out` is NULL or writable.
+ */
+limber_code limber_device_wait_done(struct limber_device *h,
+                                    struct limber_ticket ticket,
+                                    uint64_t timeout_ms,
+                                    struct limber_done *out);
+
+/*
  CMD OPEN: opens the gripper. `*ticket` (NULL: not written) is for
  `limber_gripper_wait_outcome`. Returns at once.
 
@@ -1106,6 +1188,23 @@ limber_code limber_limb_can_reach(limber_limb *h,
 limber_code limber_set_logger(limber_log_fn callback, void *user, limber_log_level min_level);
 
 /*
+ The bearing of range `index` of `scan` (rad, counter-clockwise from the sensor's x
+ axis: `min_angle + index * angular_res`) and the point it hit (`x`, `y` in the
+ sensor's frame, m; Player's `GetBearing` and `GetPoint`). `bearing`, `x`, `y` may be
+ NULL (not written). An index at or beyond `ranges_count` is
+ `LIMBER_CODE_INVALID_VALUE`.
+
+ # Safety
+ `scan` is NULL or points to a readable `limber_ranger_data`; `bearing`, `x` and `y`
+ are NULL or writable.
+ */
+limber_code limber_ranger_point(const limber_ranger_data *scan,
+                                size_t index,
+                                double *bearing,
+                                double *x,
+                                double *y);
+
+/*
  Opens the statistics of the driver of `robot` (e.g. "pioneer") in `domain` (NULL:
  `LIMBER_DOMAIN`, or "limber"); `LIMBER_CODE_NO_DRIVER` if no driver publishes them.
  Free the reader with `limber_stats_close`.
@@ -1149,7 +1248,7 @@ limber_code limber_stats_wait(struct limber_stats *h,
 
 #endif  /* LIMBER_CLIENT_H */
 
-/* Typed calls, the same for every interface X (actarray, limb, gripper), each a one-line
+/* Typed calls, the same for every interface X (actarray, limb, gripper, ranger), each a one-line
  * inline function over the limber_device_* call of the same name: it passes the program's
  * own state or geometry struct with its size, so that a program compiled against another
  * limber.h is refused (LIMBER_CODE_INCOMPATIBLE) instead of misreading shared memory.
@@ -1161,6 +1260,7 @@ limber_code limber_stats_wait(struct limber_stats *h,
  *   limber_X_wait_state(h, timeout_ms, &data or NULL)
  *   limber_X_geometry(h, timeout_ms, &geom)            limber_X_geom
  *   limber_X_wait_outcome(h, ticket, timeout_ms, &status)
+ *   limber_X_wait_done(h, ticket, timeout_ms, &done)   (how the command's motion ended)
  *   limber_X_liveness(h, max_age_ms, &liveness)   limber_X_driver_status(h, &status)
  *   limber_X_client_id(h, &id)   limber_X_acquire(h, name, heartbeat_ms)   limber_X_renew(h)
  *   limber_X_keep_lease(h, &renewed)   limber_X_release_lease(h)   limber_X_holder(h, &holder)
@@ -1213,6 +1313,10 @@ static inline limber_code limber_device_connect(const char *device, const char *
                                                         uint64_t timeout_ms, uint32_t *st) { \
         return limber_device_wait_outcome(h, ticket, timeout_ms, st);                        \
     }                                                                                        \
+    static inline limber_code limber_##X##_wait_done(limber_##X *h, limber_ticket ticket,    \
+                                                     uint64_t timeout_ms, limber_done *out) { \
+        return limber_device_wait_done(h, ticket, timeout_ms, out);                          \
+    }                                                                                        \
     static inline limber_code limber_##X##_liveness(limber_##X *h, uint64_t max_age_ms,      \
                                                     limber_liveness *out) {                  \
         return limber_device_liveness(h, max_age_ms, out);                                   \
@@ -1248,5 +1352,6 @@ static inline limber_code limber_device_connect(const char *device, const char *
 LIMBER_TYPED_CLIENT_(actarray, LIMBER_INTERFACE_ACTARRAY)
 LIMBER_TYPED_CLIENT_(limb, LIMBER_INTERFACE_LIMB)
 LIMBER_TYPED_CLIENT_(gripper, LIMBER_INTERFACE_GRIPPER)
+LIMBER_TYPED_CLIENT_(ranger, LIMBER_INTERFACE_RANGER)
 
 #endif  /* LIMBER_CLIENT_TYPED_H */

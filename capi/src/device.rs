@@ -84,7 +84,7 @@ pub(crate) fn copy_str(dst: &mut [c_char], s: &str) {
 }
 
 impl LimberDevice {
-    fn not_borrowed(&self) -> Result<(), Fail> {
+    pub(crate) fn not_borrowed(&self) -> Result<(), Fail> {
         if self.borrowed {
             Err(Fail::new(
                 LimberCode::Borrowed,
@@ -111,7 +111,7 @@ impl LimberDevice {
     }
 }
 
-fn ticket_of(t: &LimberTicket) -> Ticket {
+pub(crate) fn ticket_of(t: &LimberTicket) -> Ticket {
     Ticket {
         seq: t.seq,
         receivers: usize::try_from(t.receivers).unwrap_or(usize::MAX),

@@ -22,6 +22,8 @@ pub enum LimberInterface {
     Limb = 1,
     /// A gripper (`limber_gripper_connect`).
     Gripper = 2,
+    /// A ranger (`limber_ranger_connect`).
+    Ranger = 3,
 }
 
 /// One device found by `limber_list_devices`.

@@ -38,19 +38,23 @@ use limber_services::{Domain, ListError, NameError};
 mod actarray;
 mod device;
 mod discovery;
+mod done;
 mod gripper;
 mod lease;
 mod limb;
 mod log;
+mod ranger;
 mod stats;
 
 pub use actarray::*;
 pub use device::*;
 pub use discovery::*;
+pub use done::*;
 pub use gripper::*;
 pub use lease::*;
 pub use limb::*;
 pub use log::*;
+pub use ranger::*;
 pub use stats::*;
 
 /// What a call returned: `LIMBER_CODE_OK` (0), or why it failed. The detail of a failure is
@@ -534,6 +538,7 @@ impl LimberInterface {
             InterfaceKind::ActArray => LimberInterface::Actarray,
             InterfaceKind::Limb => LimberInterface::Limb,
             InterfaceKind::Gripper => LimberInterface::Gripper,
+            InterfaceKind::Ranger => LimberInterface::Ranger,
         }
     }
 

@@ -1,6 +1,9 @@
 //! `limber demo`: the main job. Starts a robot (the Pioneer emulator and driver, or the
-//! simulated arm) in this process and runs the paper's pick-a-block program against it,
-//! showing each step with the live joint and gripper state.
+//! simulated arm) and its world (a block at a seeded random place within reach, or where
+//! `--block` says, and the laser) in this process and runs the paper's pick-a-block
+//! program against it: the laser finds the block, the arm picks it up and puts it down,
+//! each step shown with the live joint and gripper state, then where the laser found the
+//! block against where it was.
 
 use std::io::IsTerminal;
 use std::sync::Arc;
@@ -35,9 +38,10 @@ pub struct DemoArgs {
     /// The robot to run the very same client program on.
     #[arg(long, value_enum, default_value_t = Robot::Pioneer)]
     on: Robot,
-    /// Block position x y (m, robot frame); default depends on the robot.
-    #[arg(long, num_args = 2, allow_negative_numbers = true, value_names = ["X", "Y"])]
-    block: Option<Vec<f64>>,
+    /// The world: the block (`--block X Y`, or `--seed N` for a random place within reach;
+    /// default seed 1), `--world FILE`, the laser's noise.
+    #[command(flatten)]
+    world: crate::world::WorldArgs,
     /// Drop position x y (m, robot frame); default depends on the robot.
     #[arg(long, num_args = 2, allow_negative_numbers = true, value_names = ["X", "Y"])]
     drop: Option<Vec<f64>>,
@@ -55,10 +59,13 @@ struct Running {
     arm: String,
     robot: String,
     params: PickParams,
+    /// The world's driver: the laser and the blocks (stopped before the robot).
+    world: Option<crate::world::RunningWorld>,
 }
 
 impl Drop for Running {
     fn drop(&mut self) {
+        drop(self.world.take());
         self.stop.store(true, Ordering::Relaxed);
         if let Some(t) = self.thread.take()
             && t.join().is_err()
@@ -139,10 +146,11 @@ fn start_pioneer(domain: &Domain) -> Result<Running, CliError> {
         arm: "pioneer/actarray/0".into(),
         robot: "pioneer".into(),
         params: PickParams::default(),
+        world: None,
     })
 }
 
-fn start_simarm(domain: &Domain) -> Result<Running, CliError> {
+fn start_simarm(domain: &Domain, block: Option<limber_world::Block>) -> Result<Running, CliError> {
     use limber_kinematics::chain::Chain;
     use limber_simarm::{SimArm, SimArmOptions, SimObject};
     let stop = Arc::new(AtomicBool::new(false));
@@ -159,9 +167,11 @@ fn start_simarm(domain: &Domain) -> Result<Running, CliError> {
                     return;
                 }
             };
-            // A 4 cm block where the program will look for it, so the gripper's beam sees it.
+            // The world's block, its grasp point at the paper's HandleHeight: the fingers
+            // close on it and the gripper's beam sees it.
             let opts = SimArmOptions {
-                object: Some(SimObject::block([0.45, 0.10, 0.15], 0.04)),
+                object: block
+                    .map(|b| SimObject::block([b.x, b.y, crate::world::HANDLE_HEIGHT], b.size)),
                 ..SimArmOptions::default()
             };
             let mut arm = match SimArm::new(&ctx, Chain::default_6dof(), opts) {
@@ -196,12 +206,8 @@ fn start_simarm(domain: &Domain) -> Result<Running, CliError> {
         gripper: "simarm/gripper/0".into(),
         arm: "simarm/actarray/0".into(),
         robot: "simarm".into(),
-        params: PickParams {
-            block: [0.45, 0.10],
-            drop: [0.45, -0.10],
-            grasp_height: 0.15,
-            ..PickParams::default()
-        },
+        params: PickParams::default(),
+        world: None,
     })
 }
 
@@ -220,6 +226,7 @@ fn gripper_name(g: &GripperData) -> &'static str {
 
 fn step_name(s: &Step) -> String {
     match s {
+        Step::Find => "find the block with the laser".into(),
         Step::Home => "home".into(),
         Step::OpenGripper => "open the gripper".into(),
         Step::Approach(x) => format!(
@@ -256,16 +263,41 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
         },
         domain.name()
     )?;
-    let running = match a.on {
+    let mut world_args = a.world.clone();
+    if world_args.world.is_none() && world_args.block.is_empty() && world_args.seed.is_none() {
+        world_args.seed = Some(1);
+    }
+    let world = world_args.world()?;
+    let laser_config = world_args.laser()?;
+    let placed = world.blocks.first().copied();
+    let mut running = match a.on {
         Robot::Pioneer => start_pioneer(&domain)?,
-        Robot::Simarm => start_simarm(&domain)?,
+        Robot::Simarm => start_simarm(&domain, placed)?,
     };
+    let laser = format!("{}/ranger/0", running.robot);
+    running.world = Some(crate::world::RunningWorld::start(
+        &domain,
+        &running.robot,
+        &running.limb,
+        &running.gripper,
+        world,
+        laser_config,
+    )?);
+    if let Some(b) = placed {
+        outln!(
+            "placed a block of {:.0} mm at ({:.3}, {:.3}){}; the laser {laser} will find it",
+            b.size * 1000.0,
+            b.x,
+            b.y,
+            world_args
+                .seed
+                .map(|s| format!(" (random, seed {s})"))
+                .unwrap_or_default()
+        )?;
+    }
     let ctx = Context::new(&domain, Role::Client, "demo")
         .map_err(|e| CliError::new(exit::FAILURE, e.to_string()))?;
     let mut params = running.params;
-    if let Some(b) = &a.block {
-        params.block = [b[0], b[1]];
-    }
     if let Some(d) = &a.drop {
         params.drop = [d[0], d[1]];
     }
@@ -279,15 +311,16 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
             }
         }
     }
-    let mut dev = Devices::connect(
+    let mut dev = Devices::connect_with_laser(
         &ctx,
         &running.limb,
         &running.gripper,
+        &laser,
         Duration::from_secs(5),
     )
     .map_err(crate::device::connect_err)?;
     outln!(
-        "devices: {} (joints), {} (end effector), {} (gripper)\n",
+        "devices: {} (joints), {} (end effector), {} (gripper), {laser} (laser)\n",
         running.arm,
         running.limb,
         running.gripper
@@ -314,6 +347,19 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
         }
     };
     let result = pick_block::run(&mut dev, &params, &mut |ev| match ev {
+        Event::Found(f) => {
+            let off = placed.map(|b| (f.centre[0] - b.x).hypot(f.centre[1] - b.y));
+            say(format_args!(
+                "[ 0/11] the laser's closest point ({:.3}, {:.3}); the block's centre {:.3} m further: found at ({:.3}, {:.3}){}\n",
+                f.closest[0],
+                f.closest[1],
+                params.block_radius,
+                f.centre[0],
+                f.centre[1],
+                off.map(|d| format!(", {:.1} mm from where it was", d * 1000.0))
+                    .unwrap_or_default()
+            ));
+        }
         Event::Start(s) => {
             n += 1;
             step_start = Instant::now();
@@ -377,10 +423,11 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
     }
     match result {
         Ok(s) => {
+            let picked = s.found.map_or(params.block, |f| f.centre);
             outln!(
-                "\npicked the block at ({:.2}, {:.2}) and put it down at ({:.2}, {:.2}): {} steps in {:.1} s{}",
-                params.block[0],
-                params.block[1],
+                "\npicked the block at ({:.3}, {:.3}) and put it down at ({:.2}, {:.2}): {} steps in {:.1} s{}",
+                picked[0],
+                picked[1],
                 params.drop[0],
                 params.drop[1],
                 s.steps,
@@ -408,6 +455,25 @@ pub fn run(a: DemoArgs) -> Result<(), CliError> {
                     st.refused,
                     st.requests,
                     st.bad_checksums
+                )?;
+            }
+            if let (Some(b), Some(f), Some(now)) = (
+                placed,
+                s.found,
+                running
+                    .world
+                    .as_ref()
+                    .and_then(|w| w.blocks().first().copied()),
+            ) {
+                outln!(
+                    "the block was at ({:.3}, {:.3}); the laser found it at ({:.3}, {:.3}), {:.1} mm off; it is now at ({:.3}, {:.3})",
+                    b.x,
+                    b.y,
+                    f.centre[0],
+                    f.centre[1],
+                    (f.centre[0] - b.x).hypot(f.centre[1] - b.y) * 1000.0,
+                    now.x,
+                    now.y
                 )?;
             }
             outln!("done.")?;

@@ -1,9 +1,10 @@
-//! `limber actarray|limb|gripper <device> <command>`: every command and request of each
+//! `limber actarray|limb|gripper|ranger <device> <command>`: every command and request of each
 //! interface from the shell, and `limber echo <device>`: the live state.
 
 use std::time::Duration;
 
 use clap::{Args, Subcommand, ValueEnum};
+use limber_interfaces::Describe;
 use limber_services::prelude::*;
 use limber_services::{CommandError, ConnectError, LeaseError, RequestError, WaitError};
 
@@ -22,6 +23,14 @@ pub struct Common {
     /// once the driver has taken them.
     #[arg(long, global = true)]
     no_wait: bool,
+    /// After the outcome, wait up to S seconds (default 60) until the command's motion
+    /// has ended, and say how (reached within the tolerance, stalled, stopped, preempted,
+    /// aborted, timed out) with the largest final error; exit 1 when it did not reach its
+    /// goal.
+    #[arg(long, global = true, value_name = "S", num_args = 0..=1,
+          default_missing_value = "60", value_parser = crate::parse_seconds,
+          conflicts_with = "no_wait")]
+    wait: Option<f64>,
     /// Take the device for this command (a control lease, released when it ends): refused
     /// with the holder's name if another client holds it. Without it, the last writer wins.
     #[arg(long, global = true)]
@@ -356,7 +365,10 @@ fn finish<I: Interface>(
         // "ok", or "ok, clamped to the limit": carried out either way.
         Ok(o) if o.status.is_carried_out() => {
             outln!("{}", o.status)?;
-            Ok(())
+            match common.wait {
+                Some(s) => wait_done(c, ticket, s),
+                None => Ok(()),
+            }
         }
         // Another client holds the device: "refused: held by another client (its name)".
         Ok(o) if o.status == Status::Leased => Err(held_by(o.other_name())),
@@ -370,6 +382,25 @@ fn finish<I: Interface>(
             Ok(())
         }
         Err(e) => Err(wait_err(e)),
+    }
+}
+
+/// `--wait`: how the motion of `ticket`'s command ended, in the core's sentence ("done:
+/// reached the goal within the tolerance; largest final error ..."); exit 1 when it did
+/// not reach its goal.
+fn wait_done<I: Interface>(
+    c: &mut Client<I>,
+    ticket: Ticket,
+    seconds: f64,
+) -> Result<(), CliError> {
+    match c.wait_done(ticket, Duration::from_secs_f64(seconds)) {
+        Ok(d) if d.reached() => {
+            outln!("done: {d}")?;
+            Ok(())
+        }
+        Ok(d) => Err(CliError::new(exit::FAILURE, format!("done: {d}"))),
+        Err(DoneError::Refused(s)) => Err(CliError::new(exit::REFUSED, format!("refused: {s}"))),
+        Err(DoneError::Wait(e)) => Err(wait_err(e)),
     }
 }
 
@@ -591,4 +622,70 @@ pub fn gripper(a: GripperArgs) -> Result<(), CliError> {
         }
     };
     finish(&mut c, sent, &a.common)
+}
+
+/// Arguments of `limber ranger`.
+#[derive(Debug, Args)]
+pub struct RangerArgs {
+    /// The device, e.g. pioneer/ranger/0.
+    device: String,
+    #[command(subcommand)]
+    cmd: RangerVerb,
+    #[command(flatten)]
+    common: Common,
+}
+
+/// What to read from a ranger (it has no command).
+#[derive(Debug, Subcommand)]
+pub enum RangerVerb {
+    /// Print the latest scan: one line per range (index, bearing in degrees, range in m),
+    /// then the closest one; `--json` prints the scan as `limber echo --json` does.
+    Scan {
+        /// One JSON object (the schema of `limber echo --json`).
+        #[arg(long)]
+        json: bool,
+    },
+    /// Print the geometry: the sensor's pose on the robot and its configuration (request).
+    Geom,
+}
+
+/// Runs `limber ranger`.
+pub fn ranger(a: RangerArgs) -> Result<(), CliError> {
+    let mut c = connect::<Ranger>(&a.device, &a.common)?;
+    match a.cmd {
+        RangerVerb::Scan { json } => {
+            let s = *c.current(a.common.timeout()).map_err(wait_err)?;
+            if json {
+                outln!("{}", s.json())?;
+                return Ok(());
+            }
+            for (i, r) in s.ranges().iter().enumerate() {
+                outln!("{i:3} {:+7.2} deg {r:.3} m", s.bearing(i).to_degrees())?;
+            }
+            outln!("{}", s.human())?;
+        }
+        RangerVerb::Geom => {
+            let g = c.geometry().map_err(request_err)?;
+            let (p, o) = (g.pose.position, g.pose.orientation);
+            outln!(
+                "pose ({:.4}, {:.4}, {:.4}) m yaw {:.2} deg; size {:.3} x {:.3} x {:.3} m; {} ranges over {:+.1}..{:+.1} deg every {:.2} deg; range {:.3} to {:.3} m (resolution {:.3} m); {:.1} Hz",
+                p.x,
+                p.y,
+                p.z,
+                o.yaw.to_degrees(),
+                g.size.width,
+                g.size.length,
+                g.size.height,
+                g.ranges_count,
+                g.min_angle.to_degrees(),
+                g.max_angle.to_degrees(),
+                g.angular_res.to_degrees(),
+                g.min_range,
+                g.max_range,
+                g.range_res,
+                g.frequency
+            )?;
+        }
+    }
+    Ok(())
 }

@@ -2,7 +2,8 @@
 
 use crate::{CliError, exit};
 use limber_emulator::{
-    ArmpacLayout, Emulator, EmulatorConfig, EmulatorError, Faults, ObjectPlacement, Timing,
+    ArmpacLayout, Emulator, EmulatorConfig, EmulatorError, Faults, GripperByteLayout,
+    ObjectPlacement, Timing,
 };
 use limber_services::signals;
 use std::io::{Read, Write};
@@ -37,6 +38,11 @@ pub struct EmulatorArgs {
     /// bits first).
     #[arg(long, value_name = "LAYOUT", default_value = "manual", value_parser = parse_layout)]
     pub armpac_layout: ArmpacLayout,
+    /// Gripper state byte layout (SIP and GRIPPERpac): `manual` (the Pioneer Gripper
+    /// manual: active-high bits, the breakbeams in DIGIN) or `aria` (ARIA's active-low
+    /// General-I/O switches, the beams in the byte).
+    #[arg(long, value_name = "LAYOUT", default_value = "manual", value_parser = parse_gripper_byte)]
+    pub gripper_byte: GripperByteLayout,
     /// Emulate a robot without an arm (arm commands are ignored).
     #[arg(long)]
     pub no_arm: bool,
@@ -94,6 +100,10 @@ pub struct EmulatorArgs {
     pub ignore_stdin: bool,
 }
 
+fn parse_gripper_byte(s: &str) -> Result<GripperByteLayout, String> {
+    GripperByteLayout::from_name(s).ok_or_else(|| format!("{s:?}: expected manual or aria"))
+}
+
 fn parse_layout(s: &str) -> Result<ArmpacLayout, String> {
     ArmpacLayout::from_name(s).ok_or_else(|| format!("{s:?}: expected manual or aria"))
 }
@@ -138,6 +148,7 @@ impl EmulatorArgs {
             ..EmulatorConfig::default()
         };
         cfg.model.armpac_layout = self.armpac_layout;
+        cfg.model.gripper_byte = self.gripper_byte;
         if self.no_arm {
             cfg.model.arm = None;
         }

@@ -24,8 +24,10 @@ mod logging;
 mod monitor;
 mod out;
 pub mod pioneer;
+mod player_gateway;
 mod record;
 pub mod simarm;
+pub mod world;
 
 /// limber: Player's generic limb interfaces (actarray, limb, gripper) over zero-copy
 /// shared memory, with a real-time driver for the Pioneer arm.
@@ -97,6 +99,11 @@ enum Command {
     ///
     /// Example: limber gripper pioneer/gripper/0 open
     Gripper(device::GripperArgs),
+    /// Read a ranger (a laser scanner): scan (the latest ranges with their bearings),
+    /// geom (its pose on the robot and configuration).
+    ///
+    /// Example: limber ranger simarm/ranger/0 geom
+    Ranger(device::RangerArgs),
     /// Run the Pioneer driver: the arm, limb, grippers and lift over P2OS (serial, pty or
     /// tcp://host:port). `--emulated` drives the built-in emulator.
     Pioneer(pioneer::PioneerArgs),
@@ -116,6 +123,13 @@ enum Command {
     /// bridge/README.md.
     #[cfg(feature = "bridge")]
     Bridge(bridge::BridgeArgs),
+    /// Serve Player's TCP protocol (Player 3) for every device of the domain, so that
+    /// Player's own programs (libplayerc, libplayerc++, playerv, playerprint, playerjoy)
+    /// use limber devices unchanged: point them at this address. Loopback by default.
+    ///
+    /// Runs until SIGINT, SIGTERM, SIGHUP (or SIGQUIT); prints "session N from ADDR" and
+    /// "session N ended" as clients come and go (a session's leases end with it).
+    PlayerGateway(player_gateway::PlayerGatewayArgs),
     /// Record every state, outcome and driver statistics of the domain (or of the devices
     /// named) into an MCAP file, with a progress line on stderr; `--info FILE` summarises a
     /// recorded file. Foxglove and the `mcap` tools open the files (record/README.md).
@@ -170,11 +184,13 @@ where
         Command::Actarray(args) => device::actarray(args),
         Command::Limb(args) => device::limb(args),
         Command::Gripper(args) => device::gripper(args),
+        Command::Ranger(args) => device::ranger(args),
         Command::Pioneer(args) => pioneer::run(args),
         Command::Emulator(args) => emulator::run(args),
         Command::Simarm(args) => simarm::run(args),
         #[cfg(feature = "bridge")]
         Command::Bridge(args) => bridge::run(args),
+        Command::PlayerGateway(args) => player_gateway::run(args),
         Command::Record(args) => record::record(args),
         Command::Replay(args) => record::replay(args),
         Command::View(args) => record::view(args),

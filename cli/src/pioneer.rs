@@ -51,6 +51,9 @@ pub struct PioneerArgs {
     /// Print the configuration (defaults merged with --config) as TOML and exit.
     #[arg(long)]
     pub print_config: bool,
+    /// With --emulated: the world its laser scans and its arm picks blocks from.
+    #[command(flatten)]
+    pub world: crate::world::WorldArgs,
 }
 
 /// `limber pioneer` failed.
@@ -98,6 +101,12 @@ pub fn config_from(args: &PioneerArgs) -> Result<PioneerConfig, PioneerCliError>
 /// Runs `limber pioneer` until a termination signal ([`limber_services::signals`]: SIGINT,
 /// SIGTERM, SIGHUP, SIGQUIT, SIGXCPU, SIGPWR), which stops the arm first.
 pub fn run(args: PioneerArgs) -> Result<(), CliError> {
+    if !args.emulated && args.world.given() {
+        return Err(CliError::new(
+            exit::USAGE,
+            "--world, --block and --seed describe the emulated robot's world: use them with --emulated",
+        ));
+    }
     let to_cli = |e: PioneerCliError| {
         let code = match e {
             PioneerCliError::Config(_) | PioneerCliError::Cpu(_) => exit::USAGE,
@@ -109,11 +118,25 @@ pub fn run(args: PioneerArgs) -> Result<(), CliError> {
         let cfg = config_from(&args).map_err(to_cli)?;
         return out!("{}", cfg.to_toml());
     }
+    // The emulated robot's world, checked before anything starts (a bad file is a usage
+    // error).
+    let world = if args.emulated {
+        Some((args.world.world()?, args.world.laser()?))
+    } else {
+        None
+    };
     let domain = crate::domain()?;
-    serve(args, &domain).map_err(to_cli)
+    serve(args, &domain, world).map_err(to_cli)
 }
 
-fn serve(args: PioneerArgs, domain: &limber_services::Domain) -> Result<(), PioneerCliError> {
+/// The emulated robot's world and its laser.
+type EmulatedWorld = (limber_world::World, limber_world::LaserConfig);
+
+fn serve(
+    args: PioneerArgs,
+    domain: &limber_services::Domain,
+    world: Option<EmulatedWorld>,
+) -> Result<(), PioneerCliError> {
     let cfg = config_from(&args)?;
     if let Some(n) = args.cpu {
         check_cpu(n)?;
@@ -162,6 +185,24 @@ fn serve(args: PioneerArgs, domain: &limber_services::Domain) -> Result<(), Pion
     }
     // Served or not, and why (the robot's CONFIGpac, or `body_gripper`).
     noteln!("{}", hw.gripper_note);
+    // The emulated robot's world in this process: its laser and the blocks its arm moves.
+    let _world = match world {
+        Some((w, laser)) => {
+            let blocks = crate::world::describe(&w.blocks);
+            let running = crate::world::RunningWorld::start(
+                domain,
+                r,
+                &format!("{r}/limb/0"),
+                &format!("{r}/gripper/1"),
+                w,
+                laser,
+            )
+            .map_err(|e| PioneerCliError::Setup(e.to_string()))?;
+            noteln!("serving {r}/ranger/0 (simulated laser; {blocks})");
+            Some(running)
+        }
+        None => None,
+    };
     noteln!("serving {r}/driver/0 (statistics); ready");
     let mode = if args.spin {
         LoopMode::Spin

@@ -52,11 +52,22 @@ pub struct SimArmArgs {
     /// e.g. `--object 0.45,0.1,0.1,0.04`.
     #[arg(long, value_name = "X,Y,Z,WIDTH", value_parser = parse_object)]
     pub object: Option<SimObject>,
+    /// How many objects the gripper can store (STORE swallows the object between the
+    /// fingers, RETRIEVE gives it back); 0, the default: it cannot, both unsupported.
+    #[arg(long, value_name = "N", default_value_t = 0,
+          value_parser = clap::value_parser!(u32).range(0..=i64::from(limber_simarm::MAX_STORE_CAPACITY)))]
+    pub store_capacity: u32,
+    /// The chain's joints have no brakes (BRAKES unsupported, `has_brakes` 0).
+    #[arg(long)]
+    pub no_brakes: bool,
     /// Clients each device admits at once; a few more slots are kept for priority clients
     /// (LIMBER_PRIORITY=1, --priority).
     #[arg(long, value_name = "N", default_value_t = limber_services::qos::DEFAULT_MAX_CLIENTS,
           value_parser = parse_max_clients)]
     pub max_clients: usize,
+    /// The world the laser scans and the gripper picks blocks from.
+    #[command(flatten)]
+    pub world: crate::world::WorldArgs,
 }
 
 /// `--max-clients`: 1 to `qos::MAX_CLIENTS_LIMIT`.
@@ -84,6 +95,8 @@ impl SimArmArgs {
             tick: Duration::from_millis(self.tick_ms),
             time_scale: self.time_scale,
             object: self.object,
+            store_capacity: self.store_capacity,
+            brakes: !self.no_brakes,
             ..SimArmOptions::default()
         }
     }
@@ -114,7 +127,8 @@ fn parse_object(s: &str) -> Result<SimObject, String> {
 
 /// Runs `limber simarm` until a termination signal ([`limber_services::signals`]): joins
 /// the domain of `LIMBER_DOMAIN`, prints `serving <robot>/actarray/0, <robot>/limb/0,
-/// <robot>/gripper/0; ready` and serves.
+/// <robot>/gripper/0, <robot>/ranger/0 (laser; ...); ready` and serves, with the world
+/// (the laser, the blocks) on a thread.
 pub fn run(args: SimArmArgs) -> Result<(), CliError> {
     let fail = |e: SimArmError| CliError::new(exit::FAILURE, e.to_string());
     let chain = match &args.urdf {
@@ -124,7 +138,19 @@ pub fn run(args: SimArmArgs) -> Result<(), CliError> {
             .chain()
             .map_err(|e| CliError::new(exit::USAGE, e.to_string()))?,
     };
-    let options = args.options();
+    let mut options = args.options();
+    let world = args.world.world()?;
+    args.world.laser()?;
+    // The first block is the object the simulated fingers close on (and the beams see),
+    // its grasp point at the paper's HandleHeight, unless --object names another.
+    if options.object.is_none()
+        && let Some(b) = world.blocks.first()
+    {
+        options.object = Some(SimObject::block(
+            [b.x, b.y, crate::world::HANDLE_HEIGHT],
+            b.size,
+        ));
+    }
     let domain = crate::domain()?;
     let ctx = Context::new(&domain, Role::Driver, "simarm").map_err(|e| {
         CliError::new(
@@ -162,7 +188,18 @@ pub fn run(args: SimArmArgs) -> Result<(), CliError> {
         args.time_scale,
         domain.name()
     );
-    noteln!("serving {robot}/actarray/0, {robot}/limb/0, {robot}/gripper/0; ready");
+    let blocks = crate::world::describe(&world.blocks);
+    let _world = crate::world::RunningWorld::start(
+        &domain,
+        &robot,
+        &format!("{robot}/limb/0"),
+        &format!("{robot}/gripper/0"),
+        world,
+        args.world.laser()?,
+    )?;
+    noteln!(
+        "serving {robot}/actarray/0, {robot}/limb/0, {robot}/gripper/0, {robot}/ranger/0 (laser; {blocks}); ready"
+    );
     let ended = arm.run(|| false).map_err(fail)?;
     if ended == LoopExit::Signal {
         eprintln!("limber simarm: stopped");

@@ -115,6 +115,11 @@ fn pioneer_print_config_documents_the_armpac_layout() {
     let aria = limber_pioneer::PioneerConfig::from_toml("armpac_layout = \"aria\"").unwrap();
     assert_eq!(aria.armpac_layout, limber_p2os::ArmpacLayout::Aria);
     assert!(limber_pioneer::PioneerConfig::from_toml("armpac_layout = \"player\"").is_err());
+    // The gripper state byte likewise: the manual's by default, ARIA's on request.
+    assert!(text.contains("gripper_byte = \"manual\""), "{text}");
+    let aria = limber_pioneer::PioneerConfig::from_toml("gripper_byte = \"aria\"").unwrap();
+    assert_eq!(aria.gripper_byte, limber_p2os::GripperByteLayout::Aria);
+    assert!(limber_pioneer::PioneerConfig::from_toml("gripper_byte = \"player\"").is_err());
 }
 
 /// Signals that only interrupt a wait (a stop and continue, a terminal resize, a child's

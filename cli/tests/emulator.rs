@@ -4,7 +4,7 @@ use std::time::Duration;
 
 use clap::Parser;
 use limber_cli::emulator::EmulatorArgs;
-use limber_emulator::{ArmpacLayout, Timing};
+use limber_emulator::{ArmpacLayout, GripperByteLayout, Timing};
 
 fn ms(n: u64) -> Duration {
     Duration::from_millis(n)
@@ -55,6 +55,14 @@ fn timing_and_armpac_layout_flags() {
         ArmpacLayout::Manual
     );
     assert!(Cli::try_parse_from(["emulator", "--armpac-layout", "player"]).is_err());
+    // The gripper state byte: the Pioneer Gripper manual's by default, ARIA's on request.
+    assert_eq!(cfg.model.gripper_byte, GripperByteLayout::Manual);
+    let c = Cli::try_parse_from(["emulator", "--gripper-byte", "aria"]).unwrap();
+    assert_eq!(
+        c.args.config().unwrap().model.gripper_byte,
+        GripperByteLayout::Aria
+    );
+    assert!(Cli::try_parse_from(["emulator", "--gripper-byte", "player"]).is_err());
 }
 
 /// `--drop-arm-info N` (from `limber emulator --help`): the first N ARMINFOpac replies are

@@ -14,7 +14,8 @@
 //!   README's "in another terminal" says.
 //! * `CMD &` runs in the background until `kill %N` (SIGTERM; it must exit 0) or the end
 //!   of the block; a driver must print its "ready" line first, `limber bridge expose` its
-//!   first "exposed" line and `limber bridge mirror` its first "mirrored" line.
+//!   first "exposed" line, `limber bridge mirror` its first "mirrored" line and `limber
+//!   player-gateway` its "listening on" line.
 //! * `--domain NAME` names a domain of the block's own (NAME prefixed with the block's
 //!   unique domain), so that a block may use several domains without meeting others.
 //! * `CMD > FILE`: CMD's output must equal FILE (the generated files are up to date).
@@ -342,6 +343,10 @@ impl Session {
             };
             job.wait_line(|l| l.starts_with(first), START_TIMEOUT)
                 .map_err(|seen| format!("{what}: no \"{first}\" line:\n{seen}"))?;
+        }
+        if verb == Some("player-gateway") {
+            job.wait_line(|l| l.contains(" listening on "), START_TIMEOUT)
+                .map_err(|seen| format!("{what}: no \"listening on\" line:\n{seen}"))?;
         }
         self.jobs.push(job);
         Ok(())

@@ -25,6 +25,8 @@ fn defaults_are_the_6dof_arm_named_simarm() {
     assert_eq!(o.tick, Duration::from_millis(10));
     assert_eq!(o.time_scale, 1.0);
     assert_eq!(o.object, None);
+    assert_eq!(o.store_capacity, 0);
+    assert!(o.brakes);
 }
 
 #[test]
@@ -71,4 +73,10 @@ fn chains_and_options() {
     assert_eq!(o.time_scale, 2.5);
     assert_eq!(o.object, Some(SimObject::block([0.45, 0.1, 0.15], 0.04)));
     assert!(parse(&["--object", "0.45,0.1"]).is_err());
+    let o = parse(&["--store-capacity", "3", "--no-brakes"])
+        .unwrap()
+        .options();
+    assert_eq!(o.store_capacity, 3);
+    assert!(!o.brakes);
+    assert!(parse(&["--store-capacity", "5000"]).is_err());
 }

@@ -1,5 +1,12 @@
-//! The paper's Listing 2: pick up a block, carry it, put it down, with the limb and
-//! gripper interfaces only. The same code runs on the Pioneer arm and on any simarm chain.
+//! The paper's Listing 2: find a block with the laser, pick it up, carry it, put it down,
+//! with the ranger, limb and gripper interfaces only. The same code runs on the Pioneer
+//! arm and on any simarm chain.
+//!
+//! Finding the block (the paper's lines 13-40, [`find_block`]): the laser's pose from its
+//! geometry; the closest point of the scan; the block's centre is that point plus the
+//! block's radius along the same beam; the orientation vector goes from the closest point
+//! to the centre. Without a laser ([`Devices::laser`] `None`) the block is where
+//! [`PickParams::block`] says and the orientation vector points away from the limb's base.
 //!
 //! Steps: home; open the gripper; approach 5 cm above the block with the approach vector
 //! pointing down and the orientation vector across the block; check that the pose was
@@ -15,8 +22,11 @@ use thiserror::Error;
 /// Where the block is and where it goes, in the robot frame (m).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PickParams {
-    /// Block centre, x and y.
+    /// Block centre, x and y (used when the devices have no laser).
     pub block: [f64; 2],
+    /// The block's radius: from the closest point the laser sees to its centre (m; the
+    /// paper's `BlockRadius`).
+    pub block_radius: f64,
     /// Drop point, x and y.
     pub drop: [f64; 2],
     /// Height of the grasp point above the floor (the paper's `HandleHeight`).
@@ -36,6 +46,7 @@ impl Default for PickParams {
     fn default() -> Self {
         PickParams {
             block: [0.38, 0.10],
+            block_radius: 0.02,
             drop: [0.38, -0.10],
             grasp_height: 0.17,
             clearance: 0.05,
@@ -48,6 +59,8 @@ impl Default for PickParams {
 /// One step of the program, reported as it starts and when it ends.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Step {
+    /// Finding the block in the laser's scan (before the first step; only with a laser).
+    Find,
     /// Going home.
     Home,
     /// Opening the gripper.
@@ -75,6 +88,8 @@ pub enum Step {
 /// What an observer is told.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Event<'a> {
+    /// The laser found the block (before the first step).
+    Found(Found),
     /// A step starts.
     Start(Step),
     /// A step ended; the limb and gripper states at its end.
@@ -123,6 +138,9 @@ pub enum PickError {
         /// The limit.
         timeout: Duration,
     },
+    /// The laser saw nothing within its range: no block to pick.
+    #[error("the laser sees no block")]
+    NothingSeen,
     /// The driver went away.
     #[error("{step:?}: {source}")]
     Wait {
@@ -133,9 +151,22 @@ pub enum PickError {
     },
 }
 
+/// Where the laser found the block (the paper's lines 13-40).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Found {
+    /// The closest point of the scan, x and y in the robot frame (m).
+    pub closest: [f64; 2],
+    /// The block's centre, x and y in the robot frame (m).
+    pub centre: [f64; 2],
+    /// The orientation vector: from the closest point to the centre.
+    pub orientation: [f64; 3],
+}
+
 /// What the program did.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Summary {
+    /// Where the laser found the block (`None`: no laser, the block was given).
+    pub found: Option<Found>,
     /// Steps carried out.
     pub steps: usize,
     /// Whether the gripper's beams saw the block while it was held.
@@ -152,6 +183,8 @@ pub struct Devices {
     pub limb: LimbClient,
     /// The gripper at the end of the limb.
     pub gripper: GripperClient,
+    /// The laser that finds the block (`None`: the block is where the parameters say).
+    pub laser: Option<RangerClient>,
 }
 
 impl Devices {
@@ -165,8 +198,65 @@ impl Devices {
         Ok(Devices {
             limb: LimbClient::connect_timeout(ctx, limb, timeout)?,
             gripper: GripperClient::connect_timeout(ctx, gripper, timeout)?,
+            laser: None,
         })
     }
+
+    /// Connects to `limb`, `gripper` and the laser `laser` (device names).
+    pub fn connect_with_laser(
+        ctx: &Context,
+        limb: &str,
+        gripper: &str,
+        laser: &str,
+        timeout: Duration,
+    ) -> Result<Self, ConnectError> {
+        let mut d = Devices::connect(ctx, limb, gripper, timeout)?;
+        d.laser = Some(RangerClient::connect_timeout(ctx, laser, timeout)?);
+        Ok(d)
+    }
+}
+
+/// The paper's lines 13-40: finds the block in `laser`'s latest scan (waiting up to
+/// `timeout` for one). The closest point of the scan, moved to the robot frame by the
+/// laser's pose; the centre `radius` further along the same beam; the orientation vector
+/// from the closest point to the centre.
+pub fn find_block(
+    laser: &mut RangerClient,
+    radius: f64,
+    timeout: Duration,
+) -> Result<Found, PickError> {
+    let pose = laser.geometry()?.pose;
+    let (lx, ly, yaw) = (pose.position.x, pose.position.y, pose.orientation.yaw);
+    let scan = *laser.current(timeout).map_err(|source| PickError::Wait {
+        step: Step::Find,
+        source,
+    })?;
+    let ranges = scan.ranges();
+    // Find the closest point in the laser scan.
+    let mut min_index = 0;
+    for i in 1..ranges.len() {
+        if ranges[i] < ranges[min_index] {
+            min_index = i;
+        }
+    }
+    if ranges.is_empty() || ranges[min_index] >= scan.max_range {
+        return Err(PickError::NothingSeen);
+    }
+    // In the robot frame: the laser's heading turns the bearing, its position moves it.
+    let to_robot = |range: f64| {
+        let b = yaw + scan.bearing(min_index);
+        [lx + range * b.cos(), ly + range * b.sin()]
+    };
+    let closest = to_robot(ranges[min_index]);
+    // Calculate a point in the middle of the block.
+    let centre = to_robot(ranges[min_index] + radius);
+    // The orientation vector: from the closest point to the centre.
+    let orientation = [centre[0] - closest[0], centre[1] - closest[1], 0.0];
+    Ok(Found {
+        closest,
+        centre,
+        orientation,
+    })
 }
 
 const DOWN: [f64; 3] = [0.0, 0.0, -1.0];
@@ -183,9 +273,21 @@ pub fn run(
         Some(_) => [0.0; 3],
         None => dev.limb.geometry()?.base_pos.to_array(),
     };
-    let orient = |x: [f64; 3]| match p.across {
-        Some(v) => [v[0], v[1], 0.0],
-        None => radial(base, [x[0], x[1]]),
+    let found = match dev.laser.as_mut() {
+        Some(laser) => {
+            let f = find_block(laser, p.block_radius, p.motion_timeout)?;
+            observe(Event::Found(f));
+            Some(f)
+        }
+        None => None,
+    };
+    let block = found.map_or(p.block, |f| f.centre);
+    // With the laser, the block is approached along the vector the scan gave, and carried
+    // without turning it; without, radially away from the limb's base.
+    let orient = |x: [f64; 3]| match (found, p.across) {
+        (Some(f), _) => f.orientation,
+        (None, Some(v)) => [v[0], v[1], 0.0],
+        (None, None) => radial(base, [x[0], x[1]]),
     };
     let above = |xy: [f64; 2]| [xy[0], xy[1], p.grasp_height + p.clearance];
     let at = |xy: [f64; 2]| [xy[0], xy[1], p.grasp_height];
@@ -194,7 +296,7 @@ pub fn run(
     let mut run_step = |dev: &mut Devices, step: Step| -> Result<(), PickError> {
         observe(Event::Start(step));
         let sent = match step {
-            Step::Home | Step::HomeAgain => Some(dev.limb.home()?),
+            Step::Find | Step::Home | Step::HomeAgain => Some(dev.limb.home()?),
             Step::OpenGripper | Step::Release => {
                 let t = dev.gripper.open()?;
                 wait_gripper(dev, step, t, GripperState::Open, p.motion_timeout, observe)?;
@@ -235,10 +337,10 @@ pub fn run(
     let plan = [
         Step::Home,
         Step::OpenGripper,
-        Step::Approach(above(p.block)),
-        Step::Descend(at(p.block)),
+        Step::Approach(above(block)),
+        Step::Descend(at(block)),
         Step::Grip,
-        Step::Lift(above(p.block)),
+        Step::Lift(above(block)),
         Step::Carry(above(p.drop)),
         Step::PutDown(at(p.drop)),
         Step::Release,
@@ -264,6 +366,7 @@ pub fn run(
         steps += 1;
     }
     Ok(Summary {
+        found,
         steps,
         block_seen,
         released_at,
@@ -292,7 +395,10 @@ fn wait_limb(
 ) -> Result<(), PickError> {
     let deadline = Instant::now() + timeout;
     match dev.limb.wait_outcome(ticket, timeout) {
-        Ok(Status::Ok) | Err(WaitError::Missed { .. }) => {}
+        // "ok", or "ok, orientation adjusted" (a 5-joint arm turns the orientation the
+        // laser gave to the nearest one it can hold).
+        Ok(s) if s.is_carried_out() => {}
+        Err(WaitError::Missed { .. }) => {}
         Ok(Status::OutOfReach) => return Err(PickError::OutOfReach { step }),
         Ok(status) => return Err(PickError::Refused { step, status }),
         Err(source) => return Err(PickError::Wait { step, source }),

@@ -11,7 +11,7 @@ pub const MAX_ACTUATORS: usize = 32;
 
 wire_struct! {
     /// A point or vector in 3D (Player's `point_3d`), metres or unitless.
-    pub struct Vec3 : "limber.v2.Vec3", size = 24, align = 8 {
+    pub struct Vec3 : "limber.v3.Vec3", size = 24, align = 8 {
         /// x (forward in the robot frame).
         pub x: f64,
         /// y (left).
@@ -23,7 +23,7 @@ wire_struct! {
 
 wire_struct! {
     /// Roll, pitch and yaw in radians (Player's `orientation_3d`).
-    pub struct Orientation3 : "limber.v2.Orientation3", size = 24, align = 8 {
+    pub struct Orientation3 : "limber.v3.Orientation3", size = 24, align = 8 {
         /// Rotation about x.
         pub roll: f64,
         /// Rotation about y.
@@ -35,7 +35,7 @@ wire_struct! {
 
 wire_struct! {
     /// A 3D pose (Player's `pose3d`): position in metres, orientation in radians.
-    pub struct Pose3 : "limber.v2.Pose3", size = 48, align = 8 {
+    pub struct Pose3 : "limber.v3.Pose3", size = 48, align = 8 {
         /// Position.
         pub position: Vec3,
         /// Orientation.
@@ -45,7 +45,7 @@ wire_struct! {
 
 wire_struct! {
     /// A box size in metres (Player's `bbox3d`).
-    pub struct Bbox3 : "limber.v2.Bbox3", size = 24, align = 8 {
+    pub struct Bbox3 : "limber.v3.Bbox3", size = 24, align = 8 {
         /// Width (along y).
         pub width: f64,
         /// Length (along x).
@@ -58,7 +58,7 @@ wire_struct! {
 wire_struct! {
     /// The outcome of the last command a driver applied, carried in every state sample so
     /// the sender of a command sees whether (and why not) it was carried out.
-    pub struct CmdOutcome : "limber.v2.CmdOutcome", size = 24, align = 8 {
+    pub struct CmdOutcome : "limber.v3.CmdOutcome", size = 24, align = 8 {
         /// The client that sent it (0: no command applied yet).
         pub client_id: u64,
         /// That client's sequence number of the command.
@@ -72,7 +72,7 @@ wire_struct! {
 
 wire_struct! {
     /// The header of every state sample.
-    pub struct StateHeader : "limber.v2.StateHeader", size = 48, align = 8 {
+    pub struct StateHeader : "limber.v3.StateHeader", size = 48, align = 8 {
         /// Sample sequence number, +1 per published sample of this device.
         pub seq: u64,
         /// `CLOCK_MONOTONIC` time in ns at which the state was acquired (e.g. when the
@@ -89,7 +89,7 @@ wire_struct! {
 
 wire_struct! {
     /// Metadata in front of every command and every request.
-    pub struct MsgMeta : "limber.v2.MsgMeta", size = 32, align = 8 {
+    pub struct MsgMeta : "limber.v3.MsgMeta", size = 32, align = 8 {
         /// The sending client (unique per client in a domain; never 0).
         pub client_id: u64,
         /// The client's sequence number, +1 per message it sends on this channel.
@@ -105,7 +105,7 @@ wire_struct! {
 
 wire_struct! {
     /// Metadata in front of every reply.
-    pub struct ReplyMeta : "limber.v2.ReplyMeta", size = 32, align = 8 {
+    pub struct ReplyMeta : "limber.v3.ReplyMeta", size = 32, align = 8 {
         /// The client whose request this answers.
         pub client_id: u64,
         /// The request's sequence number.
@@ -167,11 +167,19 @@ pub enum Status {
     /// `orientation_adjustment` says by how much). Counts as carried out
     /// ([`Status::is_carried_out`]).
     Adjusted = 16,
+    /// The brakes are on: a motion of a braked joint (or of the limb) would not move it.
+    Braked = 17,
+    /// The gripper's store is full: STORE cannot take one more object.
+    StoreFull = 18,
+    /// Nothing is between the gripper's fingers: STORE has nothing to store.
+    NothingToStore = 19,
+    /// The gripper's store is empty: RETRIEVE has nothing to give back.
+    NothingStored = 20,
 }
 
 impl Status {
     /// Every status, in code order.
-    pub const ALL: [Status; 17] = [
+    pub const ALL: [Status; 21] = [
         Status::Ok,
         Status::Unsupported,
         Status::UnknownJoint,
@@ -189,6 +197,10 @@ impl Status {
         Status::Preempted,
         Status::Leased,
         Status::Adjusted,
+        Status::Braked,
+        Status::StoreFull,
+        Status::NothingToStore,
+        Status::NothingStored,
     ];
 
     /// The wire code.
@@ -239,6 +251,10 @@ impl Status {
             Status::Preempted => "preempted by another client",
             Status::Leased => "held by another client",
             Status::Adjusted => "ok, orientation adjusted",
+            Status::Braked => "brakes on",
+            Status::StoreFull => "the gripper's store is full",
+            Status::NothingToStore => "nothing between the fingers to store",
+            Status::NothingStored => "nothing stored to retrieve",
         }
     }
 }
@@ -367,6 +383,26 @@ pub(crate) const STATUS_GROUP: ConstantGroup = ConstantGroup {
             name: "ADJUSTED",
             value: 16,
             doc: "carried out, the orientation adjusted to one the limb's joints can hold",
+        },
+        Constant {
+            name: "BRAKED",
+            value: 17,
+            doc: "the brakes are on: release them before moving",
+        },
+        Constant {
+            name: "STORE_FULL",
+            value: 18,
+            doc: "the gripper's store is full",
+        },
+        Constant {
+            name: "NOTHING_TO_STORE",
+            value: 19,
+            doc: "nothing between the gripper's fingers to store",
+        },
+        Constant {
+            name: "NOTHING_STORED",
+            value: 20,
+            doc: "the gripper's store is empty",
         },
     ],
 };

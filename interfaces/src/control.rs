@@ -13,7 +13,7 @@ wire_struct! {
     /// client (each keeps its own, by `client_id`): one sample when the command is applied
     /// or refused, and one more with `STATUS_PREEMPTED` when another client's command
     /// cuts short the motion it started.
-    pub struct OutcomeMsg : "limber.v2.OutcomeMsg", size = 72, align = 8 {
+    pub struct OutcomeMsg : "limber.v3.OutcomeMsg", size = 608, align = 8 {
         /// The client that sent the command.
         pub client_id: u64,
         /// That client's sequence number of the command.
@@ -30,12 +30,154 @@ wire_struct! {
         /// The name of the holder of the lease (`STATUS_LEASED`, or a preempting holder),
         /// NUL-padded UTF-8; empty if none.
         pub other_name: [u8; 32],
+        /// 0: this sample is the command's outcome (applied or refused). Otherwise a
+        /// `RESULT` code: the motion the command started has ended, and how (one such
+        /// sample per command carried out; `status` then says why, e.g. `LINK_DOWN` for
+        /// an aborted motion, and `other_client` names the command that preempted it).
+        pub result: u32,
+        /// The parts (joints) the command drove: the valid entries of `position` and
+        /// `error` (at most 32).
+        pub parts: u32,
+        /// The largest |error| of the parts, in their unit (rad or m); NaN if not known.
+        pub max_error: f64,
+        /// The device's tolerance for "reached" (the loosest of the parts'), same unit.
+        pub tolerance: f64,
+        /// Each part's final position (part i = bit i of what the command drove: joint i
+        /// of an actuator array, of a limb; 0 for a gripper); NaN if not known.
+        pub position: [f64; 32],
+        /// Each part's final error against the command's goal (position − goal); NaN if
+        /// not known (a motion preempted before its goal was set, a SPEED).
+        pub error: [f64; 32],
     }
 }
 
+/// How a motion ended: [`OutcomeMsg::result`] (0 = not a result but the command's
+/// outcome).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[repr(u32)]
+pub enum MotionResult {
+    /// Every part reached its goal, within the device's tolerance (a command that starts
+    /// no motion running on by itself is reached when carried out).
+    Reached = 1,
+    /// A part stopped short of its goal and does not move on (blocked, or no progress).
+    Stalled = 2,
+    /// A STOP (or the deadman, when the lease's holder died) stopped it.
+    Stopped = 3,
+    /// Another command (of this client or another) took over its parts.
+    Preempted = 4,
+    /// The device gave up: link lost, powered off, brakes, collision (`status` says which).
+    Aborted = 5,
+    /// The device's own time limit for the motion passed before it ended.
+    TimedOut = 6,
+}
+
+impl MotionResult {
+    /// Every result, in code order.
+    pub const ALL: [MotionResult; 6] = [
+        MotionResult::Reached,
+        MotionResult::Stalled,
+        MotionResult::Stopped,
+        MotionResult::Preempted,
+        MotionResult::Aborted,
+        MotionResult::TimedOut,
+    ];
+
+    /// The wire code.
+    pub const fn code(self) -> u32 {
+        self as u32
+    }
+
+    /// Its name as limber.h spells it without the prefix (`REACHED`, ...).
+    pub fn name(self) -> &'static str {
+        RESULT_GROUP
+            .constants
+            .iter()
+            .find(|c| c.value == i64::from(self.code()))
+            .map_or("UNKNOWN", |c| c.name)
+    }
+
+    /// A short sentence.
+    pub const fn describe(self) -> &'static str {
+        match self {
+            MotionResult::Reached => "reached the goal within the tolerance",
+            MotionResult::Stalled => "stalled short of the goal",
+            MotionResult::Stopped => "stopped",
+            MotionResult::Preempted => "preempted by another command",
+            MotionResult::Aborted => "aborted",
+            MotionResult::TimedOut => "timed out",
+        }
+    }
+
+    /// Which of two results of parts of one command the command ends with: the first
+    /// that is not `Reached` (a command reached only when every part did).
+    pub const fn combine(self, other: MotionResult) -> MotionResult {
+        match self {
+            MotionResult::Reached => other,
+            s => s,
+        }
+    }
+}
+
+impl core::fmt::Display for MotionResult {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.describe())
+    }
+}
+
+impl TryFrom<u32> for MotionResult {
+    type Error = DecodeError;
+    fn try_from(code: u32) -> Result<Self, DecodeError> {
+        MotionResult::ALL
+            .iter()
+            .find(|s| s.code() == code)
+            .copied()
+            .ok_or(DecodeError::UnknownCode {
+                field: "result",
+                value: code as i64,
+            })
+    }
+}
+
+pub(crate) const RESULT_GROUP: ConstantGroup = ConstantGroup {
+    name: "RESULT",
+    doc: "OutcomeMsg.result codes: how a motion ended (0: the sample is the command's outcome)",
+    constants: &[
+        Constant {
+            name: "REACHED",
+            value: 1,
+            doc: "every part reached its goal within the tolerance",
+        },
+        Constant {
+            name: "STALLED",
+            value: 2,
+            doc: "a part stopped short of its goal",
+        },
+        Constant {
+            name: "STOPPED",
+            value: 3,
+            doc: "a STOP (or the deadman) stopped it",
+        },
+        Constant {
+            name: "PREEMPTED",
+            value: 4,
+            doc: "another command took over its parts",
+        },
+        Constant {
+            name: "ABORTED",
+            value: 5,
+            doc: "link lost, powered off, brakes, collision (status says which)",
+        },
+        Constant {
+            name: "TIMED_OUT",
+            value: 6,
+            doc: "the device's time limit for the motion passed",
+        },
+    ],
+};
+
 wire_struct! {
     /// A request on a device's `lease` channel (`op` is a `LEASE_OP` code).
-    pub struct LeaseReq : "limber.v2.LeaseReq", size = 80, align = 8 {
+    pub struct LeaseReq : "limber.v3.LeaseReq", size = 80, align = 8 {
         /// The requesting client's id (the one its commands carry).
         pub client_id: u64,
         /// The client's sequence number of this request.
@@ -59,7 +201,7 @@ wire_struct! {
 
 wire_struct! {
     /// The answer to a [`LeaseReq`]: the status and who holds the device now.
-    pub struct LeaseReply : "limber.v2.LeaseReply", size = 80, align = 8 {
+    pub struct LeaseReply : "limber.v3.LeaseReply", size = 80, align = 8 {
         /// The holder's client id (0: nobody holds the device).
         pub holder_client: u64,
         /// The request's sequence number.
@@ -134,6 +276,39 @@ impl OutcomeMsg {
     /// The status, decoded.
     pub fn status(&self) -> Result<Status, DecodeError> {
         Status::try_from(self.status)
+    }
+
+    /// The motion's result in one sentence (empty when the sample is the command's
+    /// outcome): how it ended, why, and the largest final error against the tolerance.
+    pub fn result_sentence(&self) -> String {
+        let Ok(Some(r)) = self.motion_result() else {
+            return String::new();
+        };
+        let mut s = String::from(r.describe());
+        match self.status() {
+            Ok(Status::Ok | Status::Preempted) | Err(_) => {}
+            Ok(cause) => s = format!("{s} ({cause})"),
+        }
+        if r == MotionResult::Preempted && self.other_client != 0 {
+            s = format!("{s} (client {:#x})", self.other_client);
+        }
+        if self.max_error.is_nan() {
+            s.push_str("; final error not known");
+        } else {
+            s = format!(
+                "{s}; largest final error {:.4} (tolerance {:.4})",
+                self.max_error, self.tolerance
+            );
+        }
+        s
+    }
+
+    /// The motion's result, decoded: `None` when the sample is the command's outcome.
+    pub fn motion_result(&self) -> Result<Option<MotionResult>, DecodeError> {
+        match self.result {
+            0 => Ok(None),
+            c => MotionResult::try_from(c).map(Some),
+        }
     }
 }
 

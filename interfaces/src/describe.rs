@@ -10,6 +10,7 @@ use crate::actarray::{ActArrayData, ActuatorFlags};
 use crate::common::{StateHeader, Status, device_flag};
 use crate::gripper::{GripperData, GripperState};
 use crate::limb::{LimbData, LimbState};
+use crate::ranger::RangerData;
 
 /// A state that can be printed: one human-readable line, one JSON object.
 pub trait Describe {
@@ -194,6 +195,47 @@ impl Describe for GripperData {
             "state_name": gripper_state_name(self.state),
             "beams": self.beams,
             "stored": self.stored,
+        })
+    }
+}
+
+impl Describe for RangerData {
+    /// The number of ranges, the closest one with its bearing, and the field of view.
+    fn human(&self) -> String {
+        let ranges = self.ranges();
+        let closest = ranges
+            .iter()
+            .enumerate()
+            .min_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(i, r)| {
+                format!(
+                    " closest {r:.3} m at {:+.1} deg",
+                    self.bearing(i).to_degrees()
+                )
+            })
+            .unwrap_or_default();
+        format!(
+            "{} {} ranges over {:+.1}..{:+.1} deg{closest}",
+            header_human(&self.header),
+            ranges.len(),
+            self.min_angle.to_degrees(),
+            self.max_angle.to_degrees(),
+        )
+    }
+    fn json(&self) -> Value {
+        json!({
+            "header": header_json(&self.header),
+            "min_angle": self.min_angle,
+            "max_angle": self.max_angle,
+            "angular_res": self.angular_res,
+            "min_range": self.min_range,
+            "max_range": self.max_range,
+            "range_res": self.range_res,
+            "frequency": self.frequency,
+            "ranges_count": self.ranges_count,
+            "intensities_count": self.intensities_count,
+            "ranges": self.ranges(),
+            "intensities": self.intensities(),
         })
     }
 }

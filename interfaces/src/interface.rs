@@ -1,4 +1,4 @@
-//! The three interfaces as types, so the services layer can be written once for all of
+//! The interfaces as types, so the services layer can be written once for all of
 //! them: each names its state struct, its command, request and reply envelopes and their
 //! typed views.
 
@@ -20,6 +20,10 @@ use crate::limb::{
     LimbCmdMsg, LimbCommand, LimbData, LimbGeom, LimbReply, LimbReplyMsg, LimbReqMsg, LimbRequest,
 };
 use crate::message::{Envelope, Message, ReplyBody, ReplyEnvelope};
+use crate::ranger::{
+    RangerCmdMsg, RangerCommand, RangerData, RangerGeom, RangerReply, RangerReplyMsg, RangerReqMsg,
+    RangerRequest,
+};
 use crate::wire::WireStruct;
 
 /// The byte view of a wire struct: its fixed layout as bytes, both ways (what a bridge
@@ -42,22 +46,26 @@ pub enum InterfaceKind {
     Limb,
     /// `gripper`.
     Gripper,
+    /// `ranger`.
+    Ranger,
 }
 
 impl InterfaceKind {
     /// Every interface.
-    pub const ALL: [InterfaceKind; 3] = [
+    pub const ALL: [InterfaceKind; 4] = [
         InterfaceKind::ActArray,
         InterfaceKind::Limb,
         InterfaceKind::Gripper,
+        InterfaceKind::Ranger,
     ];
 
-    /// The name used in service names (`actarray`, `limb`, `gripper`).
+    /// The name used in service names (`actarray`, `limb`, `gripper`, `ranger`).
     pub const fn name(self) -> &'static str {
         match self {
             InterfaceKind::ActArray => "actarray",
             InterfaceKind::Limb => "limb",
             InterfaceKind::Gripper => "gripper",
+            InterfaceKind::Ranger => "ranger",
         }
     }
 
@@ -67,15 +75,17 @@ impl InterfaceKind {
             InterfaceKind::ActArray => "an actarray",
             InterfaceKind::Limb => "a limb",
             InterfaceKind::Gripper => "a gripper",
+            InterfaceKind::Ranger => "a ranger",
         }
     }
 
-    /// Player's interface code (53, 54, 3).
+    /// Player's interface code (53, 54, 3, 62).
     pub const fn player_code(self) -> u16 {
         match self {
             InterfaceKind::ActArray => 53,
             InterfaceKind::Limb => 54,
             InterfaceKind::Gripper => 3,
+            InterfaceKind::Ranger => 62,
         }
     }
 
@@ -93,6 +103,7 @@ impl InterfaceKind {
             InterfaceKind::ActArray => visitor.visit::<ActArray>(),
             InterfaceKind::Limb => visitor.visit::<Limb>(),
             InterfaceKind::Gripper => visitor.visit::<Gripper>(),
+            InterfaceKind::Ranger => visitor.visit::<Ranger>(),
         }
     }
 }
@@ -168,6 +179,7 @@ macro_rules! has_header {
 has_header!(ActArrayData);
 has_header!(LimbData);
 has_header!(GripperData);
+has_header!(RangerData);
 
 /// The actuator-array interface.
 #[derive(Debug, Clone, Copy)]
@@ -178,6 +190,9 @@ pub struct Limb;
 /// The gripper interface.
 #[derive(Debug, Clone, Copy)]
 pub struct Gripper;
+/// The ranger interface (a laser scanner).
+#[derive(Debug, Clone, Copy)]
+pub struct Ranger;
 
 impl Interface for ActArray {
     const KIND: InterfaceKind = InterfaceKind::ActArray;
@@ -231,6 +246,24 @@ impl Interface for Gripper {
     fn geometry_of(reply: GripperReply) -> Option<GripperGeom> {
         match reply {
             GripperReply::Geom(g) => Some(g),
+        }
+    }
+}
+
+impl Interface for Ranger {
+    const KIND: InterfaceKind = InterfaceKind::Ranger;
+    type Data = RangerData;
+    type CmdMsg = RangerCmdMsg;
+    type Command = RangerCommand;
+    type ReqMsg = RangerReqMsg;
+    type Request = RangerRequest;
+    type ReplyMsg = RangerReplyMsg;
+    type Reply = RangerReply;
+    type Geom = RangerGeom;
+    const GEOMETRY: RangerRequest = RangerRequest::GetGeom;
+    fn geometry_of(reply: RangerReply) -> Option<RangerGeom> {
+        match reply {
+            RangerReply::Geom(g) => Some(g),
         }
     }
 }

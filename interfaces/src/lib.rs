@@ -1,13 +1,13 @@
 //! # limber-interfaces: the wire contract
 //!
-//! Every message of Player 3's `actarray`, `limb` and `gripper` interfaces as a fixed-layout
-//! struct that travels through iceoryx2 shared memory without a copy, readable from C, C++
+//! Every message of Player 3's `actarray`, `limb`, `gripper` and `ranger` interfaces as a
+//! fixed-layout struct that travels through iceoryx2 shared memory without a copy, readable from C, C++
 //! and Python with the same layout.
 //!
 //! * Wire structs are `#[repr(C)]`, have no implicit padding (explicit `_pad` fields,
 //!   checked at compile time), derive zerocopy's `FromBytes`/`IntoBytes`/`KnownLayout`/
 //!   `Immutable` and iceoryx2's `ZeroCopySend`, and carry a versioned type name
-//!   (`limber.v2.ActArrayData`). iceoryx2 only compares name, size and alignment when a
+//!   (`limber.v3.ActArrayData`). iceoryx2 only compares name, size and alignment when a
 //!   service is opened, so the version in the name changes whenever a layout changes.
 //! * Units are SI: m, rad, s, m/s, rad/s, A. No `bool` or Rust enum on the wire: `u32`
 //!   codes, decoded by typed views that reject unknown values with a [`DecodeError`].
@@ -49,6 +49,7 @@ pub mod limb_outcome;
 pub mod manifest;
 pub mod message;
 pub mod protocol;
+pub mod ranger;
 pub mod wire;
 
 pub use common::{
@@ -58,7 +59,8 @@ pub use common::{
 pub use describe::Describe;
 pub use error::{DecodeError, ValueError};
 pub use interface::{
-    ActArray, Gripper, HasHeader, Interface, InterfaceKind, InterfaceVisitor, Limb, WireBytes,
+    ActArray, Gripper, HasHeader, Interface, InterfaceKind, InterfaceVisitor, Limb, Ranger,
+    WireBytes,
 };
 pub use manifest::Manifest;
 pub use message::{Envelope, Message, ReplyBody, ReplyEnvelope};
@@ -68,9 +70,11 @@ pub use wire::{WireField, WireStruct};
 ///
 /// Version 2 added the `outcome` and `lease` channels ([`control::OutcomeMsg`],
 /// [`control::LeaseReq`], [`control::LeaseReply`]), the statuses `PREEMPTED`, `LEASED` and
-/// `ADJUSTED`, the limb state's `orientation_adjustment` and the limb's REACH request;
-/// every type name carries the version.
-pub const LAYOUT_VERSION: u32 = 2;
+/// `ADJUSTED`, the limb state's `orientation_adjustment` and the limb's REACH request.
+/// Version 3 added the `ranger` interface ([`ranger::RangerData`] and its envelopes), and
+/// the motion results on the `outcome` channel ([`control::OutcomeMsg::result`],
+/// [`control::MotionResult`]); every type name carries the version.
+pub const LAYOUT_VERSION: u32 = 3;
 
 /// Everything a driver or client author needs, in one `use`.
 pub mod prelude {
@@ -83,7 +87,7 @@ pub mod prelude {
         Bbox3, CmdOutcome, MAX_ACTUATORS, MsgMeta, Orientation3, Pose3, ReplyMeta, StateHeader,
         Status, Vec3, device_flag,
     };
-    pub use crate::control::{LeaseReply, LeaseReq, OutcomeMsg, lease_op};
+    pub use crate::control::{LeaseReply, LeaseReq, MotionResult, OutcomeMsg, lease_op};
     pub use crate::describe::Describe;
     pub use crate::diagnostics::DriverStats;
     pub use crate::error::{DecodeError, ValueError};
@@ -92,13 +96,17 @@ pub mod prelude {
         GripperReqMsg, GripperRequest, GripperState,
     };
     pub use crate::interface::{
-        ActArray, Gripper, HasHeader, Interface, InterfaceKind, InterfaceVisitor, Limb,
+        ActArray, Gripper, HasHeader, Interface, InterfaceKind, InterfaceVisitor, Limb, Ranger,
     };
     pub use crate::limb::{
         LimbCmdMsg, LimbCommand, LimbData, LimbGeom, LimbReach, LimbReply, LimbReplyMsg,
         LimbReqMsg, LimbRequest, LimbState,
     };
     pub use crate::message::{Envelope, Message, ReplyBody, ReplyEnvelope};
+    pub use crate::ranger::{
+        MAX_RANGES, RangerCmdMsg, RangerCommand, RangerData, RangerGeom, RangerReply,
+        RangerReplyMsg, RangerReqMsg, RangerRequest,
+    };
 }
 
 /// The layout manifest of the whole contract: every wire struct (dependencies first) and
@@ -157,6 +165,12 @@ pub fn manifest() -> Manifest {
         GripperReqMsg::LAYOUT,
         GripperGeom::LAYOUT,
         GripperReplyMsg::LAYOUT,
+        // ranger
+        ranger::RangerData::LAYOUT,
+        ranger::RangerCmdMsg::LAYOUT,
+        ranger::RangerReqMsg::LAYOUT,
+        ranger::RangerGeom::LAYOUT,
+        ranger::RangerReplyMsg::LAYOUT,
         // diagnostics
         diagnostics::DriverStats::LAYOUT,
         // control (layout version 2)
@@ -172,8 +186,10 @@ pub fn manifest() -> Manifest {
     constants.extend_from_slice(actarray::GROUPS);
     constants.extend_from_slice(limb::GROUPS);
     constants.extend_from_slice(gripper::GROUPS);
+    constants.extend_from_slice(ranger::GROUPS);
     constants.extend_from_slice(diagnostics::GROUPS);
     constants.push(control::LEASE_OP_GROUP);
+    constants.push(control::RESULT_GROUP);
     constants.extend_from_slice(&[
         protocol::NAME_GROUP,
         protocol::WAKE_GROUP,

@@ -59,6 +59,7 @@ fn the_documented_schema_is_what_echo_prints() {
         arm.json(),
         LimbData::default().json(),
         GripperData::default().json(),
+        RangerData::default().json(),
     ];
     let docs = documented();
     assert_eq!(docs.len(), printed.len(), "one block per interface");

@@ -261,12 +261,12 @@ fn unknown_kinds_are_named_errors() {
 fn unknown_codes_in_state_are_named_errors() {
     let mut d = ActArrayData::default();
     d.actuators_count = 1;
-    d.actuators[0].state = 16;
+    d.actuators[0].state = 32;
     assert_eq!(
         d.validate(),
         Err(DecodeError::UnknownBits {
             field: "actuator state",
-            bits: 16
+            bits: 32
         })
     );
     d.actuators_count = 33;
@@ -439,6 +439,10 @@ fn every_status_code_decodes_to_itself_and_names_its_cause() {
     assert_eq!(Status::Preempted.code(), 14);
     assert_eq!(Status::Leased.code(), 15);
     assert_eq!(Status::Adjusted.code(), 16);
+    assert_eq!(Status::Braked.code(), 17);
+    assert_eq!(Status::StoreFull.code(), 18);
+    assert_eq!(Status::NothingToStore.code(), 19);
+    assert_eq!(Status::NothingStored.code(), 20);
     let mut texts: Vec<&str> = Status::ALL.iter().map(|s| s.describe()).collect();
     texts.sort_unstable();
     texts.dedup();
@@ -454,4 +458,58 @@ fn every_status_code_decodes_to_itself_and_names_its_cause() {
         ]
         .iter())
     );
+}
+
+/// The ranger (issue 27): its one request through the wire and back, a command of any kind
+/// refused (a ranger has none), its geometry reply, and a scan's views.
+#[test]
+fn the_ranger_request_reply_and_scan_views() {
+    use limber_interfaces::ranger::{MAX_RANGES, req};
+    assert_eq!(via_bytes(&RangerRequest::GetGeom), RangerRequest::GetGeom);
+    assert!(RangerRequest::GetGeom.is_read_only());
+    let mut raw = RangerCmdMsg::default();
+    raw.meta.kind = 1;
+    assert_eq!(
+        RangerCommand::read(&raw).unwrap_err().status(),
+        Status::Unsupported
+    );
+    let g = RangerGeom {
+        min_angle: -1.0,
+        max_angle: 1.0,
+        angular_res: 0.5,
+        max_range: 8.0,
+        ranges_count: 5,
+        ..RangerGeom::default()
+    };
+    let mut reply = RangerReplyMsg::default();
+    RangerReply::write(req::GET_GEOM, Ok(&RangerReply::Geom(g)), &mut reply);
+    assert_eq!(RangerReply::read(&reply).unwrap(), Ok(RangerReply::Geom(g)));
+    RangerReply::write(req::GET_GEOM, Err(Status::Unsupported), &mut reply);
+    assert_eq!(RangerReply::read(&reply).unwrap(), Err(Status::Unsupported));
+    let mut bad = g;
+    bad.max_range = f64::NAN;
+    RangerReply::write(req::GET_GEOM, Ok(&RangerReply::Geom(bad)), &mut reply);
+    assert!(RangerReply::read(&reply).is_err());
+
+    let mut s = RangerData {
+        min_angle: -core::f64::consts::FRAC_PI_2,
+        angular_res: core::f64::consts::FRAC_PI_2,
+        ranges_count: 3,
+        ..RangerData::default()
+    };
+    s.ranges[..3].copy_from_slice(&[1.0, 2.0, 3.0]);
+    assert_eq!(s.ranges(), &[1.0, 2.0, 3.0]);
+    assert!(s.intensities().is_empty());
+    let p = s.point(1).unwrap();
+    assert!((p[0] - 2.0).abs() < 1e-12 && p[1].abs() < 1e-12);
+    let p = s.point(2).unwrap();
+    assert!(p[0].abs() < 1e-12 && (p[1] - 3.0).abs() < 1e-12);
+    assert_eq!(s.point(3), None);
+    assert!(s.validate().is_ok());
+    s.ranges_count = MAX_RANGES as u32 + 1;
+    assert!(s.validate().is_err());
+    assert_eq!(s.ranges().len(), MAX_RANGES);
+    s.ranges_count = 3;
+    s.frequency = f64::INFINITY;
+    assert!(s.validate().is_err());
 }

@@ -4,6 +4,8 @@
   (connect, state, commands with outcomes, requests, leases), :class:`Domain`,
   :class:`Status`, :func:`list_devices`, :class:`DriverStatsReader` and the errors. See
   ``python/README.md``.
+* :mod:`limber.ranger`: :class:`RangerClient` (:class:`LaserClient`), a laser's scans and
+  geometry, and :func:`~limber.ranger.point`, the bearing and point of a range.
 * :mod:`limber._layout`: the ctypes classes generated from the layout manifest, with exactly
   the layout of the Rust structs (the states and geometries the library fills in place).
 * :mod:`limber._lib`: where liblimber is found (``LIMBER_LIB``, the package, a source
@@ -22,6 +24,8 @@ from ._layout import (
     LimbData as LimbData,
     LimbGeom as LimbGeom,
     LimbReach as LimbReach,
+    RangerData as RangerData,
+    RangerGeom as RangerGeom,
     Vec3 as Vec3,
 )
 from .client import (
@@ -61,4 +65,12 @@ from .client import (
     list_devices as list_devices,
     remove_domain_files as remove_domain_files,
     stats_text as stats_text,
+)
+from .done import (
+    Done as Done,
+    MotionResult as MotionResult,
+)
+from .ranger import (
+    LaserClient as LaserClient,
+    RangerClient as RangerClient,
 )

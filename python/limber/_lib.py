@@ -62,6 +62,25 @@ class Outcome(ctypes.Structure):
     ]
 
 
+class Done(ctypes.Structure):
+    """``limber_done``."""
+
+    _fields_ = [
+        ("seq", c_uint64),
+        ("result", c_uint32),
+        ("cause", c_uint32),
+        ("other_client", c_uint64),
+        ("stamp_ns", c_uint64),
+        ("parts", c_uint32),
+        ("_pad", c_uint32),
+        ("max_error", ctypes.c_double),
+        ("tolerance", ctypes.c_double),
+        ("position", ctypes.c_double * 32),
+        ("error", ctypes.c_double * 32),
+        ("sentence", c_char * 160),
+    ]
+
+
 class LeaseHolder(ctypes.Structure):
     """``limber_lease_holder``."""
 
@@ -107,6 +126,7 @@ CODE_LEASE_LOST = 15
 INTERFACE_ACTARRAY = 0
 INTERFACE_LIMB = 1
 INTERFACE_GRIPPER = 2
+INTERFACE_RANGER = 3
 
 LIVENESS_ALIVE = 0
 LIVENESS_STALE = 1
@@ -148,6 +168,7 @@ PROTOTYPES: "dict[str, Tuple[Any, List[Any]]]" = {
     "limber_device_refresh": (_CODE, [_H, POINTER(c_bool)]),
     "limber_device_fd": (_CODE, [_H, POINTER(c_int32)]),
     "limber_device_outcome": (_CODE, [_H, Ticket, c_uint64, POINTER(Outcome)]),
+    "limber_device_wait_done": (_CODE, [_H, Ticket, c_uint64, POINTER(Done)]),
     "limber_device_preemption": (_CODE, [_H, Ticket, POINTER(c_bool), POINTER(Outcome)]),
     "limber_device_liveness": (_CODE, [_H, c_uint64, POINTER(c_int32)]),
     "limber_device_state_age": (_CODE, [_H, POINTER(c_uint64)]),
@@ -195,6 +216,11 @@ PROTOTYPES: "dict[str, Tuple[Any, List[Any]]]" = {
     "limber_gripper_stop": (_CODE, [_H, _P_TICKET]),
     "limber_gripper_store": (_CODE, [_H, _P_TICKET]),
     "limber_gripper_retrieve": (_CODE, [_H, _P_TICKET]),
+    # ranger
+    "limber_ranger_point": (
+        _CODE,
+        [POINTER(L.RangerData), c_size_t, POINTER(c_double), POINTER(c_double), POINTER(c_double)],
+    ),
     # driver statistics
     "limber_stats_open": (_CODE, [c_char_p, c_char_p, POINTER(_H)]),
     "limber_stats_close": (None, [_H]),

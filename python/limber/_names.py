@@ -72,7 +72,7 @@ def _domain_arg(domain: "Domain | str | None") -> Optional[bytes]:
     raise ValueError(f"a domain is a Domain, a name or None, not {domain!r}")
 
 
-_INTERFACES = ("actarray", "limb", "gripper")
+_INTERFACES = ("actarray", "limb", "gripper", "ranger")
 
 
 @dataclass(frozen=True)
@@ -95,7 +95,7 @@ class DeviceName:
         ):
             raise ValueError(
                 f"invalid device name {s!r}: expected robot/interface/index, e.g. "
-                "pioneer/actarray/0 (interfaces: actarray, limb, gripper)"
+                "pioneer/actarray/0 (interfaces: actarray, limb, gripper, ranger)"
             )
         return cls(parts[0], parts[1], int(parts[2]))
 
@@ -123,7 +123,7 @@ class DeviceInfo:
 
     @property
     def interface(self) -> str:
-        """The interface: ``actarray``, ``limb`` or ``gripper``."""
+        """The interface: ``actarray``, ``limb``, ``gripper`` or ``ranger``."""
         return self.name.interface
 
 

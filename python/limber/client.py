@@ -61,6 +61,7 @@ from ._types import (  # noqa: F401
 from ._names import *  # noqa: F401,F403
 from ._names import _default_process_name, _domain_arg, _open_clients, _Owned  # noqa: F401
 from ._stats import DriverStatsReader, stats_text  # noqa: F401
+from .done import Done, wait_done as _wait_done
 
 __all__ = [
     "DOMAIN_ENV",
@@ -382,6 +383,14 @@ class _Client(_Owned, Generic[_D]):
                 raise _error(rc, newer_seq=o.seq)
             raise self._fail(rc)
         return Outcome(o.seq, _status(o.status), o.other_client, _lib.text(o.other_name))
+
+    def wait_done(self, ticket: Ticket, timeout: float) -> Done:
+        """Waits up to ``timeout`` s until the motion the command of ``ticket`` started has
+        ended, and returns how (:class:`Done`: reached within the device's tolerance,
+        stalled, stopped, preempted, aborted, timed out; each part's final position and
+        error against the goal): ``limber_device_wait_done``. Raises :class:`NackError`
+        for a refused command, :class:`WaitTimeout` when it has not ended in time."""
+        return _wait_done(self, ticket, timeout)
 
     # ----- waiting ----------------------------------------------------------------------
 

@@ -111,3 +111,4 @@ def test_a_motion_cut_short_by_another_client_is_told_preempted(pioneer):
         assert b.preempted(tb) is None
         b.release()
         assert a.driver_status() is DriverStatus.ALIVE
+

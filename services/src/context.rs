@@ -265,9 +265,18 @@ impl Context {
     }
 
     /// A new client id, unique in the domain while this process lives: the process id in
-    /// the high 32 bits, a per-process counter in the low 32 bits. Never 0.
+    /// the high 32 bits (as iceoryx2 records it in this process's node id, so that a driver
+    /// can tell a client id of another process from the sender's own: see the host's
+    /// `senders`), a per-process counter in the low 32 bits. Never 0.
     pub fn new_client_id(&self) -> u64 {
         let n = CLIENT_SEQ.fetch_add(1, Ordering::Relaxed);
-        ((std::process::id() as u64) << 32) | n as u64
+        let pid = self
+            .node()
+            .id()
+            .pid::<ipc::Service>()
+            .ok()
+            .and_then(|p| u32::try_from(p.value()).ok())
+            .unwrap_or_else(std::process::id);
+        (u64::from(pid) << 32) | u64::from(n)
     }
 }

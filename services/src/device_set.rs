@@ -24,8 +24,8 @@
 //! [`DeviceHost::holder`], its publication, its deadman check) would have to be lent it
 //! too, whereas a propagated copy is always there.
 //!
-//! About 800 lines, for a stated reason: 56 of them are this example, run as a doc test,
-//! and the rest is one job (the set, its handler and its shared leases).
+//! The handler a driver implements, and each device as a [`DeviceHandler`] of its
+//! interface, are in `device_set/handler.rs`.
 //!
 //! ```
 //! use limber_services::prelude::*;
@@ -65,120 +65,14 @@ use thiserror::Error;
 
 use crate::context::Context;
 use crate::host::{
-    Activity, DeviceHandler, DeviceHost, Holder, HostError, HostStats, Motion, Origin,
-    ProcessError, PublishError,
+    Activity, DeviceHandler, DeviceHost, Holder, HostError, HostStats, ProcessError, PublishError,
 };
 use crate::naming::DeviceName;
 
-/// What a driver implements to serve a [`DeviceSet`]: the [`DeviceHandler`] methods of
-/// each interface, with the index of the device (`gripper/0` or `gripper/1`). A device
-/// the set serves but the handler does not override answers [`Status::Unsupported`].
-pub trait DeviceSetHandler {
-    /// A validated command for `actarray/<index>`; see [`DeviceHandler::command`].
-    fn actarray_command(
-        &mut self,
-        index: u16,
-        cmd: &ActArrayCommand,
-        from: &Origin,
-        state: &mut ActArrayData,
-    ) -> Status {
-        let _ = (index, cmd, from, state);
-        Status::Unsupported
-    }
-    /// What `cmd` drives on `actarray/<index>` and which of it still moves; see
-    /// [`DeviceHandler::motion`]. Default: nothing.
-    fn actarray_motion(
-        &mut self,
-        index: u16,
-        cmd: &ActArrayCommand,
-        state: &ActArrayData,
-    ) -> Motion {
-        let _ = (index, cmd, state);
-        Motion::NONE
-    }
-    /// Stops every motion of `actarray/<index>` (the deadman); see [`DeviceHandler::stop`].
-    fn actarray_stop(&mut self, index: u16, state: &mut ActArrayData) -> Status {
-        let _ = (index, state);
-        Status::Unsupported
-    }
-    /// A validated request for `actarray/<index>`; see [`DeviceHandler::request`].
-    fn actarray_request(
-        &mut self,
-        index: u16,
-        req: &ActArrayRequest,
-        from: &Origin,
-        state: &mut ActArrayData,
-    ) -> Result<ActArrayReply, Status> {
-        let _ = (index, req, from, state);
-        Err(Status::Unsupported)
-    }
-    /// A validated command for `limb/<index>`; see [`DeviceHandler::command`].
-    fn limb_command(
-        &mut self,
-        index: u16,
-        cmd: &LimbCommand,
-        from: &Origin,
-        state: &mut LimbData,
-    ) -> Status {
-        let _ = (index, cmd, from, state);
-        Status::Unsupported
-    }
-    /// What `cmd` drives on `limb/<index>` and which of it still moves; see
-    /// [`DeviceHandler::motion`]. Default: nothing.
-    fn limb_motion(&mut self, index: u16, cmd: &LimbCommand, state: &LimbData) -> Motion {
-        let _ = (index, cmd, state);
-        Motion::NONE
-    }
-    /// Stops every motion of `limb/<index>` (the deadman); see [`DeviceHandler::stop`].
-    fn limb_stop(&mut self, index: u16, state: &mut LimbData) -> Status {
-        let _ = (index, state);
-        Status::Unsupported
-    }
-    /// A validated request for `limb/<index>`; see [`DeviceHandler::request`].
-    fn limb_request(
-        &mut self,
-        index: u16,
-        req: &LimbRequest,
-        from: &Origin,
-        state: &mut LimbData,
-    ) -> Result<LimbReply, Status> {
-        let _ = (index, req, from, state);
-        Err(Status::Unsupported)
-    }
-    /// A validated command for `gripper/<index>`; see [`DeviceHandler::command`].
-    fn gripper_command(
-        &mut self,
-        index: u16,
-        cmd: &GripperCommand,
-        from: &Origin,
-        state: &mut GripperData,
-    ) -> Status {
-        let _ = (index, cmd, from, state);
-        Status::Unsupported
-    }
-    /// What `cmd` drives on `gripper/<index>` and which of it still moves; see
-    /// [`DeviceHandler::motion`]. Default: nothing.
-    fn gripper_motion(&mut self, index: u16, cmd: &GripperCommand, state: &GripperData) -> Motion {
-        let _ = (index, cmd, state);
-        Motion::NONE
-    }
-    /// Stops every motion of `gripper/<index>` (the deadman); see [`DeviceHandler::stop`].
-    fn gripper_stop(&mut self, index: u16, state: &mut GripperData) -> Status {
-        let _ = (index, state);
-        Status::Unsupported
-    }
-    /// A validated request for `gripper/<index>`; see [`DeviceHandler::request`].
-    fn gripper_request(
-        &mut self,
-        index: u16,
-        req: &GripperRequest,
-        from: &Origin,
-        state: &mut GripperData,
-    ) -> Result<GripperReply, Status> {
-        let _ = (index, req, from, state);
-        Err(Status::Unsupported)
-    }
-}
+mod handler;
+mod motions;
+use handler::At;
+pub use handler::DeviceSetHandler;
 
 /// An operation on one device of a [`DeviceSet`] failed: which device, and why.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
@@ -191,79 +85,14 @@ pub struct DeviceError<E: std::error::Error + 'static> {
     pub source: E,
 }
 
-/// One device of the set, as a [`DeviceHandler`] of its interface.
-struct At<'a, H: ?Sized> {
-    handler: &'a mut H,
-    index: u16,
-}
-
-impl<H: DeviceSetHandler + ?Sized> DeviceHandler<ActArray> for At<'_, H> {
-    fn motion(&mut self, cmd: &ActArrayCommand, s: &ActArrayData) -> Motion {
-        self.handler.actarray_motion(self.index, cmd, s)
-    }
-    fn stop(&mut self, s: &mut ActArrayData) -> Status {
-        self.handler.actarray_stop(self.index, s)
-    }
-    fn command(&mut self, cmd: &ActArrayCommand, from: &Origin, s: &mut ActArrayData) -> Status {
-        self.handler.actarray_command(self.index, cmd, from, s)
-    }
-    fn request(
-        &mut self,
-        req: &ActArrayRequest,
-        from: &Origin,
-        s: &mut ActArrayData,
-    ) -> Result<ActArrayReply, Status> {
-        self.handler.actarray_request(self.index, req, from, s)
-    }
-}
-
-impl<H: DeviceSetHandler + ?Sized> DeviceHandler<Limb> for At<'_, H> {
-    fn motion(&mut self, cmd: &LimbCommand, s: &LimbData) -> Motion {
-        self.handler.limb_motion(self.index, cmd, s)
-    }
-    fn stop(&mut self, s: &mut LimbData) -> Status {
-        self.handler.limb_stop(self.index, s)
-    }
-    fn command(&mut self, cmd: &LimbCommand, from: &Origin, s: &mut LimbData) -> Status {
-        self.handler.limb_command(self.index, cmd, from, s)
-    }
-    fn request(
-        &mut self,
-        req: &LimbRequest,
-        from: &Origin,
-        s: &mut LimbData,
-    ) -> Result<LimbReply, Status> {
-        self.handler.limb_request(self.index, req, from, s)
-    }
-}
-
-impl<H: DeviceSetHandler + ?Sized> DeviceHandler<Gripper> for At<'_, H> {
-    fn motion(&mut self, cmd: &GripperCommand, s: &GripperData) -> Motion {
-        self.handler.gripper_motion(self.index, cmd, s)
-    }
-    fn stop(&mut self, s: &mut GripperData) -> Status {
-        self.handler.gripper_stop(self.index, s)
-    }
-    fn command(&mut self, cmd: &GripperCommand, from: &Origin, s: &mut GripperData) -> Status {
-        self.handler.gripper_command(self.index, cmd, from, s)
-    }
-    fn request(
-        &mut self,
-        req: &GripperRequest,
-        from: &Origin,
-        s: &mut GripperData,
-    ) -> Result<GripperReply, Status> {
-        self.handler.gripper_request(self.index, req, from, s)
-    }
-}
-
-/// The devices of one driver process: any number of actarray, limb and gripper hosts of
+/// The devices of one driver process: any number of actarray, limb, gripper and ranger hosts of
 /// one robot, each optional (a driver serves what the robot has), keyed by interface and
 /// index.
 pub struct DeviceSet {
     actarrays: Vec<DeviceHost<ActArray>>,
     limbs: Vec<DeviceHost<Limb>>,
     grippers: Vec<DeviceHost<Gripper>>,
+    rangers: Vec<DeviceHost<Ranger>>,
     /// The devices that move the same actuators, each group with one lease
     /// ([`DeviceSet::share_lease`]).
     groups: Vec<LeaseGroup>,
@@ -357,6 +186,7 @@ impl DeviceSet {
             actarrays: Vec::new(),
             limbs: Vec::new(),
             grippers: Vec::new(),
+            rangers: Vec::new(),
             groups: Vec::new(),
         };
         set.add(ctx, robot, driver, serve)?;
@@ -382,23 +212,25 @@ impl DeviceSet {
                 }
                 InterfaceKind::Limb => self.limbs.push(DeviceHost::new(ctx, &name, driver)?),
                 InterfaceKind::Gripper => self.grippers.push(DeviceHost::new(ctx, &name, driver)?),
+                InterfaceKind::Ranger => self.rangers.push(DeviceHost::new(ctx, &name, driver)?),
             }
         }
         Ok(())
     }
 
-    /// The names of the devices served, actarrays first, then limbs, then grippers.
+    /// The names of the devices served, actarrays first, then limbs, grippers, rangers.
     pub fn devices(&self) -> impl Iterator<Item = &DeviceName> {
         self.actarrays
             .iter()
             .map(|h| h.device())
             .chain(self.limbs.iter().map(|h| h.device()))
             .chain(self.grippers.iter().map(|h| h.device()))
+            .chain(self.rangers.iter().map(|h| h.device()))
     }
 
     /// How many devices are served.
     pub fn len(&self) -> usize {
-        self.actarrays.len() + self.limbs.len() + self.grippers.len()
+        self.actarrays.len() + self.limbs.len() + self.grippers.len() + self.rangers.len()
     }
 
     /// True when no device is served.
@@ -440,11 +272,24 @@ impl DeviceSet {
             .find(|h| h.device().index() == index)
     }
 
+    /// The host of `ranger/<index>`, if served.
+    pub fn ranger(&self, index: u16) -> Option<&DeviceHost<Ranger>> {
+        self.rangers.iter().find(|h| h.device().index() == index)
+    }
+
+    /// The host of `ranger/<index>`, if served, to update its state (a new scan).
+    pub fn ranger_mut(&mut self, index: u16) -> Option<&mut DeviceHost<Ranger>> {
+        self.rangers
+            .iter_mut()
+            .find(|h| h.device().index() == index)
+    }
+
     /// Sets the `DEVICE_FLAG` bits of every device (see [`DeviceHost::set_flags`]).
     pub fn set_flags(&mut self, flags: u32) {
         self.actarrays.iter_mut().for_each(|h| h.set_flags(flags));
         self.limbs.iter_mut().for_each(|h| h.set_flags(flags));
         self.grippers.iter_mut().for_each(|h| h.set_flags(flags));
+        self.rangers.iter_mut().for_each(|h| h.set_flags(flags));
     }
 
     /// See [`DeviceHost::set_publish_each_outcome`]; for every device.
@@ -456,6 +301,9 @@ impl DeviceSet {
             .iter_mut()
             .for_each(|h| h.set_publish_each_outcome(on));
         self.grippers
+            .iter_mut()
+            .for_each(|h| h.set_publish_each_outcome(on));
+        self.rangers
             .iter_mut()
             .for_each(|h| h.set_publish_each_outcome(on));
     }
@@ -482,6 +330,10 @@ impl DeviceSet {
             note(h.device(), r);
         }
         for h in &mut self.grippers {
+            let r = h.publish_acquired(stamp_ns);
+            note(h.device(), r);
+        }
+        for h in &mut self.rangers {
             let r = h.publish_acquired(stamp_ns);
             note(h.device(), r);
         }
@@ -577,6 +429,16 @@ impl DeviceSet {
             one::<Gripper, _>(h, &mut at, drain, &mut total, &mut first);
             self.spread_lease(InterfaceKind::Gripper, index, handler, &mut first);
         }
+        for i in 0..self.rangers.len() {
+            let h = &mut self.rangers[i];
+            let index = h.device().index();
+            let mut at = At {
+                handler: &mut *handler,
+                index,
+            };
+            one::<Ranger, _>(h, &mut at, drain, &mut total, &mut first);
+            self.spread_lease(InterfaceKind::Ranger, index, handler, &mut first);
+        }
         first.map_or(Ok(total), Err)
     }
 
@@ -595,6 +457,11 @@ impl DeviceSet {
                 .iter_mut()
                 .filter_map(|h| h.take_wake_listener()),
         );
+        out.extend(
+            self.rangers
+                .iter_mut()
+                .filter_map(|h| h.take_wake_listener()),
+        );
         out
     }
 
@@ -604,6 +471,7 @@ impl DeviceSet {
         self.actarrays.iter().for_each(|h| s += h.stats());
         self.limbs.iter().for_each(|h| s += h.stats());
         self.grippers.iter().for_each(|h| s += h.stats());
+        self.rangers.iter().for_each(|h| s += h.stats());
         s
     }
 
@@ -667,6 +535,19 @@ impl DeviceSet {
             );
             self.spread_lease(InterfaceKind::Gripper, index, handler, &mut first);
         }
+        for i in 0..self.rangers.len() {
+            let h = &mut self.rangers[i];
+            let index = h.device().index();
+            one::<Ranger, _>(
+                h,
+                &mut At {
+                    handler: &mut *handler,
+                    index,
+                },
+                &mut first,
+            );
+            self.spread_lease(InterfaceKind::Ranger, index, handler, &mut first);
+        }
         first.map_or(Ok(()), Err)
     }
 
@@ -713,6 +594,10 @@ impl DeviceSet {
                     let _ = h.take_lease_ended();
                     h.follow_lease(lease).map_err(|e| (h.device().clone(), e))
                 }),
+                InterfaceKind::Ranger => self.ranger_mut(index).map(|h| {
+                    let _ = h.take_lease_ended();
+                    h.follow_lease(lease).map_err(|e| (h.device().clone(), e))
+                }),
             };
             if let Some(Err((device, source))) = r {
                 return Err(DeviceError { device, source }.into());
@@ -738,6 +623,7 @@ impl DeviceSet {
             InterfaceKind::ActArray => self.actarray(index).map(|h| h.shared_lease()),
             InterfaceKind::Limb => self.limb(index).map(|h| h.shared_lease()),
             InterfaceKind::Gripper => self.gripper(index).map(|h| h.shared_lease()),
+            InterfaceKind::Ranger => self.ranger(index).map(|h| h.shared_lease()),
         }
     }
 
@@ -763,6 +649,9 @@ impl DeviceSet {
                 .map(|h| (h.shared_lease(), h.take_lease_ended())),
             InterfaceKind::Gripper => self
                 .gripper_mut(index)
+                .map(|h| (h.shared_lease(), h.take_lease_ended())),
+            InterfaceKind::Ranger => self
+                .ranger_mut(index)
                 .map(|h| (h.shared_lease(), h.take_lease_ended())),
         }
         .unwrap_or((None, None));
@@ -802,6 +691,9 @@ impl DeviceSet {
             InterfaceKind::Gripper => self
                 .gripper_mut(index)
                 .map(|h| (follow_one::<Gripper, _>(h, at, follow), h.device())),
+            InterfaceKind::Ranger => self
+                .ranger_mut(index)
+                .map(|h| (follow_one::<Ranger, _>(h, at, follow), h.device())),
         };
         if let Some((Err(source), device)) = r {
             tracing::warn!(device = %device, error = %source, "cannot follow the shared lease");
@@ -817,5 +709,6 @@ impl DeviceSet {
         self.actarrays.iter().for_each(|h| h.cleanup_dead());
         self.limbs.iter().for_each(|h| h.cleanup_dead());
         self.grippers.iter().for_each(|h| h.cleanup_dead());
+        self.rangers.iter().for_each(|h| h.cleanup_dead());
     }
 }

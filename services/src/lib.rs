@@ -91,9 +91,9 @@ pub use domain::cleanup;
 pub use domain::dir as domain_dir;
 
 pub use client::{
-    ActArrayClient, AnyGeom, Client, CommandError, ConnectError, DeviceClient, DriverStatus,
-    Freshness, GripperClient, Incompatibility, LeaseError, LeaseHolder, LimbClient, Outcome,
-    RequestError, Ticket, WaitError, WaitMode, connect_device,
+    ActArrayClient, AnyGeom, Client, CommandError, ConnectError, DeviceClient, Done, DoneError,
+    DriverStatus, Freshness, GripperClient, Incompatibility, LaserClient, LeaseError, LeaseHolder,
+    LimbClient, Outcome, RangerClient, RequestError, Ticket, WaitError, WaitMode, connect_device,
 };
 pub use context::{Context, ContextError, Role, monotonic_ns};
 pub use device_set::{DeviceError, DeviceSet, DeviceSetHandler, Drain, ShareLeaseError};
@@ -102,8 +102,8 @@ pub use domain::Domain;
 pub use domain::DomainError;
 pub use error::Iox2Error;
 pub use host::{
-    Activity, CLIENT_SLOTS, DeviceHandler, DeviceHost, Holder, HostError, HostStats, Motion,
-    Origin, ProcessError, PublishError,
+    Activity, CLIENT_SLOTS, DeviceHandler, DeviceHost, Holder, HostError, HostStats, MAX_TRACKED,
+    Motion, Origin, ProcessError, Progress, PublishError,
 };
 pub use naming::{Channel, DeviceName, NameError};
 pub use relay::{AnswerError, PendingLease, PendingRelay, RelayedLease, RelayedRequest};
@@ -111,14 +111,15 @@ pub use relay::{AnswerError, PendingLease, PendingRelay, RelayedLease, RelayedRe
 /// Everything a driver or client author needs, in one `use`.
 pub mod prelude {
     pub use crate::client::{
-        ActArrayClient, Client, CommandError, ConnectError, DeviceClient, DriverStatus, Freshness,
-        GripperClient, LimbClient, RequestError, Ticket, WaitError, WaitMode, connect_device,
+        ActArrayClient, Client, CommandError, ConnectError, DeviceClient, Done, DoneError,
+        DriverStatus, Freshness, GripperClient, LaserClient, LimbClient, RangerClient,
+        RequestError, Ticket, WaitError, WaitMode, connect_device,
     };
     pub use crate::context::{Context, Role, monotonic_ns};
     pub use crate::device_set::{DeviceSet, DeviceSetHandler};
     pub use crate::discovery::{DeviceInfo, list_devices};
     pub use crate::domain::Domain;
-    pub use crate::host::{DeviceHandler, DeviceHost, Motion, Origin};
+    pub use crate::host::{DeviceHandler, DeviceHost, Motion, Origin, Progress};
     pub use crate::naming::DeviceName;
     pub use limber_interfaces::prelude::*;
 }

@@ -38,7 +38,7 @@ pub enum NameError {
     Robot(String),
     /// A device name is not `robot/interface/index`.
     #[error(
-        "invalid device name {0:?}: expected robot/interface/index, e.g. pioneer/actarray/0 (interfaces: actarray, limb, gripper)"
+        "invalid device name {0:?}: expected robot/interface/index, e.g. pioneer/actarray/0 (interfaces: actarray, limb, gripper, ranger)"
     )]
     Device(String),
 }
@@ -184,7 +184,7 @@ impl FromStr for DeviceName {
 pub mod attr {
     /// The robot name.
     pub const ROBOT: &str = "limber.robot";
-    /// The interface (`actarray`, `limb`, `gripper`).
+    /// The interface (`actarray`, `limb`, `gripper`, `ranger`).
     pub const INTERFACE: &str = "limber.interface";
     /// The device index.
     pub const INDEX: &str = "limber.index";

@@ -15,7 +15,10 @@ use limber_services::{DriverStatus, RequestError};
 use limber_tests::Proc;
 
 mod bridging;
-use bridging::{CLI, arm_in, free_port, start_driver, usrpwd_configs, wait_mirrored};
+use bridging::{
+    CLI, arm_in, expose_with, free_port, mirror_with, mirrored_nothing, start_driver,
+    usrpwd_configs, wait_mirrored,
+};
 
 /// How long a mirrored device may take to be gone after its driver or a bridge dies.
 const GONE_BOUND: Duration = Duration::from_secs(10);
@@ -193,6 +196,44 @@ fn the_remote_drivers_statistics_reach_the_other_domain() {
         stats.header.flags & limber_interfaces::prelude::device_flag::LINK_UP,
         0
     );
+}
+
+/// A fourth interface crosses the bridge with no code of its own in the bridge (expose
+/// and mirror reach every interface through `InterfaceKind::visit`): the emulated
+/// Pioneer's laser, in domain B, answers its geometry and gives its scans, in which the
+/// world's block (0.38, 0.10 by default) is the closest thing; the CLI reads it too.
+#[test]
+fn the_laser_crosses_the_bridge_as_every_interface_does() {
+    let s = setup();
+    let ctx = Context::new(&s.b, Role::Client, "bridge-test").expect("join domain B");
+    let mut laser =
+        RangerClient::connect_timeout(&ctx, "pioneer/ranger/0", Duration::from_secs(10))
+            .expect("the mirrored laser");
+    let g = laser
+        .geometry()
+        .expect("the laser's geometry through the bridge");
+    assert_eq!((g.ranges_count, g.max_range), (181, 8.0));
+    assert_eq!(g.pose.position.to_array(), [0.16, 0.0, 0.20]);
+    let scan = *laser
+        .wait_state(Duration::from_secs(5))
+        .expect("a scan through the bridge");
+    let r = scan.ranges();
+    assert_eq!(r.len(), 181);
+    let (i, closest) = r
+        .iter()
+        .copied()
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .expect("ranges");
+    let expected = (0.38f64 - 0.16).hypot(0.10) - 0.02;
+    assert!(
+        (closest - expected).abs() < 0.015,
+        "closest {closest} m, not {expected}"
+    );
+    assert!((scan.bearing(i) - (0.10f64).atan2(0.22)).abs() < 0.04);
+    let (code, out) = cli_in(&s.b, &["ranger", "pioneer/ranger/0", "geom"]);
+    assert_eq!(code, Some(0), "{out}");
+    assert!(out.contains("181 ranges over -90.0..+90.0 deg"), "{out}");
 }
 
 /// Kill the driver in A, then (after a restart) the exposing bridge, then the mirror:
@@ -429,63 +470,17 @@ fn a_mirror_with_the_wrong_password_gets_nothing() {
     let a = Domain::unique_for_test();
     let _driver = start_driver(&a);
     let endpoint = format!("tcp/127.0.0.1:{}", free_port());
-    let mut expose = Proc::spawn(
-        CLI,
-        a.name(),
-        &[
-            "bridge",
-            "expose",
-            "--listen",
-            &endpoint,
-            "--zenoh-config",
-            &robot,
-        ],
-    );
-    assert!(
-        expose
-            .read_until(|l| l == "exposed pioneer/actarray/0")
-            .is_some()
-    );
+    let _expose = expose_with(&a, &["--listen", &endpoint, "--zenoh-config", &robot]);
     let b_bad = Domain::unique_for_test();
-    let mut intruder = Proc::spawn(
-        CLI,
-        b_bad.name(),
-        &[
-            "bridge",
-            "mirror",
-            "--connect",
-            &endpoint,
-            "--zenoh-config",
-            &bad,
-        ],
-    );
-    assert!(
-        intruder
-            .read_until(|l| l.starts_with("mirroring into"))
-            .is_some()
-    );
+    let intruder = mirror_with(&b_bad, &["--connect", &endpoint, "--zenoh-config", &bad]);
     let b = Domain::unique_for_test();
-    let mut mirror = Proc::spawn(
-        CLI,
-        b.name(),
-        &[
-            "bridge",
-            "mirror",
-            "--connect",
-            &endpoint,
-            "--zenoh-config",
-            &good,
-        ],
-    );
+    let mut mirror = mirror_with(&b, &["--connect", &endpoint, "--zenoh-config", &good]);
     wait_mirrored(&mut mirror);
     let mut arm = arm_in(&b);
     arm.geometry()
         .expect("the geometry with the right password");
     // The intruder started first and had as long: it mirrored nothing.
-    intruder.signal(libc::SIGTERM);
-    assert_eq!(intruder.wait_timeout(Duration::from_secs(20)), Some(0));
-    let rest = intruder.rest_of_stdout();
-    assert!(!rest.contains("mirrored"), "{rest}");
+    mirrored_nothing(intruder);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -22,7 +22,9 @@ use zerocopy::{FromBytes, IntoBytes};
 
 mod bridging;
 mod hostile;
-use bridging::{CLI, arm_in, free_port, start_driver, wait_mirrored};
+use bridging::{
+    CLI, arm_in, expose_with, free_port, mirror_with, mirrored_nothing, start_driver, wait_mirrored,
+};
 use hostile::{HOSTILE, Scratch, hostile_user};
 
 const LIMIT: Duration = Duration::from_secs(30);
@@ -135,10 +137,7 @@ fn another_unix_user_cannot_reach_the_owners_bridge() {
     wait_mirrored(&mut mirror);
     let mut arm = arm_in(&b);
     arm.geometry().expect("the owner's mirror serves the arm");
-    intruder.signal(libc::SIGTERM);
-    intruder.wait_timeout(LIMIT);
-    let rest = intruder.rest_of_stdout();
-    assert!(!rest.contains("mirrored"), "{rest}");
+    mirrored_nothing(intruder);
 }
 
 /// Makes a CA, a certificate for the robot (`localhost`), one for the laptop (`laptop`)
@@ -206,33 +205,23 @@ fn tls_with_client_certificates_lets_in_only_the_named_peer() {
     let a = Domain::unique_for_test();
     let _driver = start_driver(&a);
     let port = free_port();
-    let mut expose = Proc::spawn(
-        CLI,
-        a.name(),
+    let listen = format!("tls/127.0.0.1:{port}");
+    let _expose = expose_with(
+        &a,
         &[
-            "bridge",
-            "expose",
             "--listen",
-            &format!("tls/127.0.0.1:{port}"),
+            &listen,
             "--zenoh-config",
             &robot,
             "--peer",
             "laptop",
         ],
     );
-    assert!(
-        expose
-            .read_until(|l| l == "exposed pioneer/actarray/0")
-            .is_some()
-    );
     let connect = format!("tls/localhost:{port}");
     let b_bad = Domain::unique_for_test();
-    let mut intruder = Proc::spawn(
-        CLI,
-        b_bad.name(),
+    let intruder = mirror_with(
+        &b_bad,
         &[
-            "bridge",
-            "mirror",
             "--connect",
             &connect,
             "--zenoh-config",
@@ -241,18 +230,10 @@ fn tls_with_client_certificates_lets_in_only_the_named_peer() {
             "laptop",
         ],
     );
-    assert!(
-        intruder
-            .read_until(|l| l.starts_with("mirroring into"))
-            .is_some()
-    );
     let b = Domain::unique_for_test();
-    let mut mirror = Proc::spawn(
-        CLI,
-        b.name(),
+    let mut mirror = mirror_with(
+        &b,
         &[
-            "bridge",
-            "mirror",
             "--connect",
             &connect,
             "--zenoh-config",
@@ -269,10 +250,7 @@ fn tls_with_client_certificates_lets_in_only_the_named_peer() {
             .expect("outcome"),
         Status::Ok
     );
-    intruder.signal(libc::SIGTERM);
-    assert_eq!(intruder.wait_timeout(LIMIT), Some(0));
-    let rest = intruder.rest_of_stdout();
-    assert!(!rest.contains("mirrored"), "{rest}");
+    mirrored_nothing(intruder);
 }
 
 /// A Zenoh session of the test's own, authenticated as `user` (user/password), connected
@@ -356,36 +334,9 @@ fn a_rogue_peer_forges_no_command_lease_state_or_device() {
     let a = Domain::unique_for_test();
     let _driver = start_driver(&a);
     let endpoint = format!("tcp/127.0.0.1:{}", free_port());
-    let mut expose = Proc::spawn(
-        CLI,
-        a.name(),
-        &[
-            "bridge",
-            "expose",
-            "--listen",
-            &endpoint,
-            "--zenoh-config",
-            &robot,
-        ],
-    );
-    assert!(
-        expose
-            .read_until(|l| l == "exposed pioneer/actarray/0")
-            .is_some()
-    );
+    let _expose = expose_with(&a, &["--listen", &endpoint, "--zenoh-config", &robot]);
     let b = Domain::unique_for_test();
-    let mut mirror = Proc::spawn(
-        CLI,
-        b.name(),
-        &[
-            "bridge",
-            "mirror",
-            "--connect",
-            &endpoint,
-            "--zenoh-config",
-            &desk,
-        ],
-    );
+    let mut mirror = mirror_with(&b, &["--connect", &endpoint, "--zenoh-config", &desk]);
     wait_mirrored(&mut mirror);
     let mut holder = arm_in(&b);
     holder

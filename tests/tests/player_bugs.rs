@@ -244,7 +244,7 @@ fn bug07_moving_flags_cleared() {
     loop {
         let s = *a.wait_state(T).unwrap();
         let f = s.actuators[0].flags().unwrap();
-        saw_moving |= f == ActuatorFlags::MOVING;
+        saw_moving |= f.contains(ActuatorFlags::MOVING);
         if f == ActuatorFlags::IDLE && saw_moving {
             break;
         }

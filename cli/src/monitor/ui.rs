@@ -397,6 +397,13 @@ fn draw_device(frame: &mut Frame, area: Rect, d: &Device, selected: bool) {
             }
             InterfaceKind::Limb => limb_lines(c.state::<Limb>()),
             InterfaceKind::Gripper => gripper_lines(c.state::<Gripper>(), c.geometry::<Gripper>()),
+            // Any other interface (a ranger...): its state's one line, until it gets a
+            // panel of its own.
+            _ => vec![Line::from(
+                c.client
+                    .describe()
+                    .map_or_else(|| "no data yet".to_string(), |d| d.human()),
+            )],
         },
     };
     let mut block = Block::bordered().title(Line::from(title));

@@ -39,7 +39,7 @@
 mod model;
 mod server;
 
-pub use limber_p2os::ArmpacLayout;
+pub use limber_p2os::{ArmpacLayout, GripperByteLayout};
 pub use model::{
     AUTOPARK_DEFAULT_S, ModelConfig, ObjectPlacement, Robot, RobotState, SyncStage, Timing,
     default_arm_info,

@@ -9,8 +9,8 @@
 use limber_p2os::vendor_conventions as vc;
 use limber_p2os::{
     ArmInfo, ArmPacket, ArmStatus, ArmpacLayout, ConfigPacket, ConfigWorking, Frame,
-    GripperCommand, GripperPacket, GripperSwitchFacts, GripperSwitches, JointCalibration,
-    ReceivedCommand, RobotIdentity, Sip, SonarReading, num,
+    GripperByteLayout, GripperCommand, GripperPacket, GripperReading, GripperSwitchFacts,
+    GripperSwitches, JointCalibration, ReceivedCommand, RobotIdentity, Sip, SonarReading, num,
 };
 use std::time::{Duration, Instant};
 
@@ -104,6 +104,10 @@ pub struct ModelConfig {
     /// How the ARMpac status bytes are laid out: the vendor's manuals'
     /// (default) or ARIA's.
     pub armpac_layout: ArmpacLayout,
+    /// How the gripper state byte (SIP and GRIPPERpac) is written: the vendor's
+    /// manual's active-high state bits with the breakbeams in DIGIN (default) or ARIA's
+    /// active-low switches.
+    pub gripper_byte: GripperByteLayout,
 }
 
 impl Default for ModelConfig {
@@ -120,6 +124,7 @@ impl Default for ModelConfig {
             paddle_stroke: Duration::from_millis(1500),
             object_width: 0.35,
             armpac_layout: ArmpacLayout::default(),
+            gripper_byte: GripperByteLayout::default(),
         }
     }
 }
@@ -201,8 +206,10 @@ pub struct RobotState {
     pub object: Option<ObjectPlacement>,
     /// The object is held between the paddles.
     pub object_in_gripper: bool,
-    /// The gripper switch byte as sent.
+    /// The gripper state byte as sent.
     pub switches: GripperSwitches,
+    /// What the byte (and DIGIN) says, read in the configured layout.
+    pub gripper: GripperReading,
     /// Sonar on.
     pub sonar: bool,
     /// Valid commands received.
@@ -809,26 +816,36 @@ impl Robot {
             left_contact: closed,
             right_contact: closed,
             paddles_moving: self.paddles.moving(),
-            lift_at_limit: !self.lift.moving()
-                && (self.lift.pos <= 1e-9 || self.lift.pos >= 1.0 - 1e-9),
+            lift_up: !self.lift.moving() && self.lift.pos >= 1.0 - 1e-9,
+            lift_down: !self.lift.moving() && self.lift.pos <= 1e-9,
             lift_moving: self.lift.moving(),
             outer_beam: visible,
             inner_beam: visible && (self.gripped || self.object == Some(ObjectPlacement::Inner)),
+            gripper_error: false,
+            lift_error: false,
+        }
+    }
+
+    /// The gripper state byte and the DIGIN bits in the configured layout (nothing
+    /// without a gripper).
+    fn switches_and_digin(&self) -> (GripperSwitches, u8) {
+        if self.cfg.gripper {
+            GripperSwitches::encode(self.switch_facts(), self.cfg.gripper_byte)
+        } else {
+            (GripperSwitches(0), 0)
         }
     }
 
     fn switches(&self) -> GripperSwitches {
-        if self.cfg.gripper {
-            GripperSwitches::from_facts(self.switch_facts())
-        } else {
-            GripperSwitches(0)
-        }
+        self.switches_and_digin().0
     }
 
     /// The current standard SIP.
     pub fn sip(&self) -> Sip {
         let mut sip = Sip::default();
-        sip.timer = u16::from(self.switches().0) << 8;
+        let (switches, digin) = self.switches_and_digin();
+        sip.timer = u16::from(switches.0) << 8;
+        sip.digin = digin;
         if self.sonar {
             let readings: [SonarReading; 8] = std::array::from_fn(|i| SonarReading {
                 index: i as u8,
@@ -895,6 +912,10 @@ impl Robot {
             object: self.object,
             object_in_gripper: self.gripped,
             switches: self.switches(),
+            gripper: {
+                let (b, digin) = self.switches_and_digin();
+                b.read(self.cfg.gripper_byte, digin)
+            },
             sonar: self.sonar,
             commands: self.commands,
             autopark_s: self.autopark_s,

@@ -170,54 +170,55 @@ fn full_session(wire: Wire) {
     // Gripper: open, object in, close on it (breakbeams), lift up and down.
     c.send(&Command::Gripper(GripperCommand::Open)).unwrap();
     wait_sip(&mut c, "paddles open", |s| {
-        s.gripper_switches().paddles() == PaddleState::Open
+        s.gripper_reading(GripperByteLayout::Manual).paddles == PaddleState::Open
     });
     emu.set_object(Some(ObjectPlacement::Inner));
     wait_sip(&mut c, "both beams broken", |s| {
-        let g = s.gripper_switches();
-        g.outer_beam() && g.inner_beam()
+        let g = s.gripper_reading(GripperByteLayout::Manual);
+        g.outer_beam && g.inner_beam
     });
     c.send(&Command::Gripper(GripperCommand::Close)).unwrap();
     wait_sip(&mut c, "closed on the object", |s| {
-        s.gripper_switches().paddles() == PaddleState::Closed
+        s.gripper_reading(GripperByteLayout::Manual).paddles == PaddleState::Closed
     });
     assert!(emu.state().robot.object_in_gripper);
     c.send(&Command::Gripper(GripperCommand::LiftUp)).unwrap();
     wait_sip(&mut c, "lift moving", |s| {
-        s.gripper_switches().lift_moving()
+        s.gripper_reading(GripperByteLayout::Manual).lift == LiftState::Moving
     });
     wait_sip(&mut c, "lift up", |s| {
-        let g = s.gripper_switches();
-        g.lift_at_limit() && !g.lift_moving()
+        s.gripper_reading(GripperByteLayout::Manual).lift == LiftState::Up
     });
     let st = emu.state().robot;
     assert!(st.lift >= 1.0 && st.object_in_gripper);
     assert!(
-        c.last_sip().unwrap().gripper_switches().inner_beam(),
+        c.last_sip()
+            .unwrap()
+            .gripper_reading(GripperByteLayout::Manual)
+            .inner_beam,
         "carried object still in the beams"
     );
     c.send(&Command::Gripper(GripperCommand::LiftDown)).unwrap();
     wait_sip(&mut c, "lift moving down", |s| {
-        s.gripper_switches().lift_moving()
+        s.gripper_reading(GripperByteLayout::Manual).lift == LiftState::Moving
     });
     wait_sip(&mut c, "lift down", |s| {
-        let g = s.gripper_switches();
-        g.lift_at_limit() && !g.lift_moving()
+        s.gripper_reading(GripperByteLayout::Manual).lift == LiftState::Down
     });
     assert!(emu.state().robot.lift <= 0.0);
     c.send(&Command::Gripper(GripperCommand::Open)).unwrap();
     wait_sip(&mut c, "released", |s| {
-        s.gripper_switches().paddles() == PaddleState::Open
+        s.gripper_reading(GripperByteLayout::Manual).paddles == PaddleState::Open
     });
     assert!(!emu.state().robot.object_in_gripper);
     emu.set_object(None);
     wait_sip(&mut c, "beams clear", |s| {
-        let g = s.gripper_switches();
-        !g.outer_beam() && !g.inner_beam()
+        let g = s.gripper_reading(GripperByteLayout::Manual);
+        !g.outer_beam && !g.inner_beam
     });
     c.send(&Command::Gripper(GripperCommand::Close)).unwrap();
     wait_sip(&mut c, "closed empty", |s| {
-        s.gripper_switches().paddles() == PaddleState::Closed
+        s.gripper_reading(GripperByteLayout::Manual).paddles == PaddleState::Closed
     });
     assert!(emu.state().robot.paddles <= 0.0);
 
@@ -572,7 +573,10 @@ fn gripper_packet_stream_and_body_gripper_store_deploy() {
     assert!(r.is_ok());
     c.send(&Command::Gripper(GripperCommand::Deploy)).unwrap();
     let r = c.wait_until(WAIT, |p| {
-        matches!(p, RobotPacket::Gripper(g) if g.switches.paddles() == PaddleState::Open && g.switches.lift_at_limit())
+        matches!(p, RobotPacket::Gripper(g) if {
+            let r = g.reading(GripperByteLayout::Manual, 0);
+            r.paddles == PaddleState::Open && r.lift == LiftState::Down
+        })
     });
     assert!(r.is_ok());
     c.send(&Command::Gripper(GripperCommand::Store)).unwrap();

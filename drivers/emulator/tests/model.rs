@@ -261,17 +261,17 @@ fn lift_takes_three_and_a_half_seconds_per_stroke() {
     s.advance(1750);
     let st = s.robot.state();
     assert!((st.lift - 0.5).abs() < 1e-9 && st.lift_moving);
-    assert!(st.switches.lift_moving() && !st.switches.lift_at_limit());
+    assert_eq!(st.gripper.lift, LiftState::Moving);
     s.advance(3500);
     let st = s.robot.state();
     assert_eq!(st.lift, 1.0);
-    assert!(!st.lift_moving && st.switches.lift_at_limit());
+    assert!(!st.lift_moving && st.gripper.lift == LiftState::Up);
     // Stop half way down: not at a limit.
     s.cmd(3500, Command::Gripper(GripperCommand::LiftDown));
     s.cmd(4375, Command::Gripper(GripperCommand::LiftStop));
     let st = s.robot.state();
     assert!((st.lift - 0.75).abs() < 1e-9);
-    assert!(!st.switches.lift_at_limit() && !st.switches.lift_moving());
+    assert_eq!(st.gripper.lift, LiftState::Between);
 }
 
 #[test]
@@ -280,20 +280,20 @@ fn breakbeams_follow_the_object() {
     s.open();
     s.cmd(0, Command::Gripper(GripperCommand::Open));
     s.advance(2000);
-    assert_eq!(s.robot.state().switches.paddles(), PaddleState::Open);
+    assert_eq!(s.robot.state().gripper.paddles, PaddleState::Open);
     s.robot.set_object(Some(ObjectPlacement::Outer));
-    let sw = s.robot.sip().gripper_switches();
-    assert!(sw.outer_beam() && !sw.inner_beam());
+    let sw = s.robot.sip().gripper_reading(GripperByteLayout::Manual);
+    assert!(sw.outer_beam && !sw.inner_beam);
     s.robot.set_object(Some(ObjectPlacement::Inner));
-    let sw = s.robot.sip().gripper_switches();
-    assert!(sw.outer_beam() && sw.inner_beam());
+    let sw = s.robot.sip().gripper_reading(GripperByteLayout::Manual);
+    assert!(sw.outer_beam && sw.inner_beam);
     s.cmd(2000, Command::Gripper(GripperCommand::Close));
     s.advance(2500);
-    assert_eq!(s.robot.state().switches.paddles(), PaddleState::Moving);
+    assert_eq!(s.robot.state().gripper.paddles, PaddleState::Moving);
     s.advance(4000);
     let st = s.robot.state();
     assert!(st.object_in_gripper);
-    assert_eq!(st.switches.paddles(), PaddleState::Closed);
+    assert_eq!(st.gripper.paddles, PaddleState::Closed);
     assert!((st.paddles - 0.35).abs() < 1e-9, "stopped on the object");
     // Lifted with the paddles open, the object stays on the floor.
     s.cmd(4000, Command::Gripper(GripperCommand::Open));
@@ -301,7 +301,7 @@ fn breakbeams_follow_the_object() {
     s.advance(8000);
     let st = s.robot.state();
     assert!(!st.object_in_gripper);
-    assert!(!st.switches.outer_beam() && !st.switches.inner_beam());
+    assert!(!st.gripper.outer_beam && !st.gripper.inner_beam);
 }
 
 #[test]

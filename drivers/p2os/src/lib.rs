@@ -14,7 +14,7 @@
 //!   raw fd for epoll; [`Connection`]: the handshake state machine.
 //! * [`vendor_conventions`]: where Player, ARIA and the vendor's manuals
 //!   disagree, the reading limber follows (the manuals'; ARIA's where an
-//!   option says so, e.g. [`ArmpacLayout`]).
+//!   option says so, e.g. [`ArmpacLayout`], [`GripperByteLayout`]).
 //!
 //! ```
 //! use limber_p2os::{Command, Decoder, RobotPacket};
@@ -31,6 +31,7 @@ mod command;
 mod configpac;
 mod connection;
 mod convert;
+mod gripper_byte;
 mod link;
 mod packet;
 pub mod sys;
@@ -49,9 +50,11 @@ pub use connection::{
     BAUD_RATES, CloseError, ConfigProbe, ConnectError, ConnectOptions, Connection,
 };
 pub use convert::{ArmCalibration, ConversionError, TickTarget};
+pub use gripper_byte::{
+    GripperByteLayout, GripperReading, GripperSwitchFacts, GripperSwitches, LiftState, PaddleState,
+};
 pub use link::{DEFAULT_TCP_PORT, Link, LinkError, LinkStats, LinkTarget, OpenError};
 pub use packet::{
-    ArmInfo, ArmPacket, ArmStatus, ArmpacLayout, GripperPacket, GripperSwitchFacts,
-    GripperSwitches, JointCalibration, MAX_SONAR, MAX_VERSION, PacketError, PaddleState,
-    RobotIdentity, RobotPacket, Sip, SonarReading, ptype,
+    ArmInfo, ArmPacket, ArmStatus, ArmpacLayout, GripperPacket, JointCalibration, MAX_SONAR,
+    MAX_VERSION, PacketError, RobotIdentity, RobotPacket, Sip, SonarReading, ptype,
 };

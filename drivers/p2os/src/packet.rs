@@ -2,6 +2,7 @@
 
 use super::codec::{EncodeError, Frame, PayloadBuilder};
 use super::command::ArmJoint;
+use super::gripper_byte::{GripperByteLayout, GripperReading, GripperSwitches};
 use super::vendor_conventions as vc;
 use thiserror::Error;
 
@@ -21,7 +22,8 @@ pub mod ptype {
     pub const ARM: u8 = 0xA0;
     /// ARMINFOpac.
     pub const ARM_INFO: u8 = 0xA1;
-    /// ARIA's gripper packet.
+    /// The GRIPPERpac (the Pioneer Gripper manual; ARIA's gripper packet), answering
+    /// GRIPREQUEST (37).
     pub const GRIPPER: u8 = 0xE0;
 }
 
@@ -53,125 +55,6 @@ pub enum PacketError {
     /// A SIP announcing more sonar readings than [`MAX_SONAR`].
     #[error("SIP announces {0} sonar readings (at most {MAX_SONAR})")]
     TooManySonars(u8),
-}
-
-/// The gripper switch byte (see [`vc`] for the bit layout, ARIA's reading).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct GripperSwitches(pub u8);
-
-/// The paddles' state as read from the switches.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PaddleState {
-    /// Fully open.
-    Open,
-    /// Closed (both paddle contacts triggered).
-    Closed,
-    /// Moving.
-    Moving,
-    /// Stopped in between.
-    Between,
-}
-
-/// The facts a gripper switch byte carries, for encoding.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct GripperSwitchFacts {
-    /// Paddles fully open.
-    pub paddles_open: bool,
-    /// Left paddle contact.
-    pub left_contact: bool,
-    /// Right paddle contact.
-    pub right_contact: bool,
-    /// Paddles moving.
-    pub paddles_moving: bool,
-    /// Lift at the top or bottom limit.
-    pub lift_at_limit: bool,
-    /// Lift moving.
-    pub lift_moving: bool,
-    /// Outer breakbeam broken.
-    pub outer_beam: bool,
-    /// Inner breakbeam broken.
-    pub inner_beam: bool,
-}
-
-impl GripperSwitches {
-    /// Encodes the facts with the vendor's (active-low) bit layout.
-    pub fn from_facts(f: GripperSwitchFacts) -> GripperSwitches {
-        let mut b = 0u8;
-        if !f.paddles_open {
-            b |= vc::GRIP_SW_OPEN_LIMIT_N;
-        }
-        if !f.lift_at_limit {
-            b |= vc::GRIP_SW_LIFT_LIMIT_N;
-        }
-        if f.outer_beam {
-            b |= vc::GRIP_SW_OUTER_BEAM;
-        }
-        if f.inner_beam {
-            b |= vc::GRIP_SW_INNER_BEAM;
-        }
-        if !f.left_contact {
-            b |= vc::GRIP_SW_LEFT_CONTACT_N;
-        }
-        if !f.right_contact {
-            b |= vc::GRIP_SW_RIGHT_CONTACT_N;
-        }
-        if f.lift_moving {
-            b |= vc::GRIP_SW_LIFT_MOVING;
-        }
-        if f.paddles_moving {
-            b |= vc::GRIP_SW_PADDLES_MOVING;
-        }
-        GripperSwitches(b)
-    }
-
-    /// Decodes the byte into facts.
-    pub fn facts(self) -> GripperSwitchFacts {
-        let b = self.0;
-        GripperSwitchFacts {
-            paddles_open: b & vc::GRIP_SW_OPEN_LIMIT_N == 0,
-            left_contact: b & vc::GRIP_SW_LEFT_CONTACT_N == 0,
-            right_contact: b & vc::GRIP_SW_RIGHT_CONTACT_N == 0,
-            paddles_moving: b & vc::GRIP_SW_PADDLES_MOVING != 0,
-            lift_at_limit: b & vc::GRIP_SW_LIFT_LIMIT_N == 0,
-            lift_moving: b & vc::GRIP_SW_LIFT_MOVING != 0,
-            outer_beam: b & vc::GRIP_SW_OUTER_BEAM != 0,
-            inner_beam: b & vc::GRIP_SW_INNER_BEAM != 0,
-        }
-    }
-
-    /// The paddles' state.
-    pub fn paddles(self) -> PaddleState {
-        let f = self.facts();
-        if f.paddles_moving {
-            PaddleState::Moving
-        } else if f.paddles_open {
-            PaddleState::Open
-        } else if f.left_contact && f.right_contact {
-            PaddleState::Closed
-        } else {
-            PaddleState::Between
-        }
-    }
-
-    /// Outer breakbeam broken.
-    pub fn outer_beam(self) -> bool {
-        self.facts().outer_beam
-    }
-
-    /// Inner breakbeam broken.
-    pub fn inner_beam(self) -> bool {
-        self.facts().inner_beam
-    }
-
-    /// Lift at a limit (top or bottom).
-    pub fn lift_at_limit(self) -> bool {
-        self.facts().lift_at_limit
-    }
-
-    /// Lift moving.
-    pub fn lift_moving(self) -> bool {
-        self.facts().lift_moving
-    }
 }
 
 /// Maximum number of sonar readings a [`Sip`] holds.
@@ -327,6 +210,12 @@ impl Sip {
     /// The gripper switch byte (high byte of the timer field).
     pub fn gripper_switches(&self) -> GripperSwitches {
         GripperSwitches((self.timer >> 8) as u8)
+    }
+
+    /// The gripper's state and breakbeams as `layout` reads the switch byte (the
+    /// manual's: the beams in [`Sip::digin`]; ARIA's: in the byte).
+    pub fn gripper_reading(&self, layout: GripperByteLayout) -> GripperReading {
+        self.gripper_switches().read(layout, self.digin)
     }
 
     /// Encodes the SIP (type byte first).
@@ -704,6 +593,13 @@ impl GripperPacket {
             switches: GripperSwitches(p[2]),
             grasp_time: p[3],
         })
+    }
+
+    /// The gripper's state as `layout` reads the packet's switch byte; the manual's
+    /// layout takes the breakbeams from `digin` (the SIP's DIGIN), which this packet
+    /// does not carry.
+    pub fn reading(&self, layout: GripperByteLayout, digin: u8) -> GripperReading {
+        self.switches.read(layout, digin)
     }
 
     /// Encodes the gripper packet.

@@ -62,10 +62,48 @@ pub const ARIA_HI_POWERED: u8 = 0x04;
 /// ARIA's layout, byte B bit 3: the arm is homing.
 pub const ARIA_HI_HOMING: u8 = 0x08;
 
-/// Gripper switch byte (General-I/O gripper: high byte of the SIP "timer"
-/// field, and byte 2 of the 0xE0 gripper packet), ARIA's **active-low**
-/// reading. Player 3 instead reads bit0 = open, bit1 = closed, bit2 = moving
-/// (active-high), and its breakbeam test is always 0.
+/// Gripper state byte: the layout limber uses unless configured otherwise: the
+/// vendor's manual's ([`crate::GripperByteLayout::Manual`]).
+///
+/// The byte is the high byte of the SIP's "timer" field (just after the sonar
+/// readings) and byte 2 of the GRIPPERpac (0xE0). The Pioneer Gripper manual
+/// (Table 4 "Gripper State Byte") reads it **active high**: bit 0 paddles
+/// open, 1 paddles closed, 2 paddles moving, 3 gripper error, 4 lift up, 5
+/// lift down, 6 lift moving, 7 lift error; both bits of a pair equal = that
+/// position unknown; the breakbeams are in DIGIN ([`DIGIN_OUTER_BEAM`],
+/// [`DIGIN_INNER_BEAM`], 1 = obstructed). Player 2.0 documented the same and
+/// Player 3 decodes bits 0..2 that way (its beam test is always 0). ARIA reads
+/// the byte as the General-I/O gripper's raw switches, **active low**
+/// (`GRIP_SW_*` below); a client reading one layout from a robot writing the
+/// other sees a closed gripper OPEN and the lift STALLED. The manual wins;
+/// ARIA's stays selectable (`gripper_byte = "aria"` in the driver's
+/// configuration, `--gripper-byte aria` on the emulator).
+pub const DEFAULT_GRIPPER_BYTE: crate::GripperByteLayout = crate::GripperByteLayout::Manual;
+
+/// Manual's state byte, bit 0: paddles open.
+pub const GRIP_PADDLES_OPEN: u8 = 0x01;
+/// Manual's state byte, bit 1: paddles closed.
+pub const GRIP_PADDLES_CLOSED: u8 = 0x02;
+/// Manual's state byte, bit 2: paddles moving.
+pub const GRIP_PADDLES_MOVING: u8 = 0x04;
+/// Manual's state byte, bit 3: gripper error.
+pub const GRIP_ERROR: u8 = 0x08;
+/// Manual's state byte, bit 4: lift up.
+pub const GRIP_LIFT_UP: u8 = 0x10;
+/// Manual's state byte, bit 5: lift down.
+pub const GRIP_LIFT_DOWN: u8 = 0x20;
+/// Manual's state byte, bit 6: lift moving.
+pub const GRIP_LIFT_MOVING: u8 = 0x40;
+/// Manual's state byte, bit 7: lift error.
+pub const GRIP_LIFT_ERROR: u8 = 0x80;
+/// DIGIN bit 2 (the User I/O port): the outer breakbeam is obstructed (the
+/// manual: 1 = obstructed; the bit as Player 2.0 documented the beams byte).
+pub const DIGIN_OUTER_BEAM: u8 = 0x04;
+/// DIGIN bit 3: the inner breakbeam is obstructed.
+pub const DIGIN_INNER_BEAM: u8 = 0x08;
+
+/// ARIA's reading of the same byte (the General-I/O gripper's switches,
+/// [`crate::GripperByteLayout::Aria`]):
 ///
 /// Bit 0 **clear** = the paddles are fully open (inner limit switch).
 pub const GRIP_SW_OPEN_LIMIT_N: u8 = 0x01;

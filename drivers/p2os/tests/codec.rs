@@ -332,27 +332,63 @@ fn malformed_robot_packets_are_errors_not_panics() {
 }
 
 #[test]
-fn gripper_switches_follow_the_vendor_reading() {
-    // All switches released, nothing moving, lift mid-way: the active-low
-    // bits are all set.
-    let idle = GripperSwitches(0x33);
-    assert_eq!(idle.paddles(), PaddleState::Between);
-    assert!(!idle.lift_at_limit() && !idle.outer_beam());
-    // Bit 0 clear = open.
-    assert_eq!(GripperSwitches(0x32).paddles(), PaddleState::Open);
-    // Bits 4 and 5 clear = closed.
-    assert_eq!(GripperSwitches(0x03).paddles(), PaddleState::Closed);
-    assert_eq!(GripperSwitches(0x83).paddles(), PaddleState::Moving);
+fn gripper_byte_in_the_manual_and_in_arias_reading() {
+    let aria = |b: u8| GripperSwitches(b).read(GripperByteLayout::Aria, 0);
+    // ARIA: all switches released, nothing moving, lift mid-way: the active-low bits
+    // are all set.
+    let idle = aria(0x33);
+    assert_eq!(idle.paddles, PaddleState::Between);
+    assert_eq!(idle.lift, LiftState::Between);
+    assert!(!idle.outer_beam);
+    // Bit 0 clear = open; bits 4 and 5 clear = closed; bit 7 = moving.
+    assert_eq!(aria(0x32).paddles, PaddleState::Open);
+    assert_eq!(aria(0x03).paddles, PaddleState::Closed);
+    assert_eq!(aria(0x83).paddles, PaddleState::Moving);
+    assert_eq!(aria(0x31).lift, LiftState::AtLimit);
+    // The manual: active high, both bits of a pair equal = unknown, beams in DIGIN.
+    let manual = |b: u8, digin: u8| GripperSwitches(b).read(GripperByteLayout::Manual, digin);
+    assert_eq!(manual(0x01, 0).paddles, PaddleState::Open);
+    assert_eq!(manual(0x02, 0).paddles, PaddleState::Closed);
+    assert_eq!(manual(0x03, 0).paddles, PaddleState::Between);
+    assert_eq!(manual(0x00, 0).paddles, PaddleState::Between);
+    assert_eq!(manual(0x05, 0).paddles, PaddleState::Moving);
+    assert_eq!(manual(0x09, 0).paddles, PaddleState::Error);
+    assert_eq!(manual(0x10, 0).lift, LiftState::Up);
+    assert_eq!(manual(0x20, 0).lift, LiftState::Down);
+    assert_eq!(manual(0x30, 0).lift, LiftState::Between);
+    assert_eq!(manual(0x50, 0).lift, LiftState::Moving);
+    assert_eq!(manual(0x90, 0).lift, LiftState::Error);
+    let r = manual(0x00, vc::DIGIN_OUTER_BEAM | vc::DIGIN_INNER_BEAM);
+    assert!(r.outer_beam && r.inner_beam);
+    assert!(
+        !manual(0xFF, 0).outer_beam,
+        "the beams are not in the manual's byte"
+    );
+    // Facts written in either layout read back the same (ARIA's has no error bits and
+    // one limit switch for both ends of the lift).
     let f = GripperSwitchFacts {
         paddles_open: true,
-        lift_at_limit: true,
+        lift_down: true,
         outer_beam: true,
         inner_beam: true,
         ..Default::default()
     };
-    let s = GripperSwitches::from_facts(f);
-    assert_eq!(s.facts(), f);
-    assert!(s.inner_beam() && s.outer_beam() && s.lift_at_limit() && !s.lift_moving());
+    let (b, digin) = GripperSwitches::encode(f, GripperByteLayout::Manual);
+    assert_eq!((b, digin), (GripperSwitches(0x21), 0x0C));
+    let r = b.read(GripperByteLayout::Manual, digin);
+    assert_eq!((r.paddles, r.lift), (PaddleState::Open, LiftState::Down));
+    assert!(r.inner_beam && r.outer_beam);
+    let (b, digin) = GripperSwitches::encode(f, GripperByteLayout::Aria);
+    assert_eq!(digin, 0);
+    let r = b.read(GripperByteLayout::Aria, 0);
+    assert_eq!((r.paddles, r.lift), (PaddleState::Open, LiftState::AtLimit));
+    assert!(r.inner_beam && r.outer_beam);
+    assert_eq!(GripperByteLayout::default(), vc::DEFAULT_GRIPPER_BYTE);
+    assert_eq!(
+        GripperByteLayout::from_name("ARIA"),
+        Some(GripperByteLayout::Aria)
+    );
+    assert_eq!(GripperByteLayout::from_name("x"), None);
 }
 
 #[test]

@@ -4,7 +4,7 @@
 use std::path::Path;
 use std::time::Duration;
 
-use limber_p2os::ArmpacLayout;
+use limber_p2os::{ArmpacLayout, GripperByteLayout};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -110,6 +110,12 @@ pub struct PioneerConfig {
     /// warns when the robot's packets only make sense in the other layout.
     #[serde(with = "layout_name")]
     pub armpac_layout: ArmpacLayout,
+    /// How the body gripper's state byte (in the SIP) is read: `"manual"` (the Pioneer
+    /// Gripper manual's Table 4: active-high bits paddles open / closed / moving /
+    /// error, lift up / down / moving / error, the breakbeams in DIGIN; the default) or
+    /// `"aria"` (ARIA's General-I/O switches, active low, the beams in the byte).
+    #[serde(with = "gripper_byte_name")]
+    pub gripper_byte: GripperByteLayout,
     /// Whether the robot has the body gripper and its lift (`<robot>/gripper/0` and
     /// `<robot>/actarray/1`): `"auto"` (the default) asks the robot at connect (CONFIG;
     /// served if its CONFIGpac says a gripper is fitted, not served if it says none or
@@ -212,6 +218,25 @@ mod layout_name {
     }
 }
 
+/// `gripper_byte` as its name in TOML.
+mod gripper_byte_name {
+    use limber_p2os::GripperByteLayout;
+    use serde::{Deserialize, Deserializer, Serializer, de::Error};
+
+    pub fn serialize<S: Serializer>(l: &GripperByteLayout, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(l.name())
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<GripperByteLayout, D::Error> {
+        let name = String::deserialize(d)?;
+        GripperByteLayout::from_name(&name).ok_or_else(|| {
+            D::Error::custom(format!(
+                "gripper_byte {name:?}: expected \"manual\" or \"aria\""
+            ))
+        })
+    }
+}
+
 impl Default for PioneerConfig {
     fn default() -> Self {
         PioneerConfig {
@@ -246,6 +271,7 @@ impl Default for PioneerConfig {
             setpose_position_tolerance: 0.001,
             setpose_approach_tolerance_deg: 1.0,
             armpac_layout: ArmpacLayout::default(),
+            gripper_byte: GripperByteLayout::default(),
             body_gripper: BodyGripper::Auto,
             // The link timeout (1 s) and a reconnection or two, with room to spare.
             autopark_s: 10,
@@ -298,6 +324,11 @@ impl PioneerConfig {
                 .replacen(
                     "body_gripper =",
                     "# body_gripper: \"auto\" asks the robot (CONFIG) at connect; true/false decide for a\n# controller that does not answer (false: gripper/0 and actarray/1 never served)\nbody_gripper =",
+                    1,
+                )
+                .replacen(
+                    "gripper_byte =",
+                    "# body gripper state byte: \"manual\" (the Pioneer Gripper manual, active high, beams in DIGIN) or \"aria\" (ARIA's active-low switches)\ngripper_byte =",
                     1,
                 )
                 .replacen(

@@ -135,10 +135,14 @@ fn a_pos_command_becomes_the_arm_pos_bytes_of_the_reference() {
     want.extend_from_slice(&ck.to_be_bytes());
     assert_eq!(out[0].cmd.encode().unwrap().as_bytes(), &want[..]);
     assert_eq!(want, [0xFA, 0xFB, 6, 0x4D, 0x3B, 0x6F, 0x03, 0xBC, 0x3E]);
-    // The joint is moving toward its target until an ARMpac shows it there.
+    // The joint is moving toward its target until an ARMpac shows it there (its speed
+    // estimated from the ARMpacs).
     let mut s = ActArrayData::default();
     m.arm_state(&mut s, Instant::now());
-    assert_eq!(s.actuators[2].state, ActuatorFlags::MOVING.bits());
+    assert_eq!(
+        s.actuators[2].state,
+        (ActuatorFlags::MOVING | ActuatorFlags::SPEED_ESTIMATED).bits()
+    );
     let mut ticks = home_ticks();
     ticks[2] = 111;
     m.on_packet(

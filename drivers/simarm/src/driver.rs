@@ -55,16 +55,25 @@ impl DeviceSetHandler for Serve<'_> {
         self.0.arm_state(state);
         s
     }
-    fn limb_motion(&mut self, _: u16, _: &LimbCommand, _: &LimbData) -> Motion {
-        self.0.limb_motion()
+    fn actarray_progress(&mut self, _: u16, part: u32, _: &ActArrayData) -> Progress {
+        self.0.arm_progress(part)
+    }
+    fn limb_motion(&mut self, _: u16, cmd: &LimbCommand, _: &LimbData) -> Motion {
+        self.0.limb_motion(cmd)
+    }
+    fn limb_progress(&mut self, _: u16, part: u32, _: &LimbData) -> Progress {
+        self.0.limb_progress(part)
     }
     fn limb_stop(&mut self, _: u16, state: &mut LimbData) -> Status {
         let s = self.0.stop_limb();
         self.0.limb_state(state);
         s
     }
-    fn gripper_motion(&mut self, _: u16, _: &GripperCommand, _: &GripperData) -> Motion {
-        self.0.gripper_motion()
+    fn gripper_motion(&mut self, _: u16, cmd: &GripperCommand, _: &GripperData) -> Motion {
+        self.0.gripper_motion(cmd)
+    }
+    fn gripper_progress(&mut self, _: u16, _: u32, _: &GripperData) -> Progress {
+        self.0.gripper_progress()
     }
     fn gripper_stop(&mut self, _: u16, state: &mut GripperData) -> Status {
         let s = self.0.stop_gripper();
@@ -225,7 +234,10 @@ impl SimArm {
         if let Some(h) = self.hosts.gripper_mut(0) {
             self.model.gripper_state(h.state_mut());
         }
-        self.hosts.publish_all(monotonic_ns())
+        self.hosts.publish_all(monotonic_ns())?;
+        // After the states that show them: the results of the motions that ended.
+        self.hosts.check_motions(&mut Serve(&mut self.model));
+        Ok(())
     }
 
     /// Handles every pending command and request of the three devices (the simulation

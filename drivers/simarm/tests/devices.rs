@@ -84,6 +84,7 @@ fn pick_params(which: Which) -> PickParams {
     };
     PickParams {
         block,
+        block_radius: 0.02,
         drop,
         grasp_height: 0.15,
         clearance: 0.05,
@@ -250,20 +251,20 @@ fn refusals_reach_the_sender() {
     // The gripper actuator: 0 to the stroke (0.08 m).
     let t = arm.move_to(7, 0.2).unwrap();
     assert_eq!(arm.wait_outcome(t, TIMEOUT), Ok(Status::BeyondLimits));
-    let t = arm.set_current(Some(0), 1.0).unwrap();
-    assert_eq!(arm.wait_outcome(t, TIMEOUT), Ok(Status::Unsupported));
+    let t = arm.set_current(Some(8), 1.0).unwrap();
+    assert_eq!(arm.wait_outcome(t, TIMEOUT), Ok(Status::UnknownJoint));
     // NaN never reaches the driver.
     assert!(arm.move_to(0, f64::NAN).is_err());
     assert!(limb.set_position([f64::NAN, 0.0, 0.0]).is_err());
     assert!(limb.vec_move([0.0, 0.0, 0.0], 0.1).is_err());
     // Requests.
     assert_eq!(
-        arm.brakes(true),
-        Err(RequestError::Nack(Status::Unsupported))
+        arm.set_accel_config(8, 1.0),
+        Err(RequestError::Nack(Status::UnknownJoint))
     );
     assert_eq!(
-        arm.set_accel_config(0, 1.0),
-        Err(RequestError::Nack(Status::Unsupported))
+        arm.set_accel_config(0, -1.0),
+        Err(RequestError::Nack(Status::InvalidArgument))
     );
     assert_eq!(
         arm.set_speed_config(9, 1.0),
@@ -272,10 +273,6 @@ fn refusals_reach_the_sender() {
     assert_eq!(
         arm.set_speed_config(0, -1.0),
         Err(RequestError::Nack(Status::InvalidArgument))
-    );
-    assert_eq!(
-        limb.brakes(true),
-        Err(RequestError::Nack(Status::Unsupported))
     );
     assert_eq!(
         limb.set_speed(0.0),

@@ -95,8 +95,8 @@ fn refusals_and_out_of_reach() {
         Status::BeyondLimits
     );
     assert_eq!(
-        m.arm_command(&ActArrayCommand::current(0, 1.0).unwrap()),
-        Status::Unsupported
+        m.arm_command(&ActArrayCommand::current(9, 1.0).unwrap()),
+        Status::UnknownJoint
     );
     assert_eq!(
         m.arm_command(&ActArrayCommand::home(9).unwrap()),

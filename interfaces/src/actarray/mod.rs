@@ -72,6 +72,9 @@ bitflags! {
         const BRAKED = 4;
         /// Stopped short of its target.
         const STALLED = 8;
+        /// The speed is estimated from successive positions (the hardware does not
+        /// report it), not measured.
+        const SPEED_ESTIMATED = 16;
     }
 }
 
@@ -195,6 +198,11 @@ pub(crate) const GROUPS: &[ConstantGroup] = &[
                 name: "STALLED",
                 value: 8,
                 doc: "stopped short of its target",
+            },
+            Constant {
+                name: "SPEED_ESTIMATED",
+                value: 16,
+                doc: "speed estimated from successive positions, not measured",
             },
         ],
     },

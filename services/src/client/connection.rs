@@ -71,6 +71,8 @@ pub struct Client<I: Interface> {
     pub(crate) outcome_sub: Subscriber<ipc::Service, OutcomeMsg, ()>,
     pub(super) outcomes: [Outcome; OUTCOME_SLOTS],
     pub(super) preemptions: [Outcome; OUTCOME_SLOTS],
+    /// The motion results of this client's last commands (by sequence number).
+    pub(super) results: [Option<super::Done>; OUTCOME_SLOTS],
     pub(super) max_seen_seq: u64,
     pub(super) lease: Option<LeaseSide>,
     pub(super) wake_driver: bool,
@@ -115,6 +117,10 @@ pub type ActArrayClient = Client<ActArray>;
 pub type LimbClient = Client<Limb>;
 /// A client of a gripper.
 pub type GripperClient = Client<Gripper>;
+/// A client of a ranger (a laser scanner).
+pub type RangerClient = Client<Ranger>;
+/// Player's name for a planar laser's client: a [`RangerClient`].
+pub type LaserClient = RangerClient;
 
 impl<I: Interface> Client<I> {
     /// Connects to `device` ("robot/interface/index") in the context's domain. Fails with
@@ -344,6 +350,7 @@ impl<I: Interface> Client<I> {
             outcome_sub,
             outcomes: [Outcome::NONE; OUTCOME_SLOTS],
             preemptions: [Outcome::NONE; OUTCOME_SLOTS],
+            results: [None; OUTCOME_SLOTS],
             max_seen_seq: 0,
             lease: None,
             wake_driver: true,

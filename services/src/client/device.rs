@@ -13,8 +13,8 @@ use limber_interfaces::{InterfaceVisitor, WireBytes};
 use zerocopy::IntoBytes;
 
 use super::{
-    Client, ConnectError, DriverStatus, Freshness, LeaseError, LeaseHolder, Outcome, RequestError,
-    Ticket, WaitError, WaitMode,
+    Client, ConnectError, Done, DoneError, DriverStatus, Freshness, LeaseError, LeaseHolder,
+    Outcome, RequestError, Ticket, WaitError, WaitMode,
 };
 use crate::context::Context;
 use crate::naming::DeviceName;
@@ -62,6 +62,8 @@ pub trait DeviceClient {
     ) -> Result<Outcome, WaitError>;
     /// Whether another client's command cut short the motion of `ticket`'s command.
     fn preempted(&mut self, ticket: Ticket) -> Result<Option<Outcome>, WaitError>;
+    /// Waits until the motion of `ticket`'s command has ended ([`Client::wait_done`]).
+    fn wait_done(&mut self, ticket: Ticket, timeout: Duration) -> Result<Done, DoneError>;
 
     /// Takes the device's control lease ([`Client::acquire`]).
     fn acquire(&mut self, name: &str, heartbeat: Duration) -> Result<(), LeaseError>;
@@ -199,6 +201,9 @@ impl<I: Interface> DeviceClient for Client<I> {
     }
     fn preempted(&mut self, ticket: Ticket) -> Result<Option<Outcome>, WaitError> {
         Client::preempted(self, ticket)
+    }
+    fn wait_done(&mut self, ticket: Ticket, timeout: Duration) -> Result<Done, DoneError> {
+        Client::wait_done(self, ticket, timeout)
     }
     fn acquire(&mut self, name: &str, heartbeat: Duration) -> Result<(), LeaseError> {
         Client::acquire(self, name, heartbeat)

@@ -114,6 +114,10 @@ impl<I: Interface> Client<I> {
                     if m.client_id != self.client_id {
                         continue;
                     }
+                    if m.result != 0 {
+                        self.result_arrived(m);
+                        continue;
+                    }
                     let o = Outcome::from_msg(m);
                     let slot = (m.cmd_seq as usize) % OUTCOME_SLOTS;
                     if m.status == Status::Preempted.code() {

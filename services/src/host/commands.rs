@@ -32,9 +32,17 @@ impl<I: Interface> DeviceHost<I> {
             let raw: &I::CmdMsg = &sample;
             let meta = *raw.meta();
             // Who sent it, as the transport says: the node of its publisher.
-            let node = self
+            let sender = self
                 .cmd_senders
                 .publisher(sample.header().publisher_id().value(), &self.cmd_svc);
+            let node = sender.node;
+            if !super::senders::client_of_process(meta.client_id, sender.pid) {
+                // Another process's client id: its outcome would go to that client (who
+                // never sent it, and would take it for one of its own). Dropped, counted.
+                drop(sample);
+                self.forged_command(meta.client_id, sender.pid);
+                continue;
+            }
             let origin = Origin {
                 client_id: meta.client_id,
                 seq: meta.seq,
@@ -86,12 +94,27 @@ impl<I: Interface> DeviceHost<I> {
                 sent?;
                 self.state_sent();
             }
+            // A command that drives nothing that runs on has its result now, after its
+            // outcome (so do the motions it preempted or stopped).
+            self.publish_results();
             // The next command's outcome sample, loaned now rather than on its path.
             if self.outcome_loan.is_none() {
                 self.outcome_loan = loan_ahead(&self.outcomes, &self.device, "outcome");
             }
         }
         Ok(n)
+    }
+
+    /// A command whose client id is another process's: counted as refused, and logged
+    /// (at warning level the first time, then once per 1,000).
+    fn forged_command(&mut self, client_id: u64, pid: u32) {
+        self.stats.commands += 1;
+        self.stats.refused += 1;
+        self.forged += 1;
+        if self.forged % 1000 == 1 {
+            tracing::warn!(device = %self.device, client_id, sender_pid = pid, forged = self.forged,
+                "a command with another process's client id: dropped (no outcome to that client)");
+        }
     }
 
     /// Carries out one decoded command of a client allowed to command the device, and
@@ -104,10 +127,12 @@ impl<I: Interface> DeviceHost<I> {
         cmd: CmdRef,
     ) -> Status {
         let motion = handler.motion(decoded, &self.state);
+        self.record_before(handler, motion);
         let status = handler.command(decoded, origin, &mut self.state);
         if !status.is_carried_out() {
             return status;
         }
+        self.motion_started(cmd, motion);
         let (outcomes, loan, stats, device) = (
             &self.outcomes,
             &mut self.outcome_loan,
@@ -132,34 +157,44 @@ fn publish_outcome(
     device: &DeviceName,
     told: Told,
 ) {
+    let mut msg = OutcomeMsg {
+        client_id: told.cmd.client_id,
+        cmd_seq: told.cmd.seq,
+        other_client: told.other_client,
+        kind: told.cmd.kind,
+        status: told.status.code(),
+        ..OutcomeMsg::default()
+    };
+    if let Some(n) = told.other_name {
+        msg.other_name = n;
+    }
+    publish_message(outcomes, loan_ahead, stats, device, msg);
+}
+
+/// Publishes one sample on the `outcome` channel (an outcome or a motion's result),
+/// stamped now; see [`publish_outcome`].
+pub(super) fn publish_message(
+    outcomes: &Publisher<ipc::Service, OutcomeMsg, ()>,
+    loan_ahead: &mut Option<SampleMutUninit<ipc::Service, MaybeUninit<OutcomeMsg>, ()>>,
+    stats: &mut HostStats,
+    device: &DeviceName,
+    mut msg: OutcomeMsg,
+) {
     let loan = match loan_ahead.take() {
         Some(l) => Ok(l),
         None => outcomes.loan_uninit(),
     };
+    msg.stamp_ns = monotonic_ns();
     let sent = match loan {
-        Ok(loan) => {
-            let mut msg = OutcomeMsg {
-                client_id: told.cmd.client_id,
-                cmd_seq: told.cmd.seq,
-                other_client: told.other_client,
-                stamp_ns: monotonic_ns(),
-                kind: told.cmd.kind,
-                status: told.status.code(),
-                ..OutcomeMsg::default()
-            };
-            if let Some(n) = told.other_name {
-                msg.other_name = n;
-            }
-            loan.write_payload(msg).send().map_err(Iox2Error::from)
-        }
+        Ok(loan) => loan.write_payload(msg).send().map_err(Iox2Error::from),
         Err(e) => Err(e.into()),
     };
     match sent {
         Ok(_) => stats.outcomes += 1,
         Err(e) => {
             stats.failed_outcomes += 1;
-            tracing::warn!(device = %device, client = told.cmd.client_id, seq = told.cmd.seq,
-                error = %e, "cannot publish an outcome");
+            tracing::warn!(device = %device, client = msg.client_id, seq = msg.cmd_seq,
+                result = msg.result, error = %e, "cannot publish an outcome");
         }
     }
 }

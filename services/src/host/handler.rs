@@ -1,5 +1,5 @@
 //! What a driver implements: [`DeviceHandler`], with the [`Origin`] of each message and the
-//! [`Motion`] a command drives.
+//! [`Motion`] a command drives, and the [`Progress`] of a motion.
 
 use limber_interfaces::prelude::*;
 
@@ -45,6 +45,18 @@ pub trait DeviceHandler<I: Interface> {
         Motion::NONE
     }
 
+    /// How part `part` (a bit of [`Motion::drives`]) of a motion the host follows is
+    /// doing: still moving, or ended and how, with its position and its error against the
+    /// goal the driver holds for it. The host asks for each running part after each
+    /// command and whenever the driver calls
+    /// [`DeviceHost::check_motions`](super::DeviceHost::check_motions), and publishes a
+    /// command's result when its last part ended. Must not block. Default:
+    /// [`Progress::UNKNOWN`] (the motion ends only when another command takes its parts).
+    fn progress(&mut self, part: u32, state: &I::Data) -> Progress {
+        let _ = (part, state);
+        Progress::UNKNOWN
+    }
+
     /// Stops every motion of the device now (the deadman: the holder of the device's
     /// lease died or missed its heartbeat). Must not block. Default: unsupported (logged
     /// by the host); every driver of moving hardware implements it.
@@ -63,17 +75,80 @@ pub struct Motion {
     pub drives: u64,
     /// Those of them still moving now: the command cuts their motion short.
     pub cuts: u64,
+    /// The command is a stop: the motions it cuts end [`MotionResult::Stopped`] rather
+    /// than [`MotionResult::Preempted`].
+    pub stop: bool,
 }
 
 impl Motion {
     /// Drives nothing that runs on by itself.
-    pub const NONE: Motion = Motion { drives: 0, cuts: 0 };
+    pub const NONE: Motion = Motion {
+        drives: 0,
+        cuts: 0,
+        stop: false,
+    };
 
     /// `drives`, of which the parts in `running` are still moving.
     pub const fn of(drives: u64, running: u64) -> Motion {
         Motion {
             drives,
             cuts: drives & running,
+            stop: false,
+        }
+    }
+
+    /// The same parts, driven by a stop.
+    pub const fn stopping(self) -> Motion {
+        Motion { stop: true, ..self }
+    }
+}
+
+/// How one part of a motion is doing ([`DeviceHandler::progress`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Progress {
+    /// `None` while it moves; how it ended and why (`Ok`, or the cause: `LINK_DOWN`,
+    /// `POWERED_OFF`, `BRAKED`, ...).
+    pub end: Option<(MotionResult, Status)>,
+    /// Its position now (rad or m); NaN if not known.
+    pub position: f64,
+    /// Its position minus its goal; NaN if not known (a SPEED has no goal).
+    pub error: f64,
+    /// The device's tolerance for "reached" for this part; 0 if exact.
+    pub tolerance: f64,
+}
+
+impl Progress {
+    /// Nothing known: still moving, position and error unknown.
+    pub const UNKNOWN: Progress = Progress {
+        end: None,
+        position: f64::NAN,
+        error: f64::NAN,
+        tolerance: 0.0,
+    };
+
+    /// Still moving, at `position`, `error` from its goal.
+    pub const fn moving(position: f64, error: f64, tolerance: f64) -> Progress {
+        Progress {
+            end: None,
+            position,
+            error,
+            tolerance,
+        }
+    }
+
+    /// Ended with `result` (because of `cause`), at `position`, `error` from its goal.
+    pub const fn ended(
+        result: MotionResult,
+        cause: Status,
+        position: f64,
+        error: f64,
+        tolerance: f64,
+    ) -> Progress {
+        Progress {
+            end: Some((result, cause)),
+            position,
+            error,
+            tolerance,
         }
     }
 }

@@ -51,6 +51,7 @@ impl<I: Interface> DeviceHost<I> {
             stop = %status, "lease ended because {why}: device stopped");
         self.stats.deadman_stops += 1;
         self.publish()?;
+        self.end_motions(MotionResult::Stopped, Status::Leased);
         Ok(())
     }
 

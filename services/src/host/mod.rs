@@ -34,6 +34,7 @@ pub mod error;
 mod gaps;
 pub mod handler;
 mod lease;
+mod motions;
 mod open;
 mod requests;
 mod senders;
@@ -43,7 +44,8 @@ use arbiter::Arbiter;
 pub use arbiter::{HOLDER_CHECK_NS, Holder, MAX_LEASE_TIMEOUT_NS, MIN_LEASE_TIMEOUT_NS};
 pub use error::{HostError, ProcessError, PublishError};
 pub use gaps::CLIENT_SLOTS;
-pub use handler::{DeviceHandler, Motion, Origin};
+pub use handler::{DeviceHandler, Motion, Origin, Progress};
+pub use motions::MAX_TRACKED;
 pub use stats::{Activity, HostStats};
 
 /// [`DeviceHost::process_spin`] looks for requests on every this many calls.
@@ -95,6 +97,8 @@ pub struct DeviceHost<I: Interface> {
     >,
     /// Who sent each command, request and lease request (see `senders.rs`).
     cmd_senders: senders::PortNodes,
+    /// Commands dropped because their client id named another process than their sender.
+    forged: u64,
     req_senders: senders::PortNodes,
     lease_senders: senders::PortNodes,
     server: Server<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()>,
@@ -111,6 +115,8 @@ pub struct DeviceHost<I: Interface> {
     lease_server: Server<ipc::Service, LeaseReq, (), LeaseReply, ()>,
     /// Leases, preemption, the gap table and the outcome rules: no I/O.
     arbiter: Arbiter,
+    /// The motions running, each to end with a result (see `motions.rs`).
+    motions: motions::Motions,
     /// The lease the deadman ended here and why, until the [`DeviceSet`](crate::DeviceSet)
     /// stops the other devices that shared it (see `lease.rs`).
     lease_ended: Option<(Holder, &'static str)>,

@@ -215,6 +215,7 @@ impl<I: Interface> DeviceHost<I> {
             cmd_svc,
             req_svc,
             cmd_senders: super::senders::PortNodes::new(ports),
+            forged: 0,
             req_senders: super::senders::PortNodes::new(ports),
             lease_senders: super::senders::PortNodes::new(ports),
             server,
@@ -226,6 +227,7 @@ impl<I: Interface> DeviceHost<I> {
             // A tag of its own: of the hosts that share a lease, the one that granted it
             // looks up the holder's node.
             arbiter: Arbiter::with_tag(NEXT_ARBITER_TAG.fetch_add(1, Ordering::Relaxed)),
+            motions: super::motions::Motions::new(),
             lease_ended: None,
             state: I::Data::default(),
             seq: 0,

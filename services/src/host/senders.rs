@@ -6,15 +6,36 @@
 //!
 //! A fixed table per channel, no allocation: a port seen before is found in it; a new one
 //! refills the table from the registry (once per new port).
+//!
+//! The table also keeps the process id of each node (iceoryx2 records it in the node id):
+//! a client id carries the id of the process that made it ([`crate::Context::new_client_id`]),
+//! so a command whose client id names another process than its sender's is a forgery
+//! ([`client_of_process`]).
 
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::{publish_subscribe, request_response};
 
-/// Port id → node id of one channel.
+/// Who sent a message: its node, and that node's process id (0: not known).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Sender {
+    /// The iceoryx2 node id (0: the registry does not know the port).
+    pub(crate) node: u128,
+    /// The process id iceoryx2 recorded for the node (0: not known).
+    pub(crate) pid: u32,
+}
+
+/// Whether `client_id` can be a client id of process `pid`: its high 32 bits are the
+/// process id of the process that made it ([`crate::Context::new_client_id`]). An unknown
+/// process (0) is given the benefit of the doubt.
+pub(crate) fn client_of_process(client_id: u64, pid: u32) -> bool {
+    pid == 0 || (client_id >> 32) as u32 == pid
+}
+
+/// Port id → sender of one channel.
 #[derive(Debug, Clone)]
 pub(crate) struct PortNodes {
     /// Allocated once, when the device is offered.
-    entries: Box<[(u128, u128)]>,
+    entries: Box<[(u128, Sender)]>,
     len: usize,
 }
 
@@ -23,21 +44,21 @@ impl PortNodes {
     /// with room for as many dead ports not yet cleaned up.
     pub(crate) fn new(ports: usize) -> Self {
         PortNodes {
-            entries: vec![(0, 0); 2 * ports].into_boxed_slice(),
+            entries: vec![(0, Sender { node: 0, pid: 0 }); 2 * ports].into_boxed_slice(),
             len: 0,
         }
     }
 
-    fn find(&self, port: u128) -> Option<u128> {
+    fn find(&self, port: u128) -> Option<Sender> {
         self.entries[..self.len]
             .iter()
             .find(|(p, _)| *p == port)
             .map(|(_, n)| *n)
     }
 
-    /// The node of `port`; on a miss, `fill` lists the registry's (port, node) pairs again.
-    /// 0 when the registry does not know the port (it left meanwhile).
-    fn node_of(&mut self, port: u128, fill: impl FnOnce(&mut dyn FnMut(u128, u128))) -> u128 {
+    /// The sender of `port`; on a miss, `fill` lists the registry's (port, sender) pairs
+    /// again. Node 0 when the registry does not know the port (it left meanwhile).
+    fn node_of(&mut self, port: u128, fill: impl FnOnce(&mut dyn FnMut(u128, Sender))) -> Sender {
         if let Some(n) = self.find(port) {
             return n;
         }
@@ -49,18 +70,18 @@ impl PortNodes {
                 *len += 1;
             }
         });
-        self.find(port).unwrap_or(0)
+        self.find(port).unwrap_or(Sender { node: 0, pid: 0 })
     }
 
-    /// The node of the publisher `port` of the pub/sub service `svc`.
+    /// The sender of the publisher `port` of the pub/sub service `svc`.
     pub(crate) fn publisher<P: core::fmt::Debug + ZeroCopySend>(
         &mut self,
         port: u128,
         svc: &publish_subscribe::PortFactory<ipc::Service, P, ()>,
-    ) -> u128 {
+    ) -> Sender {
         self.node_of(port, |add| {
             svc.dynamic_config().list_publishers(|d| {
-                add(d.publisher_id.value(), d.node_id.value());
+                add(d.publisher_id.value(), sender(&d.node_id));
                 CallbackProgression::Continue
             });
         })
@@ -78,10 +99,21 @@ impl PortNodes {
     {
         self.node_of(port, |add| {
             svc.dynamic_config().list_clients(|d| {
-                add(d.client_id.value(), d.node_id.value());
+                add(d.client_id.value(), sender(&d.node_id));
                 CallbackProgression::Continue
             });
         })
+        .node
+    }
+}
+
+/// The sender of a node of the registry.
+fn sender(node: &iceoryx2::identifiers::UniqueNodeId) -> Sender {
+    Sender {
+        node: node.value(),
+        pid: node
+            .pid::<ipc::Service>()
+            .map_or(0, |p| u32::try_from(p.value()).unwrap_or(0)),
     }
 }
 
@@ -98,9 +130,10 @@ mod tests {
             t.node_of(port, |add| {
                 *fills += 1;
                 for (p, n) in registry {
-                    add(*p, *n);
+                    add(*p, Sender { node: *n, pid: 7 });
                 }
             })
+            .node
         };
         assert_eq!(look(&mut t, 2, &registry, &mut fills), 20);
         assert_eq!(look(&mut t, 1, &registry, &mut fills), 10);
@@ -109,5 +142,15 @@ mod tests {
         assert_eq!(look(&mut t, 3, &registry, &mut fills), 30);
         assert_eq!(look(&mut t, 9, &registry, &mut fills), 0, "unknown port");
         assert_eq!(fills, 3);
+    }
+
+    #[test]
+    fn a_client_id_belongs_to_the_process_that_made_it() {
+        assert!(client_of_process(42 << 32 | 7, 42));
+        assert!(!client_of_process(43 << 32 | 7, 42));
+        assert!(
+            client_of_process(43 << 32 | 7, 0),
+            "an unknown process is not judged"
+        );
     }
 }

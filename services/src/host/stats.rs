@@ -36,6 +36,8 @@ pub struct HostStats {
     pub lease_requests: u64,
     /// Deadman stops: the holder of the lease died or missed its heartbeat.
     pub deadman_stops: u64,
+    /// Motion results published (one per command carried out, when its motion ended).
+    pub results: u64,
 }
 
 impl core::ops::AddAssign for HostStats {
@@ -54,6 +56,7 @@ impl core::ops::AddAssign for HostStats {
         self.leased_refusals += o.leased_refusals;
         self.lease_requests += o.lease_requests;
         self.deadman_stops += o.deadman_stops;
+        self.results += o.results;
     }
 }
 

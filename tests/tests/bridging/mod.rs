@@ -57,3 +57,33 @@ pub fn usrpwd_configs(name: &str) -> (std::path::PathBuf, String, String, String
     let bad = usrpwd_config(&dir, "bad.json5", "robot", "a guess", None);
     (dir, robot, good, bad)
 }
+
+/// `bridge expose ARGS` in `a`, once it exposed the arm.
+pub fn expose_with(a: &Domain, args: &[&str]) -> Proc {
+    let mut e = Proc::spawn(CLI, a.name(), &[&["bridge", "expose"], args].concat());
+    assert!(
+        e.read_until(|l| l == "exposed pioneer/actarray/0")
+            .is_some(),
+        "expose did not expose the arm"
+    );
+    e
+}
+
+/// `bridge mirror ARGS` in `b`, once it started (it may mirror nothing: see
+/// [`mirrored_nothing`]).
+pub fn mirror_with(b: &Domain, args: &[&str]) -> Proc {
+    let mut m = Proc::spawn(CLI, b.name(), &[&["bridge", "mirror"], args].concat());
+    assert!(
+        m.read_until(|l| l.starts_with("mirroring into")).is_some(),
+        "the mirror did not start"
+    );
+    m
+}
+
+/// Ends mirror `m` (SIGTERM) and checks it mirrored nothing in its whole life.
+pub fn mirrored_nothing(mut m: Proc) {
+    m.signal(libc::SIGTERM);
+    m.wait_timeout(Duration::from_secs(30));
+    let rest = m.rest_of_stdout();
+    assert!(!rest.contains("mirrored"), "{rest}");
+}

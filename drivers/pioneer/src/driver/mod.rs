@@ -528,6 +528,13 @@ impl PioneerDriver {
             }
             robot.dirty.body = false;
         }
+        // After the states that show them: the results of the motions that ended.
+        let mut handler = serve::Serve {
+            robot: &mut self.robot,
+            conn: None,
+            stats: &mut self.timing,
+        };
+        self.hosts.check_motions(&mut handler);
         if now.duration_since(self.last_stats) >= Duration::from_secs(1) {
             self.last_stats = now;
             self.publish_stats();

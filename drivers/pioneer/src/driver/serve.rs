@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use limber_interfaces::prelude::*;
 use limber_p2os::Connection;
-use limber_services::{DeviceSetHandler, Motion, Origin, monotonic_ns};
+use limber_services::{DeviceSetHandler, Motion, Origin, Progress, monotonic_ns};
 
 use crate::config::GripperGeometry;
 use crate::robot::RobotModel;
@@ -112,18 +112,40 @@ impl DeviceSetHandler for Serve<'_> {
         };
         self.done(st)
     }
+    fn actarray_progress(&mut self, index: u16, part: u32, _s: &ActArrayData) -> Progress {
+        if index == 0 {
+            self.robot.arm_progress(part)
+        } else {
+            self.robot.lift_progress()
+        }
+    }
     fn limb_motion(&mut self, _index: u16, cmd: &LimbCommand, _s: &LimbData) -> Motion {
         self.robot.limb_motion(cmd)
+    }
+    fn limb_progress(&mut self, _index: u16, part: u32, _s: &LimbData) -> Progress {
+        self.robot.limb_progress(part)
+    }
+    fn gripper_progress(&mut self, index: u16, _part: u32, _s: &GripperData) -> Progress {
+        if index == 0 {
+            self.robot.gripper_progress()
+        } else {
+            self.robot.armgrip_progress()
+        }
     }
     fn limb_stop(&mut self, _index: u16, _s: &mut LimbData) -> Status {
         let st = self.robot.arm_stop();
         self.done(st)
     }
-    fn gripper_motion(&mut self, index: u16, _cmd: &GripperCommand, _s: &GripperData) -> Motion {
-        if index == 0 {
+    fn gripper_motion(&mut self, index: u16, cmd: &GripperCommand, _s: &GripperData) -> Motion {
+        let m = if index == 0 {
             self.robot.gripper_motion()
         } else {
             self.robot.armgrip_motion()
+        };
+        if *cmd == GripperCommand::Stop {
+            m.stopping()
+        } else {
+            m
         }
     }
     fn gripper_stop(&mut self, index: u16, _s: &mut GripperData) -> Status {
@@ -143,7 +165,11 @@ impl DeviceSetHandler for Serve<'_> {
     ) -> Status {
         if index == 0 {
             let st = self.robot.arm_command(cmd, from);
-            self.done(st)
+            let st = self.done(st);
+            // The state sent with the outcome shows the command: a joint given a new
+            // target is MOVING from now on, not from the next ARMpac.
+            self.robot.arm_state(s, Instant::now());
+            st
         } else {
             let st = self.robot.lift_command(cmd, from);
             let st = self.done(st);
@@ -202,14 +228,18 @@ impl DeviceSetHandler for Serve<'_> {
         index: u16,
         cmd: &GripperCommand,
         from: &Origin,
-        _s: &mut GripperData,
+        s: &mut GripperData,
     ) -> Status {
         let st = if index == 0 {
             self.robot.gripper_command(cmd, from)
         } else {
             self.robot.armgrip_command(cmd, from)
         };
-        self.done(st)
+        let st = self.done(st);
+        if index == 1 {
+            self.robot.armgrip_state(s, Instant::now());
+        }
+        st
     }
     fn gripper_request(
         &mut self,

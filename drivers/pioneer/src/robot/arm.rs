@@ -59,6 +59,7 @@ impl RobotModel {
                         let joint = ArmJoint::from_index(j).map_err(|_| Status::UnknownJoint)?;
                         self.send(&Command::ArmPos { joint, tick }, from)?;
                         self.arm.set_target(j, tick);
+                        self.arm.goal[j] = Some(v.as_slice()[j]);
                     }
                     Ok(Status::Ok)
                 })
@@ -264,16 +265,22 @@ impl RobotModel {
         // it); the ARMpacs confirm it, or correct it once the grace of a power-on is over.
         s.motor_state = self.arm.powered_or_pending() as u32;
         let q = self.joint_angles();
+        let speeds = self.estimated_speeds();
         for j in 0..n {
             let a = &mut s.actuators[j];
             a.position = q.map(|q| q[j]).unwrap_or(0.0);
-            a.speed = 0.0;
             a.acceleration = -1.0;
             a.current = -1.0;
-            a.state = self
+            let flags = self
                 .arm
-                .flags(j, now, Duration::from_millis(self.cfg.stall_timeout_ms))
-                .bits();
+                .flags(j, now, Duration::from_millis(self.cfg.stall_timeout_ms));
+            // While it moves, its speed is the one estimated from the last two ARMpacs
+            // (and says so); at rest, 0.
+            (a.speed, a.state) = if flags.contains(ActuatorFlags::MOVING) {
+                (speeds[j], (flags | ActuatorFlags::SPEED_ESTIMATED).bits())
+            } else {
+                (0.0, flags.bits())
+            };
         }
         s.header.stamp_ns = self.arm.stamp_ns;
     }

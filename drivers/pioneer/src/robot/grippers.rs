@@ -93,17 +93,19 @@ impl RobotModel {
         }
     }
 
-    /// Fills the body-gripper state from the SIP's switch byte (ARIA's reading).
+    /// Fills the body-gripper state from the SIP's gripper state byte, read in the
+    /// configured layout (`gripper_byte`: the manual's by default), and the breakbeams.
     pub fn gripper_state(&self, s: &mut GripperData) {
         let Some(sip) = self.sip.as_ref() else {
             s.state = GripperState::Error as u32;
             return;
         };
-        let sw = sip.gripper_switches();
-        s.state = match sw.paddles() {
+        let r = sip.gripper_reading(self.cfg.gripper_byte);
+        s.state = match r.paddles {
             PaddleState::Open => GripperState::Open,
             PaddleState::Closed => GripperState::Closed,
             PaddleState::Moving => GripperState::Moving,
+            PaddleState::Error => GripperState::Error,
             PaddleState::Between => {
                 if self.gripper_cmd == Some(GripperCommand::Close) {
                     GripperState::Closed
@@ -113,7 +115,7 @@ impl RobotModel {
             }
         } as u32;
         // Beam 0 = outer, beam 1 = inner.
-        s.beams = sw.outer_beam() as u32 | (sw.inner_beam() as u32) << 1;
+        s.beams = r.outer_beam as u32 | (r.inner_beam as u32) << 1;
         s.stored = 0;
     }
 }

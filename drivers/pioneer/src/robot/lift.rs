@@ -5,7 +5,7 @@ use std::time::{Duration, Instant};
 use limber_interfaces::prelude::*;
 use limber_services::Origin;
 
-use limber_p2os::{Command, GripperCommand as P2Gripper};
+use limber_p2os::{Command, GripperCommand as P2Gripper, LiftState};
 
 use super::*;
 
@@ -150,12 +150,18 @@ impl RobotModel {
     /// Applies a SIP to the lift model.
     pub fn lift_from_sip(&mut self, now: Instant) {
         if let Some(sip) = self.sip.as_ref() {
-            let sw = sip.gripper_switches();
-            self.lift.switch_moving = sw.lift_moving();
-            self.lift.at_limit = sw.lift_at_limit();
-            if self.lift.at_limit && !self.lift.switch_moving {
-                // At a limit: which one follows from where it was going.
-                let top = self.lift.target >= self.cfg.lift_stroke / 2.0;
+            let lift = sip.gripper_reading(self.cfg.gripper_byte).lift;
+            self.lift.switch_moving = lift == LiftState::Moving;
+            self.lift.at_limit =
+                matches!(lift, LiftState::Up | LiftState::Down | LiftState::AtLimit);
+            if self.lift.at_limit {
+                // At a limit: the manual's byte says which; ARIA's one limit bit does
+                // not, and it follows from where it was going.
+                let top = match lift {
+                    LiftState::Up => true,
+                    LiftState::Down => false,
+                    _ => self.lift.target >= self.cfg.lift_stroke / 2.0,
+                };
                 if self
                     .lift
                     .moving

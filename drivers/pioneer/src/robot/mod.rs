@@ -15,6 +15,7 @@ mod lift;
 mod limb;
 mod motion;
 mod outbox;
+mod progress;
 
 pub use lift::LiftModel;
 pub use outbox::{OUTBOX_CAPACITY, Outbox, OutboxFull, Queued};
@@ -91,6 +92,15 @@ pub struct ArmModel {
     pub target: [Option<u8>; ARM_JOINTS],
     /// Since when a joint has been still but short of its target.
     pub short_since: [Option<Instant>; ARM_JOINTS],
+    /// The goal a client asked for, in radians, per joint (POS, MULTI_POS): a motion's
+    /// final error is against it; `None`: the target tick is the goal (HOME, SPEED, a
+    /// VECMOVE waypoint).
+    pub goal: [Option<f64>; ARM_JOINTS],
+    /// The ticks of the ARMpac before the last, and when it arrived: the speed is
+    /// estimated from successive positions (the ARMpac has none).
+    pub prev_ticks: [u8; ARM_JOINTS],
+    /// When the ARMpac before the last arrived.
+    pub prev_packet: Option<Instant>,
     /// When the last ARMpac arrived (`CLOCK_MONOTONIC` ns).
     pub stamp_ns: u64,
     /// When the last ARMpac arrived, on the model's clock.
@@ -112,6 +122,9 @@ impl Default for ArmModel {
             power_off_sent: None,
             target: [None; ARM_JOINTS],
             short_since: [None; ARM_JOINTS],
+            goal: [None; ARM_JOINTS],
+            prev_ticks: [0; ARM_JOINTS],
+            prev_packet: None,
             stamp_ns: 0,
             last_packet: None,
             layout_mismatches: 0,
@@ -154,6 +167,13 @@ impl ArmModel {
             self.layout_mismatches += 1;
         }
         let status = p.status(layout);
+        if self.seen {
+            self.prev_ticks = self.ticks;
+            self.prev_packet = self.last_packet;
+        } else {
+            self.prev_ticks = p.ticks;
+            self.prev_packet = Some(now);
+        }
         self.ticks = p.ticks;
         self.moving = status.moving_mask();
         // "Powered" from a packet in flight when the power-off left is not believed.
@@ -204,6 +224,7 @@ impl ArmModel {
 
     pub(super) fn set_target(&mut self, j: usize, tick: u8) {
         self.target[j] = Some(tick);
+        self.goal[j] = None;
         self.short_since[j] = None;
     }
 }
@@ -733,6 +754,7 @@ impl RobotModel {
         let joint = ArmJoint::from_index(j).map_err(|_| Status::UnknownJoint)?;
         self.send(&Command::ArmPos { joint, tick }, from)?;
         self.arm.set_target(j, tick);
+        self.arm.goal[j] = Some(rad);
         Ok(())
     }
 }

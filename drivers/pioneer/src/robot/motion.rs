@@ -49,6 +49,11 @@ impl RobotModel {
                 0
             }
         };
+        let stop = match *cmd {
+            ActArrayCommand::Speed { speed, .. } => speed == 0.0,
+            ActArrayCommand::MultiSpeed(v) => v.as_slice().iter().all(|s| *s == 0.0),
+            _ => false,
+        };
         let mask = match *cmd {
             ActArrayCommand::Position { joint, .. } | ActArrayCommand::Speed { joint, .. } => {
                 one(joint)
@@ -58,13 +63,19 @@ impl RobotModel {
             ActArrayCommand::Home(JointSel::One(j)) => one(j),
             ActArrayCommand::Current { .. } | ActArrayCommand::MultiCurrent(_) => 0,
         };
-        Motion::of(mask as u64, self.joints_running())
+        let m = Motion::of(mask as u64, self.joints_running());
+        if stop { m.stopping() } else { m }
     }
 
     /// What a limb command drives (any: a new target or a stop drives every limb joint),
     /// and which limb joints still move (SETPOSE, SETPOSITION, VECMOVE, HOME).
-    pub fn limb_motion(&self, _cmd: &LimbCommand) -> Motion {
-        Motion::of(LIMB_JOINTS as u64, self.joints_running())
+    pub fn limb_motion(&self, cmd: &LimbCommand) -> Motion {
+        let m = Motion::of(LIMB_JOINTS as u64, self.joints_running());
+        if *cmd == LimbCommand::Stop {
+            m.stopping()
+        } else {
+            m
+        }
     }
 
     /// A command of the arm gripper drives it (bit 0); still moving or not.
@@ -76,10 +87,9 @@ impl RobotModel {
     /// A command of the body gripper drives it (bit 0); moving while the paddles are
     /// between their end switches.
     pub fn gripper_motion(&self) -> Motion {
-        let moving = self
-            .sip
-            .as_ref()
-            .is_some_and(|s| s.gripper_switches().paddles() == PaddleState::Moving);
+        let moving = self.sip.as_ref().is_some_and(|s| {
+            s.gripper_reading(self.cfg.gripper_byte).paddles == PaddleState::Moving
+        });
         Motion::of(1, moving as u64)
     }
 

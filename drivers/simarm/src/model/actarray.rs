@@ -16,6 +16,7 @@ impl ArmModel {
     }
 
     fn arm_command_inner(&mut self, cmd: &ActArrayCommand) -> Result<Status, Status> {
+        self.arm_unbraked(cmd)?;
         match *cmd {
             ActArrayCommand::Position { joint, position } => {
                 let j = joint as usize;
@@ -103,7 +104,7 @@ impl ArmModel {
                 Ok(Status::Ok)
             }
             ActArrayCommand::Current { .. } | ActArrayCommand::MultiCurrent(_) => {
-                Err(Status::Unsupported)
+                self.current_command(cmd)
             }
         }
     }
@@ -172,7 +173,24 @@ impl ArmModel {
                 }
                 Ok(ActArrayReply::Done)
             }
-            ActArrayRequest::Brakes(_) | ActArrayRequest::Accel { .. } => Err(Status::Unsupported),
+            ActArrayRequest::Brakes(on) => {
+                self.set_brakes(on)?;
+                Ok(ActArrayReply::Done)
+            }
+            ActArrayRequest::Accel { joint, accel } => {
+                let j = joint as usize;
+                if j > self.n {
+                    return Err(Status::UnknownJoint);
+                }
+                if !accel.is_finite() {
+                    return Err(Status::NotFinite);
+                }
+                if accel <= 0.0 {
+                    return Err(Status::InvalidArgument);
+                }
+                self.config_accel[j] = accel;
+                Ok(ActArrayReply::Done)
+            }
         }
     }
 
@@ -202,7 +220,7 @@ impl ArmModel {
                     JointKind::Rotary => ActuatorKind::Rotary,
                     JointKind::Linear => ActuatorKind::Linear,
                 } as u32,
-                has_brakes: 0,
+                has_brakes: u32::from(self.options.brakes),
                 length: j.origin.norm(),
                 orientation: Orientation3 { roll, pitch, yaw },
                 axis: Vec3::new(axis.x, axis.y, axis.z),
@@ -232,17 +250,29 @@ impl ArmModel {
         g
     }
 
-    /// Fills the actuator-array state (positions, velocities, IDLE/MOVING/STALLED).
+    /// Fills the actuator-array state: positions, velocities, the acceleration (of the
+    /// last step, for an actuator with an ACCEL limit; -1 otherwise), the motor model's
+    /// current, and BRAKED (chain joints while the brakes are on) / STALLED (blocked, or
+    /// pushed by a current and not moving) / MOVING / IDLE.
     pub fn arm_state(&self, s: &mut ActArrayData) {
         s.actuators_count = self.actuators() as u32;
         s.motor_state = self.powered as u32;
+        let currents = self.model_currents();
         let all = self.joints[..self.n].iter().chain(Some(&self.gripper));
-        for (a, m) in s.actuators.iter_mut().zip(all) {
+        for (j, (a, m)) in s.actuators.iter_mut().zip(all).enumerate() {
+            let braked = self.brakes && j < self.n;
             a.position = m.pos;
             a.speed = m.velocity;
-            a.acceleration = -1.0;
-            a.current = -1.0;
-            a.state = if m.stalled {
+            a.acceleration = if self.config_accel[j].is_finite() {
+                m.accel_now
+            } else {
+                -1.0
+            };
+            a.current = if braked { 0.0 } else { currents[j] };
+            let pushed = m.current.is_some_and(|i| i != 0.0) && !m.moving;
+            a.state = if braked {
+                ActuatorFlags::BRAKED
+            } else if m.stalled || pushed {
                 ActuatorFlags::STALLED
             } else if m.moving {
                 ActuatorFlags::MOVING

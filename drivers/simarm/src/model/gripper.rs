@@ -54,7 +54,8 @@ impl ArmModel {
         }
     }
     /// Carries out or refuses a gripper command: OPEN and CLOSE move the fingers at the
-    /// gripper speed, STOP stops them, STORE and RETRIEVE are unsupported.
+    /// gripper speed, STOP stops them, STORE and RETRIEVE use the gripper's store
+    /// (`store`).
     pub fn gripper_command(&mut self, cmd: &GripperCommand) -> Status {
         match cmd {
             GripperCommand::Open | GripperCommand::Close => {
@@ -84,7 +85,8 @@ impl ArmModel {
                 self.gripper.stop();
                 Status::Ok
             }
-            GripperCommand::Store | GripperCommand::Retrieve => Status::Unsupported,
+            GripperCommand::Store => self.store_object().err().unwrap_or(Status::Ok),
+            GripperCommand::Retrieve => self.retrieve_object().err().unwrap_or(Status::Ok),
         }
     }
 
@@ -98,7 +100,7 @@ impl ArmModel {
                     height: 0.0,
                 },
                 num_beams: 1,
-                capacity: 0,
+                capacity: self.store.capacity(),
                 ..Default::default()
             })),
         }
@@ -121,6 +123,6 @@ impl ArmModel {
             }
         } as u32;
         s.beams = self.object_between_fingers() as u32;
-        s.stored = 0;
+        s.stored = self.store.len();
     }
 }

@@ -122,6 +122,7 @@ impl ArmModel {
     }
 
     fn limb_command_inner(&mut self, cmd: &LimbCommand) -> Result<(), Status> {
+        self.limb_unbraked(cmd)?;
         let current = self.q();
         match *cmd {
             LimbCommand::Home => {
@@ -269,7 +270,10 @@ impl ArmModel {
                 self.limb_speed = Some(v);
                 Ok(LimbReply::Done)
             }
-            LimbRequest::Brakes(_) => Err(Status::Unsupported),
+            LimbRequest::Brakes(on) => {
+                self.set_brakes(on)?;
+                Ok(LimbReply::Done)
+            }
             LimbRequest::Reach {
                 position,
                 approach,
@@ -304,7 +308,9 @@ impl ArmModel {
         s.approach = Vec3::new(a.x, a.y, a.z);
         s.orientation = Vec3::new(o.x, o.y, o.z);
         s.orientation_adjustment = self.limb.adjustment;
-        s.state = if self.limb.out_of_reach {
+        s.state = if self.brakes {
+            LimbState::Braked
+        } else if self.limb.out_of_reach {
             LimbState::OutOfReach
         } else if self.limb_moving() {
             LimbState::Moving

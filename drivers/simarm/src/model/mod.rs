@@ -18,16 +18,23 @@ use limber_kinematics::Pose;
 use limber_kinematics::chain::{Chain, JointKind, JointVec, MAX_JOINTS};
 
 mod actarray;
+mod brakes;
+mod current;
+mod fingers;
 mod gripper;
 mod limb;
 mod motion;
 mod options;
 mod preemption;
+mod store;
 
 use gripper::GripperCmd;
 use limb::VecMovePlan;
 use motion::Motion;
-pub use options::{OptionsError, SimArmOptions, SimObject};
+pub use options::{MotorModel, OptionsError, SimArmOptions, SimObject};
+pub use preemption::TOLERANCE;
+pub use store::MAX_STORE_CAPACITY;
+use store::Store;
 
 /// Most waypoints of one VECMOVE (at [`SimArmOptions::vecmove_step`] apart).
 pub const MAX_WAYPOINTS: usize = 512;
@@ -47,6 +54,13 @@ pub struct ArmModel {
     joints: [Motion; MAX_JOINTS],
     /// Configured speed per joint (the chain's max speed unless changed), rad/s or m/s.
     config_speed: [f64; MAX_JOINTS],
+    /// Acceleration limit per actuator set by the ACCEL request (joints, then the
+    /// gripper at index `n`), rad/s² or m/s²; infinite until set.
+    config_accel: [f64; MAX_JOINTS + 1],
+    /// The brakes are on (every chain joint BRAKED, motion refused).
+    brakes: bool,
+    /// The objects the gripper stored (STORE), given back by RETRIEVE.
+    store: Store,
     gripper: Motion,
     gripper_stroke: f64,
     gripper_max_speed: f64,
@@ -103,11 +117,19 @@ impl ArmModel {
             .gripper()
             .map(|g| (g.stroke, g.max_speed))
             .unwrap_or((DEFAULT_GRIPPER_STROKE, DEFAULT_GRIPPER_SPEED));
+        options.motor.check()?;
+        if options.store_capacity > store::MAX_STORE_CAPACITY {
+            return Err(OptionsError::StoreCapacity);
+        }
         let object = options.object;
+        let store = Store::new(options.store_capacity);
         Ok(ArmModel {
             n,
             joints,
             config_speed,
+            config_accel: [f64::INFINITY; MAX_JOINTS + 1],
+            brakes: false,
+            store,
             gripper: Motion::at(stroke),
             gripper_stroke: stroke,
             gripper_max_speed: gspeed,
@@ -202,6 +224,8 @@ impl ArmModel {
         }
         let dt = real_dt * self.options.time_scale;
         self.time += dt;
+        // Current-driven actuators: aimed by the motor model from where they are now.
+        self.drive_currents();
         // Sub-steps so each VECMOVE waypoint starts the moment the previous one is
         // reached (a tick may span many short segments at a large time scale).
         let mut left = dt;
@@ -278,15 +302,39 @@ impl ArmModel {
         }
     }
 
-    /// Starts actuator `j` toward `v` at its configured speed (validated already).
+    /// Starts actuator `j` toward `v` at its configured speed and acceleration
+    /// (validated already).
     fn move_actuator(&mut self, j: usize, v: f64, speed: Option<f64>) {
+        let a = self.config_accel.get(j).copied().unwrap_or(f64::INFINITY);
         if j < self.n {
             let s = speed.unwrap_or(self.config_speed[j]);
-            self.joints[j].go(v, s);
+            self.joints[j].go_accel(v, s, a);
         } else {
             let s = speed.unwrap_or(self.gripper_config_speed);
             self.gripper_cmd = GripperCmd::None;
-            self.gripper.go(v, s);
+            self.gripper.go_accel(v, s, a);
+        }
+    }
+
+    /// Actuator `j`'s motion (the gripper at `n`).
+    fn actuator(&self, j: usize) -> Option<&Motion> {
+        if j < self.n {
+            self.joints.get(j)
+        } else if j == self.n {
+            Some(&self.gripper)
+        } else {
+            None
+        }
+    }
+
+    /// Actuator `j`'s motion, mutable.
+    fn actuator_mut(&mut self, j: usize) -> Option<&mut Motion> {
+        if j < self.n {
+            self.joints.get_mut(j)
+        } else if j == self.n {
+            Some(&mut self.gripper)
+        } else {
+            None
         }
     }
 

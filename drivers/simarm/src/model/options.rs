@@ -46,6 +46,67 @@ pub struct SimArmOptions {
     /// SETPOSE on a chain that cannot hold the requested frame: position and approach
     /// tolerances (1 mm, 1°), the orientation the nearest one the joints can hold.
     pub setpose: NearestOptions,
+    /// The chain's joints have brakes (the BRAKES request; `has_brakes` in the
+    /// geometry); the gripper has none. Without, BRAKES is unsupported. (true)
+    pub brakes: bool,
+    /// How many objects the gripper can store (STORE and RETRIEVE; 0: it cannot, and
+    /// both are unsupported as on the Pioneer). (0)
+    pub store_capacity: u32,
+    /// The motor model of the current mode (CURRENT, MULTI_CURRENT).
+    pub motor: MotorModel,
+}
+
+/// The motor model of the current mode: a joint driven with a current `I` feels the
+/// motor's torque `torque_constant * I` (N·m, or N on a linear joint) and the torque of
+/// gravity on `load_mass` at the tool, and moves at the speed where viscous friction
+/// (`damping`) balances the two, at most its maximum speed; a linear joint likewise with
+/// forces. A joint that is pushed (`I` not 0) but does not move (at a limit, on an
+/// object, or held by gravity) is STALLED.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MotorModel {
+    /// Torque (or force) per ampere, N·m/A or N/A (> 0). (2.0)
+    pub torque_constant: f64,
+    /// Largest current, A: more is driven at this and answered CLAMPED (> 0). (5.0)
+    pub max_current: f64,
+    /// Viscous friction, N·m·s/rad or N·s/m (> 0). (2.0)
+    pub damping: f64,
+    /// Mass carried at the tool (the arm's own weight lumped there), kg (>= 0). (1.0)
+    pub load_mass: f64,
+    /// Gravity, m/s², along -z of the robot frame (>= 0). (9.81)
+    pub gravity: f64,
+}
+
+impl Default for MotorModel {
+    fn default() -> Self {
+        MotorModel {
+            torque_constant: 2.0,
+            max_current: 5.0,
+            damping: 2.0,
+            load_mass: 1.0,
+            gravity: 9.81,
+        }
+    }
+}
+
+impl MotorModel {
+    fn valid(&self) -> bool {
+        let pos = |v: f64| v.is_finite() && v > 0.0;
+        let non_neg = |v: f64| v.is_finite() && v >= 0.0;
+        pos(self.torque_constant)
+            && pos(self.max_current)
+            && pos(self.damping)
+            && non_neg(self.load_mass)
+            && non_neg(self.gravity)
+    }
+
+    /// Checks the values (see the fields).
+    pub fn check(&self) -> Result<(), OptionsError> {
+        if self.valid() {
+            Ok(())
+        } else {
+            Err(OptionsError::Motor)
+        }
+    }
 }
 
 impl Default for SimArmOptions {
@@ -58,6 +119,9 @@ impl Default for SimArmOptions {
             object: None,
             ik: NumericIkOptions::default(),
             setpose: NearestOptions::default(),
+            brakes: true,
+            store_capacity: 0,
+            motor: MotorModel::default(),
         }
     }
 }
@@ -78,6 +142,15 @@ pub enum OptionsError {
     /// is not finite.
     #[error("object position must be finite, width and capture radius > 0")]
     Object,
+    /// The store capacity is beyond
+    /// [`MAX_STORE_CAPACITY`](super::store::MAX_STORE_CAPACITY).
+    #[error("store capacity must be at most 1024")]
+    StoreCapacity,
+    /// A motor model value is out of its range (see [`MotorModel`]).
+    #[error(
+        "motor model: torque constant, max current and damping must be > 0, load mass and gravity >= 0"
+    )]
+    Motor,
     /// The chain has more joints than an actuator array can carry with the gripper.
     #[error("chain has too many joints")]
     TooManyJoints,
