@@ -10,7 +10,6 @@
 //! refused, naming what is wrong.
 
 use std::collections::HashMap;
-use std::fmt::Write as _;
 use std::path::Path;
 
 use limber_kinematics::chain::{Chain, ChainLoadError};
@@ -186,11 +185,11 @@ pub fn chain_toml_from_urdf(text: &str) -> Result<String, UrdfError> {
     };
     // Down from the root while the way is single; fixed joints fold into the next one.
     let mut toml = String::new();
-    let _ = writeln!(
-        toml,
+    toml.push_str(&format!(
         "name = {:?}\ndescription = \"from URDF robot {name}\"",
         name
-    );
+    ));
+    toml.push('\n');
     let (mut pending_p, mut pending_r) = (Vector3::zeros(), Rotation3::identity());
     let (mut link, mut movable) = (*root, 0usize);
     let mut seen = vec![link];
@@ -213,11 +212,10 @@ pub fn chain_toml_from_urdf(text: &str) -> Result<String, UrdfError> {
         } else {
             "rotary"
         };
-        let _ = writeln!(
-            toml,
-            "\n[[joints]]\nname = {:?}\ntype = \"{kind}\"\nxyz = [{:?}, {:?}, {:?}]\nrpy = [{ro:?}, {pi:?}, {ya:?}]\naxis = [{:?}, {:?}, {:?}]\nmin = {min:?}\nmax = {max:?}\nmax_speed = {speed:?}",
+        toml.push_str(&format!("\n[[joints]]\nname = {:?}\ntype = \"{kind}\"\nxyz = [{:?}, {:?}, {:?}]\nrpy = [{ro:?}, {pi:?}, {ya:?}]\naxis = [{:?}, {:?}, {:?}]\nmin = {min:?}\nmax = {max:?}\nmax_speed = {speed:?}",
             j.name, p.x, p.y, p.z, j.axis.x, j.axis.y, j.axis.z
-        );
+        ));
+        toml.push('\n');
         movable += 1;
         (pending_p, pending_r) = (Vector3::zeros(), Rotation3::identity());
     }
@@ -227,11 +225,11 @@ pub fn chain_toml_from_urdf(text: &str) -> Result<String, UrdfError> {
         )));
     }
     let (ro, pi, ya) = pending_r.euler_angles();
-    let _ = writeln!(
-        toml,
+    toml.push_str(&format!(
         "\n[tool]\nxyz = [{:?}, {:?}, {:?}]\nrpy = [{ro:?}, {pi:?}, {ya:?}]",
         pending_p.x, pending_p.y, pending_p.z
-    );
+    ));
+    toml.push('\n');
     Ok(toml)
 }
 
