@@ -68,6 +68,16 @@ fn send(s: &mut TcpStream, op: u8, payload: &[u8]) {
     s.write_all(&f).unwrap();
 }
 
+/// Sends one masked text frame of any length (64-bit length).
+fn send_long(s: &mut TcpStream, payload: &[u8]) {
+    let mask = [0x11u8, 0x22, 0x33, 0x44];
+    let mut f = vec![0x81u8, 0x80 | 127];
+    f.extend_from_slice(&(payload.len() as u64).to_be_bytes());
+    f.extend_from_slice(&mask);
+    f.extend(payload.iter().enumerate().map(|(i, b)| b ^ mask[i % 4]));
+    s.write_all(&f).unwrap();
+}
+
 /// Reads one server frame: its opcode and payload (a server's frames are not masked).
 fn recv(s: &mut TcpStream) -> std::io::Result<(u8, Vec<u8>)> {
     let mut h = [0u8; 2];
@@ -257,6 +267,31 @@ fn hostile_clients_are_refused_and_the_server_serves_on() {
             match recv(&mut s) {
                 Ok(_) => continue, // serverInfo, advertise
                 Err(_) => break,   // closed
+            }
+        }
+    }
+
+    // Subscriptions beyond the bound are refused with a status, the connection kept.
+    let mut s = connect(&addr);
+    assert!(handshake(&mut s, Some("foxglove.websocket.v1")).starts_with("HTTP/1.1 101"));
+    let adv = [text(&mut s), text(&mut s)];
+    let channel = adv[1]["channels"][0]["id"].clone();
+    for batch in 0..3 {
+        let subs: Vec<Value> = (0..500)
+            .map(|i| json!({"id": batch * 500 + i, "channelId": channel}))
+            .collect();
+        let msg = json!({"op": "subscribe", "subscriptions": subs}).to_string();
+        send_long(&mut s, msg.as_bytes());
+    }
+    let deadline = Instant::now() + Duration::from_secs(30);
+    loop {
+        assert!(Instant::now() < deadline, "no status within 30 s");
+        let (op, p) = recv(&mut s).unwrap();
+        if op == 1 {
+            let v: Value = serde_json::from_slice(&p).unwrap();
+            if v["op"] == "status" {
+                assert_eq!(v["message"], "too many subscriptions", "{v}");
+                break;
             }
         }
     }

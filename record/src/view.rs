@@ -310,6 +310,9 @@ fn handle_op(
                 if !sh.channels.contains_key(&channel) {
                     return Some(status(1, &format!("no channel {channel}")));
                 }
+                if subs.len() >= MAX_SUBSCRIPTIONS && !subs.contains_key(&id) {
+                    return Some(status(2, "too many subscriptions"));
+                }
                 subs.insert(id, channel);
                 if let Some(p) = sh.latched.get(&channel) {
                     let latched = Out::ForSub {
@@ -718,6 +721,10 @@ fn run(
     }
     Ok(())
 }
+
+/// The most subscriptions one viewer may hold (a hostile one cannot grow the server's
+/// memory without bound).
+const MAX_SUBSCRIPTIONS: usize = 1024;
 
 /// How often the domain is looked at for new devices and drivers gone.
 const DISCOVERY: Duration = Duration::from_secs(1);
