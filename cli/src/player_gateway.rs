@@ -24,7 +24,8 @@ pub struct PlayerGatewayArgs {
     read_only: bool,
     /// Give a device a fixed Player address (repeatable), e.g.
     /// pioneer/actarray/1=actarray:0 for playerjoy, which moves the lift as actarray:0.
-    /// Other devices keep their index, or take the lowest free one.
+    /// Other devices keep their index, or take the lowest free one. A ranger is Player's
+    /// laser (pioneer/ranger/0=laser:0).
     #[arg(long = "map", value_name = "DEVICE=INTERFACE:INDEX")]
     map: Vec<MapEntry>,
     /// Show a lift (an actarray of one linear actuator) in metres instead of Player's

@@ -151,6 +151,7 @@ pub fn run(args: SimArmArgs) -> Result<(), CliError> {
             b.size,
         ));
     }
+    options.obstacles = crate::world::simarm_obstacles(&world);
     let domain = crate::domain()?;
     let ctx = Context::new(&domain, Role::Driver, "simarm").map_err(|e| {
         CliError::new(

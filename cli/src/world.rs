@@ -26,6 +26,25 @@ pub const RANDOM_REGION: [[f64; 2]; 2] = [[0.37, 0.42], [0.04, 0.12]];
 /// `HandleHeight`, where Listing 2 grips it.
 pub const HANDLE_HEIGHT: f64 = 0.17;
 
+/// The floor's height in simarm's robot frame (m): its base stands on it.
+pub const SIMARM_FLOOR: f64 = 0.0;
+
+/// What simarm's limb stops at (the COLLISION state): the floor, and the world's obstacles
+/// (boxes as tall as can be).
+pub fn simarm_obstacles(world: &World) -> limber_simarm::Obstacles {
+    limber_simarm::Obstacles {
+        floor: Some(SIMARM_FLOOR),
+        boxes: world
+            .obstacles
+            .iter()
+            .map(|o| limber_simarm::SimObstacle {
+                min: [o.x - o.length / 2.0, o.y - o.width / 2.0, f64::NEG_INFINITY],
+                max: [o.x + o.length / 2.0, o.y + o.width / 2.0, f64::INFINITY],
+            })
+            .collect(),
+    }
+}
+
 /// The world's flags.
 #[derive(Debug, Clone, Default, Args)]
 pub struct WorldArgs {

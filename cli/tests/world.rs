@@ -98,3 +98,63 @@ fn a_bad_world_is_a_usage_error_with_the_reason() {
     );
     assert_eq!(o.status.code(), Some(3), "no driver: {}", stderr(&o));
 }
+
+/// Waits (bounded) until the limb shows a command of another client than `before` (the
+/// CLI's, a process of its own) and has stopped moving; its state then.
+fn settled(
+    limb: &mut limber_services::LimbClient,
+    before: u64,
+) -> limber_interfaces::prelude::LimbData {
+    use limber_interfaces::prelude::LimbState;
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(20);
+    loop {
+        let s = *limb
+            .wait_state(std::time::Duration::from_secs(5))
+            .expect("a state");
+        if s.header.last_cmd.client_id != before && s.limb_state() != Ok(LimbState::Moving) {
+            return s;
+        }
+        assert!(std::time::Instant::now() < deadline, "not settled: {s:?}");
+    }
+}
+
+/// The paper's COLL state on `limber simarm`: a pose below the floor is carried out until
+/// the arm meets the floor, where it stops in COLLISION; the next command moves it on.
+#[test]
+fn simarm_stops_at_the_floor_in_collision_until_the_next_command() {
+    use limber_interfaces::prelude::LimbState;
+    use limber_services::{Context, LimbClient, Role};
+    let d = Domain::unique_for_test();
+    let mut sim = Bg::spawn(d.name(), &["simarm"]);
+    sim.line(|l| l.ends_with("ready"));
+    let ctx = Context::new(&d, Role::Client, "world-test").unwrap();
+    let mut limb =
+        LimbClient::connect_timeout(&ctx, "simarm/limb/0", std::time::Duration::from_secs(5))
+            .unwrap();
+    let o = limber(
+        d.name(),
+        &[
+            "limb",
+            "simarm/limb/0",
+            "setposition",
+            "0.45",
+            "0.1",
+            "-0.1",
+        ],
+    );
+    assert_eq!(stdout(&o).trim(), "ok", "{}", stderr(&o));
+    let s = settled(&mut limb, 0);
+    assert_eq!(s.limb_state(), Ok(LimbState::Collision), "{s:?}");
+    assert!(s.position.z < 0.0 && s.position.z > -0.03, "{s:?}");
+    let o = limber(d.name(), &["echo", "simarm/limb/0", "--count", "1"]);
+    assert!(stdout(&o).contains(" collision "), "{}", stdout(&o));
+    let o = limber(
+        d.name(),
+        &["limb", "simarm/limb/0", "setposition", "0.45", "0.1", "0.1"],
+    );
+    assert_eq!(stdout(&o).trim(), "ok", "{}", stderr(&o));
+    let s = settled(&mut limb, s.header.last_cmd.client_id);
+    assert_eq!(s.limb_state(), Ok(LimbState::Idle), "{s:?}");
+    assert!((s.position.z - 0.1).abs() < 0.002, "{s:?}");
+    assert_eq!(sim.term(), Some(0));
+}

@@ -9,8 +9,8 @@
 //!   header.
 //! * [`player`]: the `player` interface (DEVLIST, DRIVERINFO, DEV, DATA, DATAMODE,
 //!   ADD_REPLACE_RULE), the capability query and the banner.
-//! * [`translate`]: one module per interface (actarray, limb, gripper), Player's messages
-//!   to limber's and back.
+//! * [`translate`]: one module per interface (actarray, limb, gripper; a ranger as Player's
+//!   laser), Player's messages to limber's and back.
 //! * [`map`]: limber's `robot/interface/index` to Player's `interface:index`.
 //! * [`queue`]: PUSH and PULL, replace rules.
 //! * [`session`], [`server`]: one limber client per Player client (its own identity and

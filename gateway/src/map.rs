@@ -7,6 +7,8 @@
 //! free. `--map DEVICE=interface:index` ([`MapEntry`]) fixes a device's address first, e.g.
 //! `--map pioneer/actarray/1=actarray:0` for playerjoy, which moves the lift as
 //! `actarray:0` joint 0 (the arm then moves to the lowest free index, `actarray:1`).
+//! A ranger is Player's `laser` (`pioneer/ranger/0` is `laser:0`;
+//! `--map simarm/ranger/0=laser:1`).
 
 use std::collections::BTreeSet;
 use std::str::FromStr;
@@ -14,6 +16,8 @@ use std::str::FromStr;
 use limber_interfaces::InterfaceKind;
 use limber_services::{DeviceInfo, DeviceName};
 use thiserror::Error;
+
+use crate::translate::{player_code, player_name};
 
 /// A `--map` entry could not be read.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
@@ -31,12 +35,14 @@ pub enum MapError {
         source: limber_services::NameError,
     },
     /// The Player interface is not the device's.
-    #[error("{entry:?}: a {device} device is Player's {device} interface, not {player}")]
+    #[error("{entry:?}: a {device} device is Player's {expected} interface, not {player}")]
     Interface {
         /// The entry.
         entry: String,
         /// The device's interface.
         device: InterfaceKind,
+        /// The Player interface it is shown as.
+        expected: &'static str,
         /// The Player interface named.
         player: String,
     },
@@ -62,10 +68,11 @@ impl FromStr for MapEntry {
             entry: s.to_string(),
             source: e,
         })?;
-        if device.interface().name() != iface {
+        if player_name(device.interface()) != iface {
             return Err(MapError::Interface {
                 entry: s.to_string(),
                 device: device.interface(),
+                expected: player_name(device.interface()),
                 player: iface.to_string(),
             });
         }
@@ -85,7 +92,7 @@ pub struct Mapped {
 impl Mapped {
     /// Player's interface code.
     pub fn interf(&self) -> u16 {
-        self.info.interface().player_code()
+        player_code(self.info.interface())
     }
 }
 
@@ -105,7 +112,7 @@ pub fn assign(
         .collect();
     let mut rest = Vec::new();
     for d in &candidates {
-        let code = d.interface().player_code();
+        let code = player_code(d.interface());
         match fixed.iter().find(|e| e.device == d.name) {
             Some(e) if taken.insert((code, e.index)) => out.push(Mapped {
                 info: (*d).clone(),
@@ -115,7 +122,7 @@ pub fn assign(
         }
     }
     for d in rest {
-        let code = d.interface().player_code();
+        let code = player_code(d.interface());
         let own = d.name.index();
         let index = if !taken.contains(&(code, own)) {
             own
@@ -177,6 +184,23 @@ mod tests {
         let m = assign(&devices, &[e], |_| true);
         assert_eq!(find(&m, "pioneer/actarray/1"), 0);
         assert_eq!(find(&m, "pioneer/actarray/0"), 1);
+    }
+
+    #[test]
+    fn a_ranger_is_players_laser() {
+        let devices = [dev("pioneer/ranger/0"), dev("simarm/ranger/0")];
+        let e: MapEntry = "simarm/ranger/0=laser:0".parse().expect("an entry");
+        let m = assign(&devices, &[e], |_| true);
+        assert_eq!(find(&m, "simarm/ranger/0"), 0);
+        assert_eq!(find(&m, "pioneer/ranger/0"), 1);
+        assert!(m.iter().all(|x| x.interf() == 6));
+        assert!(matches!(
+            "pioneer/ranger/0=ranger:0".parse::<MapEntry>(),
+            Err(MapError::Interface {
+                expected: "laser",
+                ..
+            })
+        ));
     }
 
     #[test]

@@ -25,8 +25,10 @@ struct Rig {
 impl Rig {
     /// One control cycle: 4 commands sent (4 samples), the driver publishes 3 states,
     /// one outcome state per command and one sample on the `outcome` channel per command
-    /// (11 samples), the client reads 3 states and its 4 outcomes.
-    const SAMPLES_PER_CYCLE: u64 = 15;
+    /// (11 samples), and the result of each motion a command of this cycle ends (the
+    /// previous cycle's motion on the same joints, preempted: 4 samples); the client reads
+    /// 3 states, its 4 outcomes and the 4 results.
+    const SAMPLES_PER_CYCLE: u64 = 19;
 
     fn cycle(&mut self, i: u64) {
         let p = (i % 100) as f64 * 1e-3;

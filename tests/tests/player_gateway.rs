@@ -2,12 +2,14 @@
 //! facts (tests/tests/player) talks to the gateway in front of the emulated Pioneer
 //! (`limber pioneer --emulated`) over TCP: the banner, DEVLIST, DRIVERINFO, DEV, PULL and
 //! PUSH, every command and request of actarray, limb and gripper, the capability query;
+//! the simulated laser (limber's ranger) as Player's `laser:0`;
 //! a lease taken through the gateway ends with its session; --read-only refuses; a
 //! hostile client gets its session closed, never the gateway's.
 //!
 //! Each test has its own domain and its own gateway on a port the system picks; every
 //! wait is bounded.
 
+use std::f64::consts::FRAC_PI_2;
 use std::io::Write;
 use std::time::{Duration, Instant};
 
@@ -491,17 +493,113 @@ fn two_player_clients_share_simarm_beside_the_pioneer() {
     let n = Words(&a.ack(ACTARRAY, 2, 3, &[]), 0).u32();
     assert!(n >= 5, "{n} actuators");
     a.ack(ACTARRAY, 2, 1, &Body::default().u32(1).0);
-    a.send(ACTARRAY, 2, CMD, 1, &Body::default().i32(1).f32(0.4).0);
+    // -0.4: since simarm stops at the floor or an obstacle (COLLISION), joint 1 sent to
+    // +0.4 stops near 0.12 in the default world.
+    a.send(ACTARRAY, 2, CMD, 1, &Body::default().i32(1).f32(-0.4).0);
     // B reads in PUSH mode (the server's default): data comes without asking.
     let deadline = Instant::now() + Duration::from_secs(30);
     loop {
         let m = b.read();
-        if m.mtype == DATA && m.index == 2 && near(joint(&m.body, 1).into(), 0.4, 0.02) {
+        if m.mtype == DATA && m.index == 2 && near(joint(&m.body, 1).into(), -0.4, 0.02) {
             break;
         }
-        assert!(Instant::now() < deadline, "B never saw joint 1 at 0.4");
+        assert!(Instant::now() < deadline, "B never saw joint 1 at -0.4");
     }
-    a.pull_until(ACTARRAY, 2, "A sees joint 1 at 0.4", |b| {
-        near(joint(b, 1).into(), 0.4, 0.02)
+    a.pull_until(ACTARRAY, 2, "A sees joint 1 at -0.4", |b| {
+        near(joint(b, 1).into(), -0.4, 0.02)
     });
+}
+
+/// limber's ranger as Player's laser: `laser:0` of the emulated Pioneer (its simulated
+/// world has a block at (0.38, 0.10)) is listed and subscribed; its scans are Player's
+/// SCAN bytes whose closest range is the block, with increasing ids; GET_GEOM and
+/// GET_CONFIG answer; what limber cannot do (SET_CONFIG, POWER, GET_ID, SET_FILTER) is
+/// NACKed, and the capability query says so.
+#[test]
+fn the_simulated_laser_is_players_laser_0() {
+    let s = setup(&[]);
+    let mut c = libplayerc_like(s.port);
+    let list = c.ack(PLAYER, 0, 1, &[]);
+    let n = Words(&list, 0).u32() as usize;
+    let listed = (0..n).any(|i| {
+        let mut w = Words(&list, 8 + 16 * i + 8);
+        (w.u32(), w.u32()) == (LASER, 0)
+    });
+    assert!(listed, "laser:0 not in the device list");
+    // The simulated laser is served by the world driver inside `limber pioneer --emulated`.
+    assert_eq!(c.subscribe(LASER, 0).as_deref(), Some("world"));
+
+    // A scan: 181 ranges over 180 degrees, 8 m; the closest is the block's near side.
+    let body = c.pull_until(LASER, 0, "a scan of 181 ranges", |b| {
+        Scan::read(b).is_some_and(|s| s.ranges.len() == 181)
+    });
+    let scan = Scan::read(&body).expect("a scan");
+    assert!(near(scan.min_angle.into(), -FRAC_PI_2, 1e-4), "{scan:?}");
+    assert!(near(scan.max_angle.into(), FRAC_PI_2, 1e-4), "{scan:?}");
+    assert!(near(scan.resolution.into(), 1f64.to_radians(), 1e-5));
+    assert_eq!(scan.max_range, 8.0);
+    let (i, closest) = scan
+        .ranges
+        .iter()
+        .copied()
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .expect("ranges");
+    let expected = (0.38f64 - 0.16).hypot(0.10) - 0.02;
+    assert!(
+        near(closest.into(), expected, 0.015),
+        "closest {closest} m, not {expected}"
+    );
+    // The block's direction: the middle of the beams that hit it (the closest beam alone
+    // may be a neighbour, by the simulated 2 mm of noise).
+    let hits: Vec<usize> = (0..scan.ranges.len())
+        .filter(|j| scan.ranges[*j] < 0.5)
+        .collect();
+    assert!(hits.contains(&i), "{hits:?}");
+    let middle = (hits[0] + hits[hits.len() - 1]) as f64 / 2.0;
+    let bearing = f64::from(scan.min_angle) + f64::from(scan.resolution) * middle;
+    assert!(
+        near(bearing, 0.10f64.atan2(0.22), 0.03),
+        "bearing {bearing}, beams {hits:?}: {:?}",
+        &scan.ranges[hits[0]..=hits[hits.len() - 1]]
+    );
+    // The next scan has a greater id.
+    let next = c.pull_until(LASER, 0, "the next scan", |b| {
+        Scan::read(b).is_some_and(|s| s.id != scan.id)
+    });
+    assert!(Scan::read(&next).expect("a scan").id > scan.id);
+
+    // GET_GEOM: the pose (0.16, 0, 0.20) and a size; GET_CONFIG: the scan's numbers.
+    let geom = c.ack(LASER, 0, 1, &[]);
+    assert_eq!(geom.len(), 72);
+    let mut w = Words(&geom, 0);
+    let pose: Vec<f64> = (0..6).map(|_| w.f64()).collect();
+    assert_eq!(pose, [0.16, 0.0, 0.20, 0.0, 0.0, 0.0]);
+    let size: Vec<f64> = (0..3).map(|_| w.f64()).collect();
+    assert!(size.iter().all(|v| *v > 0.0), "size {size:?}");
+    let config = c.ack(LASER, 0, 3, &[]);
+    assert_eq!(config.len(), 28);
+    let mut w = Words(&config, 0);
+    let (min, max, res, range) = (w.f32(), w.f32(), w.f32(), w.f32());
+    assert_eq!(
+        (min, max, res, range),
+        (scan.min_angle, scan.max_angle, scan.resolution, 8.0)
+    );
+    let (_range_res, intensity, frequency) = (w.f32(), w.u32(), w.f32());
+    assert_eq!((intensity, frequency), (0, 10.0));
+
+    // What limber cannot do is NACKed, and the capability query says so.
+    c.nack(LASER, 0, 2, &config);
+    c.nack(LASER, 0, 4, &Body::default().u32(1).0);
+    c.nack(LASER, 0, 5, &[]);
+    c.nack(LASER, 0, 6, &Body::default().u32(1).count(0).0);
+    for sub in [1, 3] {
+        c.ack(LASER, 0, 255, &Body::default().u32(REQ).u32(sub).0);
+    }
+    for sub in [2, 4, 5, 6] {
+        c.nack(LASER, 0, 255, &Body::default().u32(REQ).u32(sub).0);
+    }
+    c.nack(LASER, 0, 255, &Body::default().u32(CMD).u32(1).0);
+    c.close(LASER, 0);
+    drop(s);
 }

@@ -39,6 +39,10 @@
 //!   (`stored` rises), and comes back between the fingers, held; refused STORE_FULL,
 //!   NOTHING_TO_STORE, NOTHING_STORED.
 //!
+//! A limb motion that brings a joint frame or the tool point below the floor or into an
+//! obstacle ([`SimArmOptions::obstacles`]) stops there, and the limb state is COLLISION
+//! until the next limb command.
+//!
 //! In steady state nothing allocates: the states are written in place, the IK works
 //! on the stack, the VECMOVE plan has a fixed capacity ([`model::MAX_WAYPOINTS`]).
 
@@ -46,4 +50,7 @@ mod driver;
 pub mod model;
 
 pub use driver::{DRIVER_NAME, SimArm, SimArmError, SimArmFailures};
-pub use model::{ArmModel, MAX_STORE_CAPACITY, MotorModel, OptionsError, SimArmOptions, SimObject};
+pub use model::{
+    ArmModel, Contact, MAX_STORE_CAPACITY, MotorModel, Obstacles, OptionsError, SimArmOptions,
+    SimObject, SimObstacle,
+};

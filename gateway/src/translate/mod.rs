@@ -1,10 +1,11 @@
 //! Player's messages of each interface, translated to limber's and back.
 //!
-//! One module per interface ([`actarray`], [`limb`], [`gripper`]), each a [`Translator`]
+//! One module per interface ([`actarray`], [`limb`], [`gripper`], and [`laser`] for
+//! limber's ranger), each a [`Translator`]
 //! in [`TRANSLATORS`]: it opens a [`PlayerDevice`] over a limber client of its interface
 //! (a `Box<dyn DeviceClient>` from [`limber_services::connect_device`]), which turns
 //! Player commands and requests into limber ones and limber states into Player DATA. A
-//! new interface (the ranger of a simulated world) is one more module and one more entry.
+//! new interface is one more module and one more entry.
 
 use limber_interfaces::prelude::*;
 use limber_services::{Client, CommandError, DeviceClient, RequestError, Ticket};
@@ -15,6 +16,7 @@ use crate::xdr::{XdrError, XdrReader, XdrWriter};
 
 pub mod actarray;
 pub mod gripper;
+pub mod laser;
 pub mod limb;
 
 /// How states and commands are presented to Player's clients.
@@ -36,19 +38,42 @@ impl Default for Conventions {
 
 /// The translation of one interface.
 pub trait Translator: Sync {
-    /// The limber interface it translates (whose [`InterfaceKind::player_code`] is the
-    /// Player interface).
+    /// The limber interface it translates.
     fn kind(&self) -> InterfaceKind;
+    /// The Player interface it presents (by default the limber interface's
+    /// [`InterfaceKind::player_code`]; `laser`, 6, for a ranger).
+    fn player_code(&self) -> u16 {
+        self.kind().player_code()
+    }
+    /// The Player interface's name, as `--map` entries write it.
+    fn player_name(&self) -> &'static str {
+        self.kind().name()
+    }
     /// Wraps a connected client of this interface.
     fn open(&self, dev: Box<dyn DeviceClient>, conv: Conventions) -> Box<dyn PlayerDevice>;
 }
 
 /// Every interface the gateway translates.
-pub static TRANSLATORS: &[&dyn Translator] = &[&actarray::ACTARRAY, &limb::LIMB, &gripper::GRIPPER];
+pub static TRANSLATORS: &[&dyn Translator] = &[
+    &actarray::ACTARRAY,
+    &limb::LIMB,
+    &gripper::GRIPPER,
+    &laser::LASER,
+];
 
 /// The translator of `kind`, if the gateway has one.
 pub fn translator(kind: InterfaceKind) -> Option<&'static dyn Translator> {
     TRANSLATORS.iter().copied().find(|t| t.kind() == kind)
+}
+
+/// The Player interface code a device of `kind` is shown as.
+pub fn player_code(kind: InterfaceKind) -> u16 {
+    translator(kind).map_or(kind.player_code(), |t| t.player_code())
+}
+
+/// The Player interface name a device of `kind` is shown as.
+pub fn player_name(kind: InterfaceKind) -> &'static str {
+    translator(kind).map_or(kind.name(), |t| t.player_name())
 }
 
 /// A subscribed device, as Player's clients see it.

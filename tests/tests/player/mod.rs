@@ -18,6 +18,7 @@ pub const NACK: u32 = 6;
 /// Interface codes.
 pub const PLAYER: u32 = 1;
 pub const GRIPPER: u32 = 3;
+pub const LASER: u32 = 6;
 pub const ACTARRAY: u32 = 53;
 pub const LIMB: u32 = 54;
 
@@ -282,4 +283,50 @@ pub fn limb_position(body: &[u8]) -> [f64; 3] {
 /// The state in a gripper DATA body.
 pub fn gripper_state(body: &[u8]) -> u32 {
     Words(body, 0).u32()
+}
+
+/// A laser DATA SCAN body (Player's `player_laser_data_t`), read word by word.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scan {
+    pub min_angle: f32,
+    pub max_angle: f32,
+    pub resolution: f32,
+    pub max_range: f32,
+    pub ranges: Vec<f32>,
+    pub intensity: Vec<u8>,
+    pub id: u32,
+}
+
+impl Scan {
+    /// Reads a scan: four floats, the ranges (count twice, a float each), the
+    /// intensities (count twice, bytes padded to a word), the id; None unless the body
+    /// is exactly that.
+    pub fn read(body: &[u8]) -> Option<Scan> {
+        if body.len() < 16 + 8 {
+            return None;
+        }
+        let mut w = Words(body, 0);
+        let (min_angle, max_angle, resolution, max_range) = (w.f32(), w.f32(), w.f32(), w.f32());
+        let n = w.u32() as usize;
+        if w.u32() as usize != n || body.len() < w.1 + 4 * n + 8 {
+            return None;
+        }
+        let ranges = (0..n).map(|_| w.f32()).collect();
+        let k = w.u32() as usize;
+        let padded = k.div_ceil(4) * 4;
+        if w.u32() as usize != k || body.len() != w.1 + padded + 4 {
+            return None;
+        }
+        let intensity = body[w.1..w.1 + k].to_vec();
+        w.1 += padded;
+        Some(Scan {
+            min_angle,
+            max_angle,
+            resolution,
+            max_range,
+            ranges,
+            intensity,
+            id: w.u32(),
+        })
+    }
 }

@@ -36,6 +36,9 @@ impl ArmModel {
     /// out-of-reach until the next valid limb command.
     pub fn limb_command(&mut self, cmd: &LimbCommand) -> Status {
         self.limb.begin();
+        // A new command ends the COLLISION state, and may move away from the contact.
+        self.collision = None;
+        self.leaving_contact = self.contact().is_some();
         let r = self.limb_command_inner(cmd);
         self.limb.settle(r)
     }
@@ -312,6 +315,8 @@ impl ArmModel {
             LimbState::Braked
         } else if self.limb.out_of_reach {
             LimbState::OutOfReach
+        } else if self.collision.is_some() {
+            LimbState::Collision
         } else if self.limb_moving() {
             LimbState::Moving
         } else {

@@ -19,6 +19,7 @@ use limber_kinematics::chain::{Chain, JointKind, JointVec, MAX_JOINTS};
 
 mod actarray;
 mod brakes;
+mod collision;
 mod current;
 mod fingers;
 mod gripper;
@@ -28,6 +29,7 @@ mod options;
 mod preemption;
 mod store;
 
+pub use collision::{Contact, Obstacles, SimObstacle};
 use gripper::GripperCmd;
 use limb::VecMovePlan;
 use motion::Motion;
@@ -76,6 +78,10 @@ pub struct ArmModel {
     vecmove: VecMovePlan,
     object: Option<SimObject>,
     held: bool,
+    /// The contact that stopped the limb (COLLISION until the next limb command).
+    collision: Option<Contact>,
+    /// The limb was in contact when its command started: it may move until it is clear.
+    leaving_contact: bool,
     options: SimArmOptions,
     /// Simulated time, s.
     time: f64,
@@ -147,6 +153,8 @@ impl ArmModel {
             },
             object,
             held: false,
+            collision: None,
+            leaving_contact: false,
             options,
             time: 0.0,
             chain,
@@ -235,6 +243,7 @@ impl ArmModel {
             }
             let step = self.step_until_waypoint(left);
             left -= step;
+            self.stop_at_contact();
         }
         self.step_gripper(dt);
         if self.held {

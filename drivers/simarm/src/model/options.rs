@@ -54,6 +54,8 @@ pub struct SimArmOptions {
     pub store_capacity: u32,
     /// The motor model of the current mode (CURRENT, MULTI_CURRENT).
     pub motor: MotorModel,
+    /// The floor and obstacles the limb stops at (state COLLISION); default none.
+    pub obstacles: super::collision::Obstacles,
 }
 
 /// The motor model of the current mode: a joint driven with a current `I` feels the
@@ -122,6 +124,7 @@ impl Default for SimArmOptions {
             brakes: true,
             store_capacity: 0,
             motor: MotorModel::default(),
+            obstacles: Default::default(),
         }
     }
 }
