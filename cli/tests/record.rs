@@ -38,9 +38,10 @@ fn python() -> Option<PathBuf> {
     None
 }
 
-/// A file in a fresh directory of this test.
+/// A file in a directory of this test under the target directory.
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("limber-record-{}-{name}", std::process::id()));
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("record-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     dir.join(format!("{name}.mcap"))
 }
