@@ -21,12 +21,24 @@ pub struct LayoutArgs {
     /// Print the generated Python ctypes module (what python/limber/_layout.py holds).
     #[arg(long)]
     python: bool,
+    /// Print the URDF limber uses for an arm (e.g. pioneer/actarray/0; the one `limber
+    /// view` serves): its driver's chain, or by the robot name (pioneer, simarm) when no
+    /// driver runs.
+    #[arg(long, value_name = "DEVICE")]
+    urdf: Option<String>,
 }
 
 /// Runs `limber layout`.
 pub fn run(args: LayoutArgs) -> Result<(), CliError> {
     let m = manifest();
-    let text = if args.json {
+    let text = if let Some(device) = &args.urdf {
+        let name = device.parse().map_err(|e: limber_services::NameError| {
+            CliError::new(crate::exit::USAGE, e.to_string())
+        })?;
+        let domain = crate::domain()?;
+        limber_record::view::urdf_of_device(&domain, &name)
+            .map_err(|e| CliError::new(crate::exit::USAGE, e.to_string()))?
+    } else if args.json {
         m.to_json() + "\n"
     } else if args.c_header {
         codegen::c_header(&m)

@@ -25,6 +25,7 @@ mod monitor;
 mod out;
 pub mod pioneer;
 mod player_gateway;
+mod record;
 pub mod simarm;
 pub mod world;
 
@@ -129,6 +130,22 @@ enum Command {
     /// Runs until SIGINT, SIGTERM, SIGHUP (or SIGQUIT); prints "session N from ADDR" and
     /// "session N ended" as clients come and go (a session's leases end with it).
     PlayerGateway(player_gateway::PlayerGatewayArgs),
+    /// Record every state, outcome and driver statistics of the domain (or of the devices
+    /// named) into an MCAP file, with a progress line on stderr; `--info FILE` summarises a
+    /// recorded file. Foxglove and the `mcap` tools open the files (record/README.md).
+    ///
+    /// Example: limber record pioneer/actarray/0 -o /tmp/limber-help.mcap --duration 2
+    Record(record::RecordArgs),
+    /// Republish a recorded file into the domain as if its devices were live: `limber
+    /// echo`, `limber monitor` and clients work on it; commands are refused.
+    ///
+    /// Example: limber replay /tmp/limber-help.mcap --rate 4
+    Replay(record::ReplayArgs),
+    /// Show the domain's devices live in Foxglove: a read-only foxglove.websocket.v1
+    /// server (loopback by default) with every state as JSON, the actuator arrays as
+    /// foxglove.JointStates and a URDF of each arm whose chain limber knows. Foxglove
+    /// connects to ws://127.0.0.1:8765 (record/README.md).
+    View(record::ViewArgs),
 }
 
 /// Runs the `limber` command line with the process's arguments.
@@ -174,6 +191,9 @@ where
         #[cfg(feature = "bridge")]
         Command::Bridge(args) => bridge::run(args),
         Command::PlayerGateway(args) => player_gateway::run(args),
+        Command::Record(args) => record::record(args),
+        Command::Replay(args) => record::replay(args),
+        Command::View(args) => record::view(args),
         Command::Bench(args) => limber_bench::run_cli(args).map_err(|e| {
             let code = if e.is_usage() {
                 exit::USAGE

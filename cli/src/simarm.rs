@@ -35,6 +35,10 @@ pub struct SimArmArgs {
     /// Shorthand for `--builtin 7dof`.
     #[arg(long)]
     pub chain_7dof: bool,
+    /// A URDF file: its chain from the root link to the first branch or the end (revolute,
+    /// continuous, prismatic and fixed joints, their limits; record/README.md).
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["chain", "builtin", "chain_7dof"])]
+    pub urdf: Option<PathBuf>,
     /// Robot name in the device names.
     #[arg(long, default_value = "simarm")]
     pub robot: String,
@@ -127,9 +131,13 @@ fn parse_object(s: &str) -> Result<SimObject, String> {
 /// (the laser, the blocks) on a thread.
 pub fn run(args: SimArmArgs) -> Result<(), CliError> {
     let fail = |e: SimArmError| CliError::new(exit::FAILURE, e.to_string());
-    let chain = args
-        .chain()
-        .map_err(|e| CliError::new(exit::USAGE, e.to_string()))?;
+    let chain = match &args.urdf {
+        Some(p) => limber_record::urdf_in::chain_from_urdf_file(p)
+            .map_err(|e| CliError::new(exit::USAGE, format!("{}: {e}", p.display())))?,
+        None => args
+            .chain()
+            .map_err(|e| CliError::new(exit::USAGE, e.to_string()))?,
+    };
     let mut options = args.options();
     let world = args.world.world()?;
     args.world.laser()?;

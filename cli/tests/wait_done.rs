@@ -19,7 +19,14 @@ fn wait_says_the_result_and_the_final_error() {
     let o = limber(
         dom,
         // Up (-): +0.4 would bring the tool to simarm's floor, where it stops (COLLISION).
-        &["actarray", "simarm/actarray/0", "pos", "1", "-0.4", "--wait"],
+        &[
+            "actarray",
+            "simarm/actarray/0",
+            "pos",
+            "1",
+            "-0.4",
+            "--wait",
+        ],
     );
     assert!(o.status.success(), "{}", stderr(&o));
     let out = stdout(&o);
