@@ -26,6 +26,11 @@ pub enum Builtin {
 /// Arguments of `limber simarm`.
 #[derive(Debug, Clone, Args)]
 pub struct SimArmArgs {
+    /// No floor: the arm may reach below its base, as one mounted at a table's edge (the
+    /// world's obstacles still stop it). By default the limb and the joints stop at the
+    /// floor (z = 0), with the limb state COLLISION.
+    #[arg(long)]
+    pub no_floor: bool,
     /// Chain file (TOML, see `drivers/kinematics/chains/`); default: the built-in 6-joint arm.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["builtin", "chain_7dof"])]
     pub chain: Option<PathBuf>,
@@ -152,6 +157,9 @@ pub fn run(args: SimArmArgs) -> Result<(), CliError> {
         ));
     }
     options.obstacles = crate::world::simarm_obstacles(&world);
+    if args.no_floor {
+        options.obstacles.floor = None;
+    }
     let domain = crate::domain()?;
     let ctx = Context::new(&domain, Role::Driver, "simarm").map_err(|e| {
         CliError::new(

@@ -41,7 +41,9 @@ class Robot(_Robot):
 
 
 @pytest.mark.parametrize("robot,args", [
-    (["simarm"], ["simarm/actarray/0", "2"]),
+    # Random moves of each joint through its range: with simarm's floor some would stop at
+    # it (STALLED, COLLISION), so the arm is mounted without one here.
+    (["simarm", "--no-floor"], ["simarm/actarray/0", "2"]),
     (["pioneer", "--emulated"], ["pioneer/actarray/0", "1"]),
 ])
 def test_listing_1_prints_each_moves_final_error_within_the_tolerance(robot, args):
