@@ -582,22 +582,18 @@ impl DeviceSet {
                     "lease ended: the device now shares the lease of the devices that move the same actuators");
             }
             let r = match kind {
-                InterfaceKind::ActArray => self.actarray_mut(index).map(|h| {
-                    let _ = h.take_lease_ended();
-                    h.follow_lease(lease).map_err(|e| (h.device().clone(), e))
-                }),
-                InterfaceKind::Limb => self.limb_mut(index).map(|h| {
-                    let _ = h.take_lease_ended();
-                    h.follow_lease(lease).map_err(|e| (h.device().clone(), e))
-                }),
-                InterfaceKind::Gripper => self.gripper_mut(index).map(|h| {
-                    let _ = h.take_lease_ended();
-                    h.follow_lease(lease).map_err(|e| (h.device().clone(), e))
-                }),
-                InterfaceKind::Ranger => self.ranger_mut(index).map(|h| {
-                    let _ = h.take_lease_ended();
-                    h.follow_lease(lease).map_err(|e| (h.device().clone(), e))
-                }),
+                InterfaceKind::ActArray => self
+                    .actarray_mut(index)
+                    .map(|h| h.join_lease(lease).map_err(|e| (h.device().clone(), e))),
+                InterfaceKind::Limb => self
+                    .limb_mut(index)
+                    .map(|h| h.join_lease(lease).map_err(|e| (h.device().clone(), e))),
+                InterfaceKind::Gripper => self
+                    .gripper_mut(index)
+                    .map(|h| h.join_lease(lease).map_err(|e| (h.device().clone(), e))),
+                InterfaceKind::Ranger => self
+                    .ranger_mut(index)
+                    .map(|h| h.join_lease(lease).map_err(|e| (h.device().clone(), e))),
             };
             if let Some(Err((device, source))) = r {
                 return Err(DeviceError { device, source }.into());

@@ -18,10 +18,9 @@ use limber_gateway::player::{self, DevReq, PLAYER_CODE};
 use limber_gateway::{GatewayConfig, GatewayEvent};
 use limber_services::monotonic_ns;
 
-use super::request::START_TIMEOUT;
+use super::request::{START_TIMEOUT, start_pioneer_driver};
 use super::{RunCtx, SAMPLE_TIMEOUT, Scenario};
 use crate::BenchError;
-use crate::child::{ChildProc, ChildSpec};
 use crate::progress::Progress;
 use crate::stats::{Measurement, Metric, Strategy, new_histogram};
 
@@ -115,15 +114,7 @@ impl Scenario for Gateway {
         }
         let domain = ctx.domain();
         let (warm, n) = (ctx.count(200, 50), ctx.count(3_000, 500));
-        let mut child = ChildProc::spawn(&ChildSpec {
-            role: "pioneer-driver".into(),
-            domain: Some(domain.name().to_string()),
-            cpu: ctx.child_cpu(),
-            emulator_cpu: ctx.client_cpu(),
-            deadline: ctx.deadline_for(warm + n, Duration::from_micros(800)),
-            ..Default::default()
-        })?;
-        child.expect("ready", START_TIMEOUT)?;
+        let mut child = start_pioneer_driver(ctx, &domain, warm + n, Duration::from_micros(800))?;
 
         let stop = Arc::new(AtomicBool::new(false));
         let (tx, rx) = std::sync::mpsc::channel();

@@ -28,6 +28,26 @@ pub const START_TIMEOUT: Duration = Duration::from_secs(30);
 #[derive(Debug, Clone, Copy)]
 pub struct Request;
 
+/// The event-driven Pioneer driver child on its emulator (fast mode) in `domain`, ready, its
+/// deadline long enough for `exchanges` of `each` (the `request` and `gateway` scenarios).
+pub(super) fn start_pioneer_driver(
+    ctx: &RunCtx,
+    domain: &Domain,
+    exchanges: u64,
+    each: Duration,
+) -> Result<ChildProc, BenchError> {
+    let mut child = ChildProc::spawn(&ChildSpec {
+        role: "pioneer-driver".into(),
+        domain: Some(domain.name().to_string()),
+        cpu: ctx.child_cpu(),
+        emulator_cpu: ctx.client_cpu(),
+        deadline: ctx.deadline_for(exchanges, each),
+        ..Default::default()
+    })?;
+    child.expect("ready", START_TIMEOUT)?;
+    Ok(child)
+}
+
 fn err(what: &str, reason: String) -> BenchError {
     BenchError::Transport {
         context: what.to_string(),
@@ -51,15 +71,7 @@ impl Scenario for Request {
         }
         let domain = ctx.domain();
         let (warm, n) = (ctx.count(200, 50), ctx.count(3_000, 500));
-        let mut child = ChildProc::spawn(&ChildSpec {
-            role: "pioneer-driver".into(),
-            domain: Some(domain.name().to_string()),
-            cpu: ctx.child_cpu(),
-            emulator_cpu: ctx.client_cpu(),
-            deadline: ctx.deadline_for(warm + n, Duration::from_micros(500)),
-            ..Default::default()
-        })?;
-        child.expect("ready", START_TIMEOUT)?;
+        let mut child = start_pioneer_driver(ctx, &domain, warm + n, Duration::from_micros(500))?;
         let cctx = Context::new(&domain, Role::Client, "bench-request")
             .map_err(|e| err("client context", e.to_string()))?;
         let mut arm = ActArrayClient::connect_timeout(&cctx, DEVICE, START_TIMEOUT)

@@ -67,6 +67,14 @@ impl<I: Interface> DeviceHost<I> {
         self.lease_ended.take()
     }
 
+    /// Joins the lease of the group this device was just put in: a lease that ended on
+    /// this device before is forgotten (the group's lease is the one that counts now), and
+    /// the group's is followed ([`DeviceHost::follow_lease`]).
+    pub(crate) fn join_lease(&mut self, lease: Option<Holder>) -> Result<(), PublishError> {
+        self.lease_ended = None;
+        self.follow_lease(lease)
+    }
+
     /// Takes the lease of its group, changed on another device of it (acquired, renewed,
     /// released); publishes the state when the holder changed, so the `LEASED` flag follows
     /// at once.
