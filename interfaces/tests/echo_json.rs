@@ -1,4 +1,4 @@
-//! docs/echo-json.md shows one object per interface: each has exactly the keys that
+//! docs/reference/echo-json.md shows one object per interface: each has exactly the keys that
 //! `Describe::json` prints (and `device`, which `limber echo` adds), nested objects and the
 //! objects of arrays included. A field renamed in the code and not in the docs fails here.
 
@@ -39,9 +39,9 @@ fn key_set(v: &Value) -> BTreeSet<String> {
 /// The JSON blocks of the page, in order.
 fn documented() -> Vec<Value> {
     let page = std::fs::read_to_string(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/echo-json.md"),
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/reference/echo-json.md"),
     )
-    .expect("docs/echo-json.md");
+    .expect("docs/reference/echo-json.md");
     page.split("```json\n")
         .skip(1)
         .map(|b| serde_json::from_str(b.split("```").next().unwrap()).expect("a JSON block"))
