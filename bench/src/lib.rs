@@ -1,3 +1,4 @@
+#![doc = include_str!("../README.md")]
 //! # limber-bench: latency of the control loop, beside its floor and its peers
 //!
 //! `limber bench` (or the `limber-bench` binary) runs latency scenarios in separate

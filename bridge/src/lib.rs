@@ -1,3 +1,4 @@
+#![doc = include_str!("../README.md")]
 //! # limber-bridge: a domain's devices over Zenoh
 //!
 //! limber is shared memory on one PC. This crate carries devices to other hosts over

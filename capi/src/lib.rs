@@ -1,3 +1,4 @@
+#![doc = include_str!("../README.md")]
 //! # limber-c: the limber client API for C and C++
 //!
 //! `liblimber.so` / `liblimber.a` and the header `include/limber_client.h` (generated from

@@ -1,7 +1,19 @@
-//! Every documented command runs as a test (issue 13 item 7), like rustdoc's doctests:
-//! each shell command in a fenced `sh` block of README.md, examples/**/README.md,
-//! python/README.md and TESTING.md, and the example of each verb's `--help`, runs as written
-//! against the emulated Pioneer or simarm, in a domain of its own, with a bounded time.
+//! Every documented command and code block runs as a test (issue 13 item 7, issue 31), like
+//! rustdoc's doctests. The documentation is every Markdown file of the repository
+//! (`README.md`, `TESTING.md`, `CHANGELOG.md`, every page under `docs/`, every crate's and
+//! example's `README.md`, `bench/results/*.md`), found by walking the tree, so a new page is
+//! covered without editing a list. Each fenced block says what it holds:
+//!
+//! * `sh` (or `bash`, `shell`, `console`): each shell command runs as written against the
+//!   emulated Pioneer or simarm, in a domain of its own, with a bounded time (below).
+//! * `rust`: a doctest. A crate's `README.md` is its rustdoc front page (`#![doc =
+//!   include_str!("../README.md")]` in its `lib.rs`); the pages of `docs/` and the top-level
+//!   files are included by `limber-examples`' build script (`examples/build.rs`), so
+//!   `cargo test --doc` compiles each block (and runs it unless `no_run`).
+//! * `c`, `cpp`, `python`: run by the test named for their page in [`ELSEWHERE`] (which
+//!   must name the page).
+//! * `text`, `json`, `json5`, `toml`: data or output, shown, not run.
+//! * Anything else, and a fence without a language, fails unless marked.
 //!
 //! How a command is run:
 //!
@@ -23,11 +35,12 @@
 //!   and must exit 0.
 //! * Anything else must exit 0.
 //!
-//! A command that cannot run here (a serial device, a release build, the whole CI, a
-//! long benchmark, a network install) is marked in the README by an HTML comment right
-//! before its block: `<!-- not run by tests: PREFIX | why -->`, PREFIX being the start of
-//! the commands it covers (`*`: the whole block). A command neither run nor marked fails
-//! the test, and so does a marker that covers no command.
+//! A command or block that cannot run here (a serial device, a release build, the whole
+//! CI, a long benchmark, a network install, a program needing Player's libraries) is marked
+//! by an HTML comment right before its block: `<!-- not run by tests: PREFIX | why -->`,
+//! PREFIX being the start of the commands it covers (`*`: the whole block, the only prefix
+//! a block of code takes). A command or block neither run nor marked fails the test, and so
+//! does a marker that covers nothing or gives no reason.
 
 use std::io::{BufRead, BufReader};
 use std::os::unix::process::ExitStatusExt;
@@ -49,17 +62,33 @@ fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// A fenced shell block: its file, first line, commands and markers.
+/// A fenced block: its file, first line, language, commands (of a shell block) and
+/// markers.
 #[derive(Debug)]
 struct Block {
     file: String,
     line: usize,
+    /// The fence's language, without its attributes (`rust,no_run` is `rust`).
+    lang: String,
     commands: Vec<String>,
     /// (prefix, reason)
     not_run: Vec<(String, String)>,
 }
 
-/// The `sh` blocks of a Markdown file, comments stripped, continuation lines joined.
+/// Languages of a shell block.
+const SHELL: &[&str] = &["sh", "bash", "shell", "console"];
+/// Languages of data or output: shown, not run.
+const DATA: &[&str] = &["text", "json", "json5", "toml"];
+/// The blocks of code that another test runs: (page, language, the test that runs them; it
+/// names the page).
+const ELSEWHERE: &[(&str, &str, &str)] = &[
+    ("docs/guide/c-and-cpp.md", "c", "capi/tests/c_programs.rs"),
+    ("docs/guide/c-and-cpp.md", "cpp", "capi/tests/c_programs.rs"),
+    ("python/README.md", "python", "python/tests/test_readme.py"),
+];
+
+/// The fenced blocks of a Markdown file, the shell blocks' comments stripped and
+/// continuation lines joined.
 fn blocks(file: &str) -> Vec<Block> {
     let text = std::fs::read_to_string(repo().join(file)).unwrap();
     let mut out = Vec::new();
@@ -80,7 +109,13 @@ fn blocks(file: &str) -> Vec<Block> {
             continue;
         }
         let lang = t.trim_start_matches('`');
-        let shell = matches!(lang, "sh" | "bash" | "shell" | "console");
+        let lang = lang
+            .split([',', ' '])
+            .next()
+            .unwrap_or("")
+            .trim()
+            .to_string();
+        let shell = SHELL.contains(&lang.as_str());
         let mut commands = Vec::new();
         let mut pending = String::new();
         for (_, l) in lines.by_ref() {
@@ -103,15 +138,13 @@ fn blocks(file: &str) -> Vec<Block> {
                 commands.push(cmd);
             }
         }
-        if shell {
-            out.push(Block {
-                file: file.to_string(),
-                line: i + 1,
-                commands,
-                not_run: std::mem::take(&mut markers),
-            });
-        }
-        markers.clear();
+        out.push(Block {
+            file: file.to_string(),
+            line: i + 1,
+            lang,
+            commands,
+            not_run: std::mem::take(&mut markers),
+        });
     }
     out
 }
@@ -174,17 +207,51 @@ fn documented(files: &[String]) -> Vec<Block> {
     files.iter().flat_map(|f| blocks(f)).collect()
 }
 
-/// The READMEs under `examples/`.
-fn example_readmes() -> Vec<String> {
-    let mut files = vec!["examples/README.md".to_string()];
-    for e in std::fs::read_dir(repo().join("examples")).unwrap() {
-        let p = e.unwrap().path().join("README.md");
-        if p.exists() {
-            files.push(p.strip_prefix(repo()).unwrap().display().to_string());
+/// Every Markdown file of the repository (relative paths, sorted), but the build's and
+/// hidden directories.
+fn doc_files() -> Vec<String> {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+        for e in std::fs::read_dir(dir).unwrap().map(Result::unwrap) {
+            let p = e.path();
+            let name = e.file_name().to_string_lossy().into_owned();
+            if p.is_dir() {
+                if !name.starts_with('.') && name != "target" && name != "node_modules" {
+                    walk(&p, out);
+                }
+            } else if name.ends_with(".md") {
+                out.push(p);
+            }
         }
     }
+    let root = repo().canonicalize().unwrap();
+    let mut found = Vec::new();
+    walk(&root, &mut found);
+    let mut files: Vec<String> = found
+        .iter()
+        .map(|p| p.strip_prefix(&root).unwrap().display().to_string())
+        .collect();
     files.sort();
     files
+}
+
+/// Which test runs a documentation file: the README, the guide, the rest of the book and
+/// the top-level files, or a crate's or example's README. Every file is in one group.
+fn group(file: &str) -> &'static str {
+    if file == "README.md" {
+        "readme"
+    } else if file.starts_with("docs/guide/") {
+        "guide"
+    } else if file.starts_with("docs/") || !file.contains('/') || file.starts_with("bench/results/")
+    {
+        "book"
+    } else {
+        "crates"
+    }
+}
+
+/// The documentation files of `g`.
+fn files_of(g: &str) -> Vec<String> {
+    doc_files().into_iter().filter(|f| group(f) == g).collect()
 }
 
 /// The `Example: ...` lines of `limber --help` and of each verb's `--help`.
@@ -478,6 +545,55 @@ fn covered(not_run: &[(String, String)], cmd: &str) -> bool {
         .any(|(p, _)| p == "*" || cmd.starts_with(p.as_str()))
 }
 
+/// Why a block of code (not a shell block) needs no marker: the test that runs it, or
+/// `None` when none does.
+fn runs_elsewhere(b: &Block) -> Option<String> {
+    let file = b.file.as_str();
+    if b.lang == "rust" {
+        // A crate's README is its rustdoc front page; the book and the top-level files are
+        // included by the examples crate's build script: either way a doctest.
+        let dir = Path::new(file).parent().unwrap_or(Path::new(""));
+        let lib = std::fs::read_to_string(repo().join(dir).join("src/lib.rs")).unwrap_or_default();
+        let top = !file.contains('/') || file.starts_with("docs/");
+        return if file.ends_with("README.md") && lib.contains("include_str!(\"../README.md\")") {
+            Some(format!("a doctest of {}", dir.display()))
+        } else if top {
+            Some("a doctest of limber-examples (examples/build.rs)".to_string())
+        } else {
+            None
+        };
+    }
+    let (_, _, test) = ELSEWHERE
+        .iter()
+        .find(|(page, lang, _)| *page == file && *lang == b.lang)?;
+    let source = std::fs::read_to_string(repo().join(test)).unwrap_or_default();
+    source.contains(file).then(|| test.to_string())
+}
+
+/// What is wrong with a block of code that no test of this file runs: `None` when another
+/// test runs it, it holds data, or a marker says why not.
+fn code_failure(b: &Block, place: &str) -> Option<String> {
+    if SHELL.contains(&b.lang.as_str()) || DATA.contains(&b.lang.as_str()) {
+        return None;
+    }
+    if b.not_run.iter().any(|(p, why)| p == "*" && !why.is_empty()) {
+        return None;
+    }
+    if b.lang.is_empty() {
+        return Some(format!(
+            "{place}: a fence without a language: say what the block holds (sh, rust, c, \
+             text, ...)"
+        ));
+    }
+    if runs_elsewhere(b).is_some() {
+        return None;
+    }
+    Some(format!(
+        "{place}: a {} block that no test runs, and no marker says why",
+        b.lang
+    ))
+}
+
 /// Runs every block of `files`: the failures and the number of commands run.
 fn failures(files: &[String]) -> (Vec<String>, usize) {
     let blocks = documented(files);
@@ -485,6 +601,7 @@ fn failures(files: &[String]) -> (Vec<String>, usize) {
     let mut ran = 0;
     for b in &blocks {
         let place = format!("{}:{}", b.file, b.line);
+        let shell = SHELL.contains(&b.lang.as_str());
         for (p, why) in &b.not_run {
             if why.is_empty() {
                 failures.push(format!("{place}: the marker for {p:?} gives no reason"));
@@ -492,7 +609,16 @@ fn failures(files: &[String]) -> (Vec<String>, usize) {
             if p != "*" && !b.commands.iter().any(|c| c.starts_with(p.as_str())) {
                 failures.push(format!("{place}: the marker {p:?} covers no command"));
             }
+            if p == "*"
+                && (DATA.contains(&b.lang.as_str()) || (!shell && runs_elsewhere(b).is_some()))
+            {
+                failures.push(format!(
+                    "{place}: the marker covers a {} block that needs none",
+                    b.lang
+                ));
+            }
         }
+        failures.extend(code_failure(b, &place));
         let run: Vec<String> = b
             .commands
             .iter()
@@ -514,27 +640,48 @@ fn check(files: &[String]) -> usize {
 
 #[test]
 fn every_command_of_the_readme_runs_or_is_marked() {
-    let ran = check(&["README.md".to_string()]);
+    let ran = check(&files_of("readme"));
     assert!(ran >= 10, "only {ran} commands ran");
 }
 
 #[test]
-fn every_command_of_the_example_readmes_runs_or_is_marked() {
-    let files = example_readmes();
-    assert!(files.len() >= 3, "{files:?}");
+fn every_block_of_the_guide_runs_or_is_marked() {
+    let files = files_of("guide");
+    assert!(files.len() >= 10, "{files:?}");
+    let ran = check(&files);
+    assert!(ran >= 10, "only {ran} commands ran");
+}
+
+#[test]
+fn every_block_of_the_book_and_the_top_level_files_runs_or_is_marked() {
+    let files = files_of("book");
+    for f in [
+        "TESTING.md",
+        "CHANGELOG.md",
+        "docs/README.md",
+        "docs/reference/wire.md",
+    ] {
+        assert!(files.iter().any(|x| x == f), "{f} missing: {files:?}");
+    }
+    let ran = check(&files);
+    assert!(ran >= 5, "only {ran} commands ran");
+}
+
+#[test]
+fn every_block_of_the_crates_and_examples_readmes_runs_or_is_marked() {
+    let files = files_of("crates");
+    for f in [
+        "python/README.md",
+        "examples/README.md",
+        "examples/c/README.md",
+        "bridge/README.md",
+        "record/README.md",
+        "interfaces/README.md",
+    ] {
+        assert!(files.iter().any(|x| x == f), "{f} missing: {files:?}");
+    }
     let ran = check(&files);
     assert!(ran >= 4, "only {ran} commands ran");
-}
-
-#[test]
-fn every_command_of_the_python_readme_runs_or_is_marked() {
-    check(&["python/README.md".to_string()]);
-}
-
-#[test]
-fn every_command_of_testing_md_runs_or_is_marked() {
-    let ran = check(&["TESTING.md".to_string()]);
-    assert!(ran >= 1, "only {ran} commands ran");
 }
 
 #[test]
@@ -595,4 +742,96 @@ fn a_command_neither_run_nor_marked_fails_and_so_does_a_stale_marker() {
         "<!-- not run by tests: bash .ci/run | every test -->\n```sh\nbash .ci/run\n```\n",
     );
     assert_eq!(failures(&[marked]), (vec![], 0));
+}
+
+#[test]
+fn a_block_of_code_neither_run_nor_marked_fails() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+    let write = |name: &str, text: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p.display().to_string()
+    };
+    // Outside docs/ and no crate's front page: no doctest compiles it.
+    let rust = write(
+        "rust.md",
+        "```rust
+fn main() { let x: u32 = \"no\"; }
+```
+",
+    );
+    let (f, _) = failures(&[rust]);
+    assert!(
+        f.len() == 1 && f[0].contains("a rust block that no test runs"),
+        "{f:?}"
+    );
+    let c = write(
+        "c.md",
+        "```c
+int main(void) { return 1; }
+```
+",
+    );
+    let (f, _) = failures(&[c]);
+    assert!(
+        f.len() == 1 && f[0].contains("a c block that no test runs"),
+        "{f:?}"
+    );
+    let bare = write(
+        "bare.md",
+        "```
+limber layout --bogus
+```
+",
+    );
+    let (f, _) = failures(&[bare]);
+    assert!(f.len() == 1 && f[0].contains("without a language"), "{f:?}");
+    let unknown = write(
+        "unknown.md",
+        "```cobol
+DISPLAY 'x'.
+```
+",
+    );
+    let (f, _) = failures(&[unknown]);
+    assert!(f.len() == 1 && f[0].contains("a cobol block"), "{f:?}");
+    let reasonless = write(
+        "reasonless.md",
+        "<!-- not run by tests: * -->\n```c\nint main(void) { return 1; }\n```\n",
+    );
+    let (f, _) = failures(&[reasonless]);
+    assert!(f.iter().any(|m| m.contains("gives no reason")), "{f:?}");
+    let marked = write(
+        "marked-c.md",
+        "<!-- not run by tests: * | needs Player's libplayerc -->\n```c\nint main(void) { return 1; }\n```\n\n```text\nany output\n```\n",
+    );
+    assert_eq!(failures(&[marked]), (vec![], 0));
+    // A data block needs no marker, and one there is stale.
+    let stale = write(
+        "stale-data.md",
+        "<!-- not run by tests: * | output -->\n```text\nany output\n```\n",
+    );
+    let (f, _) = failures(&[stale]);
+    assert!(f.len() == 1 && f[0].contains("needs none"), "{f:?}");
+}
+
+#[test]
+fn every_markdown_file_is_in_a_group_and_blocks_elsewhere_name_their_page() {
+    let files = doc_files();
+    assert!(
+        files.iter().any(|f| f == "docs/guide/concepts.md"),
+        "{files:?}"
+    );
+    assert!(!files.iter().any(|f| f.starts_with("target/")), "{files:?}");
+    // The tests that run the pages' code name them (so a moved page is noticed).
+    for (page, lang, test) in ELSEWHERE {
+        let b = Block {
+            file: page.to_string(),
+            line: 1,
+            lang: lang.to_string(),
+            commands: vec![],
+            not_run: vec![],
+        };
+        assert_eq!(runs_elsewhere(&b).as_deref(), Some(*test), "{page} {lang}");
+    }
 }

@@ -1,3 +1,4 @@
+#![doc = include_str!("../README.md")]
 //! # limber-record: record, replay and see
 //!
 //! * [`record`]: every state, outcome and driver statistics of a

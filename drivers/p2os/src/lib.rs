@@ -1,3 +1,4 @@
+#![doc = include_str!("../README.md")]
 #![warn(missing_docs)]
 
 //! The P2OS/AROS/ARCOS protocol of the Pioneer controller.
