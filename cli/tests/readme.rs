@@ -713,14 +713,15 @@ fn commands_are_read_as_a_shell_would() {
     assert!(program(&["cargo", "build", "--release"]).is_none());
 }
 
+/// A Markdown file of the test's own, by its path.
+fn write(name: &str, text: &str) -> String {
+    let p = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
+    std::fs::write(&p, text).unwrap();
+    p.display().to_string()
+}
+
 #[test]
 fn a_command_neither_run_nor_marked_fails_and_so_does_a_stale_marker() {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
-    let write = |name: &str, text: &str| {
-        let p = dir.join(name);
-        std::fs::write(&p, text).unwrap();
-        p.display().to_string()
-    };
     let unmarked = write("unmarked.md", "```sh\nbash .ci/run\n```\n");
     let (f, _) = failures(&[unmarked]);
     assert!(
@@ -746,73 +747,50 @@ fn a_command_neither_run_nor_marked_fails_and_so_does_a_stale_marker() {
 
 #[test]
 fn a_block_of_code_neither_run_nor_marked_fails() {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
-    let write = |name: &str, text: &str| {
-        let p = dir.join(name);
-        std::fs::write(&p, text).unwrap();
-        p.display().to_string()
-    };
-    // Outside docs/ and no crate's front page: no doctest compiles it.
-    let rust = write(
-        "rust.md",
-        "```rust
-fn main() { let x: u32 = \"no\"; }
-```
-",
-    );
-    let (f, _) = failures(&[rust]);
-    assert!(
-        f.len() == 1 && f[0].contains("a rust block that no test runs"),
-        "{f:?}"
-    );
-    let c = write(
-        "c.md",
-        "```c
-int main(void) { return 1; }
-```
-",
-    );
-    let (f, _) = failures(&[c]);
-    assert!(
-        f.len() == 1 && f[0].contains("a c block that no test runs"),
-        "{f:?}"
-    );
-    let bare = write(
-        "bare.md",
-        "```
-limber layout --bogus
-```
-",
-    );
-    let (f, _) = failures(&[bare]);
-    assert!(f.len() == 1 && f[0].contains("without a language"), "{f:?}");
-    let unknown = write(
-        "unknown.md",
-        "```cobol
-DISPLAY 'x'.
-```
-",
-    );
-    let (f, _) = failures(&[unknown]);
-    assert!(f.len() == 1 && f[0].contains("a cobol block"), "{f:?}");
-    let reasonless = write(
-        "reasonless.md",
-        "<!-- not run by tests: * -->\n```c\nint main(void) { return 1; }\n```\n",
-    );
-    let (f, _) = failures(&[reasonless]);
-    assert!(f.iter().any(|m| m.contains("gives no reason")), "{f:?}");
+    // (file, text, the one failure expected). Outside docs/ and no crate's front page: no
+    // doctest compiles the Rust block.
+    let cases = [
+        (
+            "rust.md",
+            "```rust\nfn main() { let x: u32 = \"no\"; }\n```\n",
+            "a rust block that no test runs",
+        ),
+        (
+            "c.md",
+            "```c\nint main(void) { return 1; }\n```\n",
+            "a c block that no test runs",
+        ),
+        (
+            "bare.md",
+            "```\nlimber layout --bogus\n```\n",
+            "without a language",
+        ),
+        (
+            "unknown.md",
+            "```cobol\nDISPLAY 'x'.\n```\n",
+            "a cobol block",
+        ),
+        (
+            "reasonless.md",
+            "<!-- not run by tests: * -->\n```c\nint main(void) { return 1; }\n```\n",
+            "gives no reason",
+        ),
+        // A data block needs no marker, and one there is stale.
+        (
+            "stale-data.md",
+            "<!-- not run by tests: * | output -->\n```text\nany output\n```\n",
+            "needs none",
+        ),
+    ];
+    for (name, text, want) in cases {
+        let (f, _) = failures(&[write(name, text)]);
+        assert!(f.iter().any(|m| m.contains(want)), "{name}: {f:?}");
+    }
     let marked = write(
         "marked-c.md",
         "<!-- not run by tests: * | needs Player's libplayerc -->\n```c\nint main(void) { return 1; }\n```\n\n```text\nany output\n```\n",
     );
     assert_eq!(failures(&[marked]), (vec![], 0));
-    // A data block needs no marker, and one there is stale.
-    let stale = write(
-        "stale-data.md",
-        "<!-- not run by tests: * | output -->\n```text\nany output\n```\n",
-    );
-    let (f, _) = failures(&[stale]);
-    assert!(f.len() == 1 && f[0].contains("needs none"), "{f:?}");
 }
 
 #[test]

@@ -118,7 +118,15 @@ fn status_sentences(s: &mut String, m: &Manifest) {
     s.push('\n');
 }
 
-/// Every key path of a JSON value (`a`, `a.b`, `a[].c`), in the order printed.
+/// Every key path of a JSON value (`a`, `a.b`, `a[].c`, the keys of an array's first
+/// element standing for all), in the order printed: what `limber echo --json` prints, as
+/// the page and `interfaces/tests/echo_json.rs` compare it.
+pub fn key_paths_of(v: &Value) -> Vec<String> {
+    let mut out = Vec::new();
+    key_paths(v, "", &mut out);
+    out
+}
+
 fn key_paths(v: &Value, prefix: &str, out: &mut Vec<String>) {
     match v {
         Value::Object(map) => {
@@ -246,8 +254,7 @@ fn echo_json(s: &mut String, m: &Manifest) {
         out!(s, "|---|---|");
         let mut json = json;
         json["device"] = Value::from("");
-        let mut paths = Vec::new();
-        key_paths(&json, "", &mut paths);
+        let paths = key_paths_of(&json);
         for p in &paths {
             out!(s, "| `{}` | {} |", p, origin(m, root, p, &paths));
         }

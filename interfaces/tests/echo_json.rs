@@ -7,33 +7,10 @@ use std::collections::BTreeSet;
 use limber_interfaces::prelude::*;
 use serde_json::Value;
 
-/// Every key path of `v`: `a`, `a.b`, `a[].c`.
-fn keys(v: &Value, prefix: &str, out: &mut BTreeSet<String>) {
-    match v {
-        Value::Object(m) => {
-            for (k, v) in m {
-                let p = if prefix.is_empty() {
-                    k.clone()
-                } else {
-                    format!("{prefix}.{k}")
-                };
-                out.insert(p.clone());
-                keys(v, &p, out);
-            }
-        }
-        Value::Array(a) => {
-            for v in a {
-                keys(v, &format!("{prefix}[]"), out);
-            }
-        }
-        _ => {}
-    }
-}
-
 fn key_set(v: &Value) -> BTreeSet<String> {
-    let mut out = BTreeSet::new();
-    keys(v, "", &mut out);
-    out
+    limber_interfaces::reference::key_paths_of(v)
+        .into_iter()
+        .collect()
 }
 
 /// The JSON blocks of the page, in order.
