@@ -11,7 +11,8 @@
 //!   files are included by `limber-examples`' build script (`examples/build.rs`), so
 //!   `cargo test --doc` compiles each block (and runs it unless `no_run`).
 //! * `c`, `cpp`, `python`: run by the test named for their page in [`ELSEWHERE`] (which
-//!   must name the page).
+//!   must name the page); the book's `python` blocks pass `mypy --strict`
+//!   (`python/tests/test_readme.py`).
 //! * `text`, `json`, `json5`, `toml`: data or output, shown, not run.
 //! * Anything else, and a fence without a language, fails unless marked.
 //!
@@ -562,6 +563,14 @@ fn runs_elsewhere(b: &Block) -> Option<String> {
         } else {
             None
         };
+    }
+    if b.lang == "python" && file.starts_with("docs/") {
+        // The book's python blocks: every one under `mypy --strict`.
+        let test = "python/tests/test_readme.py";
+        let source = std::fs::read_to_string(repo().join(test)).unwrap_or_default();
+        return source
+            .contains("docs_python_blocks")
+            .then(|| test.to_string());
     }
     let (_, _, test) = ELSEWHERE
         .iter()
