@@ -1,5 +1,5 @@
 #![doc = include_str!("../README.md")]
-//! # limber-bench: latency of the control loop, beside its floor and its peers
+//! ## The library
 //!
 //! `limber bench` (or the `limber-bench` binary) runs latency scenarios in separate
 //! processes and reports every one with percentiles from an [`hdrhistogram`], beside

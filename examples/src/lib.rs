@@ -1,4 +1,6 @@
 #![doc = include_str!("../README.md")]
+//! ## The library
+//!
 //! The two sample programs of Biggs & MacDonald's paper, written against the limber client
 //! API only, so they run unchanged on the Pioneer arm and on a simulated arm:
 //!

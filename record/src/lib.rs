@@ -1,5 +1,5 @@
 #![doc = include_str!("../README.md")]
-//! # limber-record: record, replay and see
+//! ## The library
 //!
 //! * [`record`]: every state, outcome and driver statistics of a
 //!   domain (or of the devices named) into an MCAP file, with its acquisition and receive
