@@ -1,4 +1,5 @@
-//! # limber-bench: latency of the control loop, beside its floor and its peers
+#![doc = include_str!("../README.md")]
+//! ## The library
 //!
 //! `limber bench` (or the `limber-bench` binary) runs latency scenarios in separate
 //! processes and reports every one with percentiles from an [`hdrhistogram`], beside

@@ -41,7 +41,7 @@ pub const LOCAL_PRINCIPAL: &str = "local";
 pub enum AccessError {
     /// A listener that others can reach, without credentials.
     #[error(
-        "refusing to listen on {endpoint} without credentials: anybody who reaches it (every local user, on loopback too) could command the arm. Use the default listener (a Unix socket only you can open), or give --zenoh-config with Zenoh's user/password authentication (transport/auth/usrpwd with a dictionary_file) or, on tls/, client certificates (transport/link/tls/enable_mtls); README, Security"
+        "refusing to listen on {endpoint} without credentials: anybody who reaches it (every local user, on loopback too) could command the arm. Use the default listener (a Unix socket only you can open), or give --zenoh-config with Zenoh's user/password authentication (transport/auth/usrpwd with a dictionary_file) or, on tls/, client certificates (transport/link/tls/enable_mtls); docs/guide/security.md"
     )]
     Unauthenticated {
         /// The endpoint.

@@ -1,4 +1,5 @@
-//! # limber-bridge: a domain's devices over Zenoh
+#![doc = include_str!("../README.md")]
+//! ## The library
 //!
 //! limber is shared memory on one PC. This crate carries devices to other hosts over
 //! [Zenoh](https://zenoh.io) (the `zenoh` crate, 1.x, TCP only), in two roles:

@@ -1,4 +1,5 @@
-//! # limber-c: the limber client API for C and C++
+#![doc = include_str!("../README.md")]
+//! ## The library
 //!
 //! `liblimber.so` / `liblimber.a` and the header `include/limber_client.h` (generated from
 //! this crate by cbindgen; `tests/header.rs` fails when it is stale). Every C function is

@@ -1,8 +1,8 @@
 //! C and C++ programs against liblimber, built the way a user builds them: cargo has built
 //! `liblimber.so` and `liblimber.a` for this test (in the directory of the test's own
 //! executable); `capi/install.sh` installs them with the headers and `limber.pc`; gcc and
-//! g++ compile the examples with their Makefiles (pkg-config), the README's clients with
-//! the README's own command lines, and the programs of `tests/c/` against the header and
+//! g++ compile the examples with their Makefiles (pkg-config), the C and C++ guide's clients
+//! (docs/guide/c-and-cpp.md) with its own command lines, and the programs of `tests/c/` against the header and
 //! the library directly. Each runs against the Pioneer driver on the emulator (the code
 //! of `limber pioneer --emulated`, on a thread of this process), each test in a domain of
 //! its own; every run is bounded. The examples (the paper's Listing 2) are in
@@ -21,22 +21,22 @@ use limber_services::prelude::*;
 mod common;
 use common::*;
 
-/// The fenced block of `lang` in README.md's "C and C++" section.
-fn readme_block(readme: &str, lang: &str) -> String {
-    fenced(
-        &readme[readme.find("## C and C++").expect("the section")..],
-        lang,
-    )
+/// The guide's page of C and C++ clients (the README links it as the first client).
+const GUIDE: &str = "docs/guide/c-and-cpp.md";
+
+/// The first fenced block of `lang` in the guide's C and C++ page.
+fn readme_block(page: &str, lang: &str) -> String {
+    fenced(page, lang)
 }
 
 #[test]
 fn the_readme_clients_compile_and_run_as_written() {
-    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let readme = std::fs::read_to_string(root().join(GUIDE)).unwrap();
     let dir = scratch("readme");
     let prefix = install(&dir);
     std::fs::write(dir.join("client.c"), readme_block(&readme, "c")).unwrap();
     std::fs::write(dir.join("client.cpp"), readme_block(&readme, "cpp")).unwrap();
-    // The README's own compile lines (the build and install lines before them are what
+    // The guide's own compile lines (the build and install lines before them are what
     // cargo and `install` above did, with this test's library and prefix).
     let sh = readme_block(&readme, "sh");
     let lines: Vec<&str> = sh
@@ -601,9 +601,9 @@ fn a_field_moved_in_a_message_makes_c_cpp_and_python_refuse_to_connect() {
         limber_interfaces::codegen::python_module(&moved),
     )
     .unwrap();
-    // C (joints.c, the client written from the header) and C++ (README.md's client),
+    // C (joints.c, the client written from the header) and C++ (the guide's client),
     // their moved limber.h found first.
-    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let readme = std::fs::read_to_string(root().join(GUIDE)).unwrap();
     let cpp = dir.join("client.cpp");
     std::fs::write(&cpp, readme_block(&readme, "cpp")).unwrap();
     let (c_exe, cpp_exe) = (dir.join("joints"), dir.join("client_cpp"));

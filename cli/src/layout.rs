@@ -21,6 +21,11 @@ pub struct LayoutArgs {
     /// Print the generated Python ctypes module (what python/limber/_layout.py holds).
     #[arg(long)]
     python: bool,
+    /// Print the reference page of the contract in Markdown (what docs/reference/wire.md
+    /// holds): every struct with its fields' meanings, every code, the status sentences,
+    /// and how `limber echo --json`'s keys map onto the C structs.
+    #[arg(long)]
+    markdown: bool,
     /// Print the URDF limber uses for an arm (e.g. pioneer/actarray/0; the one `limber
     /// view` serves): its driver's chain, or by the robot name (pioneer, simarm) when no
     /// driver runs.
@@ -44,6 +49,8 @@ pub fn run(args: LayoutArgs) -> Result<(), CliError> {
         codegen::c_header(&m)
     } else if args.python {
         codegen::python_module(&m)
+    } else if args.markdown {
+        limber_interfaces::reference::markdown(&m)
     } else {
         catalogue(&m)
     };

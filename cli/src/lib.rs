@@ -1,8 +1,4 @@
-//! `limber`: the command-line tool of the limber middleware. Every command-line parser of
-//! the workspace lives here; the library crates take plain configuration structs.
-//!
-//! The binary is a one-line `main` over [`run`]; the library form lets test binaries run
-//! a verb exactly as the `limber` binary does.
+#![doc = include_str!("../README.md")]
 
 use std::process::ExitCode;
 use std::sync::OnceLock;
@@ -38,9 +34,9 @@ struct Cli {
     /// different domains never see each other; a domain is its user's alone, or with
     /// $LIMBER_GROUP set the domain of a Unix group's members (its files are in
     /// $LIMBER_RUNTIME_DIR, default /tmp/limber-<uid>, in group mode /tmp/limber-g-<gid>:
-    /// README, Security).
+    /// docs/guide/security.md).
     #[arg(long, global = true, value_name = "NAME", env = limber_services::naming::DOMAIN_ENV,
-          value_parser = parse_domain)]
+          hide_env_values = true, value_parser = parse_domain)]
     domain: Option<Domain>,
 
     /// More log output on stderr (-v info, -vv debug, -vvv trace); RUST_LOG overrides.
@@ -119,7 +115,7 @@ enum Command {
     /// domain's devices on the network, `mirror` on another host hosts them in its domain
     /// under the same names.
     ///
-    /// The walkthrough is in the README ("Between hosts"), the keys and payloads in
+    /// The walkthrough is in docs/guide/bridge.md, the keys and payloads in
     /// bridge/README.md.
     #[cfg(feature = "bridge")]
     Bridge(bridge::BridgeArgs),

@@ -1,4 +1,4 @@
-//! Exit codes and messages of the command line as the README's table states them, and a
+//! Exit codes and messages of the command line as docs/guide/cli.md's table states them, and a
 //! closed stdout (`| head -1`) ending a verb quietly.
 
 use std::io::{BufRead, BufReader};

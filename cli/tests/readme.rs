@@ -1,7 +1,20 @@
-//! Every documented command runs as a test (issue 13 item 7), like rustdoc's doctests:
-//! each shell command in a fenced `sh` block of README.md, examples/**/README.md,
-//! python/README.md and TESTING.md, and the example of each verb's `--help`, runs as written
-//! against the emulated Pioneer or simarm, in a domain of its own, with a bounded time.
+//! Every documented command and code block runs as a test (issue 13 item 7, issue 31), like
+//! rustdoc's doctests. The documentation is every Markdown file of the repository
+//! (`README.md`, `TESTING.md`, `CHANGELOG.md`, every page under `docs/`, every crate's and
+//! example's `README.md`, `bench/results/*.md`), found by walking the tree, so a new page is
+//! covered without editing a list. Each fenced block says what it holds:
+//!
+//! * `sh` (or `bash`, `shell`, `console`): each shell command runs as written against the
+//!   emulated Pioneer or simarm, in a domain of its own, with a bounded time (below).
+//! * `rust`: a doctest. A crate's `README.md` is its rustdoc front page (`#![doc =
+//!   include_str!("../README.md")]` in its `lib.rs`); the pages of `docs/` and the top-level
+//!   files are included by `limber-examples`' build script (`examples/build.rs`), so
+//!   `cargo test --doc` compiles each block (and runs it unless `no_run`).
+//! * `c`, `cpp`, `python`: run by the test named for their page in [`ELSEWHERE`] (which
+//!   must name the page); the book's `python` blocks pass `mypy --strict`
+//!   (`python/tests/test_readme.py`).
+//! * `text`, `json`, `json5`, `toml`: data or output, shown, not run.
+//! * Anything else, and a fence without a language, fails unless marked.
 //!
 //! How a command is run:
 //!
@@ -23,11 +36,12 @@
 //!   and must exit 0.
 //! * Anything else must exit 0.
 //!
-//! A command that cannot run here (a serial device, a release build, the whole CI, a
-//! long benchmark, a network install) is marked in the README by an HTML comment right
-//! before its block: `<!-- not run by tests: PREFIX | why -->`, PREFIX being the start of
-//! the commands it covers (`*`: the whole block). A command neither run nor marked fails
-//! the test, and so does a marker that covers no command.
+//! A command or block that cannot run here (a serial device, a release build, the whole
+//! CI, a long benchmark, a network install, a program needing Player's libraries) is marked
+//! by an HTML comment right before its block: `<!-- not run by tests: PREFIX | why -->`,
+//! PREFIX being the start of the commands it covers (`*`: the whole block, the only prefix
+//! a block of code takes). A command or block neither run nor marked fails the test, and so
+//! does a marker that covers nothing or gives no reason.
 
 use std::io::{BufRead, BufReader};
 use std::os::unix::process::ExitStatusExt;
@@ -40,98 +54,11 @@ use limber_services::Domain;
 
 mod common;
 use common::{LIMBER, output, stderr, stdout};
+mod docs;
+use docs::*;
 
-const MARKER: &str = "<!-- not run by tests:";
 /// How long a driver may take to say "ready", and a background job to end.
 const START_TIMEOUT: Duration = Duration::from_secs(20);
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-/// A fenced shell block: its file, first line, commands and markers.
-#[derive(Debug)]
-struct Block {
-    file: String,
-    line: usize,
-    commands: Vec<String>,
-    /// (prefix, reason)
-    not_run: Vec<(String, String)>,
-}
-
-/// The `sh` blocks of a Markdown file, comments stripped, continuation lines joined.
-fn blocks(file: &str) -> Vec<Block> {
-    let text = std::fs::read_to_string(repo().join(file)).unwrap();
-    let mut out = Vec::new();
-    let mut markers: Vec<(String, String)> = Vec::new();
-    let mut lines = text.lines().enumerate();
-    while let Some((i, l)) = lines.next() {
-        let t = l.trim();
-        if let Some(m) = t.strip_prefix(MARKER) {
-            let m = m.trim_end_matches("-->").trim();
-            let (prefix, why) = m.split_once('|').unwrap_or((m, ""));
-            markers.push((prefix.trim().to_string(), why.trim().to_string()));
-            continue;
-        }
-        if !t.starts_with("```") {
-            if !t.is_empty() {
-                markers.clear();
-            }
-            continue;
-        }
-        let lang = t.trim_start_matches('`');
-        let shell = matches!(lang, "sh" | "bash" | "shell" | "console");
-        let mut commands = Vec::new();
-        let mut pending = String::new();
-        for (_, l) in lines.by_ref() {
-            if l.trim_start().starts_with("```") {
-                break;
-            }
-            if !shell {
-                continue;
-            }
-            let l = strip_comment(l);
-            if let Some(head) = l.strip_suffix('\\') {
-                pending.push_str(head);
-                pending.push(' ');
-                continue;
-            }
-            pending.push_str(&l);
-            let cmd = pending.split_whitespace().collect::<Vec<_>>().join(" ");
-            pending.clear();
-            if !cmd.is_empty() {
-                commands.push(cmd);
-            }
-        }
-        if shell {
-            out.push(Block {
-                file: file.to_string(),
-                line: i + 1,
-                commands,
-                not_run: std::mem::take(&mut markers),
-            });
-        }
-        markers.clear();
-    }
-    out
-}
-
-/// The line without its shell comment (a `#` at the start or after a blank, outside
-/// quotes).
-fn strip_comment(l: &str) -> String {
-    let mut quote = None;
-    let mut prev = ' ';
-    for (i, c) in l.char_indices() {
-        match (quote, c) {
-            (None, '"' | '\'') => quote = Some(c),
-            (Some(q), c) if c == q => quote = None,
-            (None, '#') if prev.is_whitespace() => return l[..i].trim_end().to_string(),
-            _ => {}
-        }
-        prev = c;
-    }
-    l.trim_end().to_string()
-}
 
 /// How a command maps onto a program of this build.
 fn program(words: &[&str]) -> Option<(PathBuf, Vec<String>)> {
@@ -172,19 +99,6 @@ fn program(words: &[&str]) -> Option<(PathBuf, Vec<String>)> {
 /// The blocks of `files`.
 fn documented(files: &[String]) -> Vec<Block> {
     files.iter().flat_map(|f| blocks(f)).collect()
-}
-
-/// The READMEs under `examples/`.
-fn example_readmes() -> Vec<String> {
-    let mut files = vec!["examples/README.md".to_string()];
-    for e in std::fs::read_dir(repo().join("examples")).unwrap() {
-        let p = e.unwrap().path().join("README.md");
-        if p.exists() {
-            files.push(p.strip_prefix(repo()).unwrap().display().to_string());
-        }
-    }
-    files.sort();
-    files
 }
 
 /// The `Example: ...` lines of `limber --help` and of each verb's `--help`.
@@ -485,6 +399,7 @@ fn failures(files: &[String]) -> (Vec<String>, usize) {
     let mut ran = 0;
     for b in &blocks {
         let place = format!("{}:{}", b.file, b.line);
+        let shell = SHELL.contains(&b.lang.as_str());
         for (p, why) in &b.not_run {
             if why.is_empty() {
                 failures.push(format!("{place}: the marker for {p:?} gives no reason"));
@@ -492,7 +407,16 @@ fn failures(files: &[String]) -> (Vec<String>, usize) {
             if p != "*" && !b.commands.iter().any(|c| c.starts_with(p.as_str())) {
                 failures.push(format!("{place}: the marker {p:?} covers no command"));
             }
+            if p == "*"
+                && (DATA.contains(&b.lang.as_str()) || (!shell && runs_elsewhere(b).is_some()))
+            {
+                failures.push(format!(
+                    "{place}: the marker covers a {} block that needs none",
+                    b.lang
+                ));
+            }
         }
+        failures.extend(code_failure(b, &place));
         let run: Vec<String> = b
             .commands
             .iter()
@@ -514,27 +438,48 @@ fn check(files: &[String]) -> usize {
 
 #[test]
 fn every_command_of_the_readme_runs_or_is_marked() {
-    let ran = check(&["README.md".to_string()]);
+    let ran = check(&files_of("readme"));
     assert!(ran >= 10, "only {ran} commands ran");
 }
 
 #[test]
-fn every_command_of_the_example_readmes_runs_or_is_marked() {
-    let files = example_readmes();
-    assert!(files.len() >= 3, "{files:?}");
+fn every_block_of_the_guide_runs_or_is_marked() {
+    let files = files_of("guide");
+    assert!(files.len() >= 10, "{files:?}");
+    let ran = check(&files);
+    assert!(ran >= 10, "only {ran} commands ran");
+}
+
+#[test]
+fn every_block_of_the_book_and_the_top_level_files_runs_or_is_marked() {
+    let files = files_of("book");
+    for f in [
+        "TESTING.md",
+        "CHANGELOG.md",
+        "docs/README.md",
+        "docs/reference/wire.md",
+    ] {
+        assert!(files.iter().any(|x| x == f), "{f} missing: {files:?}");
+    }
+    let ran = check(&files);
+    assert!(ran >= 5, "only {ran} commands ran");
+}
+
+#[test]
+fn every_block_of_the_crates_and_examples_readmes_runs_or_is_marked() {
+    let files = files_of("crates");
+    for f in [
+        "python/README.md",
+        "examples/README.md",
+        "examples/c/README.md",
+        "bridge/README.md",
+        "record/README.md",
+        "interfaces/README.md",
+    ] {
+        assert!(files.iter().any(|x| x == f), "{f} missing: {files:?}");
+    }
     let ran = check(&files);
     assert!(ran >= 4, "only {ran} commands ran");
-}
-
-#[test]
-fn every_command_of_the_python_readme_runs_or_is_marked() {
-    check(&["python/README.md".to_string()]);
-}
-
-#[test]
-fn every_command_of_testing_md_runs_or_is_marked() {
-    let ran = check(&["TESTING.md".to_string()]);
-    assert!(ran >= 1, "only {ran} commands ran");
 }
 
 #[test]
@@ -566,14 +511,15 @@ fn commands_are_read_as_a_shell_would() {
     assert!(program(&["cargo", "build", "--release"]).is_none());
 }
 
+/// A Markdown file of the test's own, by its path.
+fn write(name: &str, text: &str) -> String {
+    let p = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
+    std::fs::write(&p, text).unwrap();
+    p.display().to_string()
+}
+
 #[test]
 fn a_command_neither_run_nor_marked_fails_and_so_does_a_stale_marker() {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
-    let write = |name: &str, text: &str| {
-        let p = dir.join(name);
-        std::fs::write(&p, text).unwrap();
-        p.display().to_string()
-    };
     let unmarked = write("unmarked.md", "```sh\nbash .ci/run\n```\n");
     let (f, _) = failures(&[unmarked]);
     assert!(
@@ -595,4 +541,73 @@ fn a_command_neither_run_nor_marked_fails_and_so_does_a_stale_marker() {
         "<!-- not run by tests: bash .ci/run | every test -->\n```sh\nbash .ci/run\n```\n",
     );
     assert_eq!(failures(&[marked]), (vec![], 0));
+}
+
+#[test]
+fn a_block_of_code_neither_run_nor_marked_fails() {
+    // (file, text, the one failure expected). Outside docs/ and no crate's front page: no
+    // doctest compiles the Rust block.
+    let cases = [
+        (
+            "rust.md",
+            "```rust\nfn main() { let x: u32 = \"no\"; }\n```\n",
+            "a rust block that no test runs",
+        ),
+        (
+            "c.md",
+            "```c\nint main(void) { return 1; }\n```\n",
+            "a c block that no test runs",
+        ),
+        (
+            "bare.md",
+            "```\nlimber layout --bogus\n```\n",
+            "without a language",
+        ),
+        (
+            "unknown.md",
+            "```cobol\nDISPLAY 'x'.\n```\n",
+            "a cobol block",
+        ),
+        (
+            "reasonless.md",
+            "<!-- not run by tests: * -->\n```c\nint main(void) { return 1; }\n```\n",
+            "gives no reason",
+        ),
+        // A data block needs no marker, and one there is stale.
+        (
+            "stale-data.md",
+            "<!-- not run by tests: * | output -->\n```text\nany output\n```\n",
+            "needs none",
+        ),
+    ];
+    for (name, text, want) in cases {
+        let (f, _) = failures(&[write(name, text)]);
+        assert!(f.iter().any(|m| m.contains(want)), "{name}: {f:?}");
+    }
+    let marked = write(
+        "marked-c.md",
+        "<!-- not run by tests: * | needs Player's libplayerc -->\n```c\nint main(void) { return 1; }\n```\n\n```text\nany output\n```\n",
+    );
+    assert_eq!(failures(&[marked]), (vec![], 0));
+}
+
+#[test]
+fn every_markdown_file_is_in_a_group_and_blocks_elsewhere_name_their_page() {
+    let files = doc_files();
+    assert!(
+        files.iter().any(|f| f == "docs/guide/concepts.md"),
+        "{files:?}"
+    );
+    assert!(!files.iter().any(|f| f.starts_with("target/")), "{files:?}");
+    // The tests that run the pages' code name them (so a moved page is noticed).
+    for (page, lang, test) in ELSEWHERE {
+        let b = Block {
+            file: page.to_string(),
+            line: 1,
+            lang: lang.to_string(),
+            commands: vec![],
+            not_run: vec![],
+        };
+        assert_eq!(runs_elsewhere(&b).as_deref(), Some(*test), "{page} {lang}");
+    }
 }

@@ -1,3 +1,6 @@
+#![doc = include_str!("../README.md")]
+//! ## The library
+//!
 //! The two sample programs of Biggs & MacDonald's paper, written against the limber client
 //! API only, so they run unchanged on the Pioneer arm and on a simulated arm:
 //!
@@ -13,3 +16,10 @@
 
 pub mod pick_block;
 pub mod random_moves;
+
+/// The book's pages and the top-level files that hold Rust blocks, one item each, so that
+/// `cargo test --doc -p limber-examples` compiles (and runs) their blocks (examples/build.rs).
+#[cfg(doctest)]
+mod doc_pages {
+    include!(concat!(env!("OUT_DIR"), "/doc_pages.rs"));
+}

@@ -16,7 +16,7 @@ use crate::ranger::RangerData;
 pub trait Describe {
     /// One human-readable line.
     fn human(&self) -> String;
-    /// One JSON object (the schema of `limber echo --json`, docs/echo-json.md): the fields
+    /// One JSON object (the schema of `limber echo --json`, docs/reference/echo-json.md): the fields
     /// of the state's C struct (limber.h) by their names, with their values (codes as
     /// numbers, vectors as `{"x", "y", "z"}`, the `actuators` array cut to
     /// `actuators_count`), and beside each code its name (`state_name`, `status_name`).

@@ -1,38 +1,4 @@
-//! # limber-interfaces: the wire contract
-//!
-//! Every message of Player 3's `actarray`, `limb`, `gripper` and `ranger` interfaces as a
-//! fixed-layout struct that travels through iceoryx2 shared memory without a copy, readable from C, C++
-//! and Python with the same layout.
-//!
-//! * Wire structs are `#[repr(C)]`, have no implicit padding (explicit `_pad` fields,
-//!   checked at compile time), derive zerocopy's `FromBytes`/`IntoBytes`/`KnownLayout`/
-//!   `Immutable` and iceoryx2's `ZeroCopySend`, and carry a versioned type name
-//!   (`limber.v3.ActArrayData`). iceoryx2 only compares name, size and alignment when a
-//!   service is opened, so the version in the name changes whenever a layout changes.
-//! * Units are SI: m, rad, s, m/s, rad/s, A. No `bool` or Rust enum on the wire: `u32`
-//!   codes, decoded by typed views that reject unknown values with a [`DecodeError`].
-//! * Each channel carries one envelope type: state (`*Data`, with a [`StateHeader`]),
-//!   commands (`*CmdMsg`), requests (`*ReqMsg`) and replies (`*ReplyMsg`). Commands,
-//!   requests and replies are `{meta, body}`, the body holding the per-message struct
-//!   named by `meta.kind` (Player's subtype numbers).
-//! * [`manifest()`] describes every struct and constant; the C header and the Python
-//!   classes are generated from it ([`codegen`]).
-//!
-//! ```
-//! use limber_interfaces::prelude::*;
-//!
-//! // A typed command, validated when built...
-//! let cmd = ActArrayCommand::position(2, 0.5).unwrap();
-//! // ...written into the wire envelope (in place, e.g. into an iceoryx2 loan)...
-//! let mut raw = ActArrayCmdMsg::default();
-//! cmd.write(&mut raw);
-//! assert_eq!(raw.meta.kind, limber_interfaces::actarray::cmd::POS);
-//! // ...and decoded on the other side.
-//! assert_eq!(ActArrayCommand::read(&raw).unwrap(), cmd);
-//! // Bad values never make it onto the wire.
-//! assert!(ActArrayCommand::position(2, f64::NAN).is_err());
-//! ```
-
+#![doc = include_str!("../README.md")]
 #![warn(missing_docs)]
 
 pub mod actarray;
@@ -50,6 +16,7 @@ pub mod manifest;
 pub mod message;
 pub mod protocol;
 pub mod ranger;
+pub mod reference;
 pub mod wire;
 
 pub use common::{

@@ -10,6 +10,10 @@ use serde::Serialize;
 pub struct FieldLayout {
     /// Field name, as in Rust, C and Python.
     pub name: &'static str,
+    /// The field's rustdoc, one line per element (what `limber layout --markdown` prints;
+    /// not in the JSON manifest, which generators read).
+    #[serde(skip)]
+    pub doc: &'static [&'static str],
     /// Byte offset from the start of the struct.
     pub offset: usize,
     /// Size in bytes of the whole field (all elements for an array).

@@ -44,9 +44,14 @@ impl<T: WireField, const N: usize> WireField for [T; N] {
 
 /// Builds the [`FieldLayout`] of one field (used by `wire_struct!`).
 #[doc(hidden)]
-pub const fn field<T: WireField>(name: &'static str, offset: usize) -> FieldLayout {
+pub const fn field<T: WireField>(
+    name: &'static str,
+    offset: usize,
+    doc: &'static [&'static str],
+) -> FieldLayout {
     FieldLayout {
         name,
+        doc,
         offset,
         size: core::mem::size_of::<T>(),
         ty: T::ELEM,
@@ -61,7 +66,7 @@ macro_rules! wire_struct {
     (
         $(#[$meta:meta])*
         pub struct $name:ident : $type_name:literal, size = $size:literal, align = $align:literal {
-            $( $(#[$fmeta:meta])* pub $field:ident : $ty:ty ),* $(,)?
+            $( $(#[doc = $fdoc:literal])* pub $field:ident : $ty:ty ),* $(,)?
         }
     ) => {
         $(#[$meta])*
@@ -73,7 +78,7 @@ macro_rules! wire_struct {
         #[repr(C)]
         #[type_name($type_name)]
         pub struct $name {
-            $( $(#[$fmeta])* pub $field: $ty ),*
+            $( $(#[doc = $fdoc])* pub $field: $ty ),*
         }
 
         impl Default for $name {
@@ -94,7 +99,7 @@ macro_rules! wire_struct {
                 size: core::mem::size_of::<$name>(),
                 align: core::mem::align_of::<$name>(),
                 fields: &[
-                    $( $crate::wire::field::<$ty>(stringify!($field), core::mem::offset_of!($name, $field)) ),*
+                    $( $crate::wire::field::<$ty>(stringify!($field), core::mem::offset_of!($name, $field), &[$($fdoc),*]) ),*
                 ],
             };
         }

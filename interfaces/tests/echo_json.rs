@@ -1,4 +1,4 @@
-//! docs/echo-json.md shows one object per interface: each has exactly the keys that
+//! docs/reference/echo-json.md shows one object per interface: each has exactly the keys that
 //! `Describe::json` prints (and `device`, which `limber echo` adds), nested objects and the
 //! objects of arrays included. A field renamed in the code and not in the docs fails here.
 
@@ -7,41 +7,18 @@ use std::collections::BTreeSet;
 use limber_interfaces::prelude::*;
 use serde_json::Value;
 
-/// Every key path of `v`: `a`, `a.b`, `a[].c`.
-fn keys(v: &Value, prefix: &str, out: &mut BTreeSet<String>) {
-    match v {
-        Value::Object(m) => {
-            for (k, v) in m {
-                let p = if prefix.is_empty() {
-                    k.clone()
-                } else {
-                    format!("{prefix}.{k}")
-                };
-                out.insert(p.clone());
-                keys(v, &p, out);
-            }
-        }
-        Value::Array(a) => {
-            for v in a {
-                keys(v, &format!("{prefix}[]"), out);
-            }
-        }
-        _ => {}
-    }
-}
-
 fn key_set(v: &Value) -> BTreeSet<String> {
-    let mut out = BTreeSet::new();
-    keys(v, "", &mut out);
-    out
+    limber_interfaces::reference::key_paths_of(v)
+        .into_iter()
+        .collect()
 }
 
 /// The JSON blocks of the page, in order.
 fn documented() -> Vec<Value> {
     let page = std::fs::read_to_string(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/echo-json.md"),
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/reference/echo-json.md"),
     )
-    .expect("docs/echo-json.md");
+    .expect("docs/reference/echo-json.md");
     page.split("```json\n")
         .skip(1)
         .map(|b| serde_json::from_str(b.split("```").next().unwrap()).expect("a JSON block"))

@@ -28,7 +28,7 @@ class Domain:
     ``domain`` argument). ``Domain()`` is the domain named by ``LIMBER_DOMAIN`` (default
     ``limber``); ``Domain(name)`` a domain by name. The library checks the name (1 to 48
     characters of ``[A-Za-z0-9_-]``; a bad one raises ``ValueError`` where it is used) and
-    keeps the domain's files (README, Security)."""
+    keeps the domain's files (docs/guide/security.md)."""
 
     __slots__ = ("_name",)
 

@@ -1,4 +1,5 @@
-//! # limber-record: record, replay and see
+#![doc = include_str!("../README.md")]
+//! ## The library
 //!
 //! * [`record`]: every state, outcome and driver statistics of a
 //!   domain (or of the devices named) into an MCAP file, with its acquisition and receive

@@ -466,7 +466,7 @@ impl InterfaceVisitor for Open<'_> {
             &mut sh,
             format!("/{dev}/state"),
             I::Data::LAYOUT.type_name,
-            json!({"type": "object", "description": "the state as `limber echo --json` prints it (docs/echo-json.md)"}).to_string(),
+            json!({"type": "object", "description": "the state as `limber echo --json` prints it (docs/reference/echo-json.md)"}).to_string(),
         );
         let joints = schema::has_joints::<I::Data>().then(|| {
             advertise(

@@ -44,7 +44,7 @@ pub enum ContextError {
     /// iceoryx2 was refused access to the domain's files (iceoryx2's
     /// `NodeCreationFailure::InsufficientPermissions`): they belong to another user.
     #[error(
-        "cannot join domain {domain}: its files under {root} or in /dev/shm belong to another user; a domain is its owner's alone (README, Security): run as that user, or use a domain of your own (LIMBER_DOMAIN, LIMBER_RUNTIME_DIR)"
+        "cannot join domain {domain}: its files under {root} or in /dev/shm belong to another user; a domain is its owner's alone (docs/guide/security.md): run as that user, or use a domain of your own (LIMBER_DOMAIN, LIMBER_RUNTIME_DIR)"
     )]
     Permission {
         /// The domain.

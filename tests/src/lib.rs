@@ -1,5 +1,4 @@
-//! Helpers shared by the multi-process integration tests: spawning the test driver and
-//! test clients in a domain of their own, and stopping them. Every wait is bounded.
+#![doc = include_str!("../README.md")]
 
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Child, ChildStdin, Command, Stdio};

@@ -1,4 +1,4 @@
-//! Who may reach a bridge, and who a remote client is (README, Security: "The bridge"):
+//! Who may reach a bridge, and who a remote client is (docs/guide/security.md: "The bridge"):
 //! a listener others reach needs credentials; another Unix user cannot open the owner's
 //! socket; TLS with client certificates; a peer authenticated as one principal can forge
 //! nothing of another's (commands, lease requests), and nothing of the robot's (states,

@@ -1,4 +1,4 @@
-//! Group mode (README, Security): two accounts of a Unix group share the arm, a third
+//! Group mode (docs/guide/security.md): two accounts of a Unix group share the arm, a third
 //! outside the group can neither read nor command it.
 //!
 //! The tests create the group `limber-arm` and the users `limber-arm-a`, `limber-arm-b` (in
@@ -374,7 +374,7 @@ fn two_members_share_the_arm_and_an_outsider_is_locked_out() {
 }
 
 /// Removes (as root) what the members' processes of a test domain left in /dev/shm: the
-/// connections one member made and another closed (README, Security), which only their
+/// connections one member made and another closed (docs/guide/security.md), which only their
 /// owner's next process in the domain would remove.
 fn remove_leftovers(prefix: &str) {
     for f in shm_files(prefix) {

@@ -1,4 +1,4 @@
-//! Another local user can neither read, command nor deny a domain (README, Security).
+//! Another local user can neither read, command nor deny a domain (docs/guide/security.md).
 //!
 //! The hostile actions run as a second Unix user, `limber-hostile`, which the tests create
 //! (idempotently) with `useradd`; they need root, and are skipped with the reason otherwise.

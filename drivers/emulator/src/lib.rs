@@ -1,40 +1,5 @@
+#![doc = include_str!("../README.md")]
 #![warn(missing_docs)]
-
-//! A Pioneer controller in software that speaks P2OS, on a pty or on TCP.
-//!
-//! It answers the sync handshake like a real simulator (bare echoes, then
-//! the identity strings), streams a SIP every cycle (100 ms by default)
-//! after OPEN, sends ARMpac on request (ARM_STATUS 1 once, 2 every cycle)
-//! in the layout of the vendor's manuals (ARIA's with
-//! [`ModelConfig::armpac_layout`]), ARMINFOpac with a plausible
-//! calibration, steps each servo one tick per its ms/step toward its target,
-//! powers, homes, parks and stops the arm (HOME takes 1..6 or any value
-//! above 6 for all joints, STOP 1..6 or 255, as the manuals say), opens and
-//! closes the paddles with breakbeams driven by a simulated object, and
-//! raises/lowers the lift (3.5 s per stroke). It answers CONFIG (18) with a CONFIGpac
-//! built from its model ([`Robot::config_packet`]: GRIPPER says whether the body gripper
-//! is fitted); a robot without the gripper ([`ModelConfig::gripper`] false) logs and counts
-//! GRIPPER (33) and GRIPPERVAL (36) as unsupported, like a real gripperless controller.
-//!
-//! Timing ([`EmulatorConfig::timing`]): by default like the controller,
-//! whose packets go out once per cycle: SYNC replies, ARMINFOpac and a
-//! requested ARMpac leave at the next cycle boundary, and the ARMpac stream
-//! sends one per cycle. [`Timing::Fast`] answers at once and adds an ARMpac
-//! after each arm command and motion change, for benchmarks and tests that
-//! need speed. Either way commands take effect as soon as they arrive.
-//!
-//! Fault injection ([`Faults`]): dropped or corrupted bytes, wrong checksums,
-//! garbage between packets, silence, a slow wire at a given baud, and
-//! [`Emulator::disconnect`]. On a pty, [`EmulatorConfig::baud`] makes it
-//! answer only when the line is set to that baud, to exercise the baud search.
-//!
-//! ```no_run
-//! use limber_emulator::{Emulator, EmulatorConfig};
-//! let emu = Emulator::start_pty(EmulatorConfig::default()).unwrap();
-//! println!("robot at {}", emu.pty_path().unwrap().display());
-//! let state = emu.state();
-//! println!("servo ticks {:?}", state.robot.servo_ticks);
-//! ```
 
 mod model;
 mod server;

@@ -1,5 +1,8 @@
+#![doc = include_str!("../README.md")]
 #![warn(missing_docs)]
 
+//! ## The library
+//!
 //! The P2OS/AROS/ARCOS protocol of the Pioneer controller.
 //!
 //! * [`codec`]: framing, checksum, the streaming [`Decoder`] (resynchronises

@@ -1,3 +1,6 @@
+#![doc = include_str!("../README.md")]
+//! ## The library
+//!
 //! limber-world: a small world for the simulated robots (simarm, the emulated Pioneer), as
 //! Stage was for Player: the floor, blocks the gripper can carry, obstacles, and a
 //! simulated planar laser that scans them.

@@ -12,9 +12,10 @@ wire_struct! {
         pub position: f64,
         /// Current speed, rad/s or m/s (NaN-free; 0 when unknown).
         pub speed: f64,
-        /// Current acceleration (negative when unknown).
+        /// Current acceleration, rad/s² or m/s²; -1 when the device does not know it (the
+        /// Pioneer; simarm for a joint without an ACCEL setting).
         pub acceleration: f64,
-        /// Current in A (negative when unknown).
+        /// Current in A; -1 when the device does not measure it (the Pioneer arm and lift).
         pub current: f64,
         /// `ACTSTATE` bits.
         pub state: u32,

@@ -218,10 +218,10 @@ impl<I: Interface> Client<I> {
             } else if e.is_permission_denied() {
                 let hint = match ctx.domain().group().ok().flatten() {
                     Some(g) => format!(
-                        "in group mode ({}) the member who started the driver must run a limber with group mode, with LIMBER_GROUP={} set (README, Security)",
+                        "in group mode ({}) the member who started the driver must run a limber with group mode, with LIMBER_GROUP={} set (docs/guide/security.md)",
                         g.name, g.name
                     ),
-                    None => "they belong to another user; a domain is its owner's alone (README, Security)".to_string(),
+                    None => "they belong to another user; a domain is its owner's alone (docs/guide/security.md)".to_string(),
                 };
                 ConnectError::Permission {
                     device: dev.clone(),

@@ -30,7 +30,7 @@ pub enum ConnectError {
         /// The domain.
         domain: String,
         /// Empty, or a sentence naming the other users who have a domain of this name on
-        /// this machine (a domain is its owner's alone: README, Security).
+        /// this machine (a domain is its owner's alone: docs/guide/security.md).
         elsewhere: String,
     },
     /// Every client slot of the device that this client may take is taken: `max` ordinary

@@ -38,7 +38,7 @@ use thiserror::Error;
 /// in group mode `/tmp/limber-g-<gid>`).
 pub const RUNTIME_DIR_ENV: &str = "LIMBER_RUNTIME_DIR";
 /// The environment variable that turns group mode on: the name (or number) of the Unix
-/// group whose members share the domains (README, Security).
+/// group whose members share the domains (docs/guide/security.md).
 pub const GROUP_ENV: &str = "LIMBER_GROUP";
 /// Where POSIX shared memory lives on Linux.
 const SHM_DIR: &str = "/dev/shm";
@@ -706,7 +706,7 @@ pub fn elsewhere_note(domain: &str) -> String {
         return String::new();
     }
     format!(
-        "; domain {domain} also exists for {}: a domain's devices are its owner's alone, so run as that user (README, Security)",
+        "; domain {domain} also exists for {}: a domain's devices are its owner's alone, so run as that user (docs/guide/security.md)",
         others.join(", ")
     )
 }

@@ -39,7 +39,7 @@ pub enum HostError {
         device: String,
     },
     /// Group mode: the device's previous driver, a process of another member, died, and
-    /// only its user (or root) may clean up after it (README, Security).
+    /// only its user (or root) may clean up after it (docs/guide/security.md).
     #[error(
         "{device}: its previous driver, a process of {owner}, died; in group mode only that user (or root) may clean up after it: run any limber command as that user (e.g. limber list), then start the driver again"
     )]

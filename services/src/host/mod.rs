@@ -379,7 +379,7 @@ impl<I: Interface> DeviceHost<I> {
     }
 
     /// Removes the resources of dead processes (crashed clients) from this device's
-    /// services (in group mode, of this user's processes only: README, Security). Cheap
+    /// services (in group mode, of this user's processes only: docs/guide/security.md). Cheap
     /// enough for a 1 Hz housekeeping tick, not for every cycle.
     pub fn cleanup_dead(&self) {
         self.domain.cleanup_dead_nodes(&self.data_svc);

@@ -1,14 +1,4 @@
-//! `Command::output` with a time limit, for tests that run a program to completion: the
-//! program is killed and the test fails when it runs longer, and the output pipes (which a
-//! process it left behind could hold open) are read within the same limit.
-//!
-//! ```
-//! use std::process::Command;
-//! use std::time::Duration;
-//! let out = limber_bounded_run::output_within(Command::new("true"), Duration::from_secs(10));
-//! assert!(out.status.success());
-//! ```
-
+#![doc = include_str!("../README.md")]
 #![forbid(unsafe_code)]
 
 use std::io::Read;

@@ -1,22 +1,4 @@
-//! A global allocator that counts the allocations made on each thread, for the tests that
-//! prove a hot path allocates nothing. Declare it once in a test binary:
-//!
-//! ```
-//! #[global_allocator]
-//! static GLOBAL: limber_counting_alloc::Counting = limber_counting_alloc::Counting;
-//!
-//! fn main() {
-//!     let mut v = Vec::with_capacity(4);
-//!     assert_eq!(limber_counting_alloc::allocations_in(|| v.push(1u8)), 0);
-//!     assert_eq!(limber_counting_alloc::allocations_in(|| drop(vec![1u8; 8])), 1);
-//! }
-//! ```
-//!
-//! Measure with [`allocations_in`] (or [`allocations`] before and after). Only the
-//! calling thread's allocations are counted, so the test harness's other threads (and
-//! other tests running meanwhile) cannot disturb a measurement; work done on another thread
-//! must be measured on that thread. `alloc`, `alloc_zeroed` and `realloc` each count one;
-//! `dealloc` counts nothing. No dependencies besides std.
+#![doc = include_str!("../README.md")]
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;

@@ -292,7 +292,7 @@ fn main() -> std::process::ExitCode {
         first.1, last.1, first.2, last.2, first.3, last.3, first.4, last.4
     );
     let _ = std::fs::remove_file(&cfg);
-    // The domain's leftovers: iceoryx2's node counter and limber's token (README, Security).
+    // The domain's leftovers: iceoryx2's node counter and limber's token (docs/guide/security.md).
     drop(ctx);
     if let Ok(prefix) = domain.prefix() {
         for e in std::fs::read_dir("/dev/shm")
