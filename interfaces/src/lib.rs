@@ -7,7 +7,7 @@
 //! * Wire structs are `#[repr(C)]`, have no implicit padding (explicit `_pad` fields,
 //!   checked at compile time), derive zerocopy's `FromBytes`/`IntoBytes`/`KnownLayout`/
 //!   `Immutable` and iceoryx2's `ZeroCopySend`, and carry a versioned type name
-//!   (`limber.v3.ActArrayData`). iceoryx2 only compares name, size and alignment when a
+//!   (`limber.v4.ActArrayData`). iceoryx2 only compares name, size and alignment when a
 //!   service is opened, so the version in the name changes whenever a layout changes.
 //! * Units are SI: m, rad, s, m/s, rad/s, A. No `bool` or Rust enum on the wire: `u32`
 //!   codes, decoded by typed views that reject unknown values with a [`DecodeError`].
@@ -74,14 +74,19 @@ pub use wire::{WireField, WireStruct};
 /// Version 3 added the `ranger` interface ([`ranger::RangerData`] and its envelopes), and
 /// the motion results on the `outcome` channel ([`control::OutcomeMsg::result`],
 /// [`control::MotionResult`]); every type name carries the version.
-pub const LAYOUT_VERSION: u32 = 3;
+/// Version 4 added the actarray's joint trajectories (`TRAJ_CHUNK`, `TRAJ`, `TRAJ_SCALE`:
+/// [`actarray::ActArrayTrajChunkCmd`], [`actarray::ActArrayTrajCmd`],
+/// [`actarray::ActArrayTrajScaleCmd`]), the statuses `INVALID_GOAL`, `OLD_TIMESTAMP` and
+/// `TOO_FAST`, and the results `PATH_TOLERANCE_VIOLATED` and `GOAL_TOLERANCE_VIOLATED`.
+pub const LAYOUT_VERSION: u32 = 4;
 
 /// Everything a driver or client author needs, in one `use`.
 pub mod prelude {
     pub use crate::actarray::{
         ActArrayCmdMsg, ActArrayCommand, ActArrayData, ActArrayGeom, ActArrayReply,
         ActArrayReplyMsg, ActArrayReqMsg, ActArrayRequest, ActuatorFlags, ActuatorGeom,
-        ActuatorKind, ActuatorState, JointSel, JointValues,
+        ActuatorKind, ActuatorState, JointSel, JointTrajectory, JointValues, MAX_TRAJ_POINTS,
+        TrajectoryError, TrajectoryUpload,
     };
     pub use crate::common::{
         Bbox3, CmdOutcome, MAX_ACTUATORS, MsgMeta, Orientation3, Pose3, ReplyMeta, StateHeader,
@@ -136,6 +141,9 @@ pub fn manifest() -> Manifest {
         ActArrayHomeCmd::LAYOUT,
         ActArrayCurrentCmd::LAYOUT,
         ActArrayMultiCurrentCmd::LAYOUT,
+        ActArrayTrajChunkCmd::LAYOUT,
+        ActArrayTrajCmd::LAYOUT,
+        ActArrayTrajScaleCmd::LAYOUT,
         ActArrayCmdMsg::LAYOUT,
         ActArrayPowerReq::LAYOUT,
         ActArrayBrakesReq::LAYOUT,
