@@ -98,6 +98,9 @@ impl RobotModel {
             ActArrayCommand::Current { .. } | ActArrayCommand::MultiCurrent(_) => {
                 Err(Status::Unsupported)
             }
+            ActArrayCommand::TrajChunk(_)
+            | ActArrayCommand::Traj(_)
+            | ActArrayCommand::TrajScale(_) => Err(Status::Unsupported),
         };
         r.unwrap_or_else(|e| e)
     }
