@@ -23,9 +23,7 @@ fn c_follows_a_joint_trajectory_and_is_told_why_a_bad_one_is_refused() {
     let v: Vec<f64> = line.split(' ').filter_map(|w| w.parse().ok()).collect();
     assert!(v[0] <= v[1] && v[1] == 0.001, "{out}");
     assert!(
-        out.contains(
-            "invalid: invalid trajectory: point 1: time 0.5 s is not after the previous point's 1 s"
-        ),
+        out.contains("invalid: point 1: time 0.5 s is not after the previous point's 1 s"),
         "{out}"
     );
     assert!(out.contains("unknown joint: UNKNOWN_JOINT"), "{out}");
