@@ -25,7 +25,7 @@ impl RobotModel {
             LIMB_JOINTS as u64
         } else {
             0
-        };
+        } | self.traj.exec.running();
         for j in 0..ARM_JOINTS {
             if self
                 .arm
