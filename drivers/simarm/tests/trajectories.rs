@@ -139,6 +139,10 @@ fn a_trajectory_of_three_joints_is_reached_within_its_goal_tolerance() {
     for (j, x) in q.iter().enumerate() {
         assert!((done.positions()[j] - (x + 0.4)).abs() <= 0.001, "{done}");
     }
+    // The state's feedback: the last trajectory ended reached, past its last point.
+    let fb = a.wait_state(TIMEOUT).unwrap().trajectory;
+    assert_eq!((fb.active, fb.result), (2, MotionResult::Reached.code()));
+    assert_eq!((fb.point, fb.points), (4, 4));
     // It holds at the goal.
     let p = holds(&mut a, 1, 3);
     assert!((p - (q[1] + 0.4)).abs() <= 0.001);
@@ -235,6 +239,8 @@ fn a_scaling_of_zero_pauses_it_and_one_resumes_it() {
     let pause = a.set_trajectory_scale(0.0).unwrap();
     assert_eq!(a.wait_outcome(pause, TIMEOUT).unwrap(), Status::Ok);
     position(&mut a, 0);
+    let fb = a.wait_state(TIMEOUT).unwrap().trajectory;
+    assert_eq!((fb.active, fb.scale, fb.points), (1, 0.0, 2), "{fb:?}");
     let paused = holds(&mut a, 0, 20);
     assert!(paused < from + 0.5);
     assert_eq!(a.done(ticket).unwrap(), None, "paused, not ended");

@@ -6,7 +6,7 @@
 
 use limber_interfaces::prelude::*;
 use limber_services::Progress;
-use limber_trajectory::{Config, Executor, Feedback, JointLimit, Tick};
+use limber_trajectory::{Config, Executor, JointLimit, Tick};
 
 use super::ArmModel;
 
@@ -210,8 +210,8 @@ impl ArmModel {
         })
     }
 
-    /// The feedback of the trajectory running (or last run), if any.
-    pub fn trajectory_feedback(&self) -> Option<Feedback> {
-        (self.traj.joints != 0).then(|| self.traj.exec.feedback())
+    /// The trajectory's feedback as the actuator array's state carries it.
+    pub fn trajectory_state(&self) -> TrajFeedback {
+        self.traj.exec.state_feedback()
     }
 }
