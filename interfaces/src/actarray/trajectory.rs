@@ -100,6 +100,9 @@ pub enum TrajectoryError {
         /// The value.
         value: f64,
     },
+    /// The last point's time is 0: the trajectory has no duration to move in.
+    #[error("the last point's time is 0 s: a trajectory needs time to move")]
+    NoDuration,
     /// The last point has a velocity that is not zero (the joints would not stop there).
     #[error("the last point's velocity of column {column} is {velocity}, not 0")]
     FinalVelocity {
@@ -518,6 +521,9 @@ impl JointTrajectory {
                 column: 0,
                 value: self.goal_time_tolerance,
             });
+        }
+        if self.times[p - 1] <= 0.0 {
+            return Err(TrajectoryError::NoDuration);
         }
         for (column, &velocity) in self.velocities[p - 1][..n].iter().enumerate() {
             if velocity != 0.0 {
@@ -969,6 +975,9 @@ mod tests {
             t.validate().unwrap_err(),
             TrajectoryError::FinalVelocity { column: 0, .. }
         ));
+        let mut t = JointTrajectory::new(&[0]).unwrap();
+        t.push(0.0, &[0.1], None, None).unwrap();
+        assert_eq!(t.validate().unwrap_err(), TrajectoryError::NoDuration);
         let t = JointTrajectory::new(&[0]).unwrap();
         assert_eq!(t.validate().unwrap_err(), TrajectoryError::PointCount(0));
         assert!(t.commands().is_err());
