@@ -19,7 +19,8 @@ const STOP_TIME: f64 = 0.1;
 #[derive(Debug)]
 pub(super) struct Trajectories {
     exec: Box<Executor>,
-    upload: TrajectoryUpload,
+    /// Taken out while its trajectory starts (so the model can be borrowed meanwhile).
+    upload: Option<TrajectoryUpload>,
     /// Actuators whose motion the host follows is a trajectory's.
     joints: u64,
     /// The last tick's time, ns.
@@ -30,7 +31,7 @@ impl Trajectories {
     pub(super) fn new(actuators: usize) -> Self {
         Trajectories {
             exec: Executor::new(Config::new(actuators)),
-            upload: TrajectoryUpload::new(),
+            upload: Some(TrajectoryUpload::new()),
             joints: 0,
             last_ns: 0,
         }
@@ -84,7 +85,9 @@ impl ArmModel {
     ) -> Option<Status> {
         Some(match cmd {
             ActArrayCommand::TrajChunk(c) => {
-                self.traj.upload.chunk(client, c);
+                if let Some(u) = self.traj.upload.as_mut() {
+                    u.chunk(client, c);
+                }
                 Status::Ok
             }
             ActArrayCommand::TrajScale(s) => self.traj.exec.set_scale(*s),
@@ -94,26 +97,41 @@ impl ArmModel {
     }
 
     fn start_trajectory(&mut self, h: &ActArrayTrajCmd, client: u64, now_ns: u64) -> Status {
-        let config = self.traj_config();
-        let actual = self.actual();
-        let (n, actuators, powered, brakes) = (self.n, self.actuators(), self.powered, self.brakes);
-        let t = &mut self.traj;
-        let traj = match t.upload.finish(client, h) {
-            Ok(traj) => traj,
+        let Some(mut upload) = self.traj.upload.take() else {
+            return Status::Busy;
+        };
+        let status = match upload.finish(client, h) {
+            Ok(traj) => self.run_trajectory(traj, now_ns),
             Err(e) => {
                 tracing::info!(reason = %e, "trajectory refused");
-                return e.status();
+                e.status()
             }
         };
-        if !powered {
+        self.traj.upload = Some(upload);
+        status
+    }
+
+    /// Runs a validated joint trajectory from `now_ns` (`CLOCK_MONOTONIC`), wherever it
+    /// came from (an upload, a limb path sampled into joints): it replaces the running one
+    /// from its start time. The status is the command's outcome (`OK`, or why it was
+    /// refused, nothing moving); its result comes through
+    /// [`ArmModel::arm_progress`] like any motion's.
+    pub fn run_trajectory(&mut self, traj: &JointTrajectory, now_ns: u64) -> Status {
+        if !self.powered {
             return Status::PoweredOff;
         }
         let mask = Executor::joints_of(traj);
-        if brakes && mask & ((1u64 << n) - 1) != 0 {
+        if self.brakes && mask & ((1u64 << self.n) - 1) != 0 {
             return Status::Braked;
         }
-        t.exec.set_config(config);
-        if let Err(e) = t.exec.accept(traj, now_ns, &actual[..actuators]) {
+        let config = self.traj_config();
+        let actual = self.actual();
+        self.traj.exec.set_config(config);
+        if let Err(e) = self
+            .traj
+            .exec
+            .accept(traj, now_ns, &actual[..self.actuators()])
+        {
             tracing::info!(reason = %e, "trajectory refused");
             return e.status();
         }
