@@ -11,7 +11,7 @@ pub const MAX_ACTUATORS: usize = 32;
 
 wire_struct! {
     /// A point or vector in 3D (Player's `point_3d`), metres or unitless.
-    pub struct Vec3 : "limber.v3.Vec3", size = 24, align = 8 {
+    pub struct Vec3 : "limber.v4.Vec3", size = 24, align = 8 {
         /// x (forward in the robot frame).
         pub x: f64,
         /// y (left).
@@ -23,7 +23,7 @@ wire_struct! {
 
 wire_struct! {
     /// Roll, pitch and yaw in radians (Player's `orientation_3d`).
-    pub struct Orientation3 : "limber.v3.Orientation3", size = 24, align = 8 {
+    pub struct Orientation3 : "limber.v4.Orientation3", size = 24, align = 8 {
         /// Rotation about x.
         pub roll: f64,
         /// Rotation about y.
@@ -35,7 +35,7 @@ wire_struct! {
 
 wire_struct! {
     /// A 3D pose (Player's `pose3d`): position in metres, orientation in radians.
-    pub struct Pose3 : "limber.v3.Pose3", size = 48, align = 8 {
+    pub struct Pose3 : "limber.v4.Pose3", size = 48, align = 8 {
         /// Position.
         pub position: Vec3,
         /// Orientation.
@@ -45,7 +45,7 @@ wire_struct! {
 
 wire_struct! {
     /// A box size in metres (Player's `bbox3d`).
-    pub struct Bbox3 : "limber.v3.Bbox3", size = 24, align = 8 {
+    pub struct Bbox3 : "limber.v4.Bbox3", size = 24, align = 8 {
         /// Width (along y).
         pub width: f64,
         /// Length (along x).
@@ -58,7 +58,7 @@ wire_struct! {
 wire_struct! {
     /// The outcome of the last command a driver applied, carried in every state sample so
     /// the sender of a command sees whether (and why not) it was carried out.
-    pub struct CmdOutcome : "limber.v3.CmdOutcome", size = 24, align = 8 {
+    pub struct CmdOutcome : "limber.v4.CmdOutcome", size = 24, align = 8 {
         /// The client that sent it (0: no command applied yet).
         pub client_id: u64,
         /// That client's sequence number of the command.
@@ -72,7 +72,7 @@ wire_struct! {
 
 wire_struct! {
     /// The header of every state sample.
-    pub struct StateHeader : "limber.v3.StateHeader", size = 48, align = 8 {
+    pub struct StateHeader : "limber.v4.StateHeader", size = 48, align = 8 {
         /// Sample sequence number, +1 per published sample of this device.
         pub seq: u64,
         /// `CLOCK_MONOTONIC` time in ns at which the state was acquired (e.g. when the
@@ -89,7 +89,7 @@ wire_struct! {
 
 wire_struct! {
     /// Metadata in front of every command and every request.
-    pub struct MsgMeta : "limber.v3.MsgMeta", size = 32, align = 8 {
+    pub struct MsgMeta : "limber.v4.MsgMeta", size = 32, align = 8 {
         /// The sending client (unique per client in a domain; never 0).
         pub client_id: u64,
         /// The client's sequence number, +1 per message it sends on this channel.
@@ -105,7 +105,7 @@ wire_struct! {
 
 wire_struct! {
     /// Metadata in front of every reply.
-    pub struct ReplyMeta : "limber.v3.ReplyMeta", size = 32, align = 8 {
+    pub struct ReplyMeta : "limber.v4.ReplyMeta", size = 32, align = 8 {
         /// The client whose request this answers.
         pub client_id: u64,
         /// The request's sequence number.
@@ -175,11 +175,21 @@ pub enum Status {
     NothingToStore = 19,
     /// The gripper's store is empty: RETRIEVE has nothing to give back.
     NothingStored = 20,
+    /// A joint trajectory is malformed or incomplete (no points, times not increasing,
+    /// counts that do not match, a point never uploaded, a final velocity not zero):
+    /// control_msgs' INVALID_GOAL.
+    InvalidGoal = 21,
+    /// A joint trajectory's start time lies further in the past than the device accepts,
+    /// or every point of it is already past: control_msgs' OLD_HEADER_TIMESTAMP.
+    OldTimestamp = 22,
+    /// A joint trajectory asks a joint to move faster than the device can (the driver's
+    /// log names the joint, the segment and the speeds): an invalid goal.
+    TooFast = 23,
 }
 
 impl Status {
     /// Every status, in code order.
-    pub const ALL: [Status; 21] = [
+    pub const ALL: [Status; 24] = [
         Status::Ok,
         Status::Unsupported,
         Status::UnknownJoint,
@@ -201,6 +211,9 @@ impl Status {
         Status::StoreFull,
         Status::NothingToStore,
         Status::NothingStored,
+        Status::InvalidGoal,
+        Status::OldTimestamp,
+        Status::TooFast,
     ];
 
     /// The wire code.
@@ -255,6 +268,9 @@ impl Status {
             Status::StoreFull => "the gripper's store is full",
             Status::NothingToStore => "nothing between the fingers to store",
             Status::NothingStored => "nothing stored to retrieve",
+            Status::InvalidGoal => "invalid trajectory",
+            Status::OldTimestamp => "the trajectory's start time is too old",
+            Status::TooFast => "the trajectory is faster than the joints can move",
         }
     }
 }
@@ -403,6 +419,21 @@ pub(crate) const STATUS_GROUP: ConstantGroup = ConstantGroup {
             name: "NOTHING_STORED",
             value: 20,
             doc: "the gripper's store is empty",
+        },
+        Constant {
+            name: "INVALID_GOAL",
+            value: 21,
+            doc: "a joint trajectory is malformed or incomplete",
+        },
+        Constant {
+            name: "OLD_TIMESTAMP",
+            value: 22,
+            doc: "a joint trajectory's start time is too far in the past",
+        },
+        Constant {
+            name: "TOO_FAST",
+            value: 23,
+            doc: "a joint trajectory is faster than the joints can move",
         },
     ],
 };

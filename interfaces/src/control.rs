@@ -13,7 +13,7 @@ wire_struct! {
     /// client (each keeps its own, by `client_id`): one sample when the command is applied
     /// or refused, and one more with `STATUS_PREEMPTED` when another client's command
     /// cuts short the motion it started.
-    pub struct OutcomeMsg : "limber.v3.OutcomeMsg", size = 608, align = 8 {
+    pub struct OutcomeMsg : "limber.v4.OutcomeMsg", size = 608, align = 8 {
         /// The client that sent the command.
         pub client_id: u64,
         /// That client's sequence number of the command.
@@ -69,17 +69,26 @@ pub enum MotionResult {
     Aborted = 5,
     /// The device's own time limit for the motion passed before it ended.
     TimedOut = 6,
+    /// A joint of a trajectory left its path tolerance: the device holds where it is
+    /// (control_msgs' PATH_TOLERANCE_VIOLATED).
+    PathToleranceViolated = 7,
+    /// A trajectory's joints were not within their goal tolerance when its last point's
+    /// time plus the goal time tolerance had passed: the device holds where it is
+    /// (control_msgs' GOAL_TOLERANCE_VIOLATED).
+    GoalToleranceViolated = 8,
 }
 
 impl MotionResult {
     /// Every result, in code order.
-    pub const ALL: [MotionResult; 6] = [
+    pub const ALL: [MotionResult; 8] = [
         MotionResult::Reached,
         MotionResult::Stalled,
         MotionResult::Stopped,
         MotionResult::Preempted,
         MotionResult::Aborted,
         MotionResult::TimedOut,
+        MotionResult::PathToleranceViolated,
+        MotionResult::GoalToleranceViolated,
     ];
 
     /// The wire code.
@@ -105,6 +114,8 @@ impl MotionResult {
             MotionResult::Preempted => "preempted by another command",
             MotionResult::Aborted => "aborted",
             MotionResult::TimedOut => "timed out",
+            MotionResult::PathToleranceViolated => "aborted: a joint left its path tolerance",
+            MotionResult::GoalToleranceViolated => "aborted: not within the goal tolerance in time",
         }
     }
 
@@ -172,12 +183,22 @@ pub(crate) const RESULT_GROUP: ConstantGroup = ConstantGroup {
             value: 6,
             doc: "the device's time limit for the motion passed",
         },
+        Constant {
+            name: "PATH_TOLERANCE_VIOLATED",
+            value: 7,
+            doc: "a trajectory's joint left its path tolerance; the device holds",
+        },
+        Constant {
+            name: "GOAL_TOLERANCE_VIOLATED",
+            value: 8,
+            doc: "a trajectory's joints were not within the goal tolerance in time; the device holds",
+        },
     ],
 };
 
 wire_struct! {
     /// A request on a device's `lease` channel (`op` is a `LEASE_OP` code).
-    pub struct LeaseReq : "limber.v3.LeaseReq", size = 80, align = 8 {
+    pub struct LeaseReq : "limber.v4.LeaseReq", size = 80, align = 8 {
         /// The requesting client's id (the one its commands carry).
         pub client_id: u64,
         /// The client's sequence number of this request.
@@ -201,7 +222,7 @@ wire_struct! {
 
 wire_struct! {
     /// The answer to a [`LeaseReq`]: the status and who holds the device now.
-    pub struct LeaseReply : "limber.v3.LeaseReply", size = 80, align = 8 {
+    pub struct LeaseReply : "limber.v4.LeaseReply", size = 80, align = 8 {
         /// The holder's client id (0: nobody holds the device).
         pub holder_client: u64,
         /// The request's sequence number.

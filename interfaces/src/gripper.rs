@@ -65,7 +65,7 @@ impl TryFrom<u32> for GripperState {
 
 wire_struct! {
     /// The gripper's state (channel `data`).
-    pub struct GripperData : "limber.v3.GripperData", size = 64, align = 8 {
+    pub struct GripperData : "limber.v4.GripperData", size = 64, align = 8 {
         /// Common header.
         pub header: StateHeader,
         /// `GRIPPER_STATE` value.
@@ -81,7 +81,7 @@ wire_struct! {
 
 wire_struct! {
     /// The command envelope (channel `cmd`). Every gripper command has an empty body.
-    pub struct GripperCmdMsg : "limber.v3.GripperCmdMsg", size = 40, align = 8 {
+    pub struct GripperCmdMsg : "limber.v4.GripperCmdMsg", size = 40, align = 8 {
         /// Sender, sequence, time, kind, body length (0).
         pub meta: MsgMeta,
         /// Reserved, zero.
@@ -91,7 +91,7 @@ wire_struct! {
 
 wire_struct! {
     /// The request envelope (channel `req`). GET_GEOM has an empty body.
-    pub struct GripperReqMsg : "limber.v3.GripperReqMsg", size = 40, align = 8 {
+    pub struct GripperReqMsg : "limber.v4.GripperReqMsg", size = 40, align = 8 {
         /// Sender, sequence, time, kind, body length (0).
         pub meta: MsgMeta,
         /// Reserved, zero.
@@ -101,7 +101,7 @@ wire_struct! {
 
 wire_struct! {
     /// The gripper geometry (the GET_GEOM reply).
-    pub struct GripperGeom : "limber.v3.GripperGeom", size = 104, align = 8 {
+    pub struct GripperGeom : "limber.v4.GripperGeom", size = 104, align = 8 {
         /// Pose of the gripper in the robot frame.
         pub pose: Pose3,
         /// Outer size, m.
@@ -117,7 +117,7 @@ wire_struct! {
 
 wire_struct! {
     /// The reply envelope (channel `req`).
-    pub struct GripperReplyMsg : "limber.v3.GripperReplyMsg", size = 136, align = 8 {
+    pub struct GripperReplyMsg : "limber.v4.GripperReplyMsg", size = 136, align = 8 {
         /// Client, sequence, time, kind, status.
         pub meta: ReplyMeta,
         /// `GripperGeom` for GET_GEOM.

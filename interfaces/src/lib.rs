@@ -41,14 +41,20 @@ pub use wire::{WireField, WireStruct};
 /// Version 3 added the `ranger` interface ([`ranger::RangerData`] and its envelopes), and
 /// the motion results on the `outcome` channel ([`control::OutcomeMsg::result`],
 /// [`control::MotionResult`]); every type name carries the version.
-pub const LAYOUT_VERSION: u32 = 3;
+/// Version 4 added the actarray's joint trajectories (`TRAJ_CHUNK`, `TRAJ`, `TRAJ_SCALE`:
+/// [`actarray::ActArrayTrajChunkCmd`], [`actarray::ActArrayTrajCmd`],
+/// [`actarray::ActArrayTrajScaleCmd`]) and their feedback in the state
+/// ([`actarray::TrajFeedback`]), the statuses `INVALID_GOAL`, `OLD_TIMESTAMP` and
+/// `TOO_FAST`, and the results `PATH_TOLERANCE_VIOLATED` and `GOAL_TOLERANCE_VIOLATED`.
+pub const LAYOUT_VERSION: u32 = 4;
 
 /// Everything a driver or client author needs, in one `use`.
 pub mod prelude {
     pub use crate::actarray::{
         ActArrayCmdMsg, ActArrayCommand, ActArrayData, ActArrayGeom, ActArrayReply,
-        ActArrayReplyMsg, ActArrayReqMsg, ActArrayRequest, ActuatorFlags, ActuatorGeom,
-        ActuatorKind, ActuatorState, JointSel, JointValues,
+        ActArrayReplyMsg, ActArrayReqMsg, ActArrayRequest, ActArrayTrajChunkCmd, ActArrayTrajCmd,
+        ActuatorFlags, ActuatorGeom, ActuatorKind, ActuatorState, JointSel, JointTrajectory,
+        JointValues, MAX_TRAJ_POINTS, TrajFeedback, TrajectoryError, TrajectoryUpload,
     };
     pub use crate::common::{
         Bbox3, CmdOutcome, MAX_ACTUATORS, MsgMeta, Orientation3, Pose3, ReplyMeta, StateHeader,
@@ -95,6 +101,7 @@ pub fn manifest() -> Manifest {
         ReplyMeta::LAYOUT,
         // actarray
         ActuatorState::LAYOUT,
+        TrajFeedback::LAYOUT,
         ActArrayData::LAYOUT,
         ActArrayPositionCmd::LAYOUT,
         ActArrayMultiPositionCmd::LAYOUT,
@@ -103,6 +110,9 @@ pub fn manifest() -> Manifest {
         ActArrayHomeCmd::LAYOUT,
         ActArrayCurrentCmd::LAYOUT,
         ActArrayMultiCurrentCmd::LAYOUT,
+        ActArrayTrajChunkCmd::LAYOUT,
+        ActArrayTrajCmd::LAYOUT,
+        ActArrayTrajScaleCmd::LAYOUT,
         ActArrayCmdMsg::LAYOUT,
         ActArrayPowerReq::LAYOUT,
         ActArrayBrakesReq::LAYOUT,

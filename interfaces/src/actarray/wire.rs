@@ -7,7 +7,7 @@ use crate::wire::{ZeroCopySend, wire_struct};
 
 wire_struct! {
     /// The state of one actuator.
-    pub struct ActuatorState : "limber.v3.ActuatorState", size = 40, align = 8 {
+    pub struct ActuatorState : "limber.v4.ActuatorState", size = 40, align = 8 {
         /// Position, rad or m.
         pub position: f64,
         /// Current speed, rad/s or m/s (NaN-free; 0 when unknown).
@@ -25,8 +25,30 @@ wire_struct! {
 }
 
 wire_struct! {
+    /// The feedback of the device's joint trajectory (control_msgs': the current point,
+    /// the error), in its state.
+    pub struct TrajFeedback : "limber.v4.TrajFeedback", size = 40, align = 8 {
+        /// 0: no trajectory has run; 1: one runs (or waits for its start time); 2: the last
+        /// one ended (`result` says how).
+        pub active: u32,
+        /// The point it heads for (0-based; `points` once past the last).
+        pub point: u32,
+        /// Its points.
+        pub points: u32,
+        /// How the last one ended: a `RESULT` code (0 while one runs).
+        pub result: u32,
+        /// The largest |actual − desired| of its joints at the last tick, rad or m.
+        pub max_error: f64,
+        /// Trajectory time at the last tick, s (advancing at `scale` times real time).
+        pub time: f64,
+        /// The speed scaling: 0 paused, 1 nominal.
+        pub scale: f64,
+    }
+}
+
+wire_struct! {
     /// The state of an actuator array (channel `data`).
-    pub struct ActArrayData : "limber.v3.ActArrayData", size = 1336, align = 8 {
+    pub struct ActArrayData : "limber.v4.ActArrayData", size = 1376, align = 8 {
         /// Common header.
         pub header: StateHeader,
         /// Number of valid entries in `actuators`.
@@ -35,12 +57,14 @@ wire_struct! {
         pub motor_state: u32,
         /// The actuators.
         pub actuators: [ActuatorState; 32],
+        /// The joint trajectory's feedback (all zero on a device without trajectories).
+        pub trajectory: TrajFeedback,
     }
 }
 
 wire_struct! {
     /// CMD POS: move one joint to a position.
-    pub struct ActArrayPositionCmd : "limber.v3.ActArrayPositionCmd", size = 16, align = 8 {
+    pub struct ActArrayPositionCmd : "limber.v4.ActArrayPositionCmd", size = 16, align = 8 {
         /// Joint index (0-based).
         pub joint: i32,
         /// Reserved, zero.
@@ -52,7 +76,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD MULTI_POS: move every joint to a position.
-    pub struct ActArrayMultiPositionCmd : "limber.v3.ActArrayMultiPositionCmd", size = 264, align = 8 {
+    pub struct ActArrayMultiPositionCmd : "limber.v4.ActArrayMultiPositionCmd", size = 264, align = 8 {
         /// Number of valid entries.
         pub count: u32,
         /// Reserved, zero.
@@ -64,7 +88,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD SPEED: move one joint at a speed.
-    pub struct ActArraySpeedCmd : "limber.v3.ActArraySpeedCmd", size = 16, align = 8 {
+    pub struct ActArraySpeedCmd : "limber.v4.ActArraySpeedCmd", size = 16, align = 8 {
         /// Joint index.
         pub joint: i32,
         /// Reserved, zero.
@@ -76,7 +100,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD MULTI_SPEED: move every joint at a speed.
-    pub struct ActArrayMultiSpeedCmd : "limber.v3.ActArrayMultiSpeedCmd", size = 264, align = 8 {
+    pub struct ActArrayMultiSpeedCmd : "limber.v4.ActArrayMultiSpeedCmd", size = 264, align = 8 {
         /// Number of valid entries.
         pub count: u32,
         /// Reserved, zero.
@@ -88,7 +112,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD HOME: home one joint, or all (`joint = -1`).
-    pub struct ActArrayHomeCmd : "limber.v3.ActArrayHomeCmd", size = 8, align = 4 {
+    pub struct ActArrayHomeCmd : "limber.v4.ActArrayHomeCmd", size = 8, align = 4 {
         /// Joint index, or -1 for all.
         pub joint: i32,
         /// Reserved, zero.
@@ -98,7 +122,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD CURRENT: drive one joint, or all (`joint = -1`), with a current.
-    pub struct ActArrayCurrentCmd : "limber.v3.ActArrayCurrentCmd", size = 16, align = 8 {
+    pub struct ActArrayCurrentCmd : "limber.v4.ActArrayCurrentCmd", size = 16, align = 8 {
         /// Joint index, or -1 for all.
         pub joint: i32,
         /// Reserved, zero.
@@ -110,7 +134,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD MULTI_CURRENT: drive every joint with a current.
-    pub struct ActArrayMultiCurrentCmd : "limber.v3.ActArrayMultiCurrentCmd", size = 264, align = 8 {
+    pub struct ActArrayMultiCurrentCmd : "limber.v4.ActArrayMultiCurrentCmd", size = 264, align = 8 {
         /// Number of valid entries.
         pub count: u32,
         /// Reserved, zero.
@@ -121,8 +145,60 @@ wire_struct! {
 }
 
 wire_struct! {
+    /// CMD TRAJ_CHUNK: one piece of a joint trajectory being uploaded (see
+    /// `ActArrayTrajCmd`): up to 32 values of one field. `TIME`, `POSITION`, `VELOCITY` and
+    /// `ACCELERATION` carry the values of points `first .. first + count` (of joint column
+    /// `column` for the last three); `PATH_TOLERANCE` and `GOAL_TOLERANCE` one value per
+    /// joint column (`first` and `column` zero).
+    pub struct ActArrayTrajChunkCmd : "limber.v4.ActArrayTrajChunkCmd", size = 264, align = 8 {
+        /// A `TRAJ_FIELD` code.
+        pub field: u16,
+        /// The trajectory's joint column (0-based) for per-point joint values.
+        pub column: u16,
+        /// The index of the first point of `values`.
+        pub first: u16,
+        /// Valid entries of `values`.
+        pub count: u16,
+        /// The values (s, rad or m, rad/s or m/s, rad/s² or m/s²).
+        pub values: [f64; 32],
+    }
+}
+
+wire_struct! {
+    /// CMD TRAJ: run the joint trajectory uploaded by this client's `TRAJ_CHUNK`s since its
+    /// last TRAJ (control_msgs' FollowJointTrajectory goal). It replaces the trajectory
+    /// running from its start time.
+    pub struct ActArrayTrajCmd : "limber.v4.ActArrayTrajCmd", size = 64, align = 8 {
+        /// `CLOCK_MONOTONIC` ns at which point times count from; 0 = when it arrives.
+        pub start_ns: u64,
+        /// How long after the last point's time the joints may take to come within the goal
+        /// tolerance, s (0: the device's default).
+        pub goal_time_tolerance: f64,
+        /// The joint columns (1 to 32).
+        pub joint_count: u32,
+        /// The points (1 to `TRAJ_MAX_POINTS`).
+        pub point_count: u32,
+        /// `TRAJ_HAS` bits: which optional fields the points carry.
+        pub fields: u32,
+        /// Reserved, zero.
+        pub _pad: u32,
+        /// The actarray joint each column drives.
+        pub joints: [u8; 32],
+    }
+}
+
+wire_struct! {
+    /// CMD TRAJ_SCALE: the speed scaling of the running (and later) trajectories: 0
+    /// pauses, 1 is nominal.
+    pub struct ActArrayTrajScaleCmd : "limber.v4.ActArrayTrajScaleCmd", size = 8, align = 8 {
+        /// The factor, 0 to 1.
+        pub scale: f64,
+    }
+}
+
+wire_struct! {
     /// The command envelope (channel `cmd`): `body` holds the struct `meta.kind` names.
-    pub struct ActArrayCmdMsg : "limber.v3.ActArrayCmdMsg", size = 296, align = 8 {
+    pub struct ActArrayCmdMsg : "limber.v4.ActArrayCmdMsg", size = 296, align = 8 {
         /// Sender, sequence, time, kind, body length.
         pub meta: MsgMeta,
         /// One of the `ActArray*Cmd` structs.
@@ -132,7 +208,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ POWER: power on (1) or off (0).
-    pub struct ActArrayPowerReq : "limber.v3.ActArrayPowerReq", size = 4, align = 4 {
+    pub struct ActArrayPowerReq : "limber.v4.ActArrayPowerReq", size = 4, align = 4 {
         /// 0 off, 1 on.
         pub value: u32,
     }
@@ -140,7 +216,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ BRAKES: brakes on (1) or off (0).
-    pub struct ActArrayBrakesReq : "limber.v3.ActArrayBrakesReq", size = 4, align = 4 {
+    pub struct ActArrayBrakesReq : "limber.v4.ActArrayBrakesReq", size = 4, align = 4 {
         /// 0 off, 1 on.
         pub value: u32,
     }
@@ -148,7 +224,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ SPEED: the speed of one joint for later moves.
-    pub struct ActArraySpeedReq : "limber.v3.ActArraySpeedReq", size = 16, align = 8 {
+    pub struct ActArraySpeedReq : "limber.v4.ActArraySpeedReq", size = 16, align = 8 {
         /// Joint index.
         pub joint: i32,
         /// Reserved, zero.
@@ -160,7 +236,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ ACCEL: the acceleration of one joint for later moves.
-    pub struct ActArrayAccelReq : "limber.v3.ActArrayAccelReq", size = 16, align = 8 {
+    pub struct ActArrayAccelReq : "limber.v4.ActArrayAccelReq", size = 16, align = 8 {
         /// Joint index.
         pub joint: i32,
         /// Reserved, zero.
@@ -172,7 +248,7 @@ wire_struct! {
 
 wire_struct! {
     /// The request envelope (channel `req`). GET_GEOM has an empty body.
-    pub struct ActArrayReqMsg : "limber.v3.ActArrayReqMsg", size = 48, align = 8 {
+    pub struct ActArrayReqMsg : "limber.v4.ActArrayReqMsg", size = 48, align = 8 {
         /// Sender, sequence, time, kind, body length.
         pub meta: MsgMeta,
         /// One of the `ActArray*Req` structs.
@@ -182,7 +258,7 @@ wire_struct! {
 
 wire_struct! {
     /// The geometry of one actuator.
-    pub struct ActuatorGeom : "limber.v3.ActuatorGeom", size = 104, align = 8 {
+    pub struct ActuatorGeom : "limber.v4.ActuatorGeom", size = 104, align = 8 {
         /// `ACTUATOR_KIND`: 1 linear, 2 rotary.
         pub kind: u32,
         /// 1 when the actuator has brakes.
@@ -208,7 +284,7 @@ wire_struct! {
 
 wire_struct! {
     /// The geometry of the array (the GET_GEOM reply).
-    pub struct ActArrayGeom : "limber.v3.ActArrayGeom", size = 3384, align = 8 {
+    pub struct ActArrayGeom : "limber.v4.ActArrayGeom", size = 3384, align = 8 {
         /// Number of valid entries.
         pub actuators_count: u32,
         /// Reserved, zero.
@@ -224,7 +300,7 @@ wire_struct! {
 
 wire_struct! {
     /// The reply envelope (channel `req`): an ACK carries the body of the request's reply.
-    pub struct ActArrayReplyMsg : "limber.v3.ActArrayReplyMsg", size = 3416, align = 8 {
+    pub struct ActArrayReplyMsg : "limber.v4.ActArrayReplyMsg", size = 3416, align = 8 {
         /// Client, sequence, time, kind, status.
         pub meta: ReplyMeta,
         /// `ActArrayGeom` for GET_GEOM, empty otherwise.

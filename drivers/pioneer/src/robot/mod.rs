@@ -16,6 +16,7 @@ mod limb;
 mod motion;
 mod outbox;
 mod progress;
+mod trajectory;
 
 pub use lift::LiftModel;
 pub use outbox::{OUTBOX_CAPACITY, Outbox, OutboxFull, Queued};
@@ -108,6 +109,11 @@ pub struct ArmModel {
     /// ARMpacs whose status bytes make sense only in the other layout than the
     /// configured `armpac_layout` (see [`ArmPacket::suggests_other_layout`]).
     pub layout_mismatches: u64,
+    /// When each joint's target was set, and how many ticks it had to go: the time bound
+    /// of its motion (TIMED_OUT past it).
+    pub target_set: [Option<(Instant, u8)>; ARM_JOINTS],
+    /// The servo speed last commanded per joint, ms per step (0: the calibration's).
+    pub servo_ms: [u8; ARM_JOINTS],
 }
 
 impl Default for ArmModel {
@@ -128,6 +134,8 @@ impl Default for ArmModel {
             stamp_ns: 0,
             last_packet: None,
             layout_mismatches: 0,
+            target_set: [None; ARM_JOINTS],
+            servo_ms: [0; ARM_JOINTS],
         }
     }
 }
@@ -226,6 +234,7 @@ impl ArmModel {
         self.target[j] = Some(tick);
         self.goal[j] = None;
         self.short_since[j] = None;
+        self.target_set[j] = Some((Instant::now(), tick.abs_diff(self.ticks[j])));
     }
 }
 
@@ -315,6 +324,8 @@ pub struct RobotModel {
     pub(crate) armgrip_cmd: Option<GripperCommand>,
     /// What changed on the link since the last publish.
     pub(crate) dirty: Dirty,
+    /// Joint trajectories: the executor, the upload, what was streamed.
+    pub(crate) traj: trajectory::Trajectories,
 }
 
 impl core::fmt::Debug for RobotModel {
@@ -419,6 +430,7 @@ impl RobotModel {
             gripper_cmd: None,
             armgrip_cmd: None,
             dirty: Dirty::default(),
+            traj: trajectory::Trajectories::default(),
         }
     }
 
@@ -479,6 +491,11 @@ impl RobotModel {
             self.arm.power_commanded(on);
             self.dirty.arm = true;
         }
+        if let Command::ArmSpeed { joint, ms_per_step } = *cmd
+            && let Some(ms) = self.arm.servo_ms.get_mut(joint.index())
+        {
+            *ms = ms_per_step;
+        }
         Ok(())
     }
 
@@ -508,6 +525,7 @@ impl RobotModel {
         }
         self.arm.target = [None; ARM_JOINTS];
         self.vecmove = None;
+        self.abort_trajectory(Status::LinkDown);
         self.dirty.arm = true;
     }
 
@@ -530,6 +548,7 @@ impl RobotModel {
     pub fn link_down(&mut self) -> usize {
         self.link.up = false;
         self.vecmove = None;
+        self.abort_trajectory(Status::LinkDown);
         self.dirty.arm = true;
         self.dirty.body = true;
         self.outbox.clear()

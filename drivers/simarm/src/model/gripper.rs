@@ -62,6 +62,7 @@ impl ArmModel {
                 if let Err(e) = self.powered() {
                     return e;
                 }
+                self.preempt_trajectory(1 << self.n);
                 let open = *cmd == GripperCommand::Open;
                 let target = if open { self.gripper_stroke } else { 0.0 };
                 let speed = self.gripper_config_speed;

@@ -40,7 +40,15 @@ impl ArmModel {
         self.collision = None;
         self.leaving_contact = self.contact().is_some();
         let r = self.limb_command_inner(cmd);
-        self.limb.settle(r)
+        let s = self.limb.settle(r);
+        if s.is_carried_out() {
+            if *cmd == LimbCommand::Stop {
+                self.stop_trajectory();
+            } else {
+                self.preempt_trajectory((1u64 << self.n) - 1);
+            }
+        }
+        s
     }
 
     fn ik_to(&self, target: &IkTarget, seed: &[f64]) -> Result<JointVec, Status> {

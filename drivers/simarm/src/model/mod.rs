@@ -28,6 +28,7 @@ mod motion;
 mod options;
 mod preemption;
 mod store;
+mod trajectory;
 
 pub use collision::{Contact, Obstacles, SimObstacle};
 use gripper::GripperCmd;
@@ -85,6 +86,8 @@ pub struct ArmModel {
     options: SimArmOptions,
     /// Simulated time, s.
     time: f64,
+    /// Joint trajectories: the executor and the upload.
+    traj: trajectory::Trajectories,
 }
 
 fn finite3(v: &[f64; 3]) -> bool {
@@ -157,6 +160,7 @@ impl ArmModel {
             leaving_contact: false,
             options,
             time: 0.0,
+            traj: trajectory::Trajectories::new(n + 1),
             chain,
         })
     }

@@ -45,6 +45,15 @@ impl ArmModel {
             | ActArrayCommand::MultiSpeed(v)
             | ActArrayCommand::MultiCurrent(v) => (0, v.len()),
             ActArrayCommand::Home(JointSel::All) => (0, self.n + 1),
+            ActArrayCommand::Traj(h) => {
+                let drives = h.joints[..(h.joint_count as usize).min(MAX_ACTUATORS)]
+                    .iter()
+                    .fold(0u64, |m, &j| m | 1u64.checked_shl(j.into()).unwrap_or(0));
+                return Motion::of(drives, self.running());
+            }
+            ActArrayCommand::TrajChunk(_) | ActArrayCommand::TrajScale(_) => {
+                return Motion::NONE;
+            }
         };
         let drives = (first..(first + count).min(64)).fold(0u64, |m, j| m | 1 << j);
         let stop = match *cmd {
@@ -82,6 +91,9 @@ impl ArmModel {
     /// (reached within [`TOLERANCE`], stalled short of its goal, aborted by a power-off or
     /// the brakes), with its error against the goal.
     fn actuator_progress(&self, j: usize) -> Progress {
+        if let Some(p) = self.trajectory_progress(j) {
+            return p;
+        }
         let Some(m) = self.actuator(j) else {
             return Progress::UNKNOWN;
         };
@@ -123,6 +135,7 @@ impl ArmModel {
     /// The deadman's stop of the actarray: every joint and the gripper stop where they are.
     pub fn stop_arm(&mut self) -> Status {
         self.stop_all_joints();
+        self.stop_trajectory();
         self.gripper.stop();
         Status::Ok
     }
@@ -130,6 +143,7 @@ impl ArmModel {
     /// The deadman's stop of the limb: every joint stops where it is.
     pub fn stop_limb(&mut self) -> Status {
         self.stop_all_joints();
+        self.stop_trajectory();
         Status::Ok
     }
 
