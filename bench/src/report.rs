@@ -67,6 +67,41 @@ pub struct RatioDef {
 /// The ratios reported, like with like (spin with spin, blocking with blocking).
 pub const RATIOS: &[RatioDef] = &[
     RatioDef {
+        label: "state → 1 subscriber / iceoryx2 event wake paced at 1 kHz (one-way)",
+        num: "state.1.oneway",
+        den: "state.paced.event.oneway",
+        pct: Pct::P50,
+        goal: Some(Goal::AtMost(1.3)),
+    },
+    RatioDef {
+        label: "state → 1 subscriber / iceoryx2 event wake paced at 1 kHz (one-way)",
+        num: "state.1.oneway",
+        den: "state.paced.event.oneway",
+        pct: Pct::P99,
+        goal: Some(Goal::AtMost(2.0)),
+    },
+    RatioDef {
+        label: "state → 1 subscriber / futex wake paced at 1 kHz (one-way)",
+        num: "state.1.oneway",
+        den: "state.paced.futex.oneway",
+        pct: Pct::P50,
+        goal: None,
+    },
+    RatioDef {
+        label: "state → 4 subscribers / state → 1 subscriber",
+        num: "state.4.oneway",
+        den: "state.1.oneway",
+        pct: Pct::P50,
+        goal: None,
+    },
+    RatioDef {
+        label: "state → 16 subscribers / state → 1 subscriber",
+        num: "state.16.oneway",
+        den: "state.1.oneway",
+        pct: Pct::P50,
+        goal: Some(Goal::AtMost(2.0)),
+    },
+    RatioDef {
         label: "command spin one-way / floor spin one-way",
         num: "command.spin.oneway",
         den: "floor.spin.oneway",
@@ -203,13 +238,6 @@ pub const RATIOS: &[RatioDef] = &[
         label: "floor event round trip / floor spin round trip (cost of blocking)",
         num: "floor.event.rtt",
         den: "floor.spin.rtt",
-        pct: Pct::P50,
-        goal: None,
-    },
-    RatioDef {
-        label: "state to 16 subscribers / to 1 subscriber",
-        num: "state.16.oneway",
-        den: "state.1.oneway",
         pct: Pct::P50,
         goal: None,
     },

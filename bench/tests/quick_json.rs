@@ -309,6 +309,45 @@ fn gateway_measures_a_request_through_the_player_gateway() {
     std::fs::remove_dir_all(&dir).expect("remove the test's directory");
 }
 
+/// `--only state`: the fan-outs at 1 kHz beside their floors paced at the same rate (a futex
+/// wake and a raw iceoryx2 event wake), and the goals stated against them in the ratios.
+#[test]
+fn state_measures_the_fanouts_beside_floors_paced_at_their_rate() {
+    let dir = std::env::temp_dir().join(format!("limber-bench-state-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (_, ids, v, _) = run_only("state", &dir.join("state.json"), None);
+    for id in [
+        "state.paced.futex.oneway",
+        "state.paced.event.oneway",
+        "state.1.oneway",
+        "state.4.oneway",
+        "state.16.oneway",
+    ] {
+        assert!(ids.iter().any(|i| i == id), "{id} missing from {ids:?}");
+    }
+    let ratios = v["ratios"].as_array().unwrap();
+    let goal = |num: &str, den: &str, pct: &str| {
+        let r = ratios
+            .iter()
+            .find(|r| r["num"] == num && r["den"] == den && r["pct"] == pct)
+            .unwrap_or_else(|| panic!("no ratio {num} / {den} ({pct}) in {ratios:?}"));
+        let at_most = r["goal"]["at_most"].as_f64().expect("a goal");
+        let value = r["value"].as_f64().unwrap();
+        assert_eq!(r["met"].as_bool().unwrap(), value <= at_most, "{r}");
+        at_most
+    };
+    assert_eq!(
+        goal("state.1.oneway", "state.paced.event.oneway", "p50"),
+        1.3
+    );
+    assert_eq!(
+        goal("state.1.oneway", "state.paced.event.oneway", "p99"),
+        2.0
+    );
+    assert_eq!(goal("state.16.oneway", "state.1.oneway", "p50"), 2.0);
+    std::fs::remove_dir_all(&dir).expect("remove the test's directory");
+}
+
 /// What a `--quick --scale 0.2 --only <scenario>` run gave: its one scenario's status
 /// entry, the ids of its measurements (each checked to have samples), the whole report,
 /// and its stderr. `env`, if given, is set for the run.
