@@ -144,6 +144,11 @@ impl ChildProc {
         })
     }
 
+    /// The child's process id (to read its CPU time).
+    pub fn pid(&self) -> u32 {
+        self.child.id()
+    }
+
     /// The role.
     pub fn role(&self) -> &str {
         &self.role

@@ -13,6 +13,8 @@
 //!   driver's read of the robot's reply, client receipt).
 //! * [`stats`]: what a measurement is and how it is summarised (jitter = p99 − p50).
 //! * [`report`]: the terminal table, the ratios and goals, the JSON file; [`plot`]: the SVG.
+//! * [`cpu`]: the CPU time of the processes of a scenario over a window (what a latency
+//!   costs, idle and under load).
 //!
 //! Child processes are this crate's own binary re-executed with the hidden `--role`
 //! argument (see [`child`]); every child has a deadline after which it is killed.
@@ -20,6 +22,7 @@
 #![warn(missing_docs)]
 
 pub mod child;
+pub mod cpu;
 pub mod machine;
 pub mod plot;
 pub mod progress;
@@ -162,7 +165,7 @@ pub enum StrategyArg {
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct BenchArgs {
     /// Run only these scenarios (comma separated): floor, state, command, ik, peers,
-    /// request, loop, lang, bridge, gateway. Default: all.
+    /// request, loop, lang, bridge, gateway, cpu. Default: all.
     #[arg(long, value_delimiter = ',', value_name = "NAME[,NAME]")]
     pub only: Vec<String>,
     /// Small sample counts (a run takes under 20 s).
@@ -292,12 +295,14 @@ pub fn run_cli(args: BenchArgs) -> Result<(), BenchError> {
     for s in &scenarios {
         outcomes.push(scenario::run_one(s.as_ref(), &mut ctx));
     }
+    let cpu = ctx.take_cpu();
     let report = Report::new(
         ctx.machine.clone(),
         &args,
         outcomes,
         ctx.take_measurements(),
-    );
+    )
+    .with_cpu(cpu);
     print!("{}", report.table());
     if let Some(path) = &args.json {
         report.write_json(path)?;

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
+use crate::cpu::CpuCost;
 use crate::machine::Machine;
 use crate::scenario::ScenarioOutcome;
 use crate::stats::{Measurement, Metric, Strategy, Summary, fmt_ns};
@@ -470,6 +471,8 @@ pub struct Report {
     pub ratios: Vec<Ratio>,
     /// Goals in time on single series.
     pub time_goals: Vec<TimeGoal>,
+    /// What the processes cost (share of one core), idle and under load, with goals.
+    pub cpu: Vec<CpuCost>,
 }
 
 /// The floor of `m` of one kind: `(spin, blocking)` name the floor's series for each
@@ -641,7 +644,14 @@ impl Report {
             measurements: rows,
             ratios,
             time_goals,
+            cpu: Vec::new(),
         }
+    }
+
+    /// The report with the CPU costs measured in the run.
+    pub fn with_cpu(mut self, cpu: Vec<CpuCost>) -> Self {
+        self.cpu = cpu;
+        self
     }
 
     /// Scenarios that failed.
@@ -762,6 +772,10 @@ impl Report {
                 ));
             }
         }
+        t.push_str(&crate::cpu::table(&self.cpu, |id| {
+            let r = self.measurements.iter().find(|r| r.id == id)?;
+            Some((r.summary.p50_ns, r.summary.p99_ns))
+        }));
         t
     }
 

@@ -9,6 +9,7 @@
 
 pub mod bridge;
 pub mod command;
+pub mod cpu;
 pub mod floor;
 pub mod gateway;
 pub mod ik;
@@ -25,6 +26,7 @@ use std::time::{Duration, Instant};
 use limber_services::Domain;
 use serde::Serialize;
 
+use crate::cpu::CpuCost;
 use crate::machine::Machine;
 use crate::stats::Measurement;
 use crate::{BenchArgs, BenchError, StrategyArg};
@@ -139,6 +141,7 @@ pub fn registry() -> Vec<Box<dyn Scenario>> {
         Box::new(lang::Lang),
         Box::new(bridge::Bridge),
         Box::new(gateway::Gateway),
+        Box::new(cpu::Cpu),
     ]
 }
 
@@ -224,6 +227,7 @@ pub struct RunCtx {
     /// Notes of the running scenario (e.g. a skipped variant).
     pub notes: Vec<String>,
     measurements: Vec<Measurement>,
+    cpu: Vec<CpuCost>,
 }
 
 impl RunCtx {
@@ -274,6 +278,7 @@ impl RunCtx {
             tmp,
             notes: Vec::new(),
             measurements: Vec::new(),
+            cpu: Vec::new(),
         })
     }
 
@@ -340,6 +345,23 @@ impl RunCtx {
     /// Takes the measurements.
     pub fn take_measurements(&mut self) -> Vec<Measurement> {
         std::mem::take(&mut self.measurements)
+    }
+
+    /// Adds what a process cost.
+    pub fn push_cpu(&mut self, c: CpuCost) {
+        self.cpu.push(c);
+    }
+
+    /// Takes the CPU costs.
+    pub fn take_cpu(&mut self) -> Vec<CpuCost> {
+        std::mem::take(&mut self.cpu)
+    }
+
+    /// The length of a CPU window: `default`, or `quick` in quick mode, scaled (at least
+    /// 100 ms).
+    pub fn window(&self, default: Duration, quick: Duration) -> Duration {
+        let base = if self.quick { quick } else { default };
+        base.mul_f64(self.scale).max(Duration::from_millis(100))
     }
 }
 

@@ -28,6 +28,7 @@ use super::lang::run_bounded;
 use super::{READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario};
 use crate::BenchError;
 use crate::child::ChildProc;
+use crate::cpu::{self, CpuCost};
 use crate::progress::Progress;
 use crate::stats::{Measurement, Metric, Strategy, new_histogram};
 
@@ -142,6 +143,7 @@ fn run(ctx: &mut RunCtx, exe: &Path) -> Result<(), BenchError> {
             &format!("mirrored {DEVICE} as {DEVICE}"),
             deadline,
         )?;
+        idle_cost(ctx, &driver, &expose, &mirror)?;
         let rtt_direct = round_trips(ctx, &mut direct, "bridge direct", warm, n)?;
         let cctx_b = Context::new(&b, Role::Client, "bench-bridge")
             .map_err(|e| err("client context in B", e))?;
@@ -171,6 +173,47 @@ fn run(ctx: &mut RunCtx, exe: &Path) -> Result<(), BenchError> {
         "command→outcome through bridge expose+mirror (Zenoh, Unix socket)",
         rtt_bridge,
     );
+    Ok(())
+}
+
+/// The most an idle bridge of the pair may cost, percent of a core.
+pub const IDLE_BRIDGE_GOAL: f64 = 1.0;
+
+/// The CPU time of the idle pair (both bridges up, the device mirrored, nothing sent) and
+/// of the driver beside them, per second of wall time.
+fn idle_cost(
+    ctx: &mut RunCtx,
+    driver: &ChildProc,
+    expose: &ChildProc,
+    mirror: &ChildProc,
+) -> Result<(), BenchError> {
+    let window = ctx.window(Duration::from_secs(5), Duration::from_secs(1));
+    if ctx.progress {
+        eprintln!("  bridge idle: CPU over {window:?}");
+    }
+    let shares = cpu::idle(
+        &[
+            ("bridge expose", expose.pid()),
+            ("bridge mirror", mirror.pid()),
+            ("driver", driver.pid()),
+        ],
+        window,
+    )
+    .map_err(|e| err("cpu time", e))?;
+    for (process, percent) in shares {
+        let goal = process.starts_with("bridge").then_some(IDLE_BRIDGE_GOAL);
+        ctx.push_cpu(CpuCost {
+            id: format!("bridge.idle.{}", process.replace(' ', "_")),
+            scenario: "bridge",
+            mode: "bridge pair".into(),
+            load: "idle".into(),
+            process,
+            percent,
+            window_s: window.as_secs_f64(),
+            latency_id: None,
+            at_most_percent: goal,
+        });
+    }
     Ok(())
 }
 
