@@ -68,6 +68,27 @@ pub struct RatioDef {
 /// The ratios reported, like with like (spin with spin, blocking with blocking).
 pub const RATIOS: &[RatioDef] = &[
     RatioDef {
+        label: "command through the bridge pair / raw Zenoh put ping-pong (bridge)",
+        num: "bridge.zenoh.rtt",
+        den: "bridge.raw.put.rtt",
+        pct: Pct::P50,
+        goal: Some(Goal::AtMost(1.3)),
+    },
+    RatioDef {
+        label: "command through the bridge pair / raw Zenoh put ping-pong (bridge)",
+        num: "bridge.zenoh.rtt",
+        den: "bridge.raw.put.rtt",
+        pct: Pct::P99,
+        goal: Some(Goal::AtMost(1.3)),
+    },
+    RatioDef {
+        label: "raw Zenoh get→reply / raw Zenoh put ping-pong (bridge)",
+        num: "bridge.raw.get.rtt",
+        den: "bridge.raw.put.rtt",
+        pct: Pct::P50,
+        goal: None,
+    },
+    RatioDef {
         label: "state → 1 subscriber / iceoryx2 event wake paced at 1 kHz (one-way)",
         num: "state.1.oneway",
         den: "state.paced.event.oneway",

@@ -19,6 +19,7 @@ pub mod physical;
 pub mod pty_loop;
 pub mod request;
 pub mod state;
+pub mod zenoh_floor;
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};

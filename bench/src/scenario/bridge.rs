@@ -8,6 +8,9 @@
 //! direct row), then the one in B (the bridge row); the report sets the bridge row beside
 //! the TCP loopback peer row of the same run (`peers`).
 //!
+//! Its floor runs first, in the same run: raw Zenoh between two processes over a Unix
+//! socket, a put/subscribe ping-pong and a get/queryable exchange ([`zenoh_floor`]).
+//!
 //! The bridges are the `limber` executable: `$LIMBER_BIN` if set, else this executable if
 //! it is `limber`, else `limber` beside it. If none can run `limber bridge` (e.g.
 //! `limber-bench` alone, or a `limber` built without its `bridge` feature), the scenario
@@ -25,7 +28,7 @@ use limber_services::{Role, monotonic_ns};
 use super::command::{DEVICE, start_event_driver};
 use super::floor::BYTES;
 use super::lang::run_bounded;
-use super::{READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario};
+use super::{READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario, zenoh_floor};
 use crate::BenchError;
 use crate::child::ChildProc;
 use crate::cpu::{self, CpuCost};
@@ -118,6 +121,8 @@ fn start_bridge(
 fn run(ctx: &mut RunCtx, exe: &Path) -> Result<(), BenchError> {
     let (a, b) = (ctx.domain(), ctx.domain());
     let (warm, n) = (ctx.count(300, 50), ctx.count(3_000, 300));
+    // The floor first: raw Zenoh over the same kind of link, same payloads.
+    zenoh_floor::run(ctx, warm, n)?;
     // Two clients, one after the other; through the bridge an exchange takes ~1 ms or less.
     let deadline = ctx.deadline_for(2 * (warm + n), Duration::from_millis(1));
     let driver = start_event_driver(ctx, &a, "bridge-driver.hdr", deadline)?;
