@@ -259,11 +259,25 @@ fn bridge_measures_through_a_bridge_pair_or_says_why_not() {
         for m in v["measurements"].as_array().unwrap() {
             assert_eq!(m["strategy"], "blocking", "{m}");
         }
-        let ratio = v["ratios"]
-            .as_array()
-            .unwrap()
+        let ratios = v["ratios"].as_array().unwrap();
+        let ratio = ratios
             .iter()
-            .any(|r| r["num"] == "bridge.zenoh.rtt" && r["den"] == "bridge.direct.rtt");
+            .any(|r| r["num"] == "bridge.zenoh.rtt" && r["den"] == "bridge.direct.rtt")
+            // The goal against the raw Zenoh floor of the same run, at p50 and p99.
+            && ["p50", "p99"].iter().all(|pct| {
+                ratios.iter().any(|r| {
+                    r["num"] == "bridge.zenoh.rtt"
+                        && r["den"] == "bridge.raw.put.rtt"
+                        && r["pct"] == *pct
+                        && r["goal"]["at_most"] == 1.3
+                })
+            })
+            // The idle bridge pair's CPU, each with its goal.
+            && ["bridge expose", "bridge mirror"].iter().all(|p| {
+                v["cpu"].as_array().unwrap().iter().any(|c| {
+                    c["process"] == *p && c["load"] == "idle" && c["at_most_percent"] == 1.0
+                })
+            });
         (
             ids,
             ratio,
@@ -274,7 +288,9 @@ fn bridge_measures_through_a_bridge_pair_or_says_why_not() {
     let ci = std::env::var("CI").as_deref() == Ok("true");
     let (ids, ratio, detail, _) = run(&dir.join("bridge.json"), None);
     let measured = ids.contains(&"bridge.direct.rtt".to_string())
-        && ids.contains(&"bridge.zenoh.rtt".to_string());
+        && ids.contains(&"bridge.zenoh.rtt".to_string())
+        && ids.contains(&"bridge.raw.put.rtt".to_string())
+        && ids.contains(&"bridge.raw.get.rtt".to_string());
     if ci {
         assert!(measured, "the bridge rows are missing: {ids:?} ({detail})");
     } else {
@@ -345,6 +361,40 @@ fn state_measures_the_fanouts_beside_floors_paced_at_their_rate() {
         2.0
     );
     assert_eq!(goal("state.16.oneway", "state.1.oneway", "p50"), 2.0);
+    std::fs::remove_dir_all(&dir).expect("remove the test's directory");
+}
+
+/// `--only cpu`: the driver's and the client's CPU per second, idle and at 1 kHz of
+/// commands, for each mode that runs here, beside the round trip at that load; the idle
+/// event-driven driver carries its goal.
+#[test]
+fn cpu_reports_what_each_mode_costs_beside_its_latency() {
+    let dir = std::env::temp_dir().join(format!("limber-bench-cpu-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (_, ids, v, _) = run_only("cpu", &dir.join("cpu.json"), None);
+    let cpu = v["cpu"].as_array().unwrap();
+    for mode in ["event", "linger"] {
+        assert!(ids.contains(&format!("cpu.{mode}.rtt")), "{ids:?}");
+        for load in ["idle", "1khz"] {
+            for process in ["driver", "client"] {
+                let id = format!("cpu.{mode}.{load}.{process}");
+                let c = cpu
+                    .iter()
+                    .find(|c| c["id"] == id.as_str())
+                    .unwrap_or_else(|| panic!("{id} missing from {cpu:?}"));
+                assert!(c["percent"].as_f64().unwrap() >= 0.0, "{c}");
+                assert!(c["window_s"].as_f64().unwrap() > 0.0, "{c}");
+                if load == "1khz" {
+                    assert_eq!(c["latency_id"], format!("cpu.{mode}.rtt"), "{c}");
+                }
+            }
+        }
+    }
+    let idle = cpu
+        .iter()
+        .find(|c| c["id"] == "cpu.event.idle.driver")
+        .unwrap();
+    assert_eq!(idle["at_most_percent"], 1.0);
     std::fs::remove_dir_all(&dir).expect("remove the test's directory");
 }
 
