@@ -13,6 +13,8 @@
 //!   driver's read of the robot's reply, client receipt).
 //! * [`stats`]: what a measurement is and how it is summarised (jitter = p99 − p50).
 //! * [`report`]: the terminal table, the ratios and goals, the JSON file; [`plot`]: the SVG.
+//! * [`results`]: `--results DIR`, the run as a Markdown page with the machine and the
+//!   command.
 //! * [`cpu`]: the CPU time of the processes of a scenario over a window (what a latency
 //!   costs, idle and under load).
 //!
@@ -27,6 +29,7 @@ pub mod machine;
 pub mod plot;
 pub mod progress;
 pub mod report;
+pub mod results;
 pub mod roles;
 pub mod scenario;
 pub mod stats;
@@ -191,6 +194,10 @@ pub struct BenchArgs {
     /// Draw the latency percentile curves of every measurement into this SVG file.
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
+    /// Write the run to this directory as `latest.md` (the machine, the exact command, the
+    /// table, the goals missed) and `latest.json` (e.g. `--results bench/results`).
+    #[arg(long, value_name = "DIR")]
+    pub results: Option<PathBuf>,
     /// List the scenarios and exit.
     #[arg(long)]
     pub list: bool,
@@ -290,6 +297,11 @@ pub fn run_cli(args: BenchArgs) -> Result<(), BenchError> {
             check_writable(flag, path)?;
         }
     }
+    if let Some(dir) = &args.results {
+        let (md, json) = results::paths(dir);
+        check_writable("--results", &md)?;
+        check_writable("--results", &json)?;
+    }
     let mut ctx = RunCtx::new(&args)?;
     let mut outcomes = Vec::new();
     for s in &scenarios {
@@ -311,6 +323,10 @@ pub fn run_cli(args: BenchArgs) -> Result<(), BenchError> {
     if let Some(path) = &args.plot {
         plot::draw(path, &report)?;
         eprintln!("wrote {}", path.display());
+    }
+    if let Some(dir) = &args.results {
+        results::write(dir, &report, &results::command_line(std::env::args()))?;
+        eprintln!("wrote {}", results::paths(dir).0.display());
     }
     match report.failed() {
         0 => Ok(()),

@@ -774,16 +774,18 @@ impl Report {
             t.push_str("\ngoals in time (this machine, this run):\n");
             for g in &self.time_goals {
                 let met = if g.met { "met" } else { "NOT met" };
+                let x = |f: &TimeGoalFloor| g.ns as f64 / f.ns.max(1) as f64;
                 let floor = match &g.floor {
                     Some(f) if f.ns > g.at_most_ns => {
                         format!(
-                            " (the goal is below its floor: {} takes {})",
+                            " (the goal is below its floor: {} takes {}; {:.2}x it)",
                             f.what,
-                            fmt_ns(f.ns)
+                            fmt_ns(f.ns),
+                            x(f)
                         )
                     }
-                    Some(f) => format!(" ({} takes {})", f.what, fmt_ns(f.ns)),
-                    None => String::new(),
+                    Some(f) => format!(" ({} takes {}; {:.2}x it)", f.what, fmt_ns(f.ns), x(f)),
+                    None => " (no floor)".to_string(),
                 };
                 t.push_str(&format!(
                     "  {:<72} {:>24}  goal <= {}: {met}{floor}\n",

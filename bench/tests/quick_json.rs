@@ -364,6 +364,60 @@ fn state_measures_the_fanouts_beside_floors_paced_at_their_rate() {
     std::fs::remove_dir_all(&dir).expect("remove the test's directory");
 }
 
+/// `--results DIR`: the run as `DIR/latest.md` (the machine, the exact command, the table,
+/// the goals missed) and `DIR/latest.json`.
+#[test]
+fn results_writes_the_run_with_its_machine_and_command() {
+    let dir = std::env::temp_dir().join(format!("limber-bench-results-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = limber_bounded_run::output_within(
+        Command::new(env!("CARGO_BIN_EXE_limber-bench"))
+            .args(["--quick", "--scale", "0.1", "--no-progress", "--only", "ik"])
+            .arg("--results")
+            .arg(&dir),
+        Duration::from_secs(300),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let md = std::fs::read_to_string(dir.join("latest.md")).unwrap();
+    for part in [
+        "| CPU |",
+        "| cores | ",
+        "| kernel |",
+        "| load average",
+        "| build |",
+    ] {
+        assert!(md.contains(part), "{part} missing from {md}");
+    }
+    assert!(
+        md.contains("--quick --scale 0.1 --no-progress --only ik --results"),
+        "{md}"
+    );
+    assert!(md.contains("numeric IK, 6 joints, pose (p50)"), "{md}");
+    assert!(
+        md.contains("Goals **not met** in this run")
+            || md.contains("Every goal of this run was met"),
+        "{md}"
+    );
+    let v: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("latest.json")).unwrap()).unwrap();
+    assert_eq!(v["scenarios"][0]["name"], "ik");
+    // A directory that does not exist is refused before the run.
+    let out = limber_bounded_run::output_within(
+        Command::new(env!("CARGO_BIN_EXE_limber-bench"))
+            .args(["--quick", "--only", "ik", "--results"])
+            .arg(dir.join("missing")),
+        Duration::from_secs(60),
+    );
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--results"));
+    assert!(out.stdout.is_empty());
+    std::fs::remove_dir_all(&dir).expect("remove the test's directory");
+}
+
 /// `--only cpu`: the driver's and the client's CPU per second, idle and at 1 kHz of
 /// commands, for each mode that runs here, beside the round trip at that load; the idle
 /// event-driven driver carries its goal.
