@@ -25,6 +25,7 @@
 
 pub mod child;
 pub mod cpu;
+pub mod goals;
 pub mod machine;
 pub mod plot;
 pub mod progress;
@@ -168,7 +169,7 @@ pub enum StrategyArg {
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct BenchArgs {
     /// Run only these scenarios (comma separated): floor, state, command, ik, peers,
-    /// request, loop, lang, bridge, gateway, cpu. Default: all.
+    /// request, loop, lang, bridge, gateway, cpu, many. Default: all.
     #[arg(long, value_delimiter = ',', value_name = "NAME[,NAME]")]
     pub only: Vec<String>,
     /// Small sample counts (a run takes under 20 s).
@@ -221,6 +222,9 @@ pub struct BenchArgs {
     /// Internal: the file a physical-floor child maps shared.
     #[arg(long, hide = true)]
     pub shm: Option<PathBuf>,
+    /// Internal: the device a driver child offers (default `bench/actarray/0`).
+    #[arg(long, hide = true)]
+    pub device: Option<String>,
     /// Internal: how long an event-driven driver child keeps polling after activity, µs.
     #[arg(long, hide = true, default_value_t = 0)]
     pub linger_us: u64,

@@ -5,7 +5,7 @@
 //! [`RunCtx::push`] — and listing it in [`registry`]; if it needs child processes, add a
 //! role to [`crate::roles::run_role`] (`request` and `loop`, in [`pty_loop`], are worked
 //! examples with a driver child). Ratios against the floor and
-//! the peers are defined in [`crate::report::RATIOS`].
+//! the peers are defined in [`crate::goals::RATIOS`].
 
 pub mod bridge;
 pub mod command;
@@ -14,6 +14,7 @@ pub mod floor;
 pub mod gateway;
 pub mod ik;
 pub mod lang;
+pub mod many;
 pub mod peers;
 pub mod physical;
 pub mod pty_loop;
@@ -143,6 +144,7 @@ pub fn registry() -> Vec<Box<dyn Scenario>> {
         Box::new(bridge::Bridge),
         Box::new(gateway::Gateway),
         Box::new(cpu::Cpu),
+        Box::new(many::Many),
     ]
 }
 

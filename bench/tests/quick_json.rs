@@ -418,6 +418,29 @@ fn results_writes_the_run_with_its_machine_and_command() {
     std::fs::remove_dir_all(&dir).expect("remove the test's directory");
 }
 
+/// `--only many` (quick: 1 and 4 drivers, 16 clients): listing the domain and a command's
+/// round trip for each number of drivers, and the memory per driver and per client in the
+/// notes.
+#[test]
+fn many_measures_listing_round_trips_and_memory_per_number_of_drivers() {
+    let dir = std::env::temp_dir().join(format!("limber-bench-many-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (s, ids, _, _) = run_only("many", &dir.join("many.json"), None);
+    for n in [1, 4] {
+        for what in ["list", "rtt"] {
+            let id = format!("many.{n}.{what}");
+            assert!(ids.contains(&id), "{id} missing from {ids:?}");
+        }
+        let detail = s["detail"].as_str().unwrap();
+        assert!(
+            detail.contains(&format!("{n} driver(s), 16 clients: per driver RSS ")),
+            "{detail}"
+        );
+        assert!(detail.contains("per client "), "{detail}");
+    }
+    std::fs::remove_dir_all(&dir).expect("remove the test's directory");
+}
+
 /// `--only cpu`: the driver's and the client's CPU per second, idle and at 1 kHz of
 /// commands, for each mode that runs here, beside the round trip at that load; the idle
 /// event-driven driver carries its goal.
