@@ -228,6 +228,20 @@ pub const RATIOS: &[RatioDef] = &[
         num: "lang.python.rtt",
         den: "lang.rust.rtt",
         pct: Pct::P50,
+        goal: Some(Goal::AtMost(2.0)),
+    },
+    RatioDef {
+        label: "Python state read / Rust state read (lang)",
+        num: "lang.python.state",
+        den: "lang.rust.state",
+        pct: Pct::P50,
+        goal: Some(Goal::AtMost(2.0)),
+    },
+    RatioDef {
+        label: "Python state read / one ctypes call into liblimber (lang)",
+        num: "lang.python.state",
+        den: "lang.python.ffi",
+        pct: Pct::P50,
         goal: None,
     },
     RatioDef {
