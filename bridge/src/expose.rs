@@ -426,8 +426,6 @@ fn put_outcome(session: &Session, device: &DeviceName, origin: &str, o: &Outcome
     if let Err(e) = session
         .put(&key, o.as_bytes().to_vec())
         .encoding(keys::encoding(keys::outcome_type()))
-        // Sent at once, not batched: a client waits for it.
-        .express(true)
         .wait()
     {
         tracing::warn!(device = %device, error = %e, "cannot publish an outcome");
@@ -499,8 +497,6 @@ fn expose_device<I: Interface>(
     let state_pub = session
         .declare_publisher(keys::device_key(device, "state"))
         .encoding(keys::encoding(names.data))
-        // Sent at once, not batched: a control loop waits for it.
-        .express(true)
         .wait()
         .map_err(|e| e.to_string())?;
     let (d, t) = (device.clone(), tx.clone());

@@ -329,8 +329,6 @@ impl<I: Interface> MirroredDevice for Mirrored<I> {
             if let Err(e) = session
                 .put(&self.cmd_key, c)
                 .encoding(keys::encoding(self.names.cmd))
-                // Sent at once, not batched: the arm waits for it.
-                .express(true)
                 .wait()
             {
                 tracing::warn!(device = %self.local, error = %e, "cannot relay a command");

@@ -8,7 +8,6 @@
 //! * `get`: a `get` with a 296 B payload → the echo's queryable replies 1336 B (the path of
 //!   a request), consolidation off as a mirror asks.
 //!
-//! Every put is `express` (sent at once, not batched), as z_ping's and the bridge's.
 //! Round trips only, measured by the pinging parent (`bridge.raw.put.rtt`,
 //! `bridge.raw.get.rtt`). The echo answers from Zenoh's callbacks.
 
@@ -128,7 +127,6 @@ fn put_round_trips(
 ) -> Result<Histogram<u64>, BenchError> {
     let ping = session
         .declare_publisher(PING)
-        .express(true)
         .wait()
         .map_err(zerr("ping publisher"))?;
     let pongs = session
@@ -235,7 +233,6 @@ pub fn echo_role(args: &BenchArgs) -> Result<(), BenchError> {
     let session = open(&[endpoint], &[])?;
     let pong = session
         .declare_publisher(PONG)
-        .express(true)
         .wait()
         .map_err(zerr("pong publisher"))?;
     let _pings = session
