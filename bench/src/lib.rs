@@ -329,7 +329,7 @@ pub fn run_cli(args: BenchArgs) -> Result<(), BenchError> {
         eprintln!("wrote {}", path.display());
     }
     if let Some(dir) = &args.results {
-        results::write(dir, &report, &results::command_line(std::env::args()))?;
+        results::write(dir, &report, &results::invocation())?;
         eprintln!("wrote {}", results::paths(dir).0.display());
     }
     match report.failed() {

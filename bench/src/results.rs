@@ -36,6 +36,27 @@ pub fn command_line(args: impl IntoIterator<Item = String>) -> String {
         .join(" ")
 }
 
+/// The environment variables a run reads (where the bridges, the C and Python clients and
+/// the domain's files come from, Zenoh's threads): set ones go before the command.
+pub const ENV: &[&str] = &[
+    "LIMBER_RUNTIME_DIR",
+    "LIMBER_BIN",
+    "LIMBER_PYTHON",
+    "LIMBER_LIB_DIR",
+    "LIMBER_SPIN_US",
+    "LIMBER_PRIORITY",
+    "CC",
+    "ZENOH_RUNTIME",
+];
+
+/// This process's command line, after the variables of [`ENV`] that are set (`VAR=value`).
+pub fn invocation() -> String {
+    let env = ENV
+        .iter()
+        .filter_map(|k| std::env::var(k).ok().map(|v| format!("{k}={v}")));
+    command_line(env.chain(std::env::args()))
+}
+
 /// A Unix time as `YYYY-MM-DD HH:MM:SS UTC` (civil from days, proleptic Gregorian).
 fn utc(unix_s: u64) -> String {
     let (days, secs) = (unix_s / 86_400, unix_s % 86_400);
@@ -85,7 +106,10 @@ pub fn page(report: &Report, command: &str) -> String {
         let _ = writeln!(t, "| scenarios failed | {failed} |");
     }
     let _ = writeln!(t, "\nThe command:\n");
-    let first = command.split(' ').next().unwrap_or_default();
+    let first = command
+        .split(' ')
+        .find(|w| !w.contains('='))
+        .unwrap_or_default();
     let _ = writeln!(
         t,
         "<!-- not run by tests: {first} | a benchmark run, minutes long, recorded as it ran -->"
