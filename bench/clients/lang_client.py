@@ -1,14 +1,16 @@
 """The Python client of ``limber bench``'s ``lang`` scenario (run with python/limber on
 PYTHONPATH). Usage: lang_client.py WARMUP COUNT OUT. Connects to bench/actarray/0 in
 $LIMBER_DOMAIN and, WARMUP + COUNT times each, times (CLOCK_MONOTONIC, ns) reading the
-latest state (``ActArrayClient.state()``, a copy) and a command's round trip (``move_to``,
-then ``wait_outcome``); writes the samples after the warm-up to OUT, one a line: "state NS"
-or "rtt NS". Exits 1 with the reason on stderr."""
+latest state (``ActArrayClient.state()``, a copy), a command's round trip (``move_to``,
+then ``wait_outcome``) and, as Python's floor, one ctypes call into liblimber that does
+nothing else (``limber_layout_version``); writes the samples after the warm-up to OUT, one
+a line: "state NS", "rtt NS" or "ffi NS". Exits 1 with the reason on stderr."""
 
 import sys
 import time
 
 from limber import ActArrayClient, LimberError, Status
+from limber._lib import lib as _c  # the ctypes library: for the floor of one call
 
 
 def main() -> int:
@@ -29,8 +31,12 @@ def main() -> int:
             if status != Status.OK:
                 print(f"lang_client.py: refused: {status.describe()}", file=sys.stderr)
                 return 1
+            # Python's floor: one ctypes call into liblimber that does nothing else.
+            t4 = now()
+            _c.limber_layout_version()
+            t5 = now()
             if i > warm:
-                lines.append(f"state {t1 - t0}\nrtt {t3 - t2}\n")
+                lines.append(f"state {t1 - t0}\nrtt {t3 - t2}\nffi {t5 - t4}\n")
         arm.close()
     except LimberError as e:
         print(f"lang_client.py: {type(e).__name__}: {e}", file=sys.stderr)

@@ -32,6 +32,8 @@ pub struct ChildSpec {
     pub shm: Option<PathBuf>,
     /// How long an event-driven driver child keeps polling after activity.
     pub linger: Option<Duration>,
+    /// The device a driver child offers (default `bench/actarray/0`).
+    pub device: Option<String>,
     /// The core to pin to.
     pub cpu: Option<usize>,
     /// The core a Pioneer driver child pins its emulator thread to.
@@ -86,6 +88,9 @@ impl ChildProc {
         }
         if let Some(p) = &spec.shm {
             c.arg("--shm").arg(p);
+        }
+        if let Some(d) = &spec.device {
+            c.arg("--device").arg(d);
         }
         if let Some(l) = spec.linger {
             c.arg("--linger-us").arg(l.as_micros().to_string());
@@ -142,6 +147,11 @@ impl ChildProc {
             lines: rx,
             kill_at: Instant::now() + deadline + Duration::from_secs(5),
         })
+    }
+
+    /// The child's process id (to read its CPU time).
+    pub fn pid(&self) -> u32 {
+        self.child.id()
     }
 
     /// The role.

@@ -14,6 +14,10 @@
 //!   driver's read of the robot's reply, client receipt).
 //! * [`stats`]: what a measurement is and how it is summarised (jitter = p99 − p50).
 //! * [`report`]: the terminal table, the ratios and goals, the JSON file; [`plot`]: the SVG.
+//! * [`results`]: `--results DIR`, the run as a Markdown page with the machine and the
+//!   command.
+//! * [`cpu`]: the CPU time of the processes of a scenario over a window (what a latency
+//!   costs, idle and under load).
 //!
 //! Child processes are this crate's own binary re-executed with the hidden `--role`
 //! argument (see [`child`]); every child has a deadline after which it is killed.
@@ -21,10 +25,13 @@
 #![warn(missing_docs)]
 
 pub mod child;
+pub mod cpu;
+pub mod goals;
 pub mod machine;
 pub mod plot;
 pub mod progress;
 pub mod report;
+pub mod results;
 pub mod roles;
 pub mod scenario;
 pub mod stats;
@@ -163,7 +170,7 @@ pub enum StrategyArg {
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct BenchArgs {
     /// Run only these scenarios (comma separated): floor, state, command, ik, traj,
-    /// peers, request, loop, lang, bridge, gateway. Default: all.
+    /// peers, request, loop, lang, bridge, gateway, cpu, many. Default: all.
     #[arg(long, value_delimiter = ',', value_name = "NAME[,NAME]")]
     pub only: Vec<String>,
     /// Small sample counts (a run takes under 20 s).
@@ -189,6 +196,10 @@ pub struct BenchArgs {
     /// Draw the latency percentile curves of every measurement into this SVG file.
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
+    /// Write the run to this directory as `latest.md` (the machine, the exact command, the
+    /// table, the goals missed) and `latest.json` (e.g. `--results bench/results`).
+    #[arg(long, value_name = "DIR")]
+    pub results: Option<PathBuf>,
     /// List the scenarios and exit.
     #[arg(long)]
     pub list: bool,
@@ -212,6 +223,9 @@ pub struct BenchArgs {
     /// Internal: the file a physical-floor child maps shared.
     #[arg(long, hide = true)]
     pub shm: Option<PathBuf>,
+    /// Internal: the device a driver child offers (default `bench/actarray/0`).
+    #[arg(long, hide = true)]
+    pub device: Option<String>,
     /// Internal: how long an event-driven driver child keeps polling after activity, µs.
     #[arg(long, hide = true, default_value_t = 0)]
     pub linger_us: u64,
@@ -288,17 +302,24 @@ pub fn run_cli(args: BenchArgs) -> Result<(), BenchError> {
             check_writable(flag, path)?;
         }
     }
+    if let Some(dir) = &args.results {
+        let (md, json) = results::paths(dir);
+        check_writable("--results", &md)?;
+        check_writable("--results", &json)?;
+    }
     let mut ctx = RunCtx::new(&args)?;
     let mut outcomes = Vec::new();
     for s in &scenarios {
         outcomes.push(scenario::run_one(s.as_ref(), &mut ctx));
     }
+    let cpu = ctx.take_cpu();
     let report = Report::new(
         ctx.machine.clone(),
         &args,
         outcomes,
         ctx.take_measurements(),
-    );
+    )
+    .with_cpu(cpu);
     print!("{}", report.table());
     if let Some(path) = &args.json {
         report.write_json(path)?;
@@ -307,6 +328,10 @@ pub fn run_cli(args: BenchArgs) -> Result<(), BenchError> {
     if let Some(path) = &args.plot {
         plot::draw(path, &report)?;
         eprintln!("wrote {}", path.display());
+    }
+    if let Some(dir) = &args.results {
+        results::write(dir, &report, &results::invocation())?;
+        eprintln!("wrote {}", results::paths(dir).0.display());
     }
     match report.failed() {
         0 => Ok(()),

@@ -6,6 +6,8 @@ use std::path::Path;
 
 use serde::Serialize;
 
+use crate::cpu::CpuCost;
+pub use crate::goals::{RATIOS, TIME_GOALS};
 use crate::machine::Machine;
 use crate::scenario::ScenarioOutcome;
 use crate::stats::{Measurement, Metric, Strategy, Summary, fmt_ns};
@@ -64,213 +66,6 @@ pub struct RatioDef {
     pub goal: Option<Goal>,
 }
 
-/// The ratios reported, like with like (spin with spin, blocking with blocking).
-pub const RATIOS: &[RatioDef] = &[
-    RatioDef {
-        label: "command spin one-way / floor spin one-way",
-        num: "command.spin.oneway",
-        den: "floor.spin.oneway",
-        pct: Pct::P50,
-        goal: Some(Goal::AtMost(1.5)),
-    },
-    RatioDef {
-        label: "command spin one-way / floor spin one-way",
-        num: "command.spin.oneway",
-        den: "floor.spin.oneway",
-        pct: Pct::P99,
-        goal: Some(Goal::AtMost(2.0)),
-    },
-    RatioDef {
-        label: "command spin round trip / floor spin round trip",
-        num: "command.spin.rtt",
-        den: "floor.spin.rtt",
-        pct: Pct::P50,
-        goal: Some(Goal::AtMost(1.2)),
-    },
-    RatioDef {
-        label: "command spin round trip / cache-line ping-pong round trip",
-        num: "command.spin.rtt",
-        den: "floor.cacheline.rtt",
-        pct: Pct::P50,
-        goal: None,
-    },
-    RatioDef {
-        label: "command event round trip / futex ping-pong round trip",
-        num: "command.event.rtt",
-        den: "floor.futex.rtt",
-        pct: Pct::P50,
-        goal: Some(Goal::AtMost(1.5)),
-    },
-    RatioDef {
-        label: "driver wake-up (command event one-way) / futex wake-up (one-way)",
-        num: "command.event.oneway",
-        den: "floor.futex.oneway",
-        pct: Pct::P50,
-        goal: Some(Goal::AtMost(1.5)),
-    },
-    RatioDef {
-        label: "command event round trip / UDS blocking round trip",
-        num: "command.event.rtt",
-        den: "peers.uds.blocking.rtt",
-        pct: Pct::P50,
-        goal: Some(Goal::AtMost(0.8)),
-    },
-    RatioDef {
-        label: "iceoryx2 event round trip / futex ping-pong round trip",
-        num: "floor.event.rtt",
-        den: "floor.futex.rtt",
-        pct: Pct::P50,
-        goal: None,
-    },
-    RatioDef {
-        label: "iceoryx2 spin round trip / cache-line ping-pong round trip",
-        num: "floor.spin.rtt",
-        den: "floor.cacheline.rtt",
-        pct: Pct::P50,
-        goal: None,
-    },
-    RatioDef {
-        label: "futex round trip / cache-line round trip (physical cost of blocking)",
-        num: "floor.futex.rtt",
-        den: "floor.cacheline.rtt",
-        pct: Pct::P50,
-        goal: None,
-    },
-    RatioDef {
-        label: "command event round trip / floor event round trip",
-        num: "command.event.rtt",
-        den: "floor.event.rtt",
-        pct: Pct::P50,
-        goal: Some(Goal::AtMost(1.2)),
-    },
-    RatioDef {
-        label: "command event round trip / floor WaitSet-echo round trip",
-        num: "command.event.rtt",
-        den: "floor.waitset.rtt",
-        pct: Pct::P50,
-        goal: None,
-    },
-    RatioDef {
-        label: "floor WaitSet-echo round trip / floor event round trip",
-        num: "floor.waitset.rtt",
-        den: "floor.event.rtt",
-        pct: Pct::P50,
-        goal: None,
-    },
-    RatioDef {
-        label: "command event one-way / floor event one-way",
-        num: "command.event.oneway",
-        den: "floor.event.oneway",
-        pct: Pct::P50,
-        goal: None,
-    },
-    RatioDef {
-        label: "TCP spin round trip / command spin round trip",
-        num: "peers.tcp.spin.rtt",
-        den: "command.spin.rtt",
-        pct: Pct::P50,
-        goal: Some(Goal::AtLeast(10.0)),
-    },
-    RatioDef {
-        label: "UDS spin round trip / command spin round trip",
-        num: "peers.uds.spin.rtt",
-        den: "command.spin.rtt",
-        pct: Pct::P50,
-        goal: Some(Goal::AtLeast(5.0)),
-    },
-    RatioDef {
-        label: "TCP blocking round trip / command event round trip",
-        num: "peers.tcp.blocking.rtt",
-        den: "command.event.rtt",
-        pct: Pct::P50,
-        goal: Some(Goal::AtLeast(10.0)),
-    },
-    RatioDef {
-        label: "UDS blocking round trip / command event round trip",
-        num: "peers.uds.blocking.rtt",
-        den: "command.event.rtt",
-        pct: Pct::P50,
-        goal: Some(Goal::AtLeast(5.0)),
-    },
-    RatioDef {
-        label: "Pioneer GET_GEOM request / command event round trip",
-        num: "request.pioneer.rtt",
-        den: "command.event.rtt",
-        pct: Pct::P50,
-        goal: None,
-    },
-    RatioDef {
-        label: "floor event round trip / floor spin round trip (cost of blocking)",
-        num: "floor.event.rtt",
-        den: "floor.spin.rtt",
-        pct: Pct::P50,
-        goal: None,
-    },
-    RatioDef {
-        label: "state to 16 subscribers / to 1 subscriber",
-        num: "state.16.oneway",
-        den: "state.1.oneway",
-        pct: Pct::P50,
-        goal: None,
-    },
-    RatioDef {
-        label: "C command round trip / Rust command round trip (lang)",
-        num: "lang.c.rtt",
-        den: "lang.rust.rtt",
-        pct: Pct::P50,
-        goal: None,
-    },
-    RatioDef {
-        label: "Python command round trip / Rust command round trip (lang)",
-        num: "lang.python.rtt",
-        den: "lang.rust.rtt",
-        pct: Pct::P50,
-        goal: None,
-    },
-    RatioDef {
-        label: "command round trip through the Zenoh bridge pair / direct (bridge)",
-        num: "bridge.zenoh.rtt",
-        den: "bridge.direct.rtt",
-        pct: Pct::P50,
-        goal: None,
-    },
-    RatioDef {
-        label: "command round trip through the Zenoh bridge pair / direct (bridge)",
-        num: "bridge.zenoh.rtt",
-        den: "bridge.direct.rtt",
-        pct: Pct::P99,
-        goal: None,
-    },
-    RatioDef {
-        label: "command round trip through the Zenoh bridge pair / TCP loopback blocking round trip",
-        num: "bridge.zenoh.rtt",
-        den: "peers.tcp.blocking.rtt",
-        pct: Pct::P50,
-        goal: None,
-    },
-    RatioDef {
-        label: "GET_GEOM through the Player gateway / direct (gateway)",
-        num: "gateway.player.rtt",
-        den: "request.pioneer.rtt",
-        pct: Pct::P50,
-        goal: None,
-    },
-    RatioDef {
-        label: "GET_GEOM through the Player gateway / TCP loopback blocking round trip",
-        num: "gateway.player.rtt",
-        den: "peers.tcp.blocking.rtt",
-        pct: Pct::P50,
-        goal: None,
-    },
-    RatioDef {
-        label: "spinning driver's cost (arrival → bytes on the pty) / bare pty write(2)",
-        num: "loop.spin.driver",
-        den: "loop.spin.pty_write",
-        pct: Pct::P50,
-        goal: None,
-    },
-];
-
 /// A goal in time on one series of a run (issue 16's absolute goals): unlike the ratios they
 /// depend on the machine, and on this VM its compute speed varies (up to 1.8x between runs).
 #[derive(Debug, Clone, Copy)]
@@ -288,52 +83,6 @@ pub struct TimeGoalDef {
     /// the floor shows as such.
     pub floor: Option<(&'static str, &'static str)>,
 }
-
-/// The goals in time reported.
-pub const TIME_GOALS: &[TimeGoalDef] = &[
-    TimeGoalDef {
-        label: "Pioneer GET_GEOM request round trip",
-        id: "request.pioneer.rtt",
-        pct: Pct::P50,
-        at_most_ns: 16_000,
-        floor: None,
-    },
-    TimeGoalDef {
-        label: "spinning driver, command arrival → bytes on the pty",
-        id: "loop.spin.driver",
-        pct: Pct::P50,
-        at_most_ns: 2_000,
-        floor: Some(("loop.spin.pty_write", "the bare pty write(2) alone")),
-    },
-    TimeGoalDef {
-        label: "Pioneer SETPOSITION",
-        id: "ik.pioneer.position",
-        pct: Pct::P99,
-        at_most_ns: 100_000,
-        floor: None,
-    },
-    TimeGoalDef {
-        label: "numeric IK, 6 joints, pose",
-        id: "ik.chain6.pose",
-        pct: Pct::P50,
-        at_most_ns: 10_000,
-        floor: None,
-    },
-    TimeGoalDef {
-        label: "numeric IK, 6 joints, pose",
-        id: "ik.chain6.pose",
-        pct: Pct::P99,
-        at_most_ns: 100_000,
-        floor: None,
-    },
-    TimeGoalDef {
-        label: "numeric IK, 7 joints, pose",
-        id: "ik.chain7.pose",
-        pct: Pct::P99,
-        at_most_ns: 100_000,
-        floor: None,
-    },
-];
 
 /// A goal in time, as measured.
 #[derive(Debug, Clone, Serialize)]
@@ -442,6 +191,8 @@ pub struct Report {
     pub ratios: Vec<Ratio>,
     /// Goals in time on single series.
     pub time_goals: Vec<TimeGoal>,
+    /// What the processes cost (share of one core), idle and under load, with goals.
+    pub cpu: Vec<CpuCost>,
 }
 
 /// The floor of `m` of one kind: `(spin, blocking)` name the floor's series for each
@@ -613,7 +364,14 @@ impl Report {
             measurements: rows,
             ratios,
             time_goals,
+            cpu: Vec::new(),
         }
+    }
+
+    /// The report with the CPU costs measured in the run.
+    pub fn with_cpu(mut self, cpu: Vec<CpuCost>) -> Self {
+        self.cpu = cpu;
+        self
     }
 
     /// Scenarios that failed.
@@ -715,16 +473,18 @@ impl Report {
             t.push_str("\ngoals in time (this machine, this run):\n");
             for g in &self.time_goals {
                 let met = if g.met { "met" } else { "NOT met" };
+                let x = |f: &TimeGoalFloor| g.ns as f64 / f.ns.max(1) as f64;
                 let floor = match &g.floor {
                     Some(f) if f.ns > g.at_most_ns => {
                         format!(
-                            " (the goal is below its floor: {} takes {})",
+                            " (the goal is below its floor: {} takes {}; {:.2}x it)",
                             f.what,
-                            fmt_ns(f.ns)
+                            fmt_ns(f.ns),
+                            x(f)
                         )
                     }
-                    Some(f) => format!(" ({} takes {})", f.what, fmt_ns(f.ns)),
-                    None => String::new(),
+                    Some(f) => format!(" ({} takes {}; {:.2}x it)", f.what, fmt_ns(f.ns), x(f)),
+                    None => " (no floor)".to_string(),
                 };
                 t.push_str(&format!(
                     "  {:<72} {:>24}  goal <= {}: {met}{floor}\n",
@@ -734,6 +494,10 @@ impl Report {
                 ));
             }
         }
+        t.push_str(&crate::cpu::table(&self.cpu, |id| {
+            let r = self.measurements.iter().find(|r| r.id == id)?;
+            Some((r.summary.p50_ns, r.summary.p99_ns))
+        }));
         t
     }
 

@@ -12,6 +12,7 @@
 //! | `pioneer-driver` | request, loop | the emulator on a pty and the Pioneer driver on it |
 //! | `pioneer-driver-spin` | loop | the same, the driver busy-polling |
 //! | `{uds,tcp}-echo-{spin,blocking}` | peers | a socket echo with the same bytes |
+//! | `zenoh-echo` | bridge | raw Zenoh: a pong for each ping, a reply for each query |
 
 use std::io::Write;
 use std::time::{Duration, Instant};
@@ -46,6 +47,7 @@ pub fn run_role(role: &str, args: &BenchArgs) -> Result<(), BenchError> {
         "uds-echo-blocking" => peers::echo_role(args, peers::Transport::Uds, false),
         "tcp-echo-spin" => peers::echo_role(args, peers::Transport::Tcp, true),
         "tcp-echo-blocking" => peers::echo_role(args, peers::Transport::Tcp, false),
+        "zenoh-echo" => crate::scenario::zenoh_floor::echo_role(args),
         other => Err(BenchError::Args(format!("unknown role {other:?}"))),
     };
     if let Err(e) = &r {

@@ -5,20 +5,23 @@
 //! [`RunCtx::push`] — and listing it in [`registry`]; if it needs child processes, add a
 //! role to [`crate::roles::run_role`] (`request` and `loop`, in [`pty_loop`], are worked
 //! examples with a driver child). Ratios against the floor and
-//! the peers are defined in [`crate::report::RATIOS`].
+//! the peers are defined in [`crate::goals::RATIOS`].
 
 pub mod bridge;
 pub mod command;
+pub mod cpu;
 pub mod floor;
 pub mod gateway;
 pub mod ik;
 pub mod lang;
+pub mod many;
 pub mod peers;
 pub mod physical;
 pub mod pty_loop;
 pub mod request;
 pub mod state;
 pub mod traj;
+pub mod zenoh_floor;
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -26,6 +29,7 @@ use std::time::{Duration, Instant};
 use limber_services::Domain;
 use serde::Serialize;
 
+use crate::cpu::CpuCost;
 use crate::machine::Machine;
 use crate::stats::Measurement;
 use crate::{BenchArgs, BenchError, StrategyArg};
@@ -34,6 +38,84 @@ use crate::{BenchArgs, BenchError, StrategyArg};
 pub const READY_TIMEOUT: Duration = Duration::from_secs(15);
 /// How long one exchange may take before the run is declared hung.
 pub const SAMPLE_TIMEOUT: Duration = Duration::from_secs(2);
+
+/// How a floor's exchanges are spaced: back to back (the floor scenario), or at the rate
+/// of the path it is the floor of, so that each exchange starts with a wake-up after the
+/// same idle time as the path's (on a VM a wake-up after an idle millisecond costs more
+/// than one after a few microseconds).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pace {
+    /// Back to back: `floor.<key>.*`.
+    BackToBack,
+    /// One exchange per period, from a sleeping sender, as the `state` publisher does:
+    /// `<scenario>.paced.<key>.*`.
+    Paced {
+        /// The period.
+        period: Duration,
+        /// The scenario the floor belongs to (and the ids' first part).
+        scenario: &'static str,
+    },
+}
+
+impl Pace {
+    /// The scenario a measurement belongs to.
+    pub fn scenario(self) -> &'static str {
+        match self {
+            Pace::BackToBack => "floor",
+            Pace::Paced { scenario, .. } => scenario,
+        }
+    }
+    /// The measurement id `<prefix>.<key>.<suffix>`.
+    pub fn id(self, key: &str, suffix: &str) -> String {
+        match self {
+            Pace::BackToBack => format!("floor.{key}.{suffix}"),
+            Pace::Paced { scenario, .. } => format!("{scenario}.paced.{key}.{suffix}"),
+        }
+    }
+    /// What a label says about the pace (empty back to back).
+    pub fn label(self) -> String {
+        match self {
+            Pace::BackToBack => String::new(),
+            Pace::Paced { period, .. } => {
+                let hz = 1_000_000_000 / period.as_nanos().max(1);
+                if hz >= 1_000 && hz % 1_000 == 0 {
+                    format!(", {} kHz", hz / 1_000)
+                } else {
+                    format!(", {hz} Hz")
+                }
+            }
+        }
+    }
+    /// Warm-up and sample counts: `back_to_back` (default, quick) when back to back,
+    /// the state scenario's counts when paced (a few seconds at 1 kHz).
+    pub fn counts(self, ctx: &RunCtx, back_to_back: ((u64, u64), (u64, u64))) -> (u64, u64) {
+        let ((warm, warm_quick), (n, n_quick)) = match self {
+            Pace::BackToBack => back_to_back,
+            Pace::Paced { .. } => ((200, 50), (3_000, 300)),
+        };
+        (ctx.count(warm, warm_quick), ctx.count(n, n_quick))
+    }
+    /// A child's deadline for `n` exchanges of about `each` (back to back).
+    pub fn deadline(self, ctx: &RunCtx, n: u64, each: Duration) -> Duration {
+        match self {
+            Pace::BackToBack => ctx.deadline_for(n, each),
+            Pace::Paced { period, .. } => {
+                Duration::from_secs(30) + period * (n.min(u32::MAX as u64) as u32) * 3
+            }
+        }
+    }
+    /// Before exchange `i` (1-based) of a run that started at `start`: sleeps until its
+    /// time when paced.
+    pub fn wait_turn(self, start: Instant, i: u64) {
+        if let Pace::Paced { period, .. } = self {
+            let next = start + period * (i.min(u32::MAX as u64) as u32);
+            let now = Instant::now();
+            if next > now {
+                std::thread::sleep(next - now);
+            }
+        }
+    }
+}
 
 /// One benchmark scenario.
 pub trait Scenario {
@@ -63,6 +145,8 @@ pub fn registry() -> Vec<Box<dyn Scenario>> {
         Box::new(lang::Lang),
         Box::new(bridge::Bridge),
         Box::new(gateway::Gateway),
+        Box::new(cpu::Cpu),
+        Box::new(many::Many),
     ]
 }
 
@@ -148,6 +232,7 @@ pub struct RunCtx {
     /// Notes of the running scenario (e.g. a skipped variant).
     pub notes: Vec<String>,
     measurements: Vec<Measurement>,
+    cpu: Vec<CpuCost>,
 }
 
 impl RunCtx {
@@ -198,6 +283,7 @@ impl RunCtx {
             tmp,
             notes: Vec::new(),
             measurements: Vec::new(),
+            cpu: Vec::new(),
         })
     }
 
@@ -264,6 +350,23 @@ impl RunCtx {
     /// Takes the measurements.
     pub fn take_measurements(&mut self) -> Vec<Measurement> {
         std::mem::take(&mut self.measurements)
+    }
+
+    /// Adds what a process cost.
+    pub fn push_cpu(&mut self, c: CpuCost) {
+        self.cpu.push(c);
+    }
+
+    /// Takes the CPU costs.
+    pub fn take_cpu(&mut self) -> Vec<CpuCost> {
+        std::mem::take(&mut self.cpu)
+    }
+
+    /// The length of a CPU window: `default`, or `quick` in quick mode, scaled (at least
+    /// 100 ms).
+    pub fn window(&self, default: Duration, quick: Duration) -> Duration {
+        let base = if self.quick { quick } else { default };
+        base.mul_f64(self.scale).max(Duration::from_millis(100))
     }
 }
 

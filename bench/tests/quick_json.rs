@@ -259,11 +259,25 @@ fn bridge_measures_through_a_bridge_pair_or_says_why_not() {
         for m in v["measurements"].as_array().unwrap() {
             assert_eq!(m["strategy"], "blocking", "{m}");
         }
-        let ratio = v["ratios"]
-            .as_array()
-            .unwrap()
+        let ratios = v["ratios"].as_array().unwrap();
+        let ratio = ratios
             .iter()
-            .any(|r| r["num"] == "bridge.zenoh.rtt" && r["den"] == "bridge.direct.rtt");
+            .any(|r| r["num"] == "bridge.zenoh.rtt" && r["den"] == "bridge.direct.rtt")
+            // The goal against the raw Zenoh floor of the same run, at p50 and p99.
+            && ["p50", "p99"].iter().all(|pct| {
+                ratios.iter().any(|r| {
+                    r["num"] == "bridge.zenoh.rtt"
+                        && r["den"] == "bridge.raw.put.rtt"
+                        && r["pct"] == *pct
+                        && r["goal"]["at_most"] == 1.3
+                })
+            })
+            // The idle bridge pair's CPU, each with its goal.
+            && ["bridge expose", "bridge mirror"].iter().all(|p| {
+                v["cpu"].as_array().unwrap().iter().any(|c| {
+                    c["process"] == *p && c["load"] == "idle" && c["at_most_percent"] == 1.0
+                })
+            });
         (
             ids,
             ratio,
@@ -274,7 +288,9 @@ fn bridge_measures_through_a_bridge_pair_or_says_why_not() {
     let ci = std::env::var("CI").as_deref() == Ok("true");
     let (ids, ratio, detail, _) = run(&dir.join("bridge.json"), None);
     let measured = ids.contains(&"bridge.direct.rtt".to_string())
-        && ids.contains(&"bridge.zenoh.rtt".to_string());
+        && ids.contains(&"bridge.zenoh.rtt".to_string())
+        && ids.contains(&"bridge.raw.put.rtt".to_string())
+        && ids.contains(&"bridge.raw.get.rtt".to_string());
     if ci {
         assert!(measured, "the bridge rows are missing: {ids:?} ({detail})");
     } else {
@@ -306,6 +322,156 @@ fn gateway_measures_a_request_through_the_player_gateway() {
     let (s, ids, _, _) = run_only("gateway", &dir.join("gateway.json"), None);
     assert_eq!(ids, ["gateway.player.rtt"]);
     assert!(s["detail"].as_str().unwrap().contains("162 ms p50"), "{s}");
+    std::fs::remove_dir_all(&dir).expect("remove the test's directory");
+}
+
+/// `--only state`: the fan-outs at 1 kHz beside their floors paced at the same rate (a futex
+/// wake and a raw iceoryx2 event wake), and the goals stated against them in the ratios.
+#[test]
+fn state_measures_the_fanouts_beside_floors_paced_at_their_rate() {
+    let dir = std::env::temp_dir().join(format!("limber-bench-state-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (_, ids, v, _) = run_only("state", &dir.join("state.json"), None);
+    for id in [
+        "state.paced.futex.oneway",
+        "state.paced.event.oneway",
+        "state.1.oneway",
+        "state.4.oneway",
+        "state.16.oneway",
+    ] {
+        assert!(ids.iter().any(|i| i == id), "{id} missing from {ids:?}");
+    }
+    let ratios = v["ratios"].as_array().unwrap();
+    let goal = |num: &str, den: &str, pct: &str| {
+        let r = ratios
+            .iter()
+            .find(|r| r["num"] == num && r["den"] == den && r["pct"] == pct)
+            .unwrap_or_else(|| panic!("no ratio {num} / {den} ({pct}) in {ratios:?}"));
+        let at_most = r["goal"]["at_most"].as_f64().expect("a goal");
+        let value = r["value"].as_f64().unwrap();
+        assert_eq!(r["met"].as_bool().unwrap(), value <= at_most, "{r}");
+        at_most
+    };
+    assert_eq!(
+        goal("state.1.oneway", "state.paced.event.oneway", "p50"),
+        1.3
+    );
+    assert_eq!(
+        goal("state.1.oneway", "state.paced.event.oneway", "p99"),
+        2.0
+    );
+    assert_eq!(goal("state.16.oneway", "state.1.oneway", "p50"), 2.0);
+    std::fs::remove_dir_all(&dir).expect("remove the test's directory");
+}
+
+/// `--results DIR`: the run as `DIR/latest.md` (the machine, the exact command, the table,
+/// the goals missed) and `DIR/latest.json`.
+#[test]
+fn results_writes_the_run_with_its_machine_and_command() {
+    let dir = std::env::temp_dir().join(format!("limber-bench-results-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = limber_bounded_run::output_within(
+        Command::new(env!("CARGO_BIN_EXE_limber-bench"))
+            .args(["--quick", "--scale", "0.1", "--no-progress", "--only", "ik"])
+            .arg("--results")
+            .arg(&dir),
+        Duration::from_secs(300),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let md = std::fs::read_to_string(dir.join("latest.md")).unwrap();
+    for part in [
+        "| CPU |",
+        "| cores | ",
+        "| kernel |",
+        "| load average",
+        "| build |",
+    ] {
+        assert!(md.contains(part), "{part} missing from {md}");
+    }
+    assert!(
+        md.contains("--quick --scale 0.1 --no-progress --only ik --results"),
+        "{md}"
+    );
+    assert!(md.contains("numeric IK, 6 joints, pose (p50)"), "{md}");
+    assert!(
+        md.contains("Goals **not met** in this run")
+            || md.contains("Every goal of this run was met"),
+        "{md}"
+    );
+    let v: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("latest.json")).unwrap()).unwrap();
+    assert_eq!(v["scenarios"][0]["name"], "ik");
+    // A directory that does not exist is refused before the run.
+    let out = limber_bounded_run::output_within(
+        Command::new(env!("CARGO_BIN_EXE_limber-bench"))
+            .args(["--quick", "--only", "ik", "--results"])
+            .arg(dir.join("missing")),
+        Duration::from_secs(60),
+    );
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--results"));
+    assert!(out.stdout.is_empty());
+    std::fs::remove_dir_all(&dir).expect("remove the test's directory");
+}
+
+/// `--only many` (quick: 1 and 4 drivers, 16 clients): listing the domain and a command's
+/// round trip for each number of drivers, and the memory per driver and per client in the
+/// notes.
+#[test]
+fn many_measures_listing_round_trips_and_memory_per_number_of_drivers() {
+    let dir = std::env::temp_dir().join(format!("limber-bench-many-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (s, ids, _, _) = run_only("many", &dir.join("many.json"), None);
+    for n in [1, 4] {
+        for what in ["list", "rtt"] {
+            let id = format!("many.{n}.{what}");
+            assert!(ids.contains(&id), "{id} missing from {ids:?}");
+        }
+        let detail = s["detail"].as_str().unwrap();
+        assert!(
+            detail.contains(&format!("{n} driver(s), 16 clients: per driver RSS ")),
+            "{detail}"
+        );
+        assert!(detail.contains("per client "), "{detail}");
+    }
+    std::fs::remove_dir_all(&dir).expect("remove the test's directory");
+}
+
+/// `--only cpu`: the driver's and the client's CPU per second, idle and at 1 kHz of
+/// commands, for each mode that runs here, beside the round trip at that load; the idle
+/// event-driven driver carries its goal.
+#[test]
+fn cpu_reports_what_each_mode_costs_beside_its_latency() {
+    let dir = std::env::temp_dir().join(format!("limber-bench-cpu-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (_, ids, v, _) = run_only("cpu", &dir.join("cpu.json"), None);
+    let cpu = v["cpu"].as_array().unwrap();
+    for mode in ["event", "linger"] {
+        assert!(ids.contains(&format!("cpu.{mode}.rtt")), "{ids:?}");
+        for load in ["idle", "1khz"] {
+            for process in ["driver", "client"] {
+                let id = format!("cpu.{mode}.{load}.{process}");
+                let c = cpu
+                    .iter()
+                    .find(|c| c["id"] == id.as_str())
+                    .unwrap_or_else(|| panic!("{id} missing from {cpu:?}"));
+                assert!(c["percent"].as_f64().unwrap() >= 0.0, "{c}");
+                assert!(c["window_s"].as_f64().unwrap() > 0.0, "{c}");
+                if load == "1khz" {
+                    assert_eq!(c["latency_id"], format!("cpu.{mode}.rtt"), "{c}");
+                }
+            }
+        }
+    }
+    let idle = cpu
+        .iter()
+        .find(|c| c["id"] == "cpu.event.idle.driver")
+        .unwrap();
+    assert_eq!(idle["at_most_percent"], 1.0);
     std::fs::remove_dir_all(&dir).expect("remove the test's directory");
 }
 

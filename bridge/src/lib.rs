@@ -16,6 +16,7 @@
 
 pub mod access;
 pub mod allow;
+mod dirwatch;
 pub mod expose;
 mod inbox;
 pub mod keys;

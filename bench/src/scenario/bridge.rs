@@ -8,6 +8,9 @@
 //! direct row), then the one in B (the bridge row); the report sets the bridge row beside
 //! the TCP loopback peer row of the same run (`peers`).
 //!
+//! Its floor runs first, in the same run: raw Zenoh between two processes over a Unix
+//! socket, a put/subscribe ping-pong and a get/queryable exchange ([`zenoh_floor`]).
+//!
 //! The bridges are the `limber` executable: `$LIMBER_BIN` if set, else this executable if
 //! it is `limber`, else `limber` beside it. If none can run `limber bridge` (e.g.
 //! `limber-bench` alone, or a `limber` built without its `bridge` feature), the scenario
@@ -25,9 +28,10 @@ use limber_services::{Role, monotonic_ns};
 use super::command::{DEVICE, start_event_driver};
 use super::floor::BYTES;
 use super::lang::run_bounded;
-use super::{READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario};
+use super::{READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario, zenoh_floor};
 use crate::BenchError;
 use crate::child::ChildProc;
+use crate::cpu::{self, CpuCost};
 use crate::progress::Progress;
 use crate::stats::{Measurement, Metric, Strategy, new_histogram};
 
@@ -117,6 +121,8 @@ fn start_bridge(
 fn run(ctx: &mut RunCtx, exe: &Path) -> Result<(), BenchError> {
     let (a, b) = (ctx.domain(), ctx.domain());
     let (warm, n) = (ctx.count(300, 50), ctx.count(3_000, 300));
+    // The floor first: raw Zenoh over the same kind of link, same payloads.
+    zenoh_floor::run(ctx, warm, n)?;
     // Two clients, one after the other; through the bridge an exchange takes ~1 ms or less.
     let deadline = ctx.deadline_for(2 * (warm + n), Duration::from_millis(1));
     let driver = start_event_driver(ctx, &a, "bridge-driver.hdr", deadline)?;
@@ -142,6 +148,7 @@ fn run(ctx: &mut RunCtx, exe: &Path) -> Result<(), BenchError> {
             &format!("mirrored {DEVICE} as {DEVICE}"),
             deadline,
         )?;
+        idle_cost(ctx, &driver, &expose, &mirror)?;
         let rtt_direct = round_trips(ctx, &mut direct, "bridge direct", warm, n)?;
         let cctx_b = Context::new(&b, Role::Client, "bench-bridge")
             .map_err(|e| err("client context in B", e))?;
@@ -171,6 +178,47 @@ fn run(ctx: &mut RunCtx, exe: &Path) -> Result<(), BenchError> {
         "command→outcome through bridge expose+mirror (Zenoh, Unix socket)",
         rtt_bridge,
     );
+    Ok(())
+}
+
+/// The most an idle bridge of the pair may cost, percent of a core.
+pub const IDLE_BRIDGE_GOAL: f64 = 1.0;
+
+/// The CPU time of the idle pair (both bridges up, the device mirrored, nothing sent) and
+/// of the driver beside them, per second of wall time.
+fn idle_cost(
+    ctx: &mut RunCtx,
+    driver: &ChildProc,
+    expose: &ChildProc,
+    mirror: &ChildProc,
+) -> Result<(), BenchError> {
+    let window = ctx.window(Duration::from_secs(5), Duration::from_secs(1));
+    if ctx.progress {
+        eprintln!("  bridge idle: CPU over {window:?}");
+    }
+    let shares = cpu::idle(
+        &[
+            ("bridge expose", expose.pid()),
+            ("bridge mirror", mirror.pid()),
+            ("driver", driver.pid()),
+        ],
+        window,
+    )
+    .map_err(|e| err("cpu time", e))?;
+    for (process, percent) in shares {
+        let goal = process.starts_with("bridge").then_some(IDLE_BRIDGE_GOAL);
+        ctx.push_cpu(CpuCost {
+            id: format!("bridge.idle.{}", process.replace(' ', "_")),
+            scenario: "bridge",
+            mode: "bridge pair".into(),
+            load: "idle".into(),
+            process,
+            percent,
+            window_s: window.as_secs_f64(),
+            latency_id: None,
+            at_most_percent: goal,
+        });
+    }
     Ok(())
 }
 

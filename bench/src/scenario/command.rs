@@ -328,7 +328,10 @@ pub fn driver_role(args: &BenchArgs, spin: bool) -> Result<(), BenchError> {
     let deadline = roles::child_deadline(args);
     let ctx = Context::new(&domain, Role::Driver, "bench-driver")
         .map_err(|e| ctx_err("driver context")(e.to_string()))?;
-    let device: DeviceName = DEVICE
+    let device: DeviceName = args
+        .device
+        .as_deref()
+        .unwrap_or(DEVICE)
         .parse()
         .map_err(|e: limber_services::NameError| ctx_err("device")(e.to_string()))?;
     let mut host = DeviceHost::<ActArray>::new(&ctx, &device, "bench")

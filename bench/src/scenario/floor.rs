@@ -24,7 +24,7 @@ use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PsFactory
 use limber_interfaces::prelude::*;
 use limber_services::monotonic_ns;
 
-use super::{READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario, physical};
+use super::{Pace, READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario, physical};
 use crate::child::{ChildProc, ChildSpec, read_histogram};
 use crate::progress::Progress;
 use crate::roles;
@@ -52,13 +52,13 @@ impl Scenario for Floor {
     }
     fn run(&self, ctx: &mut RunCtx) -> Result<(), BenchError> {
         if ctx.spin_enabled() {
-            physical::ping_pong(ctx, physical::Wait::Spin)?;
-            ping_pong(ctx, Echo::Spin)?;
+            physical::ping_pong(ctx, physical::Wait::Spin, Pace::BackToBack)?;
+            ping_pong(ctx, Echo::Spin, Pace::BackToBack)?;
         }
         if ctx.blocking_enabled() {
-            physical::ping_pong(ctx, physical::Wait::Futex)?;
-            ping_pong(ctx, Echo::Listener)?;
-            ping_pong(ctx, Echo::WaitSet)?;
+            physical::ping_pong(ctx, physical::Wait::Futex, Pace::BackToBack)?;
+            ping_pong(ctx, Echo::Listener, Pace::BackToBack)?;
+            ping_pong(ctx, Echo::WaitSet, Pace::BackToBack)?;
         }
         Ok(())
     }
@@ -234,7 +234,9 @@ fn sync(
     }
 }
 
-fn ping_pong(ctx: &mut RunCtx, echo: Echo) -> Result<(), BenchError> {
+/// Runs the raw iceoryx2 floor with `echo`, spaced as `pace` says, and adds its three
+/// measurements.
+pub fn ping_pong(ctx: &mut RunCtx, echo: Echo, pace: Pace) -> Result<(), BenchError> {
     let event = echo != Echo::Spin;
     let domain = ctx.domain();
     let node = roles::raw_node(&domain)?;
@@ -270,9 +272,9 @@ fn ping_pong(ctx: &mut RunCtx, echo: Echo) -> Result<(), BenchError> {
         (None, None)
     };
     let (warm, n) = if event {
-        (ctx.count(500, 100), ctx.count(5_000, 1_000))
+        pace.counts(ctx, ((500, 100), (5_000, 1_000)))
     } else {
-        (ctx.count(5_000, 1_000), ctx.count(100_000, 10_000))
+        pace.counts(ctx, ((5_000, 1_000), (100_000, 10_000)))
     };
     let out = ctx.tmp_file(&format!("{tag}.hdr"));
     let mut child = ChildProc::spawn(&ChildSpec {
@@ -281,7 +283,7 @@ fn ping_pong(ctx: &mut RunCtx, echo: Echo) -> Result<(), BenchError> {
         out: Some(out.clone()),
         cpu: ctx.child_cpu(),
         warmup: warm,
-        deadline: ctx.deadline_for(warm + n, Duration::from_micros(100)),
+        deadline: pace.deadline(ctx, warm + n, Duration::from_micros(100)),
         ..Default::default()
     })?;
     child.expect("ready", READY_TIMEOUT)?;
@@ -294,9 +296,11 @@ fn ping_pong(ctx: &mut RunCtx, echo: Echo) -> Result<(), BenchError> {
 
     let mut rtt = new_histogram()?;
     let mut back = new_histogram()?;
-    let label = format!("floor {}", echo.key());
+    let label = format!("{} {}{}", pace.scenario(), echo.key(), pace.label());
     let progress = Progress::new(ctx.progress, &label, warm + n);
+    let start = Instant::now();
     for seq in 1..=warm + n {
+        pace.wait_turn(start, seq);
         let t0 = monotonic_ns();
         send_ping(&publisher, seq, 0)?;
         notify(notifier.as_ref())?;
@@ -324,9 +328,10 @@ fn ping_pong(ctx: &mut RunCtx, echo: Echo) -> Result<(), BenchError> {
     } else {
         ""
     };
+    let via = format!("{via}{}", pace.label());
     ctx.push(Measurement {
-        scenario: "floor",
-        id: format!("floor.{key}.rtt"),
+        scenario: pace.scenario(),
+        id: pace.id(key, "rtt"),
         label: format!("iceoryx2 ping-pong{via}"),
         strategy,
         metric: Metric::RoundTrip,
@@ -334,8 +339,8 @@ fn ping_pong(ctx: &mut RunCtx, echo: Echo) -> Result<(), BenchError> {
         hist: rtt,
     });
     ctx.push(Measurement {
-        scenario: "floor",
-        id: format!("floor.{key}.oneway"),
+        scenario: pace.scenario(),
+        id: pace.id(key, "oneway"),
         label: format!("iceoryx2 ping→echo{via}"),
         strategy,
         metric: Metric::OneWay,
@@ -343,8 +348,8 @@ fn ping_pong(ctx: &mut RunCtx, echo: Echo) -> Result<(), BenchError> {
         hist: oneway,
     });
     ctx.push(Measurement {
-        scenario: "floor",
-        id: format!("floor.{key}.back"),
+        scenario: pace.scenario(),
+        id: pace.id(key, "back"),
         label: format!("iceoryx2 echo→ping{via}"),
         strategy,
         metric: Metric::OneWay,

@@ -92,7 +92,7 @@ fn run(ctx: &mut RunCtx) -> Result<(), BenchError> {
         match c_client(ctx) {
             Err(why) => skip(ctx, "C", why),
             Ok(exe) => {
-                let (state, rtt) =
+                let (state, rtt, _) =
                     external(ctx, "C", Command::new(exe), &domain, warm, n, deadline)?;
                 push(ctx, "c", "C", state, rtt);
             }
@@ -100,8 +100,18 @@ fn run(ctx: &mut RunCtx) -> Result<(), BenchError> {
         match python(ctx) {
             Err(why) => skip(ctx, "Python", why),
             Ok(cmd) => {
-                let (state, rtt) = external(ctx, "Python", cmd, &domain, warm, n, deadline)?;
+                let (state, rtt, ffi) = external(ctx, "Python", cmd, &domain, warm, n, deadline)?;
                 push(ctx, "python", "Python", state, rtt);
+                // Python's floor: one ctypes call that does nothing else.
+                ctx.push(Measurement {
+                    scenario: "lang",
+                    id: "lang.python.ffi".into(),
+                    label: "Python: one ctypes call into liblimber, no work".into(),
+                    strategy: Strategy::Compute,
+                    metric: Metric::Read,
+                    bytes: None,
+                    hist: ffi,
+                });
             }
         }
         Ok(())
@@ -287,8 +297,12 @@ fn python(ctx: &RunCtx) -> Result<Command, String> {
     Ok(cmd)
 }
 
+/// An external client's samples: state reads, round trips, single calls into liblimber
+/// (Python's; empty from C).
+type Samples = (Histogram<u64>, Histogram<u64>, Histogram<u64>);
+
 /// Runs an external client (`cmd WARMUP COUNT OUT`) in the scenario's domain and reads its
-/// samples.
+/// samples: state reads, round trips, and (Python) single calls into liblimber.
 fn external(
     ctx: &RunCtx,
     lang: &str,
@@ -297,7 +311,7 @@ fn external(
     warm: u64,
     n: u64,
     limit: Duration,
-) -> Result<(Histogram<u64>, Histogram<u64>), BenchError> {
+) -> Result<Samples, BenchError> {
     let out = ctx.tmp_file(&format!("lang-{lang}.txt"));
     // The exchanges run in the client's process: announced, not ticked.
     crate::progress::Progress::new(ctx.progress, &format!("lang {lang}"), warm + n).finish();
@@ -321,7 +335,7 @@ fn external(
     }
     let text =
         std::fs::read_to_string(&out).map_err(|e| BenchError::io(out.display().to_string(), e))?;
-    let (mut state, mut rtt) = (new_histogram()?, new_histogram()?);
+    let (mut state, mut rtt, mut ffi) = (new_histogram()?, new_histogram()?, new_histogram()?);
     for line in text.lines() {
         let bad = || BenchError::ChildFailed {
             role: format!("{lang} client"),
@@ -332,16 +346,18 @@ fn external(
         match kind {
             "state" => state.saturating_record(ns),
             "rtt" => rtt.saturating_record(ns),
+            "ffi" => ffi.saturating_record(ns),
             _ => return Err(bad()),
         }
     }
+
     if state.len() != n || rtt.len() != n {
         return Err(BenchError::ChildFailed {
             role: format!("{lang} client"),
             reason: format!("{} and {} samples, not {n}", state.len(), rtt.len()),
         });
     }
-    Ok((state, rtt))
+    Ok((state, rtt, ffi))
 }
 
 fn push(ctx: &mut RunCtx, key: &str, lang: &str, state: Histogram<u64>, rtt: Histogram<u64>) {

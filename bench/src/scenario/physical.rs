@@ -21,7 +21,7 @@ use limber_services::monotonic_ns;
 use rustix::mm::{MapFlags, ProtFlags};
 use rustix::thread::futex;
 
-use super::{READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT};
+use super::{Pace, READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT};
 use crate::child::{ChildProc, ChildSpec, read_histogram};
 use crate::progress::Progress;
 use crate::stats::{Measurement, Metric, Strategy, new_histogram};
@@ -210,22 +210,29 @@ fn await_change(line: &Line, old: u32, wait: Wait, deadline: Instant) -> Option<
     }
 }
 
-/// Runs the physical floor with `wait` and adds its three measurements.
-pub fn ping_pong(ctx: &mut RunCtx, wait: Wait) -> Result<(), BenchError> {
+/// Runs the physical floor with `wait`, spaced as `pace` says, and adds its three
+/// measurements.
+pub fn ping_pong(ctx: &mut RunCtx, wait: Wait, pace: Pace) -> Result<(), BenchError> {
     let path = page_path(ctx, wait);
     let shared = Shared::map(&path, true)?;
-    let result = run(ctx, wait, &shared, &path);
+    let result = run(ctx, wait, pace, &shared, &path);
     if let Err(e) = std::fs::remove_file(&path) {
         tracing::warn!("cannot remove {}: {e}", path.display());
     }
     result
 }
 
-fn run(ctx: &mut RunCtx, wait: Wait, shared: &Shared, path: &Path) -> Result<(), BenchError> {
+fn run(
+    ctx: &mut RunCtx,
+    wait: Wait,
+    pace: Pace,
+    shared: &Shared,
+    path: &Path,
+) -> Result<(), BenchError> {
     let page = shared.page();
     let (warm, n) = match wait {
-        Wait::Futex => (ctx.count(1_000, 100), ctx.count(20_000, 2_000)),
-        Wait::Spin => (ctx.count(10_000, 1_000), ctx.count(200_000, 20_000)),
+        Wait::Futex => pace.counts(ctx, ((1_000, 100), (20_000, 2_000))),
+        Wait::Spin => pace.counts(ctx, ((10_000, 1_000), (200_000, 20_000))),
     };
     let key = wait.key();
     let out = ctx.tmp_file(&format!("{key}.hdr"));
@@ -235,19 +242,25 @@ fn run(ctx: &mut RunCtx, wait: Wait, shared: &Shared, path: &Path) -> Result<(),
         out: Some(out.clone()),
         cpu: ctx.child_cpu(),
         warmup: warm,
-        deadline: ctx.deadline_for(warm + n, Duration::from_micros(50)),
+        deadline: pace.deadline(ctx, warm + n, Duration::from_micros(50)),
         ..Default::default()
     })?;
     child.expect("ready", READY_TIMEOUT)?;
 
     let mut rtt = new_histogram()?;
     let mut back = new_histogram()?;
-    let progress = Progress::new(ctx.progress, &format!("floor {key}"), warm + n);
+    let progress = Progress::new(
+        ctx.progress,
+        &format!("{} {key}{}", pace.scenario(), pace.label()),
+        warm + n,
+    );
     let total = u32::try_from(warm + n)
         .ok()
         .filter(|t| *t < STOP)
         .ok_or_else(|| BenchError::Args(format!("too many samples for the {key} floor")))?;
+    let start = Instant::now();
     for seq in 1..=total {
+        pace.wait_turn(start, u64::from(seq));
         let t0 = monotonic_ns();
         publish(&page.ping, seq, wait);
         let deadline = Instant::now() + SAMPLE_TIMEOUT;
@@ -279,14 +292,25 @@ fn run(ctx: &mut RunCtx, wait: Wait, shared: &Shared, path: &Path) -> Result<(),
         Wait::Futex => (Strategy::Blocking, "futex ping-pong (shm)"),
         Wait::Spin => (Strategy::Spin, "cache-line ping-pong (shm)"),
     };
+    let paced = pace.label();
     for (suffix, metric, label, hist) in [
-        ("rtt", Metric::RoundTrip, what.to_string(), rtt),
-        ("oneway", Metric::OneWay, format!("{key} ping→echo"), oneway),
-        ("back", Metric::OneWay, format!("{key} echo→ping"), back),
+        ("rtt", Metric::RoundTrip, format!("{what}{paced}"), rtt),
+        (
+            "oneway",
+            Metric::OneWay,
+            format!("{key} ping→echo{paced}"),
+            oneway,
+        ),
+        (
+            "back",
+            Metric::OneWay,
+            format!("{key} echo→ping{paced}"),
+            back,
+        ),
     ] {
         ctx.push(Measurement {
-            scenario: "floor",
-            id: format!("floor.{key}.{suffix}"),
+            scenario: pace.scenario(),
+            id: pace.id(key, suffix),
             label,
             strategy,
             metric,

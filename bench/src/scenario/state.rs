@@ -4,6 +4,11 @@
 //! cores, so nobody spins here. One-way latency: the state's `header.stamp_ns` (taken
 //! just before `publish`) against the subscriber's clock when `wait_state` returned.
 //! Samples of all subscribers of one fan-out are merged into one histogram.
+//!
+//! Its floors run first, at the same rate (`state.paced.futex.*`, `state.paced.event.*`):
+//! the physical futex ping-pong and the raw iceoryx2 event ping-pong of `floor`, one
+//! exchange per millisecond from a sleeping sender, so that the echo's wake-up
+//! (`*.oneway`) comes after the idle millisecond a subscriber's does.
 
 use std::time::{Duration, Instant};
 
@@ -12,8 +17,8 @@ use limber_services::prelude::*;
 use limber_services::{Role, WaitError, monotonic_ns};
 
 use super::command::DEVICE;
-use super::floor::BYTES;
-use super::{READY_TIMEOUT, RunCtx, Scenario};
+use super::floor::{self, BYTES, Echo};
+use super::{Pace, READY_TIMEOUT, RunCtx, Scenario, physical};
 use crate::child::{ChildProc, ChildSpec, read_histogram};
 use crate::roles;
 use crate::stats::{Measurement, Metric, Strategy, new_histogram};
@@ -35,7 +40,7 @@ impl Scenario for StateFanout {
         "state"
     }
     fn description(&self) -> &'static str {
-        "driver publishes the arm state at 1 kHz; 1, 4, 16 subscriber processes block on the notify event (one-way)"
+        "driver publishes the arm state at 1 kHz; 1, 4, 16 subscriber processes block on the notify event (one-way); beside it its floors paced at the same 1 kHz: a futex wake and a raw iceoryx2 event wake"
     }
     fn run(&self, ctx: &mut RunCtx) -> Result<(), BenchError> {
         if !ctx.blocking_enabled() {
@@ -43,6 +48,15 @@ impl Scenario for StateFanout {
                 .push("state runs blocking subscribers only; skipped by --strategy spin".into());
             return Ok(());
         }
+        // The floors at the path's rate, in the same run: a wake-up after an idle
+        // millisecond, through a futex (the kernel alone) and through a raw iceoryx2 event
+        // (a sample, `notify`, a listener blocked in `timed_wait`).
+        let pace = Pace::Paced {
+            period: PERIOD,
+            scenario: "state",
+        };
+        physical::ping_pong(ctx, physical::Wait::Futex, pace)?;
+        floor::ping_pong(ctx, Echo::Listener, pace)?;
         for fan in FANOUTS {
             fanout(ctx, fan)?;
         }
