@@ -106,13 +106,9 @@ pub fn page(report: &Report, command: &str) -> String {
         let _ = writeln!(t, "| scenarios failed | {failed} |");
     }
     let _ = writeln!(t, "\nThe command:\n");
-    let first = command
-        .split(' ')
-        .find(|w| !w.contains('='))
-        .unwrap_or_default();
     let _ = writeln!(
         t,
-        "<!-- not run by tests: {first} | a benchmark run, minutes long, recorded as it ran -->"
+        "<!-- not run by tests: * | a benchmark run, minutes long, recorded as it ran -->"
     );
     let _ = writeln!(t, "```sh\n{command}\n```\n");
     let missed: Vec<String> = report
