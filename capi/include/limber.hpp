@@ -462,6 +462,14 @@ public:
     limber_ticket Store() { return Send(limber_gripper_store); }
     /// CMD RETRIEVE.
     limber_ticket Retrieve() { return Send(limber_gripper_retrieve); }
+    /// CMD GOAL: the fingers to `gap` m, with at most `effort` N, at `speed` m/s (0: the
+    /// gripper's own); WaitDone gives REACHED or STALLED (status OBJECT_PRESENT when the
+    /// beams see an object).
+    limber_ticket Goal(double gap, double effort = 0.0, double speed = 0.0) {
+        limber_ticket t{};
+        detail::Check(limber_gripper_goal(h_, gap, effort, speed, &t));
+        return t;
+    }
 
 private:
     limber_ticket Send(limber_code (*cmd)(limber_gripper*, limber_ticket*)) {

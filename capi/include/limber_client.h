@@ -986,6 +986,22 @@ limber_code limber_gripper_open(limber_gripper *h, struct limber_ticket *ticket)
 limber_code limber_gripper_close(limber_gripper *h, struct limber_ticket *ticket);
 
 /*
+ CMD GOAL: moves the fingers to `gap` m with at most `effort` N at `speed` m/s (0: the
+ gripper's own effort, its configured speed). `limber_device_wait_done` gives the
+ result: REACHED, or STALLED on an object, with status `LIMBER_STATUS_OBJECT_PRESENT`
+ when the break beams see one. A gripper that cannot set one of them refuses the goal
+ (`LIMBER_STATUS_GAP_NOT_SETTABLE`, `..._EFFORT_...`, `..._SPEED_...`).
+
+ # Safety
+ `h` is NULL or a live handle; `ticket` is NULL or writable.
+ */
+limber_code limber_gripper_goal(limber_gripper *h,
+                                double gap,
+                                double effort,
+                                double speed,
+                                struct limber_ticket *ticket);
+
+/*
  CMD STOP: stops the gripper where it is.
 
  # Safety

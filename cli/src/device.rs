@@ -253,6 +253,19 @@ pub enum GripperVerb {
     Store,
     /// Retrieve a stored object.
     Retrieve,
+    /// Move the fingers to a gap, m. With --wait the result: reached, or stalled on an
+    /// object (exit 1), "an object is between the fingers" when the beams see one. A
+    /// gripper that cannot set the gap, the effort or the speed refuses (exit 5).
+    Goal {
+        /// The gap between the fingers, m (0: closed).
+        gap: f64,
+        /// The largest grip effort, N (0: the gripper's own).
+        #[arg(long, default_value_t = 0.0)]
+        effort: f64,
+        /// The fingers' speed, m/s (0: the configured speed).
+        #[arg(long, default_value_t = 0.0)]
+        speed: f64,
+    },
     /// Print the geometry (request).
     Geom,
 }
@@ -601,6 +614,7 @@ pub fn gripper(a: GripperArgs) -> Result<(), CliError> {
         GripperVerb::Stop => c.stop(),
         GripperVerb::Store => c.store(),
         GripperVerb::Retrieve => c.retrieve(),
+        GripperVerb::Goal { gap, effort, speed } => c.goal(gap, effort, speed),
         GripperVerb::Geom => {
             let g = c.geometry().map_err(request_err)?;
             let p = g.pose.position;

@@ -11,7 +11,7 @@ pub const MAX_ACTUATORS: usize = 32;
 
 wire_struct! {
     /// A point or vector in 3D (Player's `point_3d`), metres or unitless.
-    pub struct Vec3 : "limber.v3.Vec3", size = 24, align = 8 {
+    pub struct Vec3 : "limber.v4.Vec3", size = 24, align = 8 {
         /// x (forward in the robot frame).
         pub x: f64,
         /// y (left).
@@ -23,7 +23,7 @@ wire_struct! {
 
 wire_struct! {
     /// Roll, pitch and yaw in radians (Player's `orientation_3d`).
-    pub struct Orientation3 : "limber.v3.Orientation3", size = 24, align = 8 {
+    pub struct Orientation3 : "limber.v4.Orientation3", size = 24, align = 8 {
         /// Rotation about x.
         pub roll: f64,
         /// Rotation about y.
@@ -35,7 +35,7 @@ wire_struct! {
 
 wire_struct! {
     /// A 3D pose (Player's `pose3d`): position in metres, orientation in radians.
-    pub struct Pose3 : "limber.v3.Pose3", size = 48, align = 8 {
+    pub struct Pose3 : "limber.v4.Pose3", size = 48, align = 8 {
         /// Position.
         pub position: Vec3,
         /// Orientation.
@@ -45,7 +45,7 @@ wire_struct! {
 
 wire_struct! {
     /// A box size in metres (Player's `bbox3d`).
-    pub struct Bbox3 : "limber.v3.Bbox3", size = 24, align = 8 {
+    pub struct Bbox3 : "limber.v4.Bbox3", size = 24, align = 8 {
         /// Width (along y).
         pub width: f64,
         /// Length (along x).
@@ -58,7 +58,7 @@ wire_struct! {
 wire_struct! {
     /// The outcome of the last command a driver applied, carried in every state sample so
     /// the sender of a command sees whether (and why not) it was carried out.
-    pub struct CmdOutcome : "limber.v3.CmdOutcome", size = 24, align = 8 {
+    pub struct CmdOutcome : "limber.v4.CmdOutcome", size = 24, align = 8 {
         /// The client that sent it (0: no command applied yet).
         pub client_id: u64,
         /// That client's sequence number of the command.
@@ -72,7 +72,7 @@ wire_struct! {
 
 wire_struct! {
     /// The header of every state sample.
-    pub struct StateHeader : "limber.v3.StateHeader", size = 48, align = 8 {
+    pub struct StateHeader : "limber.v4.StateHeader", size = 48, align = 8 {
         /// Sample sequence number, +1 per published sample of this device.
         pub seq: u64,
         /// `CLOCK_MONOTONIC` time in ns at which the state was acquired (e.g. when the
@@ -89,7 +89,7 @@ wire_struct! {
 
 wire_struct! {
     /// Metadata in front of every command and every request.
-    pub struct MsgMeta : "limber.v3.MsgMeta", size = 32, align = 8 {
+    pub struct MsgMeta : "limber.v4.MsgMeta", size = 32, align = 8 {
         /// The sending client (unique per client in a domain; never 0).
         pub client_id: u64,
         /// The client's sequence number, +1 per message it sends on this channel.
@@ -105,7 +105,7 @@ wire_struct! {
 
 wire_struct! {
     /// Metadata in front of every reply.
-    pub struct ReplyMeta : "limber.v3.ReplyMeta", size = 32, align = 8 {
+    pub struct ReplyMeta : "limber.v4.ReplyMeta", size = 32, align = 8 {
         /// The client whose request this answers.
         pub client_id: u64,
         /// The request's sequence number.
@@ -175,11 +175,22 @@ pub enum Status {
     NothingToStore = 19,
     /// The gripper's store is empty: RETRIEVE has nothing to give back.
     NothingStored = 20,
+    /// A gripper motion ended with an object between the fingers (the break beams see
+    /// it): the cause a gripper goal's result carries, `STALLED` when the fingers stopped
+    /// on it short of the goal.
+    ObjectPresent = 30,
+    /// This gripper only opens fully or closes fully: a goal gap between the two is
+    /// refused (the Pioneer's paddles).
+    GapNotSettable = 31,
+    /// This gripper has no effort (force) setting: a goal with a maximum effort is refused.
+    EffortNotSettable = 32,
+    /// This gripper moves at one speed: a goal with a speed is refused.
+    SpeedNotSettable = 33,
 }
 
 impl Status {
     /// Every status, in code order.
-    pub const ALL: [Status; 21] = [
+    pub const ALL: [Status; 25] = [
         Status::Ok,
         Status::Unsupported,
         Status::UnknownJoint,
@@ -201,6 +212,10 @@ impl Status {
         Status::StoreFull,
         Status::NothingToStore,
         Status::NothingStored,
+        Status::ObjectPresent,
+        Status::GapNotSettable,
+        Status::EffortNotSettable,
+        Status::SpeedNotSettable,
     ];
 
     /// The wire code.
@@ -255,6 +270,10 @@ impl Status {
             Status::StoreFull => "the gripper's store is full",
             Status::NothingToStore => "nothing between the fingers to store",
             Status::NothingStored => "nothing stored to retrieve",
+            Status::ObjectPresent => "an object is between the fingers",
+            Status::GapNotSettable => "this gripper only opens or closes fully",
+            Status::EffortNotSettable => "this gripper has no effort setting",
+            Status::SpeedNotSettable => "this gripper has no speed setting",
         }
     }
 }
@@ -403,6 +422,26 @@ pub(crate) const STATUS_GROUP: ConstantGroup = ConstantGroup {
             name: "NOTHING_STORED",
             value: 20,
             doc: "the gripper's store is empty",
+        },
+        Constant {
+            name: "OBJECT_PRESENT",
+            value: 30,
+            doc: "a gripper motion ended with an object between the fingers (the break beams)",
+        },
+        Constant {
+            name: "GAP_NOT_SETTABLE",
+            value: 31,
+            doc: "the gripper only opens or closes fully: no goal gap in between",
+        },
+        Constant {
+            name: "EFFORT_NOT_SETTABLE",
+            value: 32,
+            doc: "the gripper has no effort setting",
+        },
+        Constant {
+            name: "SPEED_NOT_SETTABLE",
+            value: 33,
+            doc: "the gripper has no speed setting",
         },
     ],
 };

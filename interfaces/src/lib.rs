@@ -7,7 +7,7 @@
 //! * Wire structs are `#[repr(C)]`, have no implicit padding (explicit `_pad` fields,
 //!   checked at compile time), derive zerocopy's `FromBytes`/`IntoBytes`/`KnownLayout`/
 //!   `Immutable` and iceoryx2's `ZeroCopySend`, and carry a versioned type name
-//!   (`limber.v3.ActArrayData`). iceoryx2 only compares name, size and alignment when a
+//!   (`limber.v4.ActArrayData`). iceoryx2 only compares name, size and alignment when a
 //!   service is opened, so the version in the name changes whenever a layout changes.
 //! * Units are SI: m, rad, s, m/s, rad/s, A. No `bool` or Rust enum on the wire: `u32`
 //!   codes, decoded by typed views that reject unknown values with a [`DecodeError`].
@@ -74,7 +74,10 @@ pub use wire::{WireField, WireStruct};
 /// Version 3 added the `ranger` interface ([`ranger::RangerData`] and its envelopes), and
 /// the motion results on the `outcome` channel ([`control::OutcomeMsg::result`],
 /// [`control::MotionResult`]); every type name carries the version.
-pub const LAYOUT_VERSION: u32 = 3;
+/// Version 4 added the gripper's GOAL command ([`gripper::GripperGoalCmd`], a wider
+/// [`gripper::GripperCmdMsg`]) and the statuses `OBJECT_PRESENT`, `GAP_NOT_SETTABLE`,
+/// `EFFORT_NOT_SETTABLE` and `SPEED_NOT_SETTABLE`.
+pub const LAYOUT_VERSION: u32 = 4;
 
 /// Everything a driver or client author needs, in one `use`.
 pub mod prelude {
@@ -161,6 +164,7 @@ pub fn manifest() -> Manifest {
         LimbReplyMsg::LAYOUT,
         // gripper
         GripperData::LAYOUT,
+        gripper::GripperGoalCmd::LAYOUT,
         GripperCmdMsg::LAYOUT,
         GripperReqMsg::LAYOUT,
         GripperGeom::LAYOUT,

@@ -89,7 +89,7 @@ impl TryFrom<u32> for LimbState {
 
 wire_struct! {
     /// The limb's state (channel `data`).
-    pub struct LimbData : "limber.v3.LimbData", size = 136, align = 8 {
+    pub struct LimbData : "limber.v4.LimbData", size = 136, align = 8 {
         /// Common header.
         pub header: StateHeader,
         /// End-effector position, robot coordinates, m.
@@ -111,7 +111,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD SETPOSE: move the end effector to a pose.
-    pub struct LimbSetPoseCmd : "limber.v3.LimbSetPoseCmd", size = 72, align = 8 {
+    pub struct LimbSetPoseCmd : "limber.v4.LimbSetPoseCmd", size = 72, align = 8 {
         /// Target position, robot coordinates, m.
         pub position: Vec3,
         /// Target approach vector (need not be unit length, must not be zero).
@@ -123,7 +123,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD SETPOSITION: move the end effector to a position, orientation left to the driver.
-    pub struct LimbSetPositionCmd : "limber.v3.LimbSetPositionCmd", size = 24, align = 8 {
+    pub struct LimbSetPositionCmd : "limber.v4.LimbSetPositionCmd", size = 24, align = 8 {
         /// Target position, robot coordinates, m.
         pub position: Vec3,
     }
@@ -131,7 +131,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD VECMOVE: move the end effector `length` m along `direction` in a straight line.
-    pub struct LimbVecMoveCmd : "limber.v3.LimbVecMoveCmd", size = 32, align = 8 {
+    pub struct LimbVecMoveCmd : "limber.v4.LimbVecMoveCmd", size = 32, align = 8 {
         /// Direction (need not be unit length, must not be zero).
         pub direction: Vec3,
         /// Distance, m.
@@ -141,7 +141,7 @@ wire_struct! {
 
 wire_struct! {
     /// The command envelope (channel `cmd`). HOME and STOP have an empty body.
-    pub struct LimbCmdMsg : "limber.v3.LimbCmdMsg", size = 104, align = 8 {
+    pub struct LimbCmdMsg : "limber.v4.LimbCmdMsg", size = 104, align = 8 {
         /// Sender, sequence, time, kind, body length.
         pub meta: MsgMeta,
         /// One of the `Limb*Cmd` structs.
@@ -151,7 +151,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ POWER: power on (1) or off (0).
-    pub struct LimbPowerReq : "limber.v3.LimbPowerReq", size = 4, align = 4 {
+    pub struct LimbPowerReq : "limber.v4.LimbPowerReq", size = 4, align = 4 {
         /// 0 off, 1 on.
         pub value: u32,
     }
@@ -159,7 +159,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ BRAKES: brakes on (1) or off (0).
-    pub struct LimbBrakesReq : "limber.v3.LimbBrakesReq", size = 4, align = 4 {
+    pub struct LimbBrakesReq : "limber.v4.LimbBrakesReq", size = 4, align = 4 {
         /// 0 off, 1 on.
         pub value: u32,
     }
@@ -167,7 +167,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ SPEED: the end-effector speed for later moves, m/s.
-    pub struct LimbSpeedReq : "limber.v3.LimbSpeedReq", size = 8, align = 8 {
+    pub struct LimbSpeedReq : "limber.v4.LimbSpeedReq", size = 8, align = 8 {
         /// Speed, m/s.
         pub speed: f64,
     }
@@ -175,7 +175,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ REACH: the pose a SETPOSE would ask for (same fields as [`LimbSetPoseCmd`]).
-    pub struct LimbReachReq : "limber.v3.LimbReachReq", size = 72, align = 8 {
+    pub struct LimbReachReq : "limber.v4.LimbReachReq", size = 72, align = 8 {
         /// Target position, robot coordinates, m.
         pub position: Vec3,
         /// Target approach vector (non-zero).
@@ -187,7 +187,7 @@ wire_struct! {
 
 wire_struct! {
     /// The request envelope (channel `req`). GEOM has an empty body.
-    pub struct LimbReqMsg : "limber.v3.LimbReqMsg", size = 104, align = 8 {
+    pub struct LimbReqMsg : "limber.v4.LimbReqMsg", size = 104, align = 8 {
         /// Sender, sequence, time, kind, body length.
         pub meta: MsgMeta,
         /// One of the `Limb*Req` structs.
@@ -197,7 +197,7 @@ wire_struct! {
 
 wire_struct! {
     /// The limb geometry (the GEOM reply).
-    pub struct LimbGeom : "limber.v3.LimbGeom", size = 24, align = 8 {
+    pub struct LimbGeom : "limber.v4.LimbGeom", size = 24, align = 8 {
         /// The limb base in robot coordinates, m.
         pub base_pos: Vec3,
     }
@@ -206,7 +206,7 @@ wire_struct! {
 wire_struct! {
     /// The REACH reply: where a SETPOSE to the requested pose would end (before the
     /// joints are rounded to the hardware's resolution) and what it would change.
-    pub struct LimbReach : "limber.v3.LimbReach", size = 104, align = 8 {
+    pub struct LimbReach : "limber.v4.LimbReach", size = 104, align = 8 {
         /// End-effector position it would end at, robot coordinates, m.
         pub position: Vec3,
         /// Approach vector it would end with.
@@ -228,7 +228,7 @@ wire_struct! {
 
 wire_struct! {
     /// The reply envelope (channel `req`).
-    pub struct LimbReplyMsg : "limber.v3.LimbReplyMsg", size = 136, align = 8 {
+    pub struct LimbReplyMsg : "limber.v4.LimbReplyMsg", size = 136, align = 8 {
         /// Client, sequence, time, kind, status.
         pub meta: ReplyMeta,
         /// `LimbGeom` for GEOM, `LimbReach` for REACH, empty otherwise.

@@ -216,6 +216,7 @@ PROTOTYPES: "dict[str, Tuple[Any, List[Any]]]" = {
     "limber_gripper_stop": (_CODE, [_H, _P_TICKET]),
     "limber_gripper_store": (_CODE, [_H, _P_TICKET]),
     "limber_gripper_retrieve": (_CODE, [_H, _P_TICKET]),
+    "limber_gripper_goal": (_CODE, [_H, c_double, c_double, c_double, _P_TICKET]),
     # ranger
     "limber_ranger_point": (
         _CODE,

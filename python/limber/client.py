@@ -752,6 +752,12 @@ class GripperClient(_Client[L.GripperData]):
         """CMD RETRIEVE."""
         return self._sent(_c.limber_gripper_retrieve(self._h, self._ticket_ref))
 
+    def goal(self, gap: float, effort: float = 0.0, speed: float = 0.0) -> Ticket:
+        """CMD GOAL: the fingers to ``gap`` m, with at most ``effort`` N, at ``speed`` m/s
+        (0: the gripper's own). :meth:`wait_done` gives REACHED or STALLED, with the
+        status ``OBJECT_PRESENT`` when the break beams see an object."""
+        return self._sent(_c.limber_gripper_goal(self._h, gap, effort, speed, self._ticket_ref))
+
     def geometry(self, *, timeout: Optional[float] = None) -> "L.GripperGeom":
         """REQ GET_GEOM: the geometry (a ``GripperGeom`` ctypes struct)."""
         g: L.GripperGeom = self._geometry(timeout)

@@ -268,7 +268,7 @@ impl DeviceHandler<Limb> for TestLimb {
     }
 }
 
-/// The test gripper: opens and closes at once; cannot store.
+/// The test gripper: opens and closes at once; cannot store nor go to a gap.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct TestGripper;
 
@@ -278,7 +278,9 @@ impl DeviceHandler<Gripper> for TestGripper {
             GripperCommand::Open => state.state = GripperState::Open as u32,
             GripperCommand::Close => state.state = GripperState::Closed as u32,
             GripperCommand::Stop => {}
-            GripperCommand::Store | GripperCommand::Retrieve => return Status::Unsupported,
+            GripperCommand::Store | GripperCommand::Retrieve | GripperCommand::Goal { .. } => {
+                return Status::Unsupported;
+            }
         }
         Status::Ok
     }

@@ -7,7 +7,7 @@ use crate::wire::{ZeroCopySend, wire_struct};
 
 wire_struct! {
     /// The state of one actuator.
-    pub struct ActuatorState : "limber.v3.ActuatorState", size = 40, align = 8 {
+    pub struct ActuatorState : "limber.v4.ActuatorState", size = 40, align = 8 {
         /// Position, rad or m.
         pub position: f64,
         /// Current speed, rad/s or m/s (NaN-free; 0 when unknown).
@@ -25,7 +25,7 @@ wire_struct! {
 
 wire_struct! {
     /// The state of an actuator array (channel `data`).
-    pub struct ActArrayData : "limber.v3.ActArrayData", size = 1336, align = 8 {
+    pub struct ActArrayData : "limber.v4.ActArrayData", size = 1336, align = 8 {
         /// Common header.
         pub header: StateHeader,
         /// Number of valid entries in `actuators`.
@@ -39,7 +39,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD POS: move one joint to a position.
-    pub struct ActArrayPositionCmd : "limber.v3.ActArrayPositionCmd", size = 16, align = 8 {
+    pub struct ActArrayPositionCmd : "limber.v4.ActArrayPositionCmd", size = 16, align = 8 {
         /// Joint index (0-based).
         pub joint: i32,
         /// Reserved, zero.
@@ -51,7 +51,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD MULTI_POS: move every joint to a position.
-    pub struct ActArrayMultiPositionCmd : "limber.v3.ActArrayMultiPositionCmd", size = 264, align = 8 {
+    pub struct ActArrayMultiPositionCmd : "limber.v4.ActArrayMultiPositionCmd", size = 264, align = 8 {
         /// Number of valid entries.
         pub count: u32,
         /// Reserved, zero.
@@ -63,7 +63,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD SPEED: move one joint at a speed.
-    pub struct ActArraySpeedCmd : "limber.v3.ActArraySpeedCmd", size = 16, align = 8 {
+    pub struct ActArraySpeedCmd : "limber.v4.ActArraySpeedCmd", size = 16, align = 8 {
         /// Joint index.
         pub joint: i32,
         /// Reserved, zero.
@@ -75,7 +75,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD MULTI_SPEED: move every joint at a speed.
-    pub struct ActArrayMultiSpeedCmd : "limber.v3.ActArrayMultiSpeedCmd", size = 264, align = 8 {
+    pub struct ActArrayMultiSpeedCmd : "limber.v4.ActArrayMultiSpeedCmd", size = 264, align = 8 {
         /// Number of valid entries.
         pub count: u32,
         /// Reserved, zero.
@@ -87,7 +87,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD HOME: home one joint, or all (`joint = -1`).
-    pub struct ActArrayHomeCmd : "limber.v3.ActArrayHomeCmd", size = 8, align = 4 {
+    pub struct ActArrayHomeCmd : "limber.v4.ActArrayHomeCmd", size = 8, align = 4 {
         /// Joint index, or -1 for all.
         pub joint: i32,
         /// Reserved, zero.
@@ -97,7 +97,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD CURRENT: drive one joint, or all (`joint = -1`), with a current.
-    pub struct ActArrayCurrentCmd : "limber.v3.ActArrayCurrentCmd", size = 16, align = 8 {
+    pub struct ActArrayCurrentCmd : "limber.v4.ActArrayCurrentCmd", size = 16, align = 8 {
         /// Joint index, or -1 for all.
         pub joint: i32,
         /// Reserved, zero.
@@ -109,7 +109,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD MULTI_CURRENT: drive every joint with a current.
-    pub struct ActArrayMultiCurrentCmd : "limber.v3.ActArrayMultiCurrentCmd", size = 264, align = 8 {
+    pub struct ActArrayMultiCurrentCmd : "limber.v4.ActArrayMultiCurrentCmd", size = 264, align = 8 {
         /// Number of valid entries.
         pub count: u32,
         /// Reserved, zero.
@@ -121,7 +121,7 @@ wire_struct! {
 
 wire_struct! {
     /// The command envelope (channel `cmd`): `body` holds the struct `meta.kind` names.
-    pub struct ActArrayCmdMsg : "limber.v3.ActArrayCmdMsg", size = 296, align = 8 {
+    pub struct ActArrayCmdMsg : "limber.v4.ActArrayCmdMsg", size = 296, align = 8 {
         /// Sender, sequence, time, kind, body length.
         pub meta: MsgMeta,
         /// One of the `ActArray*Cmd` structs.
@@ -131,7 +131,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ POWER: power on (1) or off (0).
-    pub struct ActArrayPowerReq : "limber.v3.ActArrayPowerReq", size = 4, align = 4 {
+    pub struct ActArrayPowerReq : "limber.v4.ActArrayPowerReq", size = 4, align = 4 {
         /// 0 off, 1 on.
         pub value: u32,
     }
@@ -139,7 +139,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ BRAKES: brakes on (1) or off (0).
-    pub struct ActArrayBrakesReq : "limber.v3.ActArrayBrakesReq", size = 4, align = 4 {
+    pub struct ActArrayBrakesReq : "limber.v4.ActArrayBrakesReq", size = 4, align = 4 {
         /// 0 off, 1 on.
         pub value: u32,
     }
@@ -147,7 +147,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ SPEED: the speed of one joint for later moves.
-    pub struct ActArraySpeedReq : "limber.v3.ActArraySpeedReq", size = 16, align = 8 {
+    pub struct ActArraySpeedReq : "limber.v4.ActArraySpeedReq", size = 16, align = 8 {
         /// Joint index.
         pub joint: i32,
         /// Reserved, zero.
@@ -159,7 +159,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ ACCEL: the acceleration of one joint for later moves.
-    pub struct ActArrayAccelReq : "limber.v3.ActArrayAccelReq", size = 16, align = 8 {
+    pub struct ActArrayAccelReq : "limber.v4.ActArrayAccelReq", size = 16, align = 8 {
         /// Joint index.
         pub joint: i32,
         /// Reserved, zero.
@@ -171,7 +171,7 @@ wire_struct! {
 
 wire_struct! {
     /// The request envelope (channel `req`). GET_GEOM has an empty body.
-    pub struct ActArrayReqMsg : "limber.v3.ActArrayReqMsg", size = 48, align = 8 {
+    pub struct ActArrayReqMsg : "limber.v4.ActArrayReqMsg", size = 48, align = 8 {
         /// Sender, sequence, time, kind, body length.
         pub meta: MsgMeta,
         /// One of the `ActArray*Req` structs.
@@ -181,7 +181,7 @@ wire_struct! {
 
 wire_struct! {
     /// The geometry of one actuator.
-    pub struct ActuatorGeom : "limber.v3.ActuatorGeom", size = 104, align = 8 {
+    pub struct ActuatorGeom : "limber.v4.ActuatorGeom", size = 104, align = 8 {
         /// `ACTUATOR_KIND`: 1 linear, 2 rotary.
         pub kind: u32,
         /// 1 when the actuator has brakes.
@@ -207,7 +207,7 @@ wire_struct! {
 
 wire_struct! {
     /// The geometry of the array (the GET_GEOM reply).
-    pub struct ActArrayGeom : "limber.v3.ActArrayGeom", size = 3384, align = 8 {
+    pub struct ActArrayGeom : "limber.v4.ActArrayGeom", size = 3384, align = 8 {
         /// Number of valid entries.
         pub actuators_count: u32,
         /// Reserved, zero.
@@ -223,7 +223,7 @@ wire_struct! {
 
 wire_struct! {
     /// The reply envelope (channel `req`): an ACK carries the body of the request's reply.
-    pub struct ActArrayReplyMsg : "limber.v3.ActArrayReplyMsg", size = 3416, align = 8 {
+    pub struct ActArrayReplyMsg : "limber.v4.ActArrayReplyMsg", size = 3416, align = 8 {
         /// Client, sequence, time, kind, status.
         pub meta: ReplyMeta,
         /// `ActArrayGeom` for GET_GEOM, empty otherwise.
