@@ -44,6 +44,9 @@ extern "C" {
 #define LIMBER_STATUS_STORE_FULL 18 /* the gripper's store is full */
 #define LIMBER_STATUS_NOTHING_TO_STORE 19 /* nothing between the gripper's fingers to store */
 #define LIMBER_STATUS_NOTHING_STORED 20 /* the gripper's store is empty */
+#define LIMBER_STATUS_INVALID_GOAL 21 /* a joint trajectory is malformed or incomplete */
+#define LIMBER_STATUS_OLD_TIMESTAMP 22 /* a joint trajectory's start time is too far in the past */
+#define LIMBER_STATUS_TOO_FAST 23 /* a joint trajectory is faster than the joints can move */
 #define LIMBER_STATUS_OBJECT_PRESENT 30 /* a gripper motion ended with an object between the fingers (the break beams) */
 #define LIMBER_STATUS_GAP_NOT_SETTABLE 31 /* the gripper only opens or closes fully: no goal gap in between */
 #define LIMBER_STATUS_EFFORT_NOT_SETTABLE 32 /* the gripper has no effort setting */
@@ -64,6 +67,24 @@ extern "C" {
 #define LIMBER_ACTARRAY_CMD_HOME 5 /* ActArrayHomeCmd */
 #define LIMBER_ACTARRAY_CMD_CURRENT 6 /* ActArrayCurrentCmd */
 #define LIMBER_ACTARRAY_CMD_MULTI_CURRENT 7 /* ActArrayMultiCurrentCmd */
+#define LIMBER_ACTARRAY_CMD_TRAJ_CHUNK 8 /* ActArrayTrajChunkCmd: a piece of a trajectory upload */
+#define LIMBER_ACTARRAY_CMD_TRAJ 9 /* ActArrayTrajCmd: run the uploaded trajectory */
+#define LIMBER_ACTARRAY_CMD_TRAJ_SCALE 10 /* ActArrayTrajScaleCmd: trajectory speed scaling */
+
+/* ActArrayTrajChunkCmd.field codes */
+#define LIMBER_TRAJ_FIELD_TIME 1 /* points' times from start, s */
+#define LIMBER_TRAJ_FIELD_POSITION 2 /* one column's positions */
+#define LIMBER_TRAJ_FIELD_VELOCITY 3 /* one column's velocities */
+#define LIMBER_TRAJ_FIELD_ACCELERATION 4 /* one column's accelerations */
+#define LIMBER_TRAJ_FIELD_PATH_TOLERANCE 5 /* each column's path tolerance */
+#define LIMBER_TRAJ_FIELD_GOAL_TOLERANCE 6 /* each column's goal tolerance */
+
+/* ActArrayTrajCmd.fields bits */
+#define LIMBER_TRAJ_HAS_VELOCITIES 1 /* points carry velocities (cubic) */
+#define LIMBER_TRAJ_HAS_ACCELERATIONS 2 /* points carry accelerations too (quintic) */
+
+/* joint trajectory capacity */
+#define LIMBER_TRAJ_MAX_POINTS 64 /* points of one trajectory */
 
 /* actarray request kinds (MsgMeta.kind on the req channel) */
 #define LIMBER_ACTARRAY_REQ_POWER 1 /* ActArrayPowerReq; reply empty */
@@ -152,6 +173,8 @@ extern "C" {
 #define LIMBER_RESULT_PREEMPTED 4 /* another command took over its parts */
 #define LIMBER_RESULT_ABORTED 5 /* link lost, powered off, brakes, collision (status says which) */
 #define LIMBER_RESULT_TIMED_OUT 6 /* the device's time limit for the motion passed */
+#define LIMBER_RESULT_PATH_TOLERANCE_VIOLATED 7 /* a trajectory's joint left its path tolerance; the device holds */
+#define LIMBER_RESULT_GOAL_TOLERANCE_VIOLATED 8 /* a trajectory's joints were not within the goal tolerance in time; the device holds */
 
 /* Name limits (domain and robot names are [A-Za-z0-9_-]+) */
 #define LIMBER_NAME_MAX_DOMAIN_LEN 48 /* longest domain name */
@@ -407,6 +430,53 @@ LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_actarray_multi_current_cmd) == 8, "li
 LIMBER_STATIC_ASSERT(offsetof(limber_actarray_multi_current_cmd, count) == 0, "limber_actarray_multi_current_cmd.count offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_actarray_multi_current_cmd, _pad) == 4, "limber_actarray_multi_current_cmd._pad offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_actarray_multi_current_cmd, currents) == 8, "limber_actarray_multi_current_cmd.currents offset");
+
+/* limber.v4.ActArrayTrajChunkCmd (size 264, align 8) */
+typedef struct limber_actarray_traj_chunk_cmd {
+    uint16_t field;
+    uint16_t column;
+    uint16_t first;
+    uint16_t count;
+    double values[32];
+} limber_actarray_traj_chunk_cmd;
+#define LIMBER_ACTARRAY_TRAJ_CHUNK_CMD_TYPE_NAME "limber.v4.ActArrayTrajChunkCmd"
+LIMBER_STATIC_ASSERT(sizeof(limber_actarray_traj_chunk_cmd) == 264, "limber_actarray_traj_chunk_cmd size");
+LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_actarray_traj_chunk_cmd) == 8, "limber_actarray_traj_chunk_cmd alignment");
+LIMBER_STATIC_ASSERT(offsetof(limber_actarray_traj_chunk_cmd, field) == 0, "limber_actarray_traj_chunk_cmd.field offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_actarray_traj_chunk_cmd, column) == 2, "limber_actarray_traj_chunk_cmd.column offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_actarray_traj_chunk_cmd, first) == 4, "limber_actarray_traj_chunk_cmd.first offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_actarray_traj_chunk_cmd, count) == 6, "limber_actarray_traj_chunk_cmd.count offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_actarray_traj_chunk_cmd, values) == 8, "limber_actarray_traj_chunk_cmd.values offset");
+
+/* limber.v4.ActArrayTrajCmd (size 64, align 8) */
+typedef struct limber_actarray_traj_cmd {
+    uint64_t start_ns;
+    double goal_time_tolerance;
+    uint32_t joint_count;
+    uint32_t point_count;
+    uint32_t fields;
+    uint32_t _pad;
+    uint8_t joints[32];
+} limber_actarray_traj_cmd;
+#define LIMBER_ACTARRAY_TRAJ_CMD_TYPE_NAME "limber.v4.ActArrayTrajCmd"
+LIMBER_STATIC_ASSERT(sizeof(limber_actarray_traj_cmd) == 64, "limber_actarray_traj_cmd size");
+LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_actarray_traj_cmd) == 8, "limber_actarray_traj_cmd alignment");
+LIMBER_STATIC_ASSERT(offsetof(limber_actarray_traj_cmd, start_ns) == 0, "limber_actarray_traj_cmd.start_ns offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_actarray_traj_cmd, goal_time_tolerance) == 8, "limber_actarray_traj_cmd.goal_time_tolerance offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_actarray_traj_cmd, joint_count) == 16, "limber_actarray_traj_cmd.joint_count offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_actarray_traj_cmd, point_count) == 20, "limber_actarray_traj_cmd.point_count offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_actarray_traj_cmd, fields) == 24, "limber_actarray_traj_cmd.fields offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_actarray_traj_cmd, _pad) == 28, "limber_actarray_traj_cmd._pad offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_actarray_traj_cmd, joints) == 32, "limber_actarray_traj_cmd.joints offset");
+
+/* limber.v4.ActArrayTrajScaleCmd (size 8, align 8) */
+typedef struct limber_actarray_traj_scale_cmd {
+    double scale;
+} limber_actarray_traj_scale_cmd;
+#define LIMBER_ACTARRAY_TRAJ_SCALE_CMD_TYPE_NAME "limber.v4.ActArrayTrajScaleCmd"
+LIMBER_STATIC_ASSERT(sizeof(limber_actarray_traj_scale_cmd) == 8, "limber_actarray_traj_scale_cmd size");
+LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_actarray_traj_scale_cmd) == 8, "limber_actarray_traj_scale_cmd alignment");
+LIMBER_STATIC_ASSERT(offsetof(limber_actarray_traj_scale_cmd, scale) == 0, "limber_actarray_traj_scale_cmd.scale offset");
 
 /* limber.v4.ActArrayCmdMsg (size 296, align 8) */
 typedef struct limber_actarray_cmd_msg {

@@ -175,6 +175,16 @@ pub enum Status {
     NothingToStore = 19,
     /// The gripper's store is empty: RETRIEVE has nothing to give back.
     NothingStored = 20,
+    /// A joint trajectory is malformed or incomplete (no points, times not increasing,
+    /// counts that do not match, a point never uploaded, a final velocity not zero):
+    /// control_msgs' INVALID_GOAL.
+    InvalidGoal = 21,
+    /// A joint trajectory's start time lies further in the past than the device accepts,
+    /// or every point of it is already past: control_msgs' OLD_HEADER_TIMESTAMP.
+    OldTimestamp = 22,
+    /// A joint trajectory asks a joint to move faster than the device can (the driver's
+    /// log names the joint, the segment and the speeds): an invalid goal.
+    TooFast = 23,
     /// A gripper motion ended with an object between the fingers (the break beams see
     /// it): the cause a gripper goal's result carries, `STALLED` when the fingers stopped
     /// on it short of the goal.
@@ -190,7 +200,7 @@ pub enum Status {
 
 impl Status {
     /// Every status, in code order.
-    pub const ALL: [Status; 25] = [
+    pub const ALL: [Status; 28] = [
         Status::Ok,
         Status::Unsupported,
         Status::UnknownJoint,
@@ -212,6 +222,9 @@ impl Status {
         Status::StoreFull,
         Status::NothingToStore,
         Status::NothingStored,
+        Status::InvalidGoal,
+        Status::OldTimestamp,
+        Status::TooFast,
         Status::ObjectPresent,
         Status::GapNotSettable,
         Status::EffortNotSettable,
@@ -270,6 +283,9 @@ impl Status {
             Status::StoreFull => "the gripper's store is full",
             Status::NothingToStore => "nothing between the fingers to store",
             Status::NothingStored => "nothing stored to retrieve",
+            Status::InvalidGoal => "invalid trajectory",
+            Status::OldTimestamp => "the trajectory's start time is too old",
+            Status::TooFast => "the trajectory is faster than the joints can move",
             Status::ObjectPresent => "an object is between the fingers",
             Status::GapNotSettable => "this gripper only opens or closes fully",
             Status::EffortNotSettable => "this gripper has no effort setting",
@@ -422,6 +438,21 @@ pub(crate) const STATUS_GROUP: ConstantGroup = ConstantGroup {
             name: "NOTHING_STORED",
             value: 20,
             doc: "the gripper's store is empty",
+        },
+        Constant {
+            name: "INVALID_GOAL",
+            value: 21,
+            doc: "a joint trajectory is malformed or incomplete",
+        },
+        Constant {
+            name: "OLD_TIMESTAMP",
+            value: 22,
+            doc: "a joint trajectory's start time is too far in the past",
+        },
+        Constant {
+            name: "TOO_FAST",
+            value: 23,
+            doc: "a joint trajectory is faster than the joints can move",
         },
         Constant {
             name: "OBJECT_PRESENT",

@@ -69,17 +69,26 @@ pub enum MotionResult {
     Aborted = 5,
     /// The device's own time limit for the motion passed before it ended.
     TimedOut = 6,
+    /// A joint of a trajectory left its path tolerance: the device holds where it is
+    /// (control_msgs' PATH_TOLERANCE_VIOLATED).
+    PathToleranceViolated = 7,
+    /// A trajectory's joints were not within their goal tolerance when its last point's
+    /// time plus the goal time tolerance had passed: the device holds where it is
+    /// (control_msgs' GOAL_TOLERANCE_VIOLATED).
+    GoalToleranceViolated = 8,
 }
 
 impl MotionResult {
     /// Every result, in code order.
-    pub const ALL: [MotionResult; 6] = [
+    pub const ALL: [MotionResult; 8] = [
         MotionResult::Reached,
         MotionResult::Stalled,
         MotionResult::Stopped,
         MotionResult::Preempted,
         MotionResult::Aborted,
         MotionResult::TimedOut,
+        MotionResult::PathToleranceViolated,
+        MotionResult::GoalToleranceViolated,
     ];
 
     /// The wire code.
@@ -105,6 +114,8 @@ impl MotionResult {
             MotionResult::Preempted => "preempted by another command",
             MotionResult::Aborted => "aborted",
             MotionResult::TimedOut => "timed out",
+            MotionResult::PathToleranceViolated => "aborted: a joint left its path tolerance",
+            MotionResult::GoalToleranceViolated => "aborted: not within the goal tolerance in time",
         }
     }
 
@@ -171,6 +182,16 @@ pub(crate) const RESULT_GROUP: ConstantGroup = ConstantGroup {
             name: "TIMED_OUT",
             value: 6,
             doc: "the device's time limit for the motion passed",
+        },
+        Constant {
+            name: "PATH_TOLERANCE_VIOLATED",
+            value: 7,
+            doc: "a trajectory's joint left its path tolerance; the device holds",
+        },
+        Constant {
+            name: "GOAL_TOLERANCE_VIOLATED",
+            value: 8,
+            doc: "a trajectory's joints were not within the goal tolerance in time; the device holds",
         },
     ],
 };

@@ -74,7 +74,11 @@ pub use wire::{WireField, WireStruct};
 /// Version 3 added the `ranger` interface ([`ranger::RangerData`] and its envelopes), and
 /// the motion results on the `outcome` channel ([`control::OutcomeMsg::result`],
 /// [`control::MotionResult`]); every type name carries the version.
-/// Version 4 added the gripper's GOAL command ([`gripper::GripperGoalCmd`], a wider
+/// Version 4 added the actarray's joint trajectories (`TRAJ_CHUNK`, `TRAJ`, `TRAJ_SCALE`:
+/// [`actarray::ActArrayTrajChunkCmd`], [`actarray::ActArrayTrajCmd`],
+/// [`actarray::ActArrayTrajScaleCmd`]), the statuses `INVALID_GOAL`, `OLD_TIMESTAMP` and
+/// `TOO_FAST`, and the results `PATH_TOLERANCE_VIOLATED` and `GOAL_TOLERANCE_VIOLATED`.
+/// It also added the gripper's GOAL command ([`gripper::GripperGoalCmd`], a wider
 /// [`gripper::GripperCmdMsg`]) and the statuses `OBJECT_PRESENT`, `GAP_NOT_SETTABLE`,
 /// `EFFORT_NOT_SETTABLE` and `SPEED_NOT_SETTABLE`.
 pub const LAYOUT_VERSION: u32 = 4;
@@ -84,7 +88,8 @@ pub mod prelude {
     pub use crate::actarray::{
         ActArrayCmdMsg, ActArrayCommand, ActArrayData, ActArrayGeom, ActArrayReply,
         ActArrayReplyMsg, ActArrayReqMsg, ActArrayRequest, ActuatorFlags, ActuatorGeom,
-        ActuatorKind, ActuatorState, JointSel, JointValues,
+        ActuatorKind, ActuatorState, JointSel, JointTrajectory, JointValues, MAX_TRAJ_POINTS,
+        TrajectoryError, TrajectoryUpload,
     };
     pub use crate::common::{
         Bbox3, CmdOutcome, MAX_ACTUATORS, MsgMeta, Orientation3, Pose3, ReplyMeta, StateHeader,
@@ -139,6 +144,9 @@ pub fn manifest() -> Manifest {
         ActArrayHomeCmd::LAYOUT,
         ActArrayCurrentCmd::LAYOUT,
         ActArrayMultiCurrentCmd::LAYOUT,
+        ActArrayTrajChunkCmd::LAYOUT,
+        ActArrayTrajCmd::LAYOUT,
+        ActArrayTrajScaleCmd::LAYOUT,
         ActArrayCmdMsg::LAYOUT,
         ActArrayPowerReq::LAYOUT,
         ActArrayBrakesReq::LAYOUT,

@@ -33,6 +33,9 @@ STATUS_BRAKED = 17  # the brakes are on: release them before moving
 STATUS_STORE_FULL = 18  # the gripper's store is full
 STATUS_NOTHING_TO_STORE = 19  # nothing between the gripper's fingers to store
 STATUS_NOTHING_STORED = 20  # the gripper's store is empty
+STATUS_INVALID_GOAL = 21  # a joint trajectory is malformed or incomplete
+STATUS_OLD_TIMESTAMP = 22  # a joint trajectory's start time is too far in the past
+STATUS_TOO_FAST = 23  # a joint trajectory is faster than the joints can move
 STATUS_OBJECT_PRESENT = 30  # a gripper motion ended with an object between the fingers (the break beams)
 STATUS_GAP_NOT_SETTABLE = 31  # the gripper only opens or closes fully: no goal gap in between
 STATUS_EFFORT_NOT_SETTABLE = 32  # the gripper has no effort setting
@@ -53,6 +56,24 @@ ACTARRAY_CMD_MULTI_SPEED = 4  # ActArrayMultiSpeedCmd
 ACTARRAY_CMD_HOME = 5  # ActArrayHomeCmd
 ACTARRAY_CMD_CURRENT = 6  # ActArrayCurrentCmd
 ACTARRAY_CMD_MULTI_CURRENT = 7  # ActArrayMultiCurrentCmd
+ACTARRAY_CMD_TRAJ_CHUNK = 8  # ActArrayTrajChunkCmd: a piece of a trajectory upload
+ACTARRAY_CMD_TRAJ = 9  # ActArrayTrajCmd: run the uploaded trajectory
+ACTARRAY_CMD_TRAJ_SCALE = 10  # ActArrayTrajScaleCmd: trajectory speed scaling
+
+# ActArrayTrajChunkCmd.field codes
+TRAJ_FIELD_TIME = 1  # points' times from start, s
+TRAJ_FIELD_POSITION = 2  # one column's positions
+TRAJ_FIELD_VELOCITY = 3  # one column's velocities
+TRAJ_FIELD_ACCELERATION = 4  # one column's accelerations
+TRAJ_FIELD_PATH_TOLERANCE = 5  # each column's path tolerance
+TRAJ_FIELD_GOAL_TOLERANCE = 6  # each column's goal tolerance
+
+# ActArrayTrajCmd.fields bits
+TRAJ_HAS_VELOCITIES = 1  # points carry velocities (cubic)
+TRAJ_HAS_ACCELERATIONS = 2  # points carry accelerations too (quintic)
+
+# joint trajectory capacity
+TRAJ_MAX_POINTS = 64  # points of one trajectory
 
 # actarray request kinds (MsgMeta.kind on the req channel)
 ACTARRAY_REQ_POWER = 1  # ActArrayPowerReq; reply empty
@@ -141,6 +162,8 @@ RESULT_STOPPED = 3  # a STOP (or the deadman) stopped it
 RESULT_PREEMPTED = 4  # another command took over its parts
 RESULT_ABORTED = 5  # link lost, powered off, brakes, collision (status says which)
 RESULT_TIMED_OUT = 6  # the device's time limit for the motion passed
+RESULT_PATH_TOLERANCE_VIOLATED = 7  # a trajectory's joint left its path tolerance; the device holds
+RESULT_GOAL_TOLERANCE_VIOLATED = 8  # a trajectory's joints were not within the goal tolerance in time; the device holds
 
 # Name limits (domain and robot names are [A-Za-z0-9_-]+)
 NAME_MAX_DOMAIN_LEN = 48  # longest domain name
@@ -181,6 +204,9 @@ DESCRIBE_STATUS = {
     18: "the gripper's store is full",
     19: "nothing between the fingers to store",
     20: "nothing stored to retrieve",
+    21: "invalid trajectory",
+    22: "the trajectory's start time is too old",
+    23: "the trajectory is faster than the joints can move",
     30: "an object is between the fingers",
     31: "this gripper only opens or closes fully",
     32: "this gripper has no effort setting",
@@ -433,6 +459,52 @@ class ActArrayMultiCurrentCmd(ctypes.Structure):
     @staticmethod
     def type_name() -> str:
         return "limber.v4.ActArrayMultiCurrentCmd"
+
+
+class ActArrayTrajChunkCmd(ctypes.Structure):
+    """limber.v4.ActArrayTrajChunkCmd (size 264, align 8)."""
+
+    _fields_ = [
+        ("field", ctypes.c_uint16),
+        ("column", ctypes.c_uint16),
+        ("first", ctypes.c_uint16),
+        ("count", ctypes.c_uint16),
+        ("values", ctypes.c_double * 32),
+    ]
+
+    @staticmethod
+    def type_name() -> str:
+        return "limber.v4.ActArrayTrajChunkCmd"
+
+
+class ActArrayTrajCmd(ctypes.Structure):
+    """limber.v4.ActArrayTrajCmd (size 64, align 8)."""
+
+    _fields_ = [
+        ("start_ns", ctypes.c_uint64),
+        ("goal_time_tolerance", ctypes.c_double),
+        ("joint_count", ctypes.c_uint32),
+        ("point_count", ctypes.c_uint32),
+        ("fields", ctypes.c_uint32),
+        ("_pad", ctypes.c_uint32),
+        ("joints", ctypes.c_uint8 * 32),
+    ]
+
+    @staticmethod
+    def type_name() -> str:
+        return "limber.v4.ActArrayTrajCmd"
+
+
+class ActArrayTrajScaleCmd(ctypes.Structure):
+    """limber.v4.ActArrayTrajScaleCmd (size 8, align 8)."""
+
+    _fields_ = [
+        ("scale", ctypes.c_double),
+    ]
+
+    @staticmethod
+    def type_name() -> str:
+        return "limber.v4.ActArrayTrajScaleCmd"
 
 
 class ActArrayCmdMsg(ctypes.Structure):
@@ -1028,6 +1100,9 @@ STRUCTS = [
     ActArrayHomeCmd,
     ActArrayCurrentCmd,
     ActArrayMultiCurrentCmd,
+    ActArrayTrajChunkCmd,
+    ActArrayTrajCmd,
+    ActArrayTrajScaleCmd,
     ActArrayCmdMsg,
     ActArrayPowerReq,
     ActArrayBrakesReq,

@@ -143,6 +143,14 @@ pub enum ActArrayCommand {
     },
     /// Drive joints 0..n with these currents.
     MultiCurrent(JointValues),
+    /// A piece of a joint trajectory upload (see [`JointTrajectory::commands`]).
+    ///
+    /// [`JointTrajectory::commands`]: super::JointTrajectory::commands
+    TrajChunk(ActArrayTrajChunkCmd),
+    /// Run the uploaded joint trajectory with this header.
+    Traj(ActArrayTrajCmd),
+    /// The speed scaling of trajectories: 0 pauses, 1 is nominal.
+    TrajScale(f64),
 }
 
 impl ActArrayCommand {
@@ -179,6 +187,10 @@ impl ActArrayCommand {
             current: finite_value("current", current)?,
         })
     }
+    /// TRAJ_SCALE, validated (finite; the driver clamps it to 0..1 and says so).
+    pub fn traj_scale(scale: f64) -> Result<Self, ValueError> {
+        finite_value("scale", scale).map(ActArrayCommand::TrajScale)
+    }
     /// MULTI_CURRENT, validated.
     pub fn multi_current(currents: &[f64]) -> Result<Self, ValueError> {
         JointValues::new("currents", currents).map(ActArrayCommand::MultiCurrent)
@@ -206,6 +218,9 @@ impl Message for ActArrayCommand {
             ActArrayCommand::Home(_) => cmd::HOME,
             ActArrayCommand::Current { .. } => cmd::CURRENT,
             ActArrayCommand::MultiCurrent(_) => cmd::MULTI_CURRENT,
+            ActArrayCommand::TrajChunk(_) => cmd::TRAJ_CHUNK,
+            ActArrayCommand::Traj(_) => cmd::TRAJ,
+            ActArrayCommand::TrajScale(_) => cmd::TRAJ_SCALE,
         }
     }
 
@@ -276,6 +291,9 @@ impl Message for ActArrayCommand {
                     },
                 )
             }
+            ActArrayCommand::TrajChunk(c) => message::put(b, &c),
+            ActArrayCommand::Traj(h) => message::put(b, &h),
+            ActArrayCommand::TrajScale(scale) => message::put(b, &ActArrayTrajScaleCmd { scale }),
         };
         raw.meta.kind = self.kind();
         raw.meta.body_len = len;
@@ -323,6 +341,20 @@ impl Message for ActArrayCommand {
                     c.count,
                     &c.currents,
                 )?)
+            }
+            cmd::TRAJ_CHUNK => {
+                let c: ActArrayTrajChunkCmd = message::get(ch, k, b, n)?;
+                super::trajectory::check_chunk(&c)?;
+                ActArrayCommand::TrajChunk(c)
+            }
+            cmd::TRAJ => {
+                let h: ActArrayTrajCmd = message::get(ch, k, b, n)?;
+                super::trajectory::check_header(&h)?;
+                ActArrayCommand::Traj(h)
+            }
+            cmd::TRAJ_SCALE => {
+                let c: ActArrayTrajScaleCmd = message::get(ch, k, b, n)?;
+                ActArrayCommand::traj_scale(c.scale)?
             }
             _ => {
                 return Err(DecodeError::UnknownKind {

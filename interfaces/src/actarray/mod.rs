@@ -17,12 +17,16 @@ use crate::manifest::{Constant, ConstantGroup};
 
 mod command;
 mod request;
+mod trajectory;
 mod views;
 mod wire;
 
 pub use command::{ActArrayCommand, JointSel, JointValues};
 pub(crate) use request::on_off;
 pub use request::{ActArrayReply, ActArrayRequest};
+pub use trajectory::{
+    Interpolation, JointTrajectory, MAX_TRAJ_POINTS, TrajectoryError, TrajectoryUpload,
+};
 pub use wire::*;
 
 /// Command kinds (Player's `PLAYER_ACTARRAY_CMD_*` numbers).
@@ -41,6 +45,36 @@ pub mod cmd {
     pub const CURRENT: u32 = 6;
     /// Drive every joint with a current.
     pub const MULTI_CURRENT: u32 = 7;
+    /// One piece of a joint trajectory being uploaded (limber's own).
+    pub const TRAJ_CHUNK: u32 = 8;
+    /// Run the joint trajectory uploaded (limber's own).
+    pub const TRAJ: u32 = 9;
+    /// The speed scaling of trajectories (limber's own).
+    pub const TRAJ_SCALE: u32 = 10;
+}
+
+/// `ActArrayTrajChunkCmd::field` codes: what a chunk carries.
+pub mod traj_field {
+    /// Points' times from start, s.
+    pub const TIME: u16 = 1;
+    /// One column's positions.
+    pub const POSITION: u16 = 2;
+    /// One column's velocities.
+    pub const VELOCITY: u16 = 3;
+    /// One column's accelerations.
+    pub const ACCELERATION: u16 = 4;
+    /// The path tolerance of each column.
+    pub const PATH_TOLERANCE: u16 = 5;
+    /// The goal tolerance of each column.
+    pub const GOAL_TOLERANCE: u16 = 6;
+}
+
+/// `ActArrayTrajCmd::fields` bits: the optional fields the points carry.
+pub mod traj_has {
+    /// Velocities (cubic interpolation).
+    pub const VELOCITIES: u32 = 1;
+    /// Accelerations too (quintic interpolation).
+    pub const ACCELERATIONS: u32 = 2;
 }
 
 /// Request kinds (Player's `PLAYER_ACTARRAY_REQ_*` numbers).
@@ -142,7 +176,83 @@ pub(crate) const GROUPS: &[ConstantGroup] = &[
                 value: 7,
                 doc: "ActArrayMultiCurrentCmd",
             },
+            Constant {
+                name: "TRAJ_CHUNK",
+                value: 8,
+                doc: "ActArrayTrajChunkCmd: a piece of a trajectory upload",
+            },
+            Constant {
+                name: "TRAJ",
+                value: 9,
+                doc: "ActArrayTrajCmd: run the uploaded trajectory",
+            },
+            Constant {
+                name: "TRAJ_SCALE",
+                value: 10,
+                doc: "ActArrayTrajScaleCmd: trajectory speed scaling",
+            },
         ],
+    },
+    ConstantGroup {
+        name: "TRAJ_FIELD",
+        doc: "ActArrayTrajChunkCmd.field codes",
+        constants: &[
+            Constant {
+                name: "TIME",
+                value: 1,
+                doc: "points' times from start, s",
+            },
+            Constant {
+                name: "POSITION",
+                value: 2,
+                doc: "one column's positions",
+            },
+            Constant {
+                name: "VELOCITY",
+                value: 3,
+                doc: "one column's velocities",
+            },
+            Constant {
+                name: "ACCELERATION",
+                value: 4,
+                doc: "one column's accelerations",
+            },
+            Constant {
+                name: "PATH_TOLERANCE",
+                value: 5,
+                doc: "each column's path tolerance",
+            },
+            Constant {
+                name: "GOAL_TOLERANCE",
+                value: 6,
+                doc: "each column's goal tolerance",
+            },
+        ],
+    },
+    ConstantGroup {
+        name: "TRAJ_HAS",
+        doc: "ActArrayTrajCmd.fields bits",
+        constants: &[
+            Constant {
+                name: "VELOCITIES",
+                value: 1,
+                doc: "points carry velocities (cubic)",
+            },
+            Constant {
+                name: "ACCELERATIONS",
+                value: 2,
+                doc: "points carry accelerations too (quintic)",
+            },
+        ],
+    },
+    ConstantGroup {
+        name: "TRAJ",
+        doc: "joint trajectory capacity",
+        constants: &[Constant {
+            name: "MAX_POINTS",
+            value: 64,
+            doc: "points of one trajectory",
+        }],
     },
     ConstantGroup {
         name: "ACTARRAY_REQ",

@@ -120,6 +120,58 @@ wire_struct! {
 }
 
 wire_struct! {
+    /// CMD TRAJ_CHUNK: one piece of a joint trajectory being uploaded (see
+    /// `ActArrayTrajCmd`): up to 32 values of one field. `TIME`, `POSITION`, `VELOCITY` and
+    /// `ACCELERATION` carry the values of points `first .. first + count` (of joint column
+    /// `column` for the last three); `PATH_TOLERANCE` and `GOAL_TOLERANCE` one value per
+    /// joint column (`first` and `column` zero).
+    pub struct ActArrayTrajChunkCmd : "limber.v4.ActArrayTrajChunkCmd", size = 264, align = 8 {
+        /// A `TRAJ_FIELD` code.
+        pub field: u16,
+        /// The trajectory's joint column (0-based) for per-point joint values.
+        pub column: u16,
+        /// The index of the first point of `values`.
+        pub first: u16,
+        /// Valid entries of `values`.
+        pub count: u16,
+        /// The values (s, rad or m, rad/s or m/s, rad/s² or m/s²).
+        pub values: [f64; 32],
+    }
+}
+
+wire_struct! {
+    /// CMD TRAJ: run the joint trajectory uploaded by this client's `TRAJ_CHUNK`s since its
+    /// last TRAJ (control_msgs' FollowJointTrajectory goal). It replaces the trajectory
+    /// running from its start time.
+    pub struct ActArrayTrajCmd : "limber.v4.ActArrayTrajCmd", size = 64, align = 8 {
+        /// `CLOCK_MONOTONIC` ns at which point times count from; 0 = when it arrives.
+        pub start_ns: u64,
+        /// How long after the last point's time the joints may take to come within the goal
+        /// tolerance, s (0: the device's default).
+        pub goal_time_tolerance: f64,
+        /// The joint columns (1 to 32).
+        pub joint_count: u32,
+        /// The points (1 to `TRAJ_MAX_POINTS`).
+        pub point_count: u32,
+        /// `TRAJ_HAS` bits: which optional fields the points carry.
+        pub fields: u32,
+        /// Reserved, zero.
+        pub _pad: u32,
+        /// The actarray joint each column drives.
+        pub joints: [u8; 32],
+    }
+}
+
+wire_struct! {
+    /// CMD TRAJ_SCALE: the speed scaling of the running (and later) trajectories: 0
+    /// pauses, 1 is nominal.
+    pub struct ActArrayTrajScaleCmd : "limber.v4.ActArrayTrajScaleCmd", size = 8, align = 8 {
+        /// The factor, 0 to 1.
+        pub scale: f64,
+    }
+}
+
+wire_struct! {
     /// The command envelope (channel `cmd`): `body` holds the struct `meta.kind` names.
     pub struct ActArrayCmdMsg : "limber.v4.ActArrayCmdMsg", size = 296, align = 8 {
         /// Sender, sequence, time, kind, body length.

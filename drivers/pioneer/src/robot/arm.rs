@@ -95,6 +95,11 @@ impl RobotModel {
                 })
             }
             ActArrayCommand::Home(sel) => self.home(sel, from).map(|()| Status::Ok),
+            // Joint trajectories reach the Pioneer with i28-traj's streaming (not merged
+            // here yet): until then, unsupported.
+            ActArrayCommand::TrajChunk(_)
+            | ActArrayCommand::Traj(_)
+            | ActArrayCommand::TrajScale(_) => Err(Status::Unsupported),
             ActArrayCommand::Current { .. } | ActArrayCommand::MultiCurrent(_) => {
                 Err(Status::Unsupported)
             }

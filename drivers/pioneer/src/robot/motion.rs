@@ -61,7 +61,11 @@ impl RobotModel {
             ActArrayCommand::MultiPosition(v) | ActArrayCommand::MultiSpeed(v) => first(v.len()),
             ActArrayCommand::Home(JointSel::All) => all,
             ActArrayCommand::Home(JointSel::One(j)) => one(j),
-            ActArrayCommand::Current { .. } | ActArrayCommand::MultiCurrent(_) => 0,
+            ActArrayCommand::Current { .. }
+            | ActArrayCommand::MultiCurrent(_)
+            | ActArrayCommand::TrajChunk(_)
+            | ActArrayCommand::Traj(_)
+            | ActArrayCommand::TrajScale(_) => 0,
         };
         let m = Motion::of(mask as u64, self.joints_running());
         if stop { m.stopping() } else { m }

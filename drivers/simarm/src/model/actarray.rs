@@ -106,6 +106,10 @@ impl ArmModel {
             ActArrayCommand::Current { .. } | ActArrayCommand::MultiCurrent(_) => {
                 self.current_command(cmd)
             }
+            // Joint trajectories on the actarray are i28-traj's (not merged here yet).
+            ActArrayCommand::TrajChunk(_)
+            | ActArrayCommand::Traj(_)
+            | ActArrayCommand::TrajScale(_) => Err(Status::Unsupported),
         }
     }
 

@@ -43,6 +43,9 @@ impl ArmModel {
                 v.len().min(n) > 0
             }
             ActArrayCommand::MultiSpeed(v) => v.as_slice().iter().take(n).any(|s| *s != 0.0),
+            ActArrayCommand::TrajChunk(_)
+            | ActArrayCommand::Traj(_)
+            | ActArrayCommand::TrajScale(_) => false,
             ActArrayCommand::Home(JointSel::All)
             | ActArrayCommand::Current {
                 joint: JointSel::All,

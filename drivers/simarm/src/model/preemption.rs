@@ -45,6 +45,9 @@ impl ArmModel {
             | ActArrayCommand::MultiSpeed(v)
             | ActArrayCommand::MultiCurrent(v) => (0, v.len()),
             ActArrayCommand::Home(JointSel::All) => (0, self.n + 1),
+            ActArrayCommand::TrajChunk(_)
+            | ActArrayCommand::Traj(_)
+            | ActArrayCommand::TrajScale(_) => (0, 0),
         };
         let drives = (first..(first + count).min(64)).fold(0u64, |m, j| m | 1 << j);
         let stop = match *cmd {
