@@ -6,8 +6,8 @@ use limber_interfaces::limb_outcome::adjustment_reported;
 use limber_interfaces::prelude::*;
 use nalgebra::Vector3;
 
-use limber_kinematics::chain::{ChainIkError, IkTarget, JointKind, JointVec, NearestSolution};
-use limber_kinematics::{Pose, fit_angle_to_limits, unit_direction};
+use limber_kinematics::chain::{ChainIkError, IkTarget, JointVec, NearestSolution};
+use limber_kinematics::{Pose, unit_direction};
 
 use super::{ArmModel, MAX_WAYPOINTS};
 
@@ -83,19 +83,8 @@ impl ArmModel {
     }
 
     fn nearest_turns(&self, q: JointVec, seed: &[f64]) -> Result<JointVec, Status> {
-        let mut q = q;
         // Take the turn of each revolute joint nearest to the seed (less travel).
-        for ((v, j), s) in q.iter_mut().zip(self.chain.joints()).zip(seed) {
-            if j.kind == JointKind::Rotary
-                && let Some(w) = fit_angle_to_limits(*v, j.min, j.max, *s, 0.0)
-            {
-                *v = w;
-            }
-        }
-        if !self.chain.within_limits(&q) {
-            return Err(Status::BeyondLimits);
-        }
-        Ok(q)
+        limber_kinematics::path::nearest_turns(&self.chain, q, seed).ok_or(Status::BeyondLimits)
     }
 
     /// The cause of an IK failure: beyond the reach; a position reached but not the
