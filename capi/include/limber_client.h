@@ -1150,6 +1150,41 @@ limber_code limber_limb_vec_move(limber_limb *h,
                                  struct limber_ticket *ticket);
 
 /*
+ CMD LINE: moves the tool in a straight line to `position` (m), its orientation kept
+ (`approach` or `orientation` NULL) or turned evenly to the given vectors, at most
+ `speed` m/s (0: the limb's own). A line that leaves the reach or hits the world is
+ refused before anything moves (`LIMBER_STATUS_OUT_OF_REACH`,
+ `LIMBER_STATUS_PATH_COLLIDES`, ...; the limb state's `refused_at` and
+ `refused_fraction` say where). `limber_device_wait_done` gives its result.
+
+ # Safety
+ `h` is NULL or a live handle; `approach`, `orientation` NULL or readable; `ticket`
+ NULL or writable.
+ */
+limber_code limber_limb_line(limber_limb *h,
+                             limber_vec3 position,
+                             const limber_vec3 *approach,
+                             const limber_vec3 *orientation,
+                             double speed,
+                             struct limber_ticket *ticket);
+
+/*
+ CMD PTP: moves the joints, interpolated, to where the tool is at `position` with its
+ orientation kept (`approach` or `orientation` NULL) or the given one, the fastest joint
+ at most `speed` rad/s (0: the joints' own); checked and refused as `limber_limb_line`.
+
+ # Safety
+ `h` is NULL or a live handle; `approach`, `orientation` NULL or readable; `ticket`
+ NULL or writable.
+ */
+limber_code limber_limb_ptp(limber_limb *h,
+                            limber_vec3 position,
+                            const limber_vec3 *approach,
+                            const limber_vec3 *orientation,
+                            double speed,
+                            struct limber_ticket *ticket);
+
+/*
  REQ POWER: power on (`on` true) or off; waits up to `timeout_ms` for the reply.
 
  # Safety

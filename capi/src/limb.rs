@@ -106,6 +106,79 @@ pub unsafe extern "C" fn limber_limb_vec_move(
     })
 }
 
+/// The orientation of a path: kept when `approach` or `orientation` is NULL, else the
+/// given vectors.
+///
+/// # Safety
+/// Each pointer is NULL or readable.
+unsafe fn path_orientation(
+    approach: *const Vec3,
+    orientation: *const Vec3,
+) -> Option<([f64; 3], [f64; 3])> {
+    // SAFETY: the caller's promise: NULL or readable.
+    let (a, o) = unsafe { (approach.as_ref(), orientation.as_ref()) };
+    a.zip(o).map(|(a, o)| (a.to_array(), o.to_array()))
+}
+
+/// CMD LINE: moves the tool in a straight line to `position` (m), its orientation kept
+/// (`approach` or `orientation` NULL) or turned evenly to the given vectors, at most
+/// `speed` m/s (0: the limb's own). A line that leaves the reach or hits the world is
+/// refused before anything moves (`LIMBER_STATUS_OUT_OF_REACH`,
+/// `LIMBER_STATUS_PATH_COLLIDES`, ...; the limb state's `refused_at` and
+/// `refused_fraction` say where). `limber_device_wait_done` gives its result.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `approach`, `orientation` NULL or readable; `ticket`
+/// NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_line(
+    h: *mut LimberLimb,
+    position: Vec3,
+    approach: *const Vec3,
+    orientation: *const Vec3,
+    speed: f64,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, ticket) = unsafe { (arg(h, "handle")?, ticket.as_mut()) };
+        // SAFETY: the caller's promise: NULL or readable.
+        let o = unsafe { path_orientation(approach, orientation) };
+        sent(
+            h.typed::<Limb>()?.line(position.to_array(), o, speed),
+            ticket,
+        )
+    })
+}
+
+/// CMD PTP: moves the joints, interpolated, to where the tool is at `position` with its
+/// orientation kept (`approach` or `orientation` NULL) or the given one, the fastest joint
+/// at most `speed` rad/s (0: the joints' own); checked and refused as `limber_limb_line`.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `approach`, `orientation` NULL or readable; `ticket`
+/// NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_ptp(
+    h: *mut LimberLimb,
+    position: Vec3,
+    approach: *const Vec3,
+    orientation: *const Vec3,
+    speed: f64,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, ticket) = unsafe { (arg(h, "handle")?, ticket.as_mut()) };
+        // SAFETY: the caller's promise: NULL or readable.
+        let o = unsafe { path_orientation(approach, orientation) };
+        sent(
+            h.typed::<Limb>()?.ptp(position.to_array(), o, speed),
+            ticket,
+        )
+    })
+}
+
 /// REQ POWER: power on (`on` true) or off; waits up to `timeout_ms` for the reply.
 ///
 /// # Safety

@@ -43,7 +43,7 @@ pub struct Common {
 }
 
 impl Common {
-    fn timeout(&self) -> Duration {
+    pub(crate) fn timeout(&self) -> Duration {
         Duration::from_secs_f64(self.timeout.clamp(0.0, 3600.0))
     }
 }
@@ -210,6 +210,11 @@ pub enum LimbVerb {
         #[arg(num_args = 4, required = true, allow_negative_numbers = true, value_names = ["DX", "DY", "DZ", "LEN"])]
         args: Vec<f64>,
     },
+    /// Move the tool in a straight line to x y z (m), checked whole before anything
+    /// moves: a line out of reach or into the world is refused (exit 5) with where.
+    Line(crate::path::PathArgs),
+    /// Move the joints, interpolated, to where the tool is at x y z (m), checked as line.
+    Ptp(crate::path::PathArgs),
     /// Power on or off (request).
     Power {
         /// on or off.
@@ -364,7 +369,7 @@ fn lease_err(e: LeaseError) -> CliError {
 }
 
 /// Sends a command and reports its outcome.
-fn finish<I: Interface>(
+pub(crate) fn finish<I: Interface>(
     c: &mut Client<I>,
     sent: Result<Ticket, CommandError>,
     common: &Common,
@@ -556,6 +561,8 @@ pub fn limb(a: LimbArgs) -> Result<(), CliError> {
         } => c.set_pose(v3(&position), v3(&approach), v3(&orient)),
         LimbVerb::Setposition { position } => c.set_position(v3(&position)),
         LimbVerb::Vecmove { args } => c.vec_move(v3(&args), args[3]),
+        LimbVerb::Line(p) => return crate::path::run(&mut c, p, true, &a.common),
+        LimbVerb::Ptp(p) => return crate::path::run(&mut c, p, false, &a.common),
         LimbVerb::Power { value } => return done(&mut c, |c| c.power(value.on())),
         LimbVerb::Brakes { value } => return done(&mut c, |c| c.brakes(value.on())),
         LimbVerb::Speed { speed } => return done(&mut c, |c| c.set_speed(speed)),

@@ -196,11 +196,17 @@ pub enum Status {
     EffortNotSettable = 32,
     /// This gripper moves at one speed: a goal with a speed is refused.
     SpeedNotSettable = 33,
+    /// The path (LINE, PTP) would bring the arm into the floor or an obstacle: refused
+    /// before it started (the limb state's `refused_at` says where).
+    PathCollides = 34,
+    /// The joints would jump on the way (the line passes a singularity or leaves the
+    /// configuration it started in): refused before it started (`refused_at` says where).
+    PathJumps = 35,
 }
 
 impl Status {
     /// Every status, in code order.
-    pub const ALL: [Status; 28] = [
+    pub const ALL: [Status; 30] = [
         Status::Ok,
         Status::Unsupported,
         Status::UnknownJoint,
@@ -229,6 +235,8 @@ impl Status {
         Status::GapNotSettable,
         Status::EffortNotSettable,
         Status::SpeedNotSettable,
+        Status::PathCollides,
+        Status::PathJumps,
     ];
 
     /// The wire code.
@@ -290,6 +298,8 @@ impl Status {
             Status::GapNotSettable => "this gripper only opens or closes fully",
             Status::EffortNotSettable => "this gripper has no effort setting",
             Status::SpeedNotSettable => "this gripper has no speed setting",
+            Status::PathCollides => "the path would hit the floor or an obstacle",
+            Status::PathJumps => "the joints would jump on the way (a singularity)",
         }
     }
 }
@@ -473,6 +483,16 @@ pub(crate) const STATUS_GROUP: ConstantGroup = ConstantGroup {
             name: "SPEED_NOT_SETTABLE",
             value: 33,
             doc: "the gripper has no speed setting",
+        },
+        Constant {
+            name: "PATH_COLLIDES",
+            value: 34,
+            doc: "the path would hit the floor or an obstacle (the limb state's refused_at says where)",
+        },
+        Constant {
+            name: "PATH_JUMPS",
+            value: 35,
+            doc: "the joints would jump on the way (the limb state's refused_at says where)",
         },
     ],
 };

@@ -80,7 +80,9 @@ pub use wire::{WireField, WireStruct};
 /// `TOO_FAST`, and the results `PATH_TOLERANCE_VIOLATED` and `GOAL_TOLERANCE_VIOLATED`.
 /// It also added the gripper's GOAL command ([`gripper::GripperGoalCmd`], a wider
 /// [`gripper::GripperCmdMsg`]) and the statuses `OBJECT_PRESENT`, `GAP_NOT_SETTABLE`,
-/// `EFFORT_NOT_SETTABLE` and `SPEED_NOT_SETTABLE`.
+/// `EFFORT_NOT_SETTABLE` and `SPEED_NOT_SETTABLE`, and the limb's paths (LINE, PTP:
+/// [`limb::LimbPathCmd`], a wider [`limb::LimbCmdMsg`]; the limb state's path fields) with
+/// the statuses `PATH_COLLIDES` and `PATH_JUMPS`.
 pub const LAYOUT_VERSION: u32 = 4;
 
 /// Everything a driver or client author needs, in one `use`.
@@ -161,6 +163,7 @@ pub fn manifest() -> Manifest {
         LimbSetPoseCmd::LAYOUT,
         LimbSetPositionCmd::LAYOUT,
         LimbVecMoveCmd::LAYOUT,
+        limb::LimbPathCmd::LAYOUT,
         LimbCmdMsg::LAYOUT,
         LimbPowerReq::LAYOUT,
         LimbBrakesReq::LAYOUT,

@@ -109,6 +109,16 @@ def _vec3(v: Sequence[float]) -> "L.Vec3":
     return L.Vec3(float(x), float(y), float(z))
 
 
+def _path_orientation(
+    o: "Optional[Tuple[Sequence[float], Sequence[float]]]",
+) -> "Tuple[Any, Any]":
+    """A path's orientation for C: two NULLs (kept) or pointers to the two vectors."""
+    if o is None:
+        return None, None
+    a, v = o
+    return byref(_vec3(a)), byref(_vec3(v))
+
+
 def _doubles(values: Sequence[float]) -> "Tuple[Any, int]":
     """A sequence of numbers as a C array of doubles and its length."""
     vs = [float(v) for v in values]
@@ -679,6 +689,33 @@ class LimbClient(_Client[L.LimbData]):
         """CMD VECMOVE: move ``length`` m along ``direction`` in a straight line."""
         d = _vec3(direction)
         return self._sent(_c.limber_limb_vec_move(self._h, d, length, self._ticket_ref))
+
+    def line(
+        self,
+        position: Sequence[float],
+        orientation: Optional[Tuple[Sequence[float], Sequence[float]]] = None,
+        speed: float = 0.0,
+    ) -> Ticket:
+        """CMD LINE: the tool in a straight line to ``position``, its orientation kept
+        (``None``) or turned evenly to ``(approach, orientation)``, at most ``speed`` m/s
+        (0: the limb's own). Refused before anything moves when the line leaves the reach
+        or hits the world (the state's ``refused_at`` says where)."""
+        a, o = _path_orientation(orientation)
+        p = _vec3(position)
+        return self._sent(_c.limber_limb_line(self._h, p, a, o, speed, self._ticket_ref))
+
+    def ptp(
+        self,
+        position: Sequence[float],
+        orientation: Optional[Tuple[Sequence[float], Sequence[float]]] = None,
+        speed: float = 0.0,
+    ) -> Ticket:
+        """CMD PTP: the joints interpolated to where the tool is at ``position`` with its
+        orientation kept (``None``) or the given ``(approach, orientation)``, the fastest
+        joint at most ``speed`` rad/s (0: the joints' own); refused as :meth:`line`."""
+        a, o = _path_orientation(orientation)
+        p = _vec3(position)
+        return self._sent(_c.limber_limb_ptp(self._h, p, a, o, speed, self._ticket_ref))
 
     def power(self, on: bool, *, timeout: Optional[float] = None) -> None:
         """REQ POWER."""

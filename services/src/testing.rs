@@ -228,6 +228,8 @@ impl DeviceHandler<Limb> for TestLimb {
                     p.z + direction.z / n * length,
                 )
             }
+            // No path checks here: the test limb has no kinematics.
+            LimbCommand::Line(_) | LimbCommand::Ptp(_) => return Status::Unsupported,
         };
         if target.norm() > REACH {
             state.state = LimbState::OutOfReach as u32;

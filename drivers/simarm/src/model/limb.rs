@@ -16,7 +16,7 @@ use super::{ArmModel, MAX_WAYPOINTS};
 const MAX_WAYPOINT_JUMP: f64 = 0.5;
 
 /// Tolerance (rad) on the perpendicularity of SETPOSE's approach and orientation.
-const PERPENDICULAR_TOLERANCE: f64 = 0.05;
+pub(super) const PERPENDICULAR_TOLERANCE: f64 = 0.05;
 
 /// The VECMOVE being streamed.
 #[derive(Debug)]
@@ -39,6 +39,7 @@ impl ArmModel {
         // A new command ends the COLLISION state, and may move away from the contact.
         self.collision = None;
         self.leaving_contact = self.contact().is_some();
+        self.clear_refused_path();
         let r = self.limb_command_inner(cmd);
         self.limb.settle(r)
     }
@@ -89,7 +90,7 @@ impl ArmModel {
 
     /// The cause of an IK failure: beyond the reach; a position reached but not the
     /// orientation (the joints cannot hold it); or neither within the joint limits.
-    fn ik_status(&self, e: &ChainIkError) -> Status {
+    pub(super) fn ik_status(&self, e: &ChainIkError) -> Status {
         let ik = &self.options.ik;
         match *e {
             ChainIkError::NonFinite => Status::NotFinite,
@@ -166,6 +167,8 @@ impl ArmModel {
                 self.powered()?;
                 self.plan_vecmove(&dir, length)
             }
+            LimbCommand::Line(ref p) => self.start_path(true, p),
+            LimbCommand::Ptp(ref p) => self.start_path(false, p),
         }
     }
 
@@ -300,6 +303,7 @@ impl ArmModel {
         s.approach = Vec3::new(a.x, a.y, a.z);
         s.orientation = Vec3::new(o.x, o.y, o.z);
         s.orientation_adjustment = self.limb.adjustment;
+        self.path_state(s);
         s.state = if self.brakes {
             LimbState::Braked
         } else if self.limb.out_of_reach {

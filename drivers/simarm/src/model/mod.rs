@@ -26,6 +26,7 @@ mod gripper;
 mod limb;
 mod motion;
 mod options;
+mod paths;
 mod preemption;
 mod store;
 
@@ -76,6 +77,8 @@ pub struct ArmModel {
     limb: limber_interfaces::limb_outcome::LimbOutcome,
     powered: bool,
     vecmove: VecMovePlan,
+    /// LINE and PTP: their executor and what runs.
+    path: paths::PathRun,
     object: Option<SimObject>,
     held: bool,
     /// The contact that stopped the limb (COLLISION until the next limb command).
@@ -129,6 +132,7 @@ impl ArmModel {
         }
         let object = options.object;
         let store = Store::new(options.store_capacity);
+        let path = paths::PathRun::new(&chain);
         Ok(ArmModel {
             n,
             joints,
@@ -144,6 +148,7 @@ impl ArmModel {
             limb_speed: None,
             limb: Default::default(),
             powered: true,
+            path,
             vecmove: VecMovePlan {
                 waypoints: Vec::with_capacity(MAX_WAYPOINTS),
                 scratch: Vec::with_capacity(MAX_WAYPOINTS),
@@ -218,7 +223,7 @@ impl ArmModel {
 
     /// True when any chain joint moves or a VECMOVE is being streamed.
     pub fn limb_moving(&self) -> bool {
-        self.vecmove.active || self.joints[..self.n].iter().any(|m| m.moving)
+        self.vecmove.active || self.path.active || self.joints[..self.n].iter().any(|m| m.moving)
     }
 
     // ----- time ------------------------------------------------------------------------
@@ -234,6 +239,9 @@ impl ArmModel {
         self.time += dt;
         // Current-driven actuators: aimed by the motor model from where they are now.
         self.drive_currents();
+        // A LINE or PTP: the joints where its trajectory is now.
+        self.step_path();
+        self.stop_at_contact();
         // Sub-steps so each VECMOVE waypoint starts the moment the previous one is
         // reached (a tick may span many short segments at a large time scale).
         let mut left = dt;
@@ -316,6 +324,7 @@ impl ArmModel {
     fn move_actuator(&mut self, j: usize, v: f64, speed: Option<f64>) {
         let a = self.config_accel.get(j).copied().unwrap_or(f64::INFINITY);
         if j < self.n {
+            self.release_path();
             let s = speed.unwrap_or(self.config_speed[j]);
             self.joints[j].go_accel(v, s, a);
         } else {
@@ -367,6 +376,7 @@ impl ArmModel {
     /// Starts a coordinated move of the chain joints to `q`: every joint arrives at the
     /// same time, `min_time` s at least.
     fn move_joints_together(&mut self, q: &[f64], min_time: f64) {
+        self.release_path();
         let mut t = min_time.max(0.0);
         for (j, (m, v)) in self.joints.iter().zip(q).enumerate().take(self.n) {
             let s = self.limb_joint_speed(j);
@@ -382,6 +392,7 @@ impl ArmModel {
     }
 
     fn stop_all_joints(&mut self) {
+        self.halt_path();
         self.vecmove.active = false;
         for m in &mut self.joints[..self.n] {
             m.stop();

@@ -17,7 +17,7 @@ impl ArmModel {
     fn running(&self) -> u64 {
         let mut bits = 0u64;
         for j in 0..self.n {
-            if self.vecmove.active || self.joints[j].moving {
+            if self.vecmove.active || self.path.active || self.joints[j].moving {
                 bits |= 1 << j;
             }
         }
@@ -88,6 +88,14 @@ impl ArmModel {
         let Some(m) = self.actuator(j) else {
             return Progress::UNKNOWN;
         };
+        // A LINE's or PTP's joint: as its executor says (unless the power or the brakes
+        // ended it: below).
+        if self.powered
+            && !(self.brakes && j < self.n)
+            && let Some(p) = self.path_progress(j)
+        {
+            return p;
+        }
         let error = m.pos - m.goal;
         if m.moving || (j < self.n && self.vecmove.active) {
             return Progress::moving(m.pos, error, TOLERANCE);
