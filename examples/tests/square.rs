@@ -1,0 +1,116 @@
+//! The square example (issue 28) as a user runs it: the `square` binary against simarm (a
+//! thread of this process, its own domain): a PTP to the first corner, four straight
+//! edges, each waited for with `wait_done`; every motion ends REACHED with its final error
+//! within the tolerance. A square out of reach is refused before anything moves.
+
+use std::process::{Command, Output};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+use limber_kinematics::chain::Chain;
+use limber_services::{Context, Domain, Role};
+use limber_simarm::{SimArm, SimArmOptions};
+
+const SQUARE: &str = env!("CARGO_BIN_EXE_square");
+const RUN_TIMEOUT: Duration = Duration::from_secs(120);
+
+/// simarm on a thread (5x real time); stops and joins when dropped.
+struct Driver {
+    stop: Arc<AtomicBool>,
+    handle: Option<JoinHandle<()>>,
+}
+
+impl Drop for Driver {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(h) = self.handle.take() {
+            h.join().expect("the driver thread ends cleanly");
+        }
+    }
+}
+
+fn simarm(domain: &Domain) -> Driver {
+    let stop = Arc::new(AtomicBool::new(false));
+    let (ready_tx, ready_rx) = mpsc::channel();
+    let name = domain.name().to_string();
+    let flag = stop.clone();
+    let handle = std::thread::spawn(move || {
+        let domain = Domain::new(&name).expect("domain");
+        let ctx = Context::new(&domain, Role::Driver, "simarm").expect("context");
+        let options = SimArmOptions {
+            time_scale: 5.0,
+            ..SimArmOptions::default()
+        };
+        let mut arm = SimArm::new(&ctx, Chain::default_6dof(), options).expect("simarm starts");
+        ready_tx.send(()).expect("test waits");
+        arm.run(|| flag.load(Ordering::Relaxed))
+            .expect("simarm runs");
+    });
+    ready_rx
+        .recv_timeout(Duration::from_secs(20))
+        .expect("simarm ready in time");
+    Driver {
+        stop,
+        handle: Some(handle),
+    }
+}
+
+fn run(domain: &Domain, args: &[&str]) -> Output {
+    let mut cmd = Command::new(SQUARE);
+    cmd.args(args).env("LIMBER_DOMAIN", domain.name());
+    limber_bounded_run::output_within(cmd, RUN_TIMEOUT)
+}
+
+#[test]
+fn the_square_is_drawn_and_every_edge_ends_within_the_tolerance() {
+    let d = Domain::unique_for_test();
+    let _drv = simarm(&d);
+    let o = run(
+        &d,
+        &["--limb", "simarm/limb/0", "--side", "0.1", "--speed", "0.1"],
+    );
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{out}{err}");
+    let strokes: Vec<&str> = out
+        .lines()
+        .filter(|l| l.starts_with("ptp ") || l.starts_with("line "))
+        .collect();
+    assert_eq!(strokes.len(), 5, "{out}");
+    assert!(
+        strokes[0].starts_with("ptp 0 to (0.350, -0.050, 0.250)"),
+        "{out}"
+    );
+    assert!(
+        strokes[4].starts_with("line 4 to (0.350, -0.050, 0.250)"),
+        "{out}"
+    );
+    for s in &strokes {
+        // ... : REACHED error E tolerance T
+        let w: Vec<&str> = s.split_whitespace().collect();
+        let n = w.len();
+        assert_eq!(w[n - 5], "REACHED", "{s}");
+        let (error, tolerance): (f64, f64) = (w[n - 3].parse().unwrap(), w[n - 1].parse().unwrap());
+        assert!(error <= tolerance, "{s}");
+    }
+    assert!(out.ends_with("square drawn\n"), "{out}");
+}
+
+#[test]
+fn a_square_out_of_reach_is_refused_with_the_reason() {
+    let d = Domain::unique_for_test();
+    let _drv = simarm(&d);
+    let o = run(
+        &d,
+        &["--limb", "simarm/limb/0", "--centre", "1.5", "0", "0.25"],
+    );
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("square: motion 0: the command was refused: out of reach"),
+        "{err}"
+    );
+}
