@@ -161,8 +161,8 @@ pub enum StrategyArg {
 /// The options of `limber bench`.
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct BenchArgs {
-    /// Run only these scenarios (comma separated): floor, state, command, ik, peers,
-    /// request, loop, lang, bridge, gateway. Default: all.
+    /// Run only these scenarios (comma separated): floor, state, command, ik, traj,
+    /// peers, request, loop, lang, bridge, gateway. Default: all.
     #[arg(long, value_delimiter = ',', value_name = "NAME[,NAME]")]
     pub only: Vec<String>,
     /// Small sample counts (a run takes under 20 s).

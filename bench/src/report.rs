@@ -460,7 +460,7 @@ fn floor_of(m: &Measurement, (spin, blocking): (&str, &str)) -> Option<String> {
         Metric::RoundTrip => "rtt",
         Metric::OneWay if m.id.ends_with(".back") => "back",
         Metric::OneWay => "oneway",
-        Metric::Solve | Metric::Read => return None,
+        Metric::Solve | Metric::Read | Metric::Period => return None,
     };
     Some(format!("floor.{k}.{what}"))
 }

@@ -18,6 +18,7 @@ pub mod physical;
 pub mod pty_loop;
 pub mod request;
 pub mod state;
+pub mod traj;
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -56,6 +57,7 @@ pub fn registry() -> Vec<Box<dyn Scenario>> {
         Box::new(command::Command),
         Box::new(peers::Peers),
         Box::new(ik::Ik),
+        Box::new(traj::Traj),
         Box::new(request::Request),
         Box::new(pty_loop::Loop),
         Box::new(lang::Lang),

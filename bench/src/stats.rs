@@ -55,6 +55,8 @@ pub enum Metric {
     Solve,
     /// Time of one local read (the latest state from shared memory into the program).
     Read,
+    /// Time between two successive events of one periodic loop (or its deviation).
+    Period,
 }
 
 impl Metric {
@@ -65,6 +67,7 @@ impl Metric {
             Metric::OneWay => "one-way",
             Metric::Solve => "solve",
             Metric::Read => "read",
+            Metric::Period => "period",
         }
     }
 }

@@ -343,6 +343,31 @@ public:
         detail::Check(limber_actarray_move_at_speed_multi(h_, speeds.data(), speeds.size(), &t));
         return t;
     }
+    /// CMD TRAJ: follows a joint trajectory of `joints` (row-major `positions` of
+    /// times.size() x joints.size(); `velocities`, `accelerations` the same or empty; the
+    /// tolerances one per joint or empty): see limber_actarray_follow_trajectory.
+    limber_ticket FollowTrajectory(const std::vector<uint32_t>& joints,
+                                   const std::vector<double>& times,
+                                   const std::vector<double>& positions,
+                                   const std::vector<double>& velocities = {},
+                                   const std::vector<double>& accelerations = {},
+                                   const std::vector<double>& path_tolerance = {},
+                                   const std::vector<double>& goal_tolerance = {},
+                                   double goal_time_tolerance = 0.0, uint64_t start_ns = 0) {
+        auto p = [](const std::vector<double>& v) { return v.empty() ? nullptr : v.data(); };
+        limber_ticket t{};
+        detail::Check(limber_actarray_follow_trajectory(
+            h_, joints.data(), joints.size(), times.data(), times.size(), positions.data(),
+            p(velocities), p(accelerations), p(path_tolerance), p(goal_tolerance),
+            goal_time_tolerance, start_ns, &t));
+        return t;
+    }
+    /// CMD TRAJ_SCALE: the speed scaling of trajectories (0 pauses, 1 nominal).
+    limber_ticket SetTrajectoryScale(double scale) {
+        limber_ticket t{};
+        detail::Check(limber_actarray_set_trajectory_scale(h_, scale, &t));
+        return t;
+    }
     /// CMD HOME: homes `joint`, or every joint if negative (the default).
     limber_ticket MoveHome(int32_t joint = -1) {
         limber_ticket t{};

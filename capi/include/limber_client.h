@@ -662,6 +662,50 @@ limber_code limber_actarray_set_accel_config(limber_actarray *h,
                                              uint64_t timeout_ms);
 
 /*
+ CMD TRAJ: follows a joint trajectory (control_msgs' FollowJointTrajectory) of
+ `point_count` points (up to `LIMBER_TRAJ_MAX_POINTS`) for the `joint_count` actarray
+ joints `joints[0..joint_count]`. Point i is reached `times[i]` s after the start (strictly
+ increasing); its positions are `positions[i * joint_count + c]` (column c drives
+ `joints[c]`); `velocities` and `accelerations` are laid out the same way or NULL
+ (positions only: linear; with velocities: cubic; with accelerations too: quintic).
+ `path_tolerance` and `goal_tolerance` hold one value per column or are NULL (0: not
+ enforced); `goal_time_tolerance` s (0: the driver's default); `start_ns` the
+ `CLOCK_MONOTONIC` start (0: when it arrives). It replaces a running trajectory from its
+ start time. `limber_actarray_wait_done` returns its result. An invalid trajectory is
+ `LIMBER_CODE_INVALID_VALUE` with the reason in `limber_last_error()`, nothing sent.
+
+ # Safety
+ `h` is NULL or a live handle; `joints` points to `joint_count` values; `times` to
+ `point_count`; `positions` (and `velocities`, `accelerations` unless NULL) to
+ `point_count * joint_count`; the tolerances (unless NULL) to `joint_count`; `ticket` is
+ NULL or writable.
+ */
+limber_code limber_actarray_follow_trajectory(limber_actarray *h,
+                                              const uint32_t *joints,
+                                              size_t joint_count,
+                                              const double *times,
+                                              size_t point_count,
+                                              const double *positions,
+                                              const double *velocities,
+                                              const double *accelerations,
+                                              const double *path_tolerance,
+                                              const double *goal_tolerance,
+                                              double goal_time_tolerance,
+                                              uint64_t start_ns,
+                                              struct limber_ticket *ticket);
+
+/*
+ CMD TRAJ_SCALE: the speed scaling of trajectories: 0 pauses the running one, 1 is
+ nominal (above 1: clamped, the outcome `LIMBER_STATUS_CLAMPED`).
+
+ # Safety
+ `h` is NULL or a live handle; `ticket` is NULL or writable.
+ */
+limber_code limber_actarray_set_trajectory_scale(limber_actarray *h,
+                                                 double scale,
+                                                 struct limber_ticket *ticket);
+
+/*
  Connects to `device` ("robot/interface/index") in `domain` (NULL: `LIMBER_DOMAIN`, or
  "limber"), waiting up to `timeout_ms` for a driver to offer it; `*out` is the new
  handle (free it with `limber_device_disconnect`). Call it through the inline functions

@@ -151,6 +151,16 @@ pub enum ActArrayVerb {
         /// Acceleration.
         accel: f64,
     },
+    /// Follow a joint trajectory read from a CSV file (`-`: standard input): a header
+    /// `t,j0,j1,...` (time from start in s, then each joint's position), optional
+    /// `v0,...` velocity and `a0,...` acceleration columns, one line per point. With
+    /// `--wait`, the result and each joint's final error.
+    Traj(crate::traj::TrajArgs),
+    /// The speed scaling of trajectories: 0 pauses the running one, 1 is nominal.
+    Scale {
+        /// The factor, 0 to 1.
+        factor: f64,
+    },
 }
 
 /// Arguments of `limber limb`.
@@ -298,7 +308,7 @@ pub(crate) fn connect_err(e: ConnectError) -> CliError {
     CliError::new(code, e.to_string())
 }
 
-fn command_err(e: CommandError) -> CliError {
+pub(crate) fn command_err(e: CommandError) -> CliError {
     let code = match e {
         CommandError::Invalid(_) => exit::USAGE,
         CommandError::NoDriver => exit::NO_DRIVER,
@@ -374,7 +384,17 @@ pub(crate) fn finish<I: Interface>(
     sent: Result<Ticket, CommandError>,
     common: &Common,
 ) -> Result<(), CliError> {
-    let ticket = sent.map_err(command_err)?;
+    finish_ticket(c, sent.map_err(command_err)?, common, false)
+}
+
+/// Reports the outcome of a command sent (with `--wait`, its result; `per_joint`: and
+/// each joint's final error).
+fn finish_ticket<I: Interface>(
+    c: &mut Client<I>,
+    ticket: Ticket,
+    common: &Common,
+    per_joint: bool,
+) -> Result<(), CliError> {
     if common.no_wait {
         outln!("sent")?;
         return Ok(());
@@ -384,7 +404,7 @@ pub(crate) fn finish<I: Interface>(
         Ok(o) if o.status.is_carried_out() => {
             outln!("{}", o.status)?;
             match common.wait {
-                Some(s) => wait_done(c, ticket, s),
+                Some(s) => wait_done(c, ticket, s, per_joint),
                 None => Ok(()),
             }
         }
@@ -410,13 +430,23 @@ fn wait_done<I: Interface>(
     c: &mut Client<I>,
     ticket: Ticket,
     seconds: f64,
+    per_joint: bool,
 ) -> Result<(), CliError> {
     match c.wait_done(ticket, Duration::from_secs_f64(seconds)) {
         Ok(d) if d.reached() => {
             outln!("done: {d}")?;
+            if per_joint {
+                crate::traj::print_errors(&d)?;
+            }
             Ok(())
         }
-        Ok(d) => Err(CliError::new(exit::FAILURE, format!("done: {d}"))),
+        Ok(d) => {
+            if per_joint {
+                outln!("done: {d}")?;
+                crate::traj::print_errors(&d)?;
+            }
+            Err(CliError::new(exit::FAILURE, format!("done: {d}")))
+        }
         Err(DoneError::Refused(s)) => Err(CliError::new(exit::REFUSED, format!("refused: {s}"))),
         Err(DoneError::Wait(e)) => Err(wait_err(e)),
     }
@@ -503,6 +533,11 @@ pub fn actarray(a: ActArrayArgs) -> Result<(), CliError> {
         ActArrayVerb::Accel { joint, accel } => {
             return done(&mut c, |c| c.set_accel_config(joint, accel));
         }
+        ActArrayVerb::Traj(t) => {
+            let ticket = crate::traj::send(&mut c, &t, a.common.timeout())?;
+            return finish_ticket(&mut c, ticket, &a.common, true);
+        }
+        ActArrayVerb::Scale { factor } => c.set_trajectory_scale(factor),
         ActArrayVerb::Geom => {
             let g = c.geometry().map_err(request_err)?;
             outln!(

@@ -28,6 +28,7 @@ pub mod pioneer;
 mod player_gateway;
 mod record;
 pub mod simarm;
+mod traj;
 pub mod world;
 
 /// limber: Player's generic limb interfaces (actarray, limb, gripper) over zero-copy

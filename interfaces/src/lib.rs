@@ -89,9 +89,9 @@ pub const LAYOUT_VERSION: u32 = 4;
 pub mod prelude {
     pub use crate::actarray::{
         ActArrayCmdMsg, ActArrayCommand, ActArrayData, ActArrayGeom, ActArrayReply,
-        ActArrayReplyMsg, ActArrayReqMsg, ActArrayRequest, ActuatorFlags, ActuatorGeom,
-        ActuatorKind, ActuatorState, JointSel, JointTrajectory, JointValues, MAX_TRAJ_POINTS,
-        TrajectoryError, TrajectoryUpload,
+        ActArrayReplyMsg, ActArrayReqMsg, ActArrayRequest, ActArrayTrajChunkCmd, ActArrayTrajCmd,
+        ActuatorFlags, ActuatorGeom, ActuatorKind, ActuatorState, JointSel, JointTrajectory,
+        JointValues, MAX_TRAJ_POINTS, TrajectoryError, TrajectoryUpload,
     };
     pub use crate::common::{
         Bbox3, CmdOutcome, MAX_ACTUATORS, MsgMeta, Orientation3, Pose3, ReplyMeta, StateHeader,

@@ -42,6 +42,12 @@ pub trait Message: Sized + Copy {
     fn is_read_only(&self) -> bool {
         false
     }
+    /// True for a piece of a larger command (a trajectory upload's chunk): it has an
+    /// outcome but no motion result of its own (the command it belongs to has). Default:
+    /// false.
+    fn is_piece(&self) -> bool {
+        false
+    }
 }
 
 /// A typed reply body (the payload of an ACK) carried in envelope `Raw`.

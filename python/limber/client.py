@@ -32,7 +32,7 @@ from __future__ import annotations
 import atexit
 import ctypes
 import math
-from ctypes import byref, c_bool, c_double, c_int32, c_uint64, c_void_p, sizeof
+from ctypes import byref, c_bool, c_double, c_int32, c_uint32, c_uint64, c_void_p, sizeof
 from typing import (
     Any,
     ClassVar,
@@ -579,6 +579,52 @@ class ActArrayClient(_Client[L.ActArrayData]):
         """CMD MULTI_POS: move joints 0..n to ``positions``."""
         arr, n = _doubles(positions)
         return self._sent(_c.limber_actarray_move_to_multi(self._h, arr, n, self._ticket_ref))
+
+    def follow_trajectory(
+        self,
+        joints: Sequence[int],
+        times: Sequence[float],
+        positions: Sequence[Sequence[float]],
+        velocities: Optional[Sequence[Sequence[float]]] = None,
+        accelerations: Optional[Sequence[Sequence[float]]] = None,
+        path_tolerance: Optional[Sequence[float]] = None,
+        goal_tolerance: Optional[Sequence[float]] = None,
+        goal_time_tolerance: float = 0.0,
+        start_ns: int = 0,
+    ) -> Ticket:
+        """CMD TRAJ: follow a joint trajectory (``limber_actarray_follow_trajectory``):
+        point i reached ``times[i]`` s after the start with ``positions[i]`` (one per joint
+        of ``joints``), optional velocities and accelerations per point (cubic, quintic),
+        tolerances per joint (0: not enforced). It replaces a running trajectory from its
+        start time; :meth:`wait_done` returns its result. An invalid trajectory raises
+        ``ValueError`` with the reason (nothing sent)."""
+
+        def rows(v: Optional[Sequence[Sequence[float]]]) -> Any:
+            return None if v is None else _doubles([x for row in v for x in row])[0]
+
+        ids = (c_uint32 * max(1, len(joints)))(*joints)
+        ts, n = _doubles(times)
+        pos = rows(positions)
+        rc = _c.limber_actarray_follow_trajectory(
+            self._h,
+            ids,
+            len(joints),
+            ts,
+            n,
+            pos,
+            rows(velocities),
+            rows(accelerations),
+            None if path_tolerance is None else _doubles(path_tolerance)[0],
+            None if goal_tolerance is None else _doubles(goal_tolerance)[0],
+            goal_time_tolerance,
+            start_ns,
+            self._ticket_ref,
+        )
+        return self._sent(rc)
+
+    def set_trajectory_scale(self, scale: float) -> Ticket:
+        """CMD TRAJ_SCALE: the speed scaling of trajectories (0 pauses, 1 nominal)."""
+        return self._sent(_c.limber_actarray_set_trajectory_scale(self._h, scale, self._ticket_ref))
 
     def move_at_speed(self, joint: int, speed: float) -> Ticket:
         """CMD SPEED: move ``joint`` at ``speed`` (rad/s or m/s)."""

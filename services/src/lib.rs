@@ -93,7 +93,8 @@ pub use domain::dir as domain_dir;
 pub use client::{
     ActArrayClient, AnyGeom, Client, CommandError, ConnectError, DeviceClient, Done, DoneError,
     DriverStatus, Freshness, GripperClient, Incompatibility, LaserClient, LeaseError, LeaseHolder,
-    LimbClient, Outcome, RangerClient, RequestError, Ticket, WaitError, WaitMode, connect_device,
+    LimbClient, Outcome, RangerClient, RequestError, Ticket, TrajectorySendError, WaitError,
+    WaitMode, connect_device,
 };
 pub use context::{Context, ContextError, Role, monotonic_ns};
 pub use device_set::{DeviceError, DeviceSet, DeviceSetHandler, Drain, ShareLeaseError};
@@ -113,7 +114,7 @@ pub mod prelude {
     pub use crate::client::{
         ActArrayClient, Client, CommandError, ConnectError, DeviceClient, Done, DoneError,
         DriverStatus, Freshness, GripperClient, LaserClient, LimbClient, RangerClient,
-        RequestError, Ticket, WaitError, WaitMode, connect_device,
+        RequestError, Ticket, TrajectorySendError, WaitError, WaitMode, connect_device,
     };
     pub use crate::context::{Context, Role, monotonic_ns};
     pub use crate::device_set::{DeviceSet, DeviceSetHandler};

@@ -84,10 +84,16 @@ impl DeviceSetHandler for Serve<'_> {
         &mut self,
         _: u16,
         cmd: &ActArrayCommand,
-        _: &Origin,
+        from: &Origin,
         state: &mut ActArrayData,
     ) -> Status {
-        let s = self.0.arm_command(cmd);
+        let s = match self
+            .0
+            .trajectory_command(cmd, from.client_id, monotonic_ns())
+        {
+            Some(s) => s,
+            None => self.0.arm_command(cmd),
+        };
         self.0.arm_state(state);
         s
     }
@@ -221,6 +227,7 @@ impl SimArm {
         let dt = now.duration_since(self.last).as_secs_f64();
         self.last = now;
         self.model.advance(dt);
+        self.model.step_trajectory(monotonic_ns());
     }
 
     /// Fills and publishes the state of all three devices.

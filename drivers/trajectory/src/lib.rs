@@ -396,7 +396,7 @@ impl Executor {
             let j = j as usize;
             from[c] = self.state_of(j, actual);
         }
-        self.check(traj, &from, age)?;
+        self.check_goal(traj, &from, age)?;
         *self.next = traj.clone();
         self.next_pending = true;
         self.next_start_ns = start_ns;
@@ -430,7 +430,7 @@ impl Executor {
 
     /// Limits and speeds of every segment from `from` (the columns' start state) at
     /// trajectory time `tau0`.
-    fn check(&self, traj: &JointTrajectory, from: &[Knot], tau0: f64) -> Result<(), Refusal> {
+    fn check_goal(&self, traj: &JointTrajectory, from: &[Knot], tau0: f64) -> Result<(), Refusal> {
         let kind = traj.interpolation();
         let first = (0..traj.len())
             .find(|&i| traj.time(i) > tau0)
@@ -519,6 +519,17 @@ impl Executor {
     /// computes the desired positions, checks the tolerances, ends the trajectory when it
     /// is done. Allocation-free.
     pub fn tick(&mut self, now_ns: u64, actual: &[f64]) -> Tick {
+        match self.sample(now_ns, actual) {
+            Tick::Running if self.phase == Phase::Running => self.check(actual),
+            t => t,
+        }
+    }
+
+    /// The first half of [`Executor::tick`], for a simulator that puts its joints where
+    /// they are wanted before it measures them: advances to `now_ns` and computes the
+    /// desired positions (`actual`: where the joints are, for a trajectory that becomes
+    /// active now). Follow it with [`Executor::check`]. Allocation-free.
+    pub fn sample(&mut self, now_ns: u64, actual: &[f64]) -> Tick {
         let n = actual.len().min(MAX_ACTUATORS);
         self.actual[..n].copy_from_slice(&actual[..n]);
         if self.next_pending && now_ns >= self.next_start_ns {
@@ -528,11 +539,14 @@ impl Executor {
             Phase::Idle => Tick::Idle,
             Phase::Holding => Tick::Running,
             Phase::Decelerating { since } => self.decelerate(now_ns, since),
-            Phase::Running => self.run(now_ns),
+            Phase::Running => {
+                self.desire(now_ns);
+                Tick::Running
+            }
         }
     }
 
-    fn run(&mut self, now_ns: u64) -> Tick {
+    fn desire(&mut self, now_ns: u64) {
         let dt = now_ns.saturating_sub(self.last_ns) as f64 * 1e-9;
         self.last_ns = now_ns;
         self.tau += dt * self.scale;
@@ -547,11 +561,8 @@ impl Executor {
             let i = self.point.min(traj.len() - 1);
             (traj.time(i.saturating_sub(1)), traj.time(i))
         };
-        let mut max_error: f64 = 0.0;
-        let mut violated = false;
         for (c, &j) in traj.joints().iter().enumerate() {
-            let j = j as usize;
-            let d = if self.point >= traj.len() {
+            self.desired[j as usize] = if self.point >= traj.len() {
                 point_knot(traj, kind, traj.len() - 1, c)
             } else {
                 let k1 = point_knot(traj, kind, self.point, c);
@@ -562,8 +573,24 @@ impl Executor {
                 };
                 spline::sample(kind, k0, k1, t1 - t0, self.tau - t0)
             };
-            self.desired[j] = d;
-            let e = self.actual[j] - d.p;
+        }
+    }
+
+    /// The second half of [`Executor::tick`]: the joints' actual positions now against the
+    /// desired ones: the path tolerance, and after the last point the goal tolerance and
+    /// the goal time. Allocation-free.
+    pub fn check(&mut self, actual: &[f64]) -> Tick {
+        if self.phase != Phase::Running {
+            return Tick::Running;
+        }
+        let n = actual.len().min(MAX_ACTUATORS);
+        self.actual[..n].copy_from_slice(&actual[..n]);
+        let traj = &*self.active;
+        let mut max_error: f64 = 0.0;
+        let mut violated = false;
+        for (c, &j) in traj.joints().iter().enumerate() {
+            let j = j as usize;
+            let e = self.actual[j] - self.desired[j].p;
             max_error = max_error.max(e.abs());
             let tol = traj.path_tolerance()[c];
             if tol > 0.0 && e.abs() > tol && self.point < traj.len() {

@@ -299,6 +299,10 @@ impl Message for ActArrayCommand {
         raw.meta.body_len = len;
     }
 
+    fn is_piece(&self) -> bool {
+        matches!(self, ActArrayCommand::TrajChunk(_))
+    }
+
     fn read(raw: &ActArrayCmdMsg) -> Result<Self, DecodeError> {
         let (k, b, n) = (raw.meta.kind, &raw.body[..], raw.meta.body_len);
         let ch = Self::CHANNEL;

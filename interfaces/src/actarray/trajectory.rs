@@ -12,10 +12,12 @@
 //! shared memory (~850 MB per device). So a trajectory goes as a series of ordinary
 //! commands: `TRAJ_CHUNK`s of up to 32 values of one field (times, or one joint's
 //! positions, velocities or accelerations, or the tolerances), then one `TRAJ` with the
-//! header that runs it. The largest upload (64 points, 32 joints, three fields) is
-//! 2 + 2 + 32·3·2 = 198 chunks: below the 256 outcomes a client may miss between two looks
-//! (`OUTCOME_BUFFER`), so one upload never overwrites another client's outcome; a 6-joint
-//! arm's 64 positions go in 2 + 2 + 6·2 = 16. 64 points also give each field of a joint a
+//! header that runs it. Each chunk has an outcome (and no result of its own,
+//! [`Message::is_piece`](crate::Message::is_piece)). The largest upload (64 points, 32
+//! joints, three fields) is 2 + 2 + 32·3·2 = 198 chunks: below the 256 outcomes a client may
+//! miss between two looks (`OUTCOME_BUFFER`), so one upload does not overwrite another
+//! client's outcome; a 6-joint arm's 64 positions go in 2 + 2 + 6·2 = 16. 64 points also
+//! give each field of a joint a
 //! `u64` bit mask of what arrived. At the Pioneer's servo pace (a full 6-joint update every
 //! ~12 ms) 64 points at one every 50-100 ms are 3-6 s of motion; a longer path is several
 //! trajectories, each replacing the last from its start time.

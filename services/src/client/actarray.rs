@@ -2,7 +2,7 @@
 
 use limber_interfaces::prelude::*;
 
-use super::{Client, CommandError, RequestError, Ticket};
+use super::{Client, CommandError, RequestError, Ticket, TrajectorySendError};
 
 fn joint_index(j: usize) -> i64 {
     j.min(i64::MAX as usize) as i64
@@ -46,6 +46,27 @@ impl Client<ActArray> {
     /// CMD MULTI_CURRENT: drive joints 0..n with `currents` A.
     pub fn set_current_multi(&mut self, currents: &[f64]) -> Result<Ticket, CommandError> {
         self.send(&ActArrayCommand::multi_current(currents)?)
+    }
+    /// TRAJ: uploads joint trajectory `traj` (as `TRAJ_CHUNK`s; see
+    /// [`JointTrajectory::commands`]) and runs it; the ticket is the `TRAJ`'s, so
+    /// [`Client::wait_outcome`] says whether it was accepted (or why not) and
+    /// [`Client::wait_done`] returns its result. It replaces a running trajectory from its
+    /// start time. Validated here first (nothing is sent when it is invalid).
+    pub fn follow_trajectory(
+        &mut self,
+        traj: &JointTrajectory,
+    ) -> Result<Ticket, TrajectorySendError> {
+        let commands = traj.commands()?;
+        let mut ticket = None;
+        for c in &commands {
+            ticket = Some(self.send(c)?);
+        }
+        ticket.ok_or(TrajectorySendError::Invalid(TrajectoryError::PointCount(0)))
+    }
+    /// TRAJ_SCALE: the speed scaling of trajectories (0 pauses, 1 is nominal; above 1 is
+    /// clamped to 1 and answered CLAMPED).
+    pub fn set_trajectory_scale(&mut self, scale: f64) -> Result<Ticket, CommandError> {
+        self.send(&ActArrayCommand::traj_scale(scale)?)
     }
     /// REQ POWER.
     pub fn power(&mut self, on: bool) -> Result<(), RequestError> {

@@ -143,6 +143,18 @@ pub enum CommandError {
     Transport(#[source] Iox2Error),
 }
 
+/// Sending a joint trajectory failed ([`Client::follow_trajectory`](super::Client)).
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum TrajectorySendError {
+    /// The trajectory is invalid; nothing was sent.
+    #[error("invalid trajectory: {0}")]
+    Invalid(#[from] TrajectoryError),
+    /// A command of its upload could not be sent (the driver refuses the `TRAJ` of an
+    /// incomplete upload).
+    #[error(transparent)]
+    Send(#[from] CommandError),
+}
+
 /// A request failed.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
 pub enum RequestError {

@@ -28,7 +28,10 @@ pub use connection::{
 };
 pub use device::{AnyGeom, DeviceClient, connect_device};
 pub use done::{Done, DoneError};
-pub use error::{CommandError, ConnectError, Incompatibility, LeaseError, RequestError, WaitError};
+pub use error::{
+    CommandError, ConnectError, Incompatibility, LeaseError, RequestError, TrajectorySendError,
+    WaitError,
+};
 pub use ownership::{LeaseHolder, Outcome};
 pub use waiting::{DriverStatus, FRESHNESS_CHECK_AGE, Freshness, WaitMode};
 

@@ -132,6 +132,10 @@ impl<I: Interface> DeviceHost<I> {
         if !status.is_carried_out() {
             return status;
         }
+        if decoded.is_piece() {
+            // A piece of a larger command: its outcome only (no result of its own).
+            return status;
+        }
         self.motion_started(cmd, motion);
         let (outcomes, loan, stats, device) = (
             &self.outcomes,

@@ -34,6 +34,13 @@ impl PioneerDriver {
             self.try_reconnect();
         }
         self.robot.check_arm_reporting(now);
+        // A joint trajectory's next targets.
+        self.robot.step_trajectory();
+        if let Err(status) =
+            super::serve::flush(&mut self.robot, self.conn.as_mut(), &mut self.timing)
+        {
+            tracing::debug!("trajectory targets not written: {status}");
+        }
         // Time-based lift estimate and stall detection move without packets.
         if self.robot.lift.moving.is_some() {
             self.robot.dirty.body = true;

@@ -40,6 +40,10 @@ impl RobotModel {
     /// A SPEED faster than the joint's configured speed (the geometry's `config_speed`,
     /// from the calibration) runs at that speed and is answered CLAMPED.
     pub fn arm_command(&mut self, cmd: &ActArrayCommand, from: &Origin) -> Status {
+        if let Some(r) = self.trajectory_command(cmd, from) {
+            return r.unwrap_or_else(|e| e);
+        }
+        let motion = self.arm_motion(cmd);
         let r = match *cmd {
             ActArrayCommand::Position { joint, position } => {
                 self.vecmove = None;
@@ -95,15 +99,16 @@ impl RobotModel {
                 })
             }
             ActArrayCommand::Home(sel) => self.home(sel, from).map(|()| Status::Ok),
-            // Joint trajectories reach the Pioneer with i28-traj's streaming (not merged
-            // here yet): until then, unsupported.
-            ActArrayCommand::TrajChunk(_)
-            | ActArrayCommand::Traj(_)
-            | ActArrayCommand::TrajScale(_) => Err(Status::Unsupported),
             ActArrayCommand::Current { .. } | ActArrayCommand::MultiCurrent(_) => {
                 Err(Status::Unsupported)
             }
+            ActArrayCommand::TrajChunk(_)
+            | ActArrayCommand::Traj(_)
+            | ActArrayCommand::TrajScale(_) => Err(Status::Unsupported),
         };
+        if r.is_ok_and(|s| s.is_carried_out()) {
+            self.end_trajectory(motion.drives, motion.stop);
+        }
         r.unwrap_or_else(|e| e)
     }
 

@@ -56,7 +56,11 @@ impl RobotModel {
     pub fn limb_command(&mut self, cmd: &LimbCommand, from: &Origin) -> Status {
         self.limb.begin();
         let r = self.limb_command_inner(cmd, from);
-        self.limb.settle(r)
+        let s = self.limb.settle(r);
+        if s.is_carried_out() {
+            self.end_trajectory(0b1_1111, *cmd == LimbCommand::Stop);
+        }
+        s
     }
 
     pub(super) fn limb_command_inner(

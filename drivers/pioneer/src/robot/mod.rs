@@ -16,6 +16,7 @@ mod limb;
 mod motion;
 mod outbox;
 mod progress;
+mod trajectory;
 
 pub use lift::LiftModel;
 pub use outbox::{OUTBOX_CAPACITY, Outbox, OutboxFull, Queued};
@@ -315,6 +316,8 @@ pub struct RobotModel {
     pub(crate) armgrip_cmd: Option<GripperCommand>,
     /// What changed on the link since the last publish.
     pub(crate) dirty: Dirty,
+    /// Joint trajectories: the executor, the upload, what was streamed.
+    pub(crate) traj: trajectory::Trajectories,
 }
 
 impl core::fmt::Debug for RobotModel {
@@ -419,6 +422,7 @@ impl RobotModel {
             gripper_cmd: None,
             armgrip_cmd: None,
             dirty: Dirty::default(),
+            traj: trajectory::Trajectories::default(),
         }
     }
 
@@ -508,6 +512,7 @@ impl RobotModel {
         }
         self.arm.target = [None; ARM_JOINTS];
         self.vecmove = None;
+        self.abort_trajectory(Status::LinkDown);
         self.dirty.arm = true;
     }
 
@@ -530,6 +535,7 @@ impl RobotModel {
     pub fn link_down(&mut self) -> usize {
         self.link.up = false;
         self.vecmove = None;
+        self.abort_trajectory(Status::LinkDown);
         self.dirty.arm = true;
         self.dirty.body = true;
         self.outbox.clear()

@@ -25,7 +25,7 @@ impl RobotModel {
             LIMB_JOINTS as u64
         } else {
             0
-        };
+        } | self.traj.exec.running();
         for j in 0..ARM_JOINTS {
             if self
                 .arm
@@ -61,11 +61,11 @@ impl RobotModel {
             ActArrayCommand::MultiPosition(v) | ActArrayCommand::MultiSpeed(v) => first(v.len()),
             ActArrayCommand::Home(JointSel::All) => all,
             ActArrayCommand::Home(JointSel::One(j)) => one(j),
-            ActArrayCommand::Current { .. }
-            | ActArrayCommand::MultiCurrent(_)
-            | ActArrayCommand::TrajChunk(_)
-            | ActArrayCommand::Traj(_)
-            | ActArrayCommand::TrajScale(_) => 0,
+            ActArrayCommand::Current { .. } | ActArrayCommand::MultiCurrent(_) => 0,
+            ActArrayCommand::Traj(h) => h.joints[..(h.joint_count as usize).min(MAX_ACTUATORS)]
+                .iter()
+                .fold(0, |m, &j| m | one(j.into())),
+            ActArrayCommand::TrajChunk(_) | ActArrayCommand::TrajScale(_) => 0,
         };
         let m = Motion::of(mask as u64, self.joints_running());
         if stop { m.stopping() } else { m }

@@ -70,6 +70,9 @@ impl RobotModel {
 
     /// How part `part` of an arm actarray motion is doing (joint `part`).
     pub fn arm_progress(&self, part: u32) -> Progress {
+        if let Some(p) = self.trajectory_progress(part as usize) {
+            return p;
+        }
         self.joint_progress(part as usize, false, Instant::now())
     }
 

@@ -11,8 +11,20 @@ use super::gripper::GripperCmd;
 impl ArmModel {
     /// Carries out or refuses an actuator-array command. A SPEED above the actuator's
     /// maximum speed runs at the maximum and is answered CLAMPED.
+    /// Trajectory commands need their sender and the time: [`ArmModel::trajectory_command`]
+    /// (here they are `UNSUPPORTED`). A motion carried out ends a running trajectory: a
+    /// stop decelerates it, anything else preempts it.
     pub fn arm_command(&mut self, cmd: &ActArrayCommand) -> Status {
-        self.arm_command_inner(cmd).unwrap_or_else(|e| e)
+        let motion = self.arm_motion(cmd);
+        let s = self.arm_command_inner(cmd).unwrap_or_else(|e| e);
+        if s.is_carried_out() {
+            if motion.stop {
+                self.stop_trajectory();
+            } else {
+                self.preempt_trajectory(motion.drives);
+            }
+        }
+        s
     }
 
     fn arm_command_inner(&mut self, cmd: &ActArrayCommand) -> Result<Status, Status> {
@@ -106,7 +118,6 @@ impl ArmModel {
             ActArrayCommand::Current { .. } | ActArrayCommand::MultiCurrent(_) => {
                 self.current_command(cmd)
             }
-            // Joint trajectories on the actarray are i28-traj's (not merged here yet).
             ActArrayCommand::TrajChunk(_)
             | ActArrayCommand::Traj(_)
             | ActArrayCommand::TrajScale(_) => Err(Status::Unsupported),
@@ -204,6 +215,7 @@ impl ArmModel {
         if !on {
             self.stop_all_joints();
             self.gripper.stop();
+            self.abort_trajectory(Status::PoweredOff);
         }
     }
 

@@ -23,6 +23,7 @@ impl ArmModel {
         }
         if on {
             self.stop_all_joints();
+            self.abort_trajectory(Status::Braked);
         }
         self.brakes = on;
         Ok(())
@@ -43,6 +44,7 @@ impl ArmModel {
                 v.len().min(n) > 0
             }
             ActArrayCommand::MultiSpeed(v) => v.as_slice().iter().take(n).any(|s| *s != 0.0),
+            // TRAJ checks the brakes against the joints it names when it starts.
             ActArrayCommand::TrajChunk(_)
             | ActArrayCommand::Traj(_)
             | ActArrayCommand::TrajScale(_) => false,

@@ -44,7 +44,6 @@ impl ArmModel {
             return;
         }
         if let Some(c) = contact {
-            self.stall_path();
             self.stop_all_joints();
             self.collision = Some(c);
             tracing::info!(contact = ?c, "simarm: the limb collided and stopped");

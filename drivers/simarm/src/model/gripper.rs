@@ -90,6 +90,7 @@ impl ArmModel {
     /// speed; clamped to the maximum), gripping with at most `effort` (clamped to
     /// [`GRIPPER_MAX_EFFORT`]); [`Status::Clamped`] when any of them was.
     fn gripper_goal(&mut self, gap: f64, effort: f64, speed: f64) -> Status {
+        self.preempt_trajectory(1 << self.n);
         let clamped = gap > self.gripper_stroke
             || speed > self.gripper_max_speed
             || effort > GRIPPER_MAX_EFFORT;

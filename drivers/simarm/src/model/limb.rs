@@ -41,7 +41,19 @@ impl ArmModel {
         self.leaving_contact = self.contact().is_some();
         self.clear_refused_path();
         let r = self.limb_command_inner(cmd);
-        self.limb.settle(r)
+        let s = self.limb.settle(r);
+        if s.is_carried_out() {
+            match cmd {
+                LimbCommand::Stop => self.stop_trajectory(),
+                // A path's trajectory replaces the running one in the executor.
+                LimbCommand::Line(_) | LimbCommand::Ptp(_) => {}
+                _ => {
+                    self.end_path();
+                    self.preempt_trajectory((1u64 << self.n) - 1);
+                }
+            }
+        }
+        s
     }
 
     fn ik_to(&self, target: &IkTarget, seed: &[f64]) -> Result<JointVec, Status> {

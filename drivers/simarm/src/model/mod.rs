@@ -29,6 +29,7 @@ mod options;
 mod paths;
 mod preemption;
 mod store;
+mod trajectory;
 
 pub use collision::{Contact, Obstacles, SimObstacle};
 use gripper::GripperCmd;
@@ -88,6 +89,8 @@ pub struct ArmModel {
     options: SimArmOptions,
     /// Simulated time, s.
     time: f64,
+    /// Joint trajectories: the executor and the upload.
+    traj: trajectory::Trajectories,
 }
 
 fn finite3(v: &[f64; 3]) -> bool {
@@ -132,7 +135,6 @@ impl ArmModel {
         }
         let object = options.object;
         let store = Store::new(options.store_capacity);
-        let path = paths::PathRun::new(&chain);
         Ok(ArmModel {
             n,
             joints,
@@ -148,7 +150,7 @@ impl ArmModel {
             limb_speed: None,
             limb: Default::default(),
             powered: true,
-            path,
+            path: paths::PathRun::default(),
             vecmove: VecMovePlan {
                 waypoints: Vec::with_capacity(MAX_WAYPOINTS),
                 scratch: Vec::with_capacity(MAX_WAYPOINTS),
@@ -162,6 +164,7 @@ impl ArmModel {
             leaving_contact: false,
             options,
             time: 0.0,
+            traj: trajectory::Trajectories::new(n + 1),
             chain,
         })
     }
@@ -223,7 +226,7 @@ impl ArmModel {
 
     /// True when any chain joint moves or a VECMOVE is being streamed.
     pub fn limb_moving(&self) -> bool {
-        self.vecmove.active || self.path.active || self.joints[..self.n].iter().any(|m| m.moving)
+        self.vecmove.active || self.joints[..self.n].iter().any(|m| m.moving)
     }
 
     // ----- time ------------------------------------------------------------------------
@@ -239,9 +242,6 @@ impl ArmModel {
         self.time += dt;
         // Current-driven actuators: aimed by the motor model from where they are now.
         self.drive_currents();
-        // A LINE or PTP: the joints where its trajectory is now.
-        self.step_path();
-        self.stop_at_contact();
         // Sub-steps so each VECMOVE waypoint starts the moment the previous one is
         // reached (a tick may span many short segments at a large time scale).
         let mut left = dt;
@@ -324,7 +324,6 @@ impl ArmModel {
     fn move_actuator(&mut self, j: usize, v: f64, speed: Option<f64>) {
         let a = self.config_accel.get(j).copied().unwrap_or(f64::INFINITY);
         if j < self.n {
-            self.release_path();
             let s = speed.unwrap_or(self.config_speed[j]);
             self.joints[j].go_accel(v, s, a);
         } else {
@@ -376,7 +375,6 @@ impl ArmModel {
     /// Starts a coordinated move of the chain joints to `q`: every joint arrives at the
     /// same time, `min_time` s at least.
     fn move_joints_together(&mut self, q: &[f64], min_time: f64) {
-        self.release_path();
         let mut t = min_time.max(0.0);
         for (j, (m, v)) in self.joints.iter().zip(q).enumerate().take(self.n) {
             let s = self.limb_joint_speed(j);
@@ -392,7 +390,6 @@ impl ArmModel {
     }
 
     fn stop_all_joints(&mut self) {
-        self.halt_path();
         self.vecmove.active = false;
         for m in &mut self.joints[..self.n] {
             m.stop();

@@ -1,18 +1,18 @@
 //! LINE and PTP (issue 28) on the simulated arm: the path is checked whole before anything
 //! moves ([`limber_kinematics::path`]: reachable, within the limits, no jump, clear of the
-//! floor and the obstacles), its samples become a joint trajectory, and the trajectory
-//! executor ([`limber_trajectory::Executor`], the one every driver ticks) runs it: each
-//! step of the simulation the joints take its desired positions exactly. A refused path
-//! leaves the running motion as it was and the limb state names where it failed.
+//! floor and the obstacles), its samples become a joint trajectory, and the arm's one
+//! trajectory executor runs it as it runs an uploaded one (`trajectory.rs`: the joints
+//! take its desired positions exactly, a contact stops them, STOP, power and brakes end
+//! it). A refused path leaves the running motion as it was and the limb state names where
+//! it failed.
 
 use limber_interfaces::actarray::{JointTrajectory, MAX_TRAJ_POINTS};
 use limber_interfaces::limb::{LimbPath, PathOrientation, cmd as limb_cmd};
 use limber_interfaces::prelude::*;
 use limber_kinematics::Pose;
-use limber_kinematics::chain::{Chain, IkTarget, JointVec};
+use limber_kinematics::chain::{IkTarget, JointVec};
 use limber_kinematics::path::{self as kpath, BadSample, Orientation, PathFault, PathOptions};
-use limber_services::Progress;
-use limber_trajectory::{Config, Executor, JointLimit, Tick};
+use limber_services::monotonic_ns;
 use nalgebra::Vector3;
 
 use super::ArmModel;
@@ -22,42 +22,17 @@ use super::preemption::TOLERANCE;
 /// m/s.
 pub const DEFAULT_LINE_SPEED: f64 = 0.1;
 
-/// The paths of the limb: the executor, the trajectory being built, what runs.
-#[derive(Debug)]
+/// The limb's paths: the kind of the last one and its duration (its trajectory runs on the
+/// arm's executor), and where the last refused one failed.
+#[derive(Debug, Default)]
 pub(super) struct PathRun {
-    exec: Box<Executor>,
-    /// The executor drives the joints (the path has not ended).
-    pub(super) active: bool,
     /// The kind of the last path (`LIMB_CMD_LINE`, `LIMB_CMD_PTP`) until another motion
-    /// of the joints: its results come from the executor. 0: none.
+    /// of the joints; 0: none.
     kind: u32,
-    /// The running path's duration, s.
+    /// Its trajectory's duration, s.
     duration: f64,
     /// The last limb command was this path, refused at this sample.
     refused: Option<(u32, BadSample)>,
-}
-
-impl PathRun {
-    /// Idle, for `chain`'s joints at their limits and maximum speeds (a STOP holds at
-    /// once: the simulated joints stop where they are).
-    pub(super) fn new(chain: &Chain) -> Self {
-        let mut config = Config::new(chain.dof());
-        for (l, j) in config.limits.iter_mut().zip(chain.joints()) {
-            *l = JointLimit {
-                min: j.min,
-                max: j.max,
-                max_velocity: j.max_speed,
-                max_deceleration: 0.0,
-            };
-        }
-        PathRun {
-            exec: Executor::new(config),
-            active: false,
-            kind: 0,
-            duration: 0.0,
-            refused: None,
-        }
-    }
 }
 
 /// The status a path refused at a bad sample answers.
@@ -73,11 +48,6 @@ fn fault_status(why: PathFault) -> Status {
 }
 
 impl ArmModel {
-    /// Simulated time, ns (the executor's clock).
-    fn now_ns(&self) -> u64 {
-        (self.time * 1e9) as u64
-    }
-
     /// LINE (`line`) or PTP: checked whole, then run on the executor. A refusal records
     /// where (the limb state's `refused_at`) and changes nothing else.
     pub(super) fn start_path(&mut self, line: bool, p: &LimbPath) -> Result<(), Status> {
@@ -138,22 +108,10 @@ impl ArmModel {
         })?;
         self.powered()?;
         let (traj, duration) = self.time_samples(&q, &samples.q, samples.spacing, line, p.speed)?;
-        let now = self.now_ns();
-        self.path.exec.accept(&traj, now, &q).map_err(|r| {
-            tracing::info!(kind, refusal = %r, "simarm: path refused by the executor");
-            r.status()
-        })?;
-        // The executor drives the joints from here on.
-        self.vecmove.active = false;
-        for m in &mut self.joints[..self.n] {
-            m.stop();
+        let st = self.run_trajectory(&traj, monotonic_ns());
+        if !st.is_carried_out() {
+            return Err(st);
         }
-        if let Some(last) = samples.q.last() {
-            for (m, g) in self.joints.iter_mut().zip(last.iter()) {
-                m.goal = *g;
-            }
-        }
-        self.path.active = true;
         self.path.kind = kind;
         self.path.duration = duration;
         Ok(())
@@ -200,49 +158,9 @@ impl ArmModel {
         Ok((traj, t))
     }
 
-    /// One step of the running path: the executor's desired positions become the joints'.
-    pub(super) fn step_path(&mut self) {
-        if !self.path.active {
-            return;
-        }
-        let now = self.now_ns();
-        let q = self.q();
-        let tick = self.path.exec.tick(now, &q);
-        let driven = self.path.exec.driven();
-        for j in 0..self.n {
-            if driven & (1 << j) != 0 {
-                self.joints[j].pos = self.path.exec.desired(j);
-            }
-        }
-        if matches!(tick, Tick::Ended(_) | Tick::Idle) {
-            self.path.active = false;
-        }
-    }
-
-    /// The joints stop where they are (STOP, power off, brakes): the path ends STOPPED.
-    pub(super) fn halt_path(&mut self) {
-        if self.path.active {
-            let now = self.now_ns();
-            self.path.exec.stop(now);
-            self.path.active = false;
-        }
-    }
-
-    /// The limb touched something: the path ends STALLED where it is.
-    pub(super) fn stall_path(&mut self) {
-        if self.path.active {
-            self.path.exec.abort(MotionResult::Stalled, Status::Ok);
-            self.path.active = false;
-        }
-    }
-
-    /// Another motion of the joints takes them: the path (if any) is done with.
-    pub(super) fn release_path(&mut self) {
-        if self.path.kind != 0 {
-            self.path.exec.release();
-            self.path.active = false;
-            self.path.kind = 0;
-        }
+    /// Another motion takes the joints: no path runs.
+    pub(super) fn end_path(&mut self) {
+        self.path.kind = 0;
     }
 
     /// A new limb command: no path refused yet.
@@ -250,24 +168,12 @@ impl ArmModel {
         self.path.refused = None;
     }
 
-    /// How joint `j` of the last path is doing (`None`: no path drives it).
-    pub(super) fn path_progress(&self, j: usize) -> Option<Progress> {
-        if self.path.kind == 0 || j >= self.n {
-            return None;
-        }
-        let p = self.path.exec.progress(j);
-        let pos = self.joints[j].pos;
-        Some(match p.end {
-            None => Progress::moving(pos, p.error, TOLERANCE),
-            Some((r, s)) => Progress::ended(r, s, pos, pos - self.joints[j].goal, TOLERANCE),
-        })
-    }
-
     /// The limb state's path fields: the running path and how far it got, the last
     /// refused one and where.
     pub(super) fn path_state(&self, s: &mut LimbData) {
-        if self.path.active {
-            let f = self.path.exec.feedback();
+        let joints = (1u64 << self.n) - 1;
+        let running = self.path.kind != 0 && self.trajectory_running() & joints != 0;
+        if let (true, Some(f)) = (running, self.trajectory_feedback()) {
             s.path_kind = self.path.kind;
             s.path_progress = if self.path.duration > 0.0 {
                 (f.time / self.path.duration).clamp(0.0, 1.0)

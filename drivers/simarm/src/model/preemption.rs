@@ -17,7 +17,7 @@ impl ArmModel {
     fn running(&self) -> u64 {
         let mut bits = 0u64;
         for j in 0..self.n {
-            if self.vecmove.active || self.path.active || self.joints[j].moving {
+            if self.vecmove.active || self.joints[j].moving {
                 bits |= 1 << j;
             }
         }
@@ -45,9 +45,15 @@ impl ArmModel {
             | ActArrayCommand::MultiSpeed(v)
             | ActArrayCommand::MultiCurrent(v) => (0, v.len()),
             ActArrayCommand::Home(JointSel::All) => (0, self.n + 1),
-            ActArrayCommand::TrajChunk(_)
-            | ActArrayCommand::Traj(_)
-            | ActArrayCommand::TrajScale(_) => (0, 0),
+            ActArrayCommand::Traj(h) => {
+                let drives = h.joints[..(h.joint_count as usize).min(MAX_ACTUATORS)]
+                    .iter()
+                    .fold(0u64, |m, &j| m | 1u64.checked_shl(j.into()).unwrap_or(0));
+                return Motion::of(drives, self.running());
+            }
+            ActArrayCommand::TrajChunk(_) | ActArrayCommand::TrajScale(_) => {
+                return Motion::NONE;
+            }
         };
         let drives = (first..(first + count).min(64)).fold(0u64, |m, j| m | 1 << j);
         let stop = match *cmd {
@@ -85,17 +91,12 @@ impl ArmModel {
     /// (reached within [`TOLERANCE`], stalled short of its goal, aborted by a power-off or
     /// the brakes), with its error against the goal.
     fn actuator_progress(&self, j: usize) -> Progress {
+        if let Some(p) = self.trajectory_progress(j) {
+            return p;
+        }
         let Some(m) = self.actuator(j) else {
             return Progress::UNKNOWN;
         };
-        // A LINE's or PTP's joint: as its executor says (unless the power or the brakes
-        // ended it: below).
-        if self.powered
-            && !(self.brakes && j < self.n)
-            && let Some(p) = self.path_progress(j)
-        {
-            return p;
-        }
         let error = m.pos - m.goal;
         if m.moving || (j < self.n && self.vecmove.active) {
             return Progress::moving(m.pos, error, TOLERANCE);
@@ -142,6 +143,7 @@ impl ArmModel {
     /// The deadman's stop of the actarray: every joint and the gripper stop where they are.
     pub fn stop_arm(&mut self) -> Status {
         self.stop_all_joints();
+        self.stop_trajectory();
         self.gripper.stop();
         Status::Ok
     }
@@ -149,6 +151,7 @@ impl ArmModel {
     /// The deadman's stop of the limb: every joint stops where it is.
     pub fn stop_limb(&mut self) -> Status {
         self.stop_all_joints();
+        self.stop_trajectory();
         Status::Ok
     }
 

@@ -1,0 +1,275 @@
+//! Joint trajectories on the simulated arm, executed exactly: every tick the joints a
+//! trajectory drives are where [`limber_trajectory::Executor`] wants them, unless something
+//! stops them (a contact with the world: they stay at the contact, and the executor's path
+//! tolerance ends the trajectory). Trajectory time is real time (`CLOCK_MONOTONIC`, as its
+//! start time), whatever the simulation's time scale.
+
+use limber_interfaces::prelude::*;
+use limber_services::Progress;
+use limber_trajectory::{Config, Executor, Feedback, JointLimit, Tick};
+
+use super::ArmModel;
+
+/// Deceleration on a STOP of a joint without an ACCEL limit: its highest speed lost in
+/// this many seconds.
+const STOP_TIME: f64 = 0.1;
+
+/// The trajectory side of the model: the executor, the upload being received, and which
+/// actuators' last motion was a trajectory.
+#[derive(Debug)]
+pub(super) struct Trajectories {
+    exec: Box<Executor>,
+    upload: TrajectoryUpload,
+    /// Actuators whose motion the host follows is a trajectory's.
+    joints: u64,
+    /// The last tick's time, ns.
+    last_ns: u64,
+}
+
+impl Trajectories {
+    pub(super) fn new(actuators: usize) -> Self {
+        Trajectories {
+            exec: Executor::new(Config::new(actuators)),
+            upload: TrajectoryUpload::new(),
+            joints: 0,
+            last_ns: 0,
+        }
+    }
+}
+
+/// What [`accept`] checks a trajectory against.
+struct Arm<'a> {
+    config: Config,
+    actual: &'a [f64],
+    n: usize,
+    powered: bool,
+    brakes: bool,
+}
+
+/// Checks `traj` against the arm (power, brakes) and hands it to `exec`: the actuators it
+/// drives, or why it was refused.
+fn accept(
+    exec: &mut Executor,
+    traj: &JointTrajectory,
+    arm: &Arm<'_>,
+    now_ns: u64,
+) -> Result<u64, Status> {
+    if !arm.powered {
+        return Err(Status::PoweredOff);
+    }
+    let mask = Executor::joints_of(traj);
+    if arm.brakes && mask & ((1u64 << arm.n) - 1) != 0 {
+        return Err(Status::Braked);
+    }
+    exec.set_config(arm.config);
+    exec.accept(traj, now_ns, arm.actual).map_err(|e| {
+        tracing::info!(reason = %e, "trajectory refused");
+        e.status()
+    })?;
+    Ok(mask)
+}
+
+impl ArmModel {
+    /// The executor's view of the arm: every actuator's limits, highest speed and STOP
+    /// deceleration (its ACCEL, else its highest speed lost in 0.1 s).
+    fn traj_config(&self) -> Config {
+        let mut c = Config::new(self.actuators());
+        for (j, l) in c.limits.iter_mut().enumerate().take(self.actuators()) {
+            let Some((min, max)) = self.joint_limits(j) else {
+                continue;
+            };
+            let max_velocity = if j < self.n {
+                self.chain.joints()[j].max_speed
+            } else {
+                self.gripper_max_speed
+            };
+            let accel = self.config_accel[j];
+            *l = JointLimit {
+                min,
+                max,
+                max_velocity,
+                max_deceleration: if accel.is_finite() {
+                    accel
+                } else {
+                    max_velocity / STOP_TIME
+                },
+            };
+        }
+        c
+    }
+
+    fn actual(&self) -> [f64; MAX_ACTUATORS] {
+        let mut a = [0.0; MAX_ACTUATORS];
+        for (j, v) in a.iter_mut().enumerate().take(self.actuators()) {
+            *v = self.actuator(j).map_or(0.0, |m| m.pos);
+        }
+        a
+    }
+
+    /// Carries out a trajectory command of client `client` at `now_ns`
+    /// (`CLOCK_MONOTONIC`): `None` for any other command.
+    pub fn trajectory_command(
+        &mut self,
+        cmd: &ActArrayCommand,
+        client: u64,
+        now_ns: u64,
+    ) -> Option<Status> {
+        Some(match cmd {
+            ActArrayCommand::TrajChunk(c) => {
+                self.traj.upload.chunk(client, c);
+                Status::Ok
+            }
+            ActArrayCommand::TrajScale(s) => self.traj.exec.set_scale(*s),
+            ActArrayCommand::Traj(h) => self.start_trajectory(h, client, now_ns),
+            _ => return None,
+        })
+    }
+
+    fn start_trajectory(&mut self, h: &ActArrayTrajCmd, client: u64, now_ns: u64) -> Status {
+        let config = self.traj_config();
+        let actual = self.actual();
+        let (n, actuators, powered, brakes) = (self.n, self.actuators(), self.powered, self.brakes);
+        let t = &mut self.traj;
+        let traj = match t.upload.finish(client, h) {
+            Ok(traj) => traj,
+            Err(e) => {
+                tracing::info!(reason = %e, "trajectory refused");
+                return e.status();
+            }
+        };
+        let arm = Arm {
+            config,
+            actual: &actual[..actuators],
+            n,
+            powered,
+            brakes,
+        };
+        match accept(&mut t.exec, traj, &arm, now_ns) {
+            Ok(mask) => self.trajectory_started(mask, now_ns),
+            Err(s) => s,
+        }
+    }
+
+    /// Hands `traj` to the executor at `now_ns` (`CLOCK_MONOTONIC`): the trajectory of a
+    /// limb path (LINE, PTP), run as an uploaded one is.
+    pub(super) fn run_trajectory(&mut self, traj: &JointTrajectory, now_ns: u64) -> Status {
+        let config = self.traj_config();
+        let actual = self.actual();
+        let arm = Arm {
+            config,
+            actual: &actual[..self.actuators()],
+            n: self.n,
+            powered: self.powered,
+            brakes: self.brakes,
+        };
+        match accept(&mut self.traj.exec, traj, &arm, now_ns) {
+            Ok(mask) => self.trajectory_started(mask, now_ns),
+            Err(s) => s,
+        }
+    }
+
+    /// The executor took a trajectory of actuators `mask`: they are its from now on.
+    fn trajectory_started(&mut self, mask: u64, now_ns: u64) -> Status {
+        // A new motion ends the COLLISION state, and may move away from the contact.
+        self.collision = None;
+        self.leaving_contact = self.contact().is_some();
+        if mask & ((1u64 << self.n) - 1) != 0 {
+            self.vecmove.active = false;
+        }
+        self.traj.joints |= mask;
+        self.traj.last_ns = now_ns;
+        for j in 0..self.actuators() {
+            if mask & (1 << j) != 0
+                && let Some(m) = self.actuator_mut(j)
+            {
+                m.stop();
+                m.moving = true;
+            }
+        }
+        Status::Ok
+    }
+
+    /// Advances the trajectory to `now_ns`: the joints it drives go where it wants them
+    /// (unless in contact with the world), then a contact stops them.
+    pub fn step_trajectory(&mut self, now_ns: u64) {
+        let actual = self.actual();
+        let tick = self.traj.exec.sample(now_ns, &actual[..self.actuators()]);
+        self.traj.last_ns = now_ns;
+        if tick == Tick::Idle {
+            return;
+        }
+        let driven = self.traj.exec.driven();
+        let blocked = self.collision.is_some();
+        for j in 0..self.actuators() {
+            if driven & (1 << j) == 0 || (blocked && j < self.n) {
+                continue;
+            }
+            let (p, v) = (
+                self.traj.exec.desired(j),
+                self.traj.exec.desired_velocity(j),
+            );
+            if let Some(m) = self.actuator_mut(j) {
+                m.pos = p;
+                m.target = p;
+                m.velocity = v;
+                m.moving = true;
+                m.stalled = false;
+            }
+        }
+        self.stop_at_contact();
+        // Measured where they are now: exact unless something stopped them.
+        let actual = self.actual();
+        self.traj.exec.check(&actual[..self.actuators()]);
+        let running = self.traj.exec.running();
+        for j in 0..self.actuators() {
+            if driven & (1 << j) != 0
+                && let Some(m) = self.actuator_mut(j)
+            {
+                m.moving = running & (1 << j) != 0;
+                if !m.moving {
+                    m.velocity = 0.0;
+                }
+            }
+        }
+    }
+
+    /// A STOP (or the deadman): the trajectory decelerates and ends stopped.
+    pub(crate) fn stop_trajectory(&mut self) {
+        self.traj.exec.stop(self.traj.last_ns);
+    }
+
+    /// Another command takes actuators `drives`: the trajectory ends preempted.
+    pub(crate) fn preempt_trajectory(&mut self, drives: u64) {
+        if self.traj.exec.driven() & drives != 0 {
+            self.traj.exec.release();
+        }
+        self.traj.joints &= !drives;
+    }
+
+    /// The power went off or the brakes on: the trajectory ends aborted.
+    pub(super) fn abort_trajectory(&mut self, cause: Status) {
+        self.traj.exec.abort(MotionResult::Aborted, cause);
+    }
+
+    /// How actuator `j`'s trajectory is doing, when its last motion was a trajectory's.
+    pub(super) fn trajectory_progress(&self, j: usize) -> Option<Progress> {
+        if j >= 64 || self.traj.joints & (1 << j) == 0 {
+            return None;
+        }
+        let p = self.traj.exec.progress(j);
+        Some(match p.end {
+            None => Progress::moving(p.position, p.error, p.tolerance),
+            Some((r, cause)) => Progress::ended(r, cause, p.position, p.error, p.tolerance),
+        })
+    }
+
+    /// The actuators a trajectory still drives toward its goal.
+    pub(super) fn trajectory_running(&self) -> u64 {
+        self.traj.exec.running()
+    }
+
+    /// The feedback of the trajectory running (or last run), if any.
+    pub fn trajectory_feedback(&self) -> Option<Feedback> {
+        (self.traj.joints != 0).then(|| self.traj.exec.feedback())
+    }
+}
