@@ -1,6 +1,6 @@
 //! Every documented command runs as a test (issue 13 item 7), like rustdoc's doctests:
 //! each shell command in a fenced `sh` block of README.md, examples/**/README.md,
-//! python/README.md, TESTING.md and docs/guide/motions.md, and the example of each verb's `--help`, runs as written
+//! python/README.md, TESTING.md, docs/guide/motions.md and docs/guide/paths-and-grippers.md, and the example of each verb's `--help`, runs as written
 //! against the emulated Pioneer or simarm, in a domain of its own, with a bounded time.
 //!
 //! How a command is run:
@@ -534,6 +534,12 @@ fn every_command_of_the_python_readme_runs_or_is_marked() {
 #[test]
 fn every_command_of_the_motions_guide_runs_or_is_marked() {
     let ran = check(&["docs/guide/motions.md".to_string()]);
+    assert!(ran >= 5, "only {ran} commands ran");
+}
+
+#[test]
+fn every_command_of_the_paths_and_grippers_guide_runs_or_is_marked() {
+    let ran = check(&["docs/guide/paths-and-grippers.md".to_string()]);
     assert!(ran >= 5, "only {ran} commands ran");
 }
 
