@@ -106,18 +106,40 @@ pub unsafe extern "C" fn limber_limb_vec_move(
     })
 }
 
-/// The orientation of a path: kept when `approach` or `orientation` is NULL, else the
-/// given vectors.
+/// Sends a LINE (`line`) or a PTP: the orientation kept when `approach` or
+/// `orientation` is NULL, else the given vectors.
 ///
 /// # Safety
-/// Each pointer is NULL or readable.
-unsafe fn path_orientation(
+/// `h` is NULL or a live handle; `approach`, `orientation` NULL or readable; `ticket`
+/// NULL or writable.
+unsafe fn send_path(
+    h: *mut LimberLimb,
+    line: bool,
+    position: Vec3,
     approach: *const Vec3,
     orientation: *const Vec3,
-) -> Option<([f64; 3], [f64; 3])> {
-    // SAFETY: the caller's promise: NULL or readable.
-    let (a, o) = unsafe { (approach.as_ref(), orientation.as_ref()) };
-    a.zip(o).map(|(a, o)| (a.to_array(), o.to_array()))
+    speed: f64,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, ticket, a, o) = unsafe {
+            (
+                arg(h, "handle")?,
+                ticket.as_mut(),
+                approach.as_ref(),
+                orientation.as_ref(),
+            )
+        };
+        let o = a.zip(o).map(|(a, o)| (a.to_array(), o.to_array()));
+        let limb = h.typed::<Limb>()?;
+        let r = if line {
+            limb.line(position.to_array(), o, speed)
+        } else {
+            limb.ptp(position.to_array(), o, speed)
+        };
+        sent(r, ticket)
+    })
 }
 
 /// CMD LINE: moves the tool in a straight line to `position` (m), its orientation kept
@@ -139,16 +161,8 @@ pub unsafe extern "C" fn limber_limb_line(
     speed: f64,
     ticket: *mut LimberTicket,
 ) -> LimberCode {
-    guard(|| {
-        // SAFETY: the caller's promise on the pointers, checked for NULL here.
-        let (h, ticket) = unsafe { (arg(h, "handle")?, ticket.as_mut()) };
-        // SAFETY: the caller's promise: NULL or readable.
-        let o = unsafe { path_orientation(approach, orientation) };
-        sent(
-            h.typed::<Limb>()?.line(position.to_array(), o, speed),
-            ticket,
-        )
-    })
+    // SAFETY: the caller's promise, passed on.
+    unsafe { send_path(h, true, position, approach, orientation, speed, ticket) }
 }
 
 /// CMD PTP: moves the joints, interpolated, to where the tool is at `position` with its
@@ -167,16 +181,8 @@ pub unsafe extern "C" fn limber_limb_ptp(
     speed: f64,
     ticket: *mut LimberTicket,
 ) -> LimberCode {
-    guard(|| {
-        // SAFETY: the caller's promise on the pointers, checked for NULL here.
-        let (h, ticket) = unsafe { (arg(h, "handle")?, ticket.as_mut()) };
-        // SAFETY: the caller's promise: NULL or readable.
-        let o = unsafe { path_orientation(approach, orientation) };
-        sent(
-            h.typed::<Limb>()?.ptp(position.to_array(), o, speed),
-            ticket,
-        )
-    })
+    // SAFETY: the caller's promise, passed on.
+    unsafe { send_path(h, false, position, approach, orientation, speed, ticket) }
 }
 
 /// REQ POWER: power on (`on` true) or off; waits up to `timeout_ms` for the reply.

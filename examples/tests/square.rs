@@ -4,58 +4,28 @@
 //! within the tolerance. A square out of reach is refused before anything moves.
 
 use std::process::{Command, Output};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc;
-use std::thread::JoinHandle;
 use std::time::Duration;
 
 use limber_kinematics::chain::Chain;
-use limber_services::{Context, Domain, Role};
-use limber_simarm::{SimArm, SimArmOptions};
+use limber_services::Domain;
+use limber_simarm::{SimArmOptions, SimArmThread};
 
 const SQUARE: &str = env!("CARGO_BIN_EXE_square");
 const RUN_TIMEOUT: Duration = Duration::from_secs(120);
 
-/// simarm on a thread (5x real time); stops and joins when dropped.
-struct Driver {
-    stop: Arc<AtomicBool>,
-    handle: Option<JoinHandle<()>>,
-}
-
-impl Drop for Driver {
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
-        if let Some(h) = self.handle.take() {
-            h.join().expect("the driver thread ends cleanly");
-        }
-    }
-}
-
-fn simarm(domain: &Domain) -> Driver {
-    let stop = Arc::new(AtomicBool::new(false));
-    let (ready_tx, ready_rx) = mpsc::channel();
-    let name = domain.name().to_string();
-    let flag = stop.clone();
-    let handle = std::thread::spawn(move || {
-        let domain = Domain::new(&name).expect("domain");
-        let ctx = Context::new(&domain, Role::Driver, "simarm").expect("context");
-        let options = SimArmOptions {
-            time_scale: 5.0,
-            ..SimArmOptions::default()
-        };
-        let mut arm = SimArm::new(&ctx, Chain::default_6dof(), options).expect("simarm starts");
-        ready_tx.send(()).expect("test waits");
-        arm.run(|| flag.load(Ordering::Relaxed))
-            .expect("simarm runs");
-    });
-    ready_rx
-        .recv_timeout(Duration::from_secs(20))
-        .expect("simarm ready in time");
-    Driver {
-        stop,
-        handle: Some(handle),
-    }
+/// simarm (5x real time) on a thread of this process.
+fn simarm(domain: &Domain) -> SimArmThread {
+    let options = SimArmOptions {
+        time_scale: 5.0,
+        ..SimArmOptions::default()
+    };
+    SimArmThread::start(
+        domain.name(),
+        Chain::default_6dof(),
+        options,
+        Duration::from_secs(20),
+    )
+    .expect("simarm starts")
 }
 
 fn run(domain: &Domain, args: &[&str]) -> Output {

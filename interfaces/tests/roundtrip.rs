@@ -65,6 +65,13 @@ fn limb_command() -> impl Strategy<Value = LimbCommand> {
         (vec3(), dir3(), dir3()).prop_map(|(p, a, o)| LimbCommand::set_pose(p, a, o).unwrap()),
         vec3().prop_map(|p| LimbCommand::set_position(p).unwrap()),
         (dir3(), finite()).prop_map(|(d, l)| LimbCommand::vec_move(d, l).unwrap()),
+        (vec3(), 0.0f64..10.0).prop_map(|(p, v)| LimbCommand::line(p, None, v).unwrap()),
+        (vec3(), dir3(), dir3(), 0.0f64..10.0).prop_map(|(p, a, o, v)| LimbCommand::ptp(
+            p,
+            Some((a, o)),
+            v
+        )
+        .unwrap()),
     ]
 }
 
@@ -374,6 +381,35 @@ fn non_finite_values_are_rejected() {
     assert!(matches!(
         ActArrayCommand::multi_position(&[0.0; 33]),
         Err(ValueError::TooMany { count: 33, .. })
+    ));
+}
+
+#[test]
+fn a_path_is_finite_with_a_speed_not_negative_and_a_known_orientation_mode() {
+    let p = Vec3::new(0.4, 0.0, 0.3);
+    assert_eq!(
+        LimbCommand::line(p, None, -0.1),
+        Err(ValueError::Negative { field: "speed" })
+    );
+    assert_eq!(
+        LimbCommand::ptp(p, Some((Vec3::default(), Vec3::new(1.0, 0.0, 0.0))), 0.0),
+        Err(ValueError::ZeroVector { field: "approach" })
+    );
+    assert_eq!(
+        LimbCommand::line(Vec3::new(f64::NAN, 0.0, 0.0), None, 0.0),
+        Err(ValueError::NotFinite { field: "position" })
+    );
+    // An orientation mode nobody defined: refused by the decoder.
+    let mut raw = LimbCmdMsg::default();
+    LimbCommand::line(p, None, 0.1).unwrap().write(&mut raw);
+    assert_eq!(raw.meta.body_len, 88);
+    raw.body[80..84].copy_from_slice(&7u32.to_ne_bytes());
+    assert!(matches!(
+        LimbCommand::read(&raw),
+        Err(DecodeError::UnknownCode {
+            field: "path orientation",
+            value: 7
+        })
     ));
 }
 

@@ -4,64 +4,28 @@
 //! malformed goal is refused before anything moves. The driver runs on a thread of the
 //! test process, in its own domain per test.
 
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc;
-use std::thread::JoinHandle;
 use std::time::Duration;
 
 use limber_kinematics::chain::Chain;
 use limber_services::prelude::*;
 use limber_services::{CommandError, Domain, Role};
 use limber_simarm::model::{SimObject, TOLERANCE};
-use limber_simarm::{SimArm, SimArmOptions};
+use limber_simarm::{SimArmOptions, SimArmThread};
 
 const TIMEOUT: Duration = Duration::from_secs(20);
 /// Where the object is: where the limb puts the tool below.
 const BLOCK: [f64; 3] = [0.45, 0.1, 0.15];
 const BLOCK_WIDTH: f64 = 0.04;
 
-/// The driver thread; stops and joins when dropped.
-struct Driver {
-    stop: Arc<AtomicBool>,
-    handle: Option<JoinHandle<()>>,
-}
-
-impl Drop for Driver {
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
-        if let Some(h) = self.handle.take() {
-            h.join().expect("the driver thread ends cleanly");
-        }
-    }
-}
-
 /// simarm (6 joints, 10x real time) with a block at [`BLOCK`].
-fn start(domain: &Domain) -> Driver {
-    let stop = Arc::new(AtomicBool::new(false));
-    let (ready_tx, ready_rx) = mpsc::channel();
-    let name = domain.name().to_string();
-    let flag = stop.clone();
-    let handle = std::thread::spawn(move || {
-        let domain = Domain::new(&name).expect("domain");
-        let ctx = Context::new(&domain, Role::Driver, "simarm").expect("context");
-        let options = SimArmOptions {
-            time_scale: 10.0,
-            object: Some(SimObject::block(BLOCK, BLOCK_WIDTH)),
-            ..SimArmOptions::default()
-        };
-        let mut arm = SimArm::new(&ctx, Chain::default_6dof(), options).expect("simarm starts");
-        ready_tx.send(()).expect("test waits");
-        arm.run(|| flag.load(Ordering::Relaxed))
-            .expect("simarm runs");
-    });
-    ready_rx
-        .recv_timeout(TIMEOUT)
-        .expect("simarm ready in time");
-    Driver {
-        stop,
-        handle: Some(handle),
-    }
+fn start(domain: &Domain) -> SimArmThread {
+    let options = SimArmOptions {
+        time_scale: 10.0,
+        object: Some(SimObject::block(BLOCK, BLOCK_WIDTH)),
+        ..SimArmOptions::default()
+    };
+    SimArmThread::start(domain.name(), Chain::default_6dof(), options, TIMEOUT)
+        .expect("simarm starts")
 }
 
 #[test]

@@ -4,10 +4,6 @@
 //! where; a PTP reaches its goal; a STOP ends a running line STOPPED. The driver runs on a
 //! thread of the test process, in its own domain per test.
 
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc;
-use std::thread::JoinHandle;
 use std::time::Duration;
 
 use limber_interfaces::limb::cmd as limb_cmd;
@@ -15,7 +11,7 @@ use limber_kinematics::chain::Chain;
 use limber_services::prelude::*;
 use limber_services::{Domain, Role};
 use limber_simarm::model::TOLERANCE;
-use limber_simarm::{Obstacles, SimArm, SimArmOptions, SimObstacle};
+use limber_simarm::{Obstacles, SimArmOptions, SimArmThread, SimObstacle};
 
 const TIMEOUT: Duration = Duration::from_secs(20);
 /// Where the lines start: the tool over the table, pointing down.
@@ -26,47 +22,15 @@ const FORWARD: [f64; 3] = [1.0, 0.0, 0.0];
 /// 5 mm apart and the joints move linearly between them (measured: well under this).
 const ON_LINE: f64 = 0.001;
 
-/// The driver thread; stops and joins when dropped.
-struct Driver {
-    stop: Arc<AtomicBool>,
-    handle: Option<JoinHandle<()>>,
-}
-
-impl Drop for Driver {
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
-        if let Some(h) = self.handle.take() {
-            h.join().expect("the driver thread ends cleanly");
-        }
-    }
-}
-
 /// simarm (6 joints, 5x real time) with these obstacles.
-fn start(domain: &Domain, obstacles: Obstacles) -> Driver {
-    let stop = Arc::new(AtomicBool::new(false));
-    let (ready_tx, ready_rx) = mpsc::channel();
-    let name = domain.name().to_string();
-    let flag = stop.clone();
-    let handle = std::thread::spawn(move || {
-        let domain = Domain::new(&name).expect("domain");
-        let ctx = Context::new(&domain, Role::Driver, "simarm").expect("context");
-        let options = SimArmOptions {
-            time_scale: 5.0,
-            obstacles,
-            ..SimArmOptions::default()
-        };
-        let mut arm = SimArm::new(&ctx, Chain::default_6dof(), options).expect("simarm starts");
-        ready_tx.send(()).expect("test waits");
-        arm.run(|| flag.load(Ordering::Relaxed))
-            .expect("simarm runs");
-    });
-    ready_rx
-        .recv_timeout(TIMEOUT)
-        .expect("simarm ready in time");
-    Driver {
-        stop,
-        handle: Some(handle),
-    }
+fn start(domain: &Domain, obstacles: Obstacles) -> SimArmThread {
+    let options = SimArmOptions {
+        time_scale: 5.0,
+        obstacles,
+        ..SimArmOptions::default()
+    };
+    SimArmThread::start(domain.name(), Chain::default_6dof(), options, TIMEOUT)
+        .expect("simarm starts")
 }
 
 /// A limb client with the tool at [`START`], pointing down.

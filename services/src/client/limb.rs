@@ -47,8 +47,7 @@ impl Client<Limb> {
         orientation: Option<([f64; 3], [f64; 3])>,
         speed: f64,
     ) -> Result<Ticket, CommandError> {
-        let o = orientation.map(|(a, o)| (a.into(), o.into()));
-        self.send(&LimbCommand::line(position.into(), o, speed)?)
+        self.send(&LimbCommand::Line(path(position, orientation, speed)?))
     }
     /// CMD PTP (limber's): the joints interpolated to where the tool is at `position`
     /// with its orientation kept (`None`) or the given one, the fastest joint at most
@@ -59,8 +58,7 @@ impl Client<Limb> {
         orientation: Option<([f64; 3], [f64; 3])>,
         speed: f64,
     ) -> Result<Ticket, CommandError> {
-        let o = orientation.map(|(a, o)| (a.into(), o.into()));
-        self.send(&LimbCommand::ptp(position.into(), o, speed)?)
+        self.send(&LimbCommand::Ptp(path(position, orientation, speed)?))
     }
     /// REQ POWER.
     pub fn power(&mut self, on: bool) -> Result<(), RequestError> {
@@ -89,4 +87,14 @@ impl Client<Limb> {
             LimbReply::Done | LimbReply::Geom(_) => Err(RequestError::Unexpected),
         }
     }
+}
+
+/// A path's goal from plain arrays, validated.
+fn path(
+    position: [f64; 3],
+    orientation: Option<([f64; 3], [f64; 3])>,
+    speed: f64,
+) -> Result<limber_interfaces::limb::LimbPath, ValueError> {
+    let o = orientation.map(|(a, o)| (a.into(), o.into()));
+    limber_interfaces::limb::LimbPath::new(position.into(), o, speed)
 }
