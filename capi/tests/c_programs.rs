@@ -640,9 +640,9 @@ fn a_field_moved_in_a_message_makes_c_cpp_and_python_refuse_to_connect() {
     let p = Pioneer::start();
     let version = limber_interfaces::LAYOUT_VERSION;
     let detail = format!(
-        "this program was compiled against limber.h layout version {} (limber_actarray_data 1336 bytes, \
+        "this program was compiled against limber.h layout version {} (limber_actarray_data 1376 bytes, \
          limber_actarray_geom 3384 bytes), but this liblimber speaks layout version {version} \
-         (1336 and 3384 bytes): rebuild the program against the limber.h installed with this library",
+         (1376 and 3384 bytes): rebuild the program against the limber.h installed with this library",
         version + 1
     );
     let o = run_in(&p, &c_exe, &[]);

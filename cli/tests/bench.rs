@@ -27,47 +27,18 @@ fn bench_lists_its_scenarios() {
     }
 }
 
-#[test]
-fn bench_runs_child_processes_under_a_global_domain() {
+/// Runs `limber --domain D bench --quick --no-progress --only ONLY --json F [EXTRA]`,
+/// asserting success; the JSON report.
+fn quick_report(only: &str, extra: &[&str]) -> String {
     let domain = Domain::unique_for_test();
-    let dir = std::env::temp_dir().join(format!("limber-cli-bench-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let json = dir.join("report.json");
-    let out = common::output(
-        Command::new(LIMBER)
-            .args([
-                "--domain",
-                domain.name(),
-                "bench",
-                "--quick",
-                "--scale",
-                "0.05",
-            ])
-            .args(["--no-progress", "--only", "floor", "--json"])
-            .arg(&json),
-    );
-    assert!(
-        out.status.success(),
-        "{}\n{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report = std::fs::read_to_string(&json).unwrap();
-    assert!(report.contains("\"measurements\""), "{report}");
-    assert!(report.contains("\"floor\""), "{report}");
-    std::fs::remove_dir_all(&dir).unwrap();
-}
-
-#[test]
-fn bench_quick_reports_the_trajectory_tick_period_and_jitter() {
-    let domain = Domain::unique_for_test();
-    let dir = std::env::temp_dir().join(format!("limber-cli-bench-traj-{}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("limber-cli-bench-{only}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let json = dir.join("report.json");
     let out = common::output(
         Command::new(LIMBER)
             .args(["--domain", domain.name(), "bench", "--quick"])
-            .args(["--no-progress", "--only", "traj", "--json"])
+            .args(extra)
+            .args(["--no-progress", "--only", only, "--json"])
             .arg(&json),
     );
     assert!(
@@ -77,8 +48,21 @@ fn bench_quick_reports_the_trajectory_tick_period_and_jitter() {
         String::from_utf8_lossy(&out.stderr)
     );
     let report = std::fs::read_to_string(&json).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    report
+}
+
+#[test]
+fn bench_runs_child_processes_under_a_global_domain() {
+    let report = quick_report("floor", &["--scale", "0.05"]);
+    assert!(report.contains("\"measurements\""), "{report}");
+    assert!(report.contains("\"floor\""), "{report}");
+}
+
+#[test]
+fn bench_quick_reports_the_trajectory_tick_period_and_jitter() {
+    let report = quick_report("traj", &[]);
     for id in ["traj.tick", "traj.period", "traj.jitter"] {
         assert!(report.contains(&format!("\"{id}\"")), "{id}: {report}");
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -335,20 +335,43 @@ LIMBER_STATIC_ASSERT(offsetof(limber_actuator_state, current) == 24, "limber_act
 LIMBER_STATIC_ASSERT(offsetof(limber_actuator_state, state) == 32, "limber_actuator_state.state offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_actuator_state, _pad) == 36, "limber_actuator_state._pad offset");
 
-/* limber.v4.ActArrayData (size 1336, align 8) */
+/* limber.v4.TrajFeedback (size 40, align 8) */
+typedef struct limber_traj_feedback {
+    uint32_t active;
+    uint32_t point;
+    uint32_t points;
+    uint32_t result;
+    double max_error;
+    double time;
+    double scale;
+} limber_traj_feedback;
+#define LIMBER_TRAJ_FEEDBACK_TYPE_NAME "limber.v4.TrajFeedback"
+LIMBER_STATIC_ASSERT(sizeof(limber_traj_feedback) == 40, "limber_traj_feedback size");
+LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_traj_feedback) == 8, "limber_traj_feedback alignment");
+LIMBER_STATIC_ASSERT(offsetof(limber_traj_feedback, active) == 0, "limber_traj_feedback.active offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_traj_feedback, point) == 4, "limber_traj_feedback.point offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_traj_feedback, points) == 8, "limber_traj_feedback.points offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_traj_feedback, result) == 12, "limber_traj_feedback.result offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_traj_feedback, max_error) == 16, "limber_traj_feedback.max_error offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_traj_feedback, time) == 24, "limber_traj_feedback.time offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_traj_feedback, scale) == 32, "limber_traj_feedback.scale offset");
+
+/* limber.v4.ActArrayData (size 1376, align 8) */
 typedef struct limber_actarray_data {
     limber_state_header header;
     uint32_t actuators_count;
     uint32_t motor_state;
     limber_actuator_state actuators[32];
+    limber_traj_feedback trajectory;
 } limber_actarray_data;
 #define LIMBER_ACTARRAY_DATA_TYPE_NAME "limber.v4.ActArrayData"
-LIMBER_STATIC_ASSERT(sizeof(limber_actarray_data) == 1336, "limber_actarray_data size");
+LIMBER_STATIC_ASSERT(sizeof(limber_actarray_data) == 1376, "limber_actarray_data size");
 LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_actarray_data) == 8, "limber_actarray_data alignment");
 LIMBER_STATIC_ASSERT(offsetof(limber_actarray_data, header) == 0, "limber_actarray_data.header offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_actarray_data, actuators_count) == 48, "limber_actarray_data.actuators_count offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_actarray_data, motor_state) == 52, "limber_actarray_data.motor_state offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_actarray_data, actuators) == 56, "limber_actarray_data.actuators offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_actarray_data, trajectory) == 1336, "limber_actarray_data.trajectory offset");
 
 /* limber.v4.ActArrayPositionCmd (size 16, align 8) */
 typedef struct limber_actarray_position_cmd {

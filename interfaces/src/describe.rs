@@ -97,6 +97,16 @@ impl Describe for ActArrayData {
                 actuator_state_name(a.state)
             ));
         }
+        if self.trajectory.active == 1 {
+            let t = &self.trajectory;
+            s.push_str(&format!(
+                " | trajectory point {}/{} max error {:.4}{}",
+                t.point.min(t.points),
+                t.points,
+                t.max_error,
+                if t.scale == 0.0 { " paused" } else { "" }
+            ));
+        }
         s
     }
     fn json(&self) -> Value {
@@ -112,6 +122,15 @@ impl Describe for ActArrayData {
                 "state": a.state,
                 "state_name": actuator_state_name(a.state),
             })).collect::<Vec<_>>(),
+            "trajectory": {
+                "active": self.trajectory.active,
+                "point": self.trajectory.point,
+                "points": self.trajectory.points,
+                "result": self.trajectory.result,
+                "max_error": self.trajectory.max_error,
+                "time": self.trajectory.time,
+                "scale": self.trajectory.scale,
+            },
         })
     }
 }

@@ -76,7 +76,8 @@ pub use wire::{WireField, WireStruct};
 /// [`control::MotionResult`]); every type name carries the version.
 /// Version 4 added the actarray's joint trajectories (`TRAJ_CHUNK`, `TRAJ`, `TRAJ_SCALE`:
 /// [`actarray::ActArrayTrajChunkCmd`], [`actarray::ActArrayTrajCmd`],
-/// [`actarray::ActArrayTrajScaleCmd`]), the statuses `INVALID_GOAL`, `OLD_TIMESTAMP` and
+/// [`actarray::ActArrayTrajScaleCmd`]) and their feedback in the state
+/// ([`actarray::TrajFeedback`]), the statuses `INVALID_GOAL`, `OLD_TIMESTAMP` and
 /// `TOO_FAST`, and the results `PATH_TOLERANCE_VIOLATED` and `GOAL_TOLERANCE_VIOLATED`.
 /// It also added the gripper's GOAL command ([`gripper::GripperGoalCmd`], a wider
 /// [`gripper::GripperCmdMsg`]) and the statuses `OBJECT_PRESENT`, `GAP_NOT_SETTABLE`,
@@ -91,7 +92,7 @@ pub mod prelude {
         ActArrayCmdMsg, ActArrayCommand, ActArrayData, ActArrayGeom, ActArrayReply,
         ActArrayReplyMsg, ActArrayReqMsg, ActArrayRequest, ActArrayTrajChunkCmd, ActArrayTrajCmd,
         ActuatorFlags, ActuatorGeom, ActuatorKind, ActuatorState, JointSel, JointTrajectory,
-        JointValues, MAX_TRAJ_POINTS, TrajectoryError, TrajectoryUpload,
+        JointValues, MAX_TRAJ_POINTS, TrajFeedback, TrajectoryError, TrajectoryUpload,
     };
     pub use crate::common::{
         Bbox3, CmdOutcome, MAX_ACTUATORS, MsgMeta, Orientation3, Pose3, ReplyMeta, StateHeader,
@@ -138,6 +139,7 @@ pub fn manifest() -> Manifest {
         ReplyMeta::LAYOUT,
         // actarray
         ActuatorState::LAYOUT,
+        TrajFeedback::LAYOUT,
         ActArrayData::LAYOUT,
         ActArrayPositionCmd::LAYOUT,
         ActArrayMultiPositionCmd::LAYOUT,

@@ -359,14 +359,33 @@ class ActuatorState(ctypes.Structure):
         return "limber.v4.ActuatorState"
 
 
+class TrajFeedback(ctypes.Structure):
+    """limber.v4.TrajFeedback (size 40, align 8)."""
+
+    _fields_ = [
+        ("active", ctypes.c_uint32),
+        ("point", ctypes.c_uint32),
+        ("points", ctypes.c_uint32),
+        ("result", ctypes.c_uint32),
+        ("max_error", ctypes.c_double),
+        ("time", ctypes.c_double),
+        ("scale", ctypes.c_double),
+    ]
+
+    @staticmethod
+    def type_name() -> str:
+        return "limber.v4.TrajFeedback"
+
+
 class ActArrayData(ctypes.Structure):
-    """limber.v4.ActArrayData (size 1336, align 8)."""
+    """limber.v4.ActArrayData (size 1376, align 8)."""
 
     _fields_ = [
         ("header", StateHeader),
         ("actuators_count", ctypes.c_uint32),
         ("motor_state", ctypes.c_uint32),
         ("actuators", ActuatorState * 32),
+        ("trajectory", TrajFeedback),
     ]
 
     @staticmethod
@@ -1124,6 +1143,7 @@ STRUCTS = [
     MsgMeta,
     ReplyMeta,
     ActuatorState,
+    TrajFeedback,
     ActArrayData,
     ActArrayPositionCmd,
     ActArrayMultiPositionCmd,

@@ -1,5 +1,5 @@
 //! `floor`: raw iceoryx2 between two processes, with the payloads of the command path
-//! (a 296 B `ActArrayCmdMsg` out, a 1336 B `ActArrayData` back), no limber-services.
+//! (a 296 B `ActArrayCmdMsg` out, a 1376 B `ActArrayData` back), no limber-services.
 //!
 //! * spin: both sides busy-poll `receive()`; the floor of the driver's `--spin` mode.
 //! * blocking (`event`): each message is followed by a `notify()` on an event service and
@@ -48,7 +48,7 @@ impl Scenario for Floor {
         "floor"
     }
     fn description(&self) -> &'static str {
-        "the floors, 2 processes: a futex and a spinning cache-line ping-pong in shared memory (no middleware), and raw iceoryx2, 296 B out / 1336 B back: spinning, and event wake-up (notify -> blocking listener, or WaitSet on the echo side)"
+        "the floors, 2 processes: a futex and a spinning cache-line ping-pong in shared memory (no middleware), and raw iceoryx2, 296 B out / 1376 B back: spinning, and event wake-up (notify -> blocking listener, or WaitSet on the echo side)"
     }
     fn run(&self, ctx: &mut RunCtx) -> Result<(), BenchError> {
         if ctx.spin_enabled() {

@@ -1,5 +1,5 @@
 //! `peers`: the command round trip with the same bytes (a 296 B `ActArrayCmdMsg` out, a
-//! 1336 B `ActArrayData` back) over a Unix domain stream socket and over TCP loopback
+//! 1376 B `ActArrayData` back) over a Unix domain stream socket and over TCP loopback
 //! (Player's transport, `TCP_NODELAY`), between two processes, each both blocking
 //! (blocking `read`) and spinning (non-blocking `read` in a loop).
 //!
@@ -336,7 +336,7 @@ fn ping<S: Sock>(
 }
 
 /// The echo child (`{uds,tcp}-echo-{spin,blocking}`): connects to `--addr`, answers every
-/// 296 B message with 1336 B, records the one-way latency, stops at end of stream.
+/// 296 B message with 1376 B, records the one-way latency, stops at end of stream.
 pub fn echo_role(args: &BenchArgs, t: Transport, spin: bool) -> Result<(), BenchError> {
     let addr = args
         .addr

@@ -1,4 +1,4 @@
-//! `state`: a driver process (`DeviceHost<ActArray>`) publishes the 1336 B arm state at
+//! `state`: a driver process (`DeviceHost<ActArray>`) publishes the 1376 B arm state at
 //! 1 kHz; 1, 4 and 16 subscriber processes (`ActArrayClient`, `WaitMode::Event`) block in
 //! `wait_state` on the driver's notify event — never more spinning processes than
 //! cores, so nobody spins here. One-way latency: the state's `header.stamp_ns` (taken

@@ -478,6 +478,7 @@ fn actarray_lines(
                 ""
             }
         )),
+        Span::styled(trajectory_progress(s), Style::new().fg(Color::Cyan)),
     ])];
     // "j0 " + bar + " +0.1234 rad [-3.1416, +3.1416] v +0.000 stalled" ≈ 48 + bar.
     let bar_w = (width as usize).saturating_sub(52).clamp(8, 40);
@@ -533,6 +534,26 @@ fn actarray_lines(
         out.push(Line::from("no actuators"));
     }
     out
+}
+
+/// A running joint trajectory's progress (point i/N, the largest error, paused), or how
+/// the last one ended; empty before the first.
+fn trajectory_progress(s: &ActArrayData) -> String {
+    let t = &s.trajectory;
+    match t.active {
+        1 => format!(
+            " · trajectory point {}/{}, max error {:.4}{}",
+            t.point.min(t.points),
+            t.points,
+            t.max_error,
+            if t.scale == 0.0 { ", paused" } else { "" }
+        ),
+        2 => match MotionResult::try_from(t.result) {
+            Ok(r) => format!(" · last trajectory: {}", r.name()),
+            Err(_) => String::new(),
+        },
+        _ => String::new(),
+    }
 }
 
 /// The name and colour of a limb state.
@@ -659,4 +680,29 @@ pub fn render_text(app: &App, width: u16) -> String {
         .draw(|f| draw(f, app))
         .expect("drawing into memory");
     buffer_text(terminal.backend().buffer())
+}
+
+#[cfg(test)]
+mod trajectory_tests {
+    use super::*;
+
+    #[test]
+    fn a_running_trajectory_shows_its_point_and_error_and_an_ended_one_its_result() {
+        let mut s = ActArrayData::default();
+        assert_eq!(trajectory_progress(&s), "");
+        s.trajectory.active = 1;
+        s.trajectory.point = 3;
+        s.trajectory.points = 8;
+        s.trajectory.max_error = 0.0125;
+        assert_eq!(
+            trajectory_progress(&s),
+            " · trajectory point 3/8, max error 0.0125"
+        );
+        s.trajectory.active = 2;
+        s.trajectory.result = MotionResult::PathToleranceViolated.code();
+        assert_eq!(
+            trajectory_progress(&s),
+            " · last trajectory: PATH_TOLERANCE_VIOLATED"
+        );
+    }
 }

@@ -513,3 +513,37 @@ fn motor_state_shows_the_power_asked_until_the_robot_corrects_it() {
     m.on_packet(&RobotPacket::Arm(arm_packet(true, 0, home_ticks())), later);
     assert_eq!(motor(&m), 1);
 }
+
+#[test]
+fn a_move_still_going_past_its_travel_bound_ends_timed_out() {
+    let (mut m, _) = ready();
+    let home = home_ticks();
+    let target = m.arm().ticks[2];
+    let geom_goal = {
+        let mut s = ActArrayData::default();
+        m.arm_state(&mut s, Instant::now());
+        s.actuators[2].position - 0.3
+    };
+    let o = m.arm_command(
+        &ActArrayCommand::position(2, geom_goal).unwrap(),
+        &now_origin(),
+    );
+    assert_eq!(o, Status::Ok);
+    drain(&mut m);
+    let bound = m.travel_bound(2).expect("a bound");
+    assert!(bound > Duration::from_secs(2), "{bound:?}");
+    // The controller says the joint moves, but it never gets anywhere.
+    let start = Instant::now();
+    let mut t = start;
+    while t < start + bound + Duration::from_millis(500) {
+        t += Duration::from_millis(100);
+        m.on_packet(&RobotPacket::Arm(arm_packet(true, 1 << 2, home)), t);
+        let p = m.joint_progress(2, false, t);
+        if t < start + bound {
+            assert_eq!(p.end, None, "{:?} after {:?}", p, t - start);
+        }
+    }
+    let p = m.joint_progress(2, false, t);
+    assert_eq!(p.end, Some((MotionResult::TimedOut, Status::Timeout)));
+    assert_eq!(m.arm().ticks[2], target);
+}

@@ -3,64 +3,15 @@
 //! power-off, and a refused command has no result. The driver runs on a thread of the
 //! test process, in its own domain per test; nothing asserts speed.
 
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc;
-use std::thread::JoinHandle;
 use std::time::Duration;
 
-use limber_kinematics::chain::Chain;
 use limber_services::prelude::*;
 use limber_services::{Domain, Role};
+use limber_simarm::SimArmOptions;
 use limber_simarm::model::TOLERANCE;
-use limber_simarm::{SimArm, SimArmOptions};
 
-const TIMEOUT: Duration = Duration::from_secs(20);
-
-/// The driver thread; stops and joins when dropped.
-struct Driver {
-    stop: Arc<AtomicBool>,
-    handle: Option<JoinHandle<()>>,
-}
-
-impl Drop for Driver {
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
-        if let Some(h) = self.handle.take() {
-            let _ = h.join();
-        }
-    }
-}
-
-/// simarm (6 joints) at `time_scale`.
-fn start(domain: &Domain, time_scale: f64) -> Driver {
-    let stop = Arc::new(AtomicBool::new(false));
-    let (ready_tx, ready_rx) = mpsc::channel();
-    let name = domain.name().to_string();
-    let flag = stop.clone();
-    let handle = std::thread::spawn(move || {
-        let domain = Domain::new(&name).expect("domain");
-        let ctx = Context::new(&domain, Role::Driver, "simarm").expect("context");
-        let options = SimArmOptions {
-            time_scale,
-            ..SimArmOptions::default()
-        };
-        let mut arm = SimArm::new(&ctx, Chain::default_6dof(), options).expect("simarm starts");
-        ready_tx.send(()).expect("test waits");
-        let _ = arm.run(|| flag.load(Ordering::Relaxed));
-    });
-    ready_rx
-        .recv_timeout(TIMEOUT)
-        .expect("simarm ready in time");
-    Driver {
-        stop,
-        handle: Some(handle),
-    }
-}
-
-fn arm(ctx: &Context) -> ActArrayClient {
-    ActArrayClient::connect_timeout(ctx, "simarm/actarray/0", TIMEOUT).expect("arm")
-}
+mod common;
+use common::{TIMEOUT, arm};
 
 /// A position of joint `j` a quarter of the way from its centre toward its max.
 fn target(geom: &ActArrayGeom, j: usize, fraction: f64) -> f64 {
@@ -182,4 +133,15 @@ fn the_deadman_stops_a_motion_whose_holder_missed_its_heartbeat() {
         "{done}"
     );
     assert!(done.errors()[0].abs() > TOLERANCE, "stopped short: {done}");
+}
+
+/// simarm at `time_scale`.
+fn start(domain: &Domain, time_scale: f64) -> common::Driver {
+    common::start(
+        domain,
+        SimArmOptions {
+            time_scale,
+            ..SimArmOptions::default()
+        },
+    )
 }

@@ -4,64 +4,13 @@
 //! of 0 and resumed by 1, and invalid goals refused with their cause. The driver runs on a
 //! thread of the test process, in its own domain per test; nothing asserts speed.
 
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc;
-use std::thread::JoinHandle;
-use std::time::Duration;
-
 use limber_interfaces::actarray::{JointTrajectory, cmd, traj_field};
-use limber_kinematics::chain::Chain;
 use limber_services::prelude::*;
 use limber_services::{Domain, Role, TrajectorySendError};
-use limber_simarm::{Obstacles, SimArm, SimArmOptions};
+use limber_simarm::{Obstacles, SimArmOptions};
 
-const TIMEOUT: Duration = Duration::from_secs(20);
-
-/// The driver thread; stops and joins when dropped.
-struct Driver {
-    stop: Arc<AtomicBool>,
-    handle: Option<JoinHandle<()>>,
-}
-
-impl Drop for Driver {
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
-        if let Some(h) = self.handle.take() {
-            let _ = h.join();
-        }
-    }
-}
-
-/// simarm (6 joints and the gripper), with these obstacles.
-fn start(domain: &Domain, obstacles: Obstacles) -> Driver {
-    let stop = Arc::new(AtomicBool::new(false));
-    let (ready_tx, ready_rx) = mpsc::channel();
-    let name = domain.name().to_string();
-    let flag = stop.clone();
-    let handle = std::thread::spawn(move || {
-        let domain = Domain::new(&name).expect("domain");
-        let ctx = Context::new(&domain, Role::Driver, "simarm").expect("context");
-        let options = SimArmOptions {
-            obstacles,
-            ..SimArmOptions::default()
-        };
-        let mut arm = SimArm::new(&ctx, Chain::default_6dof(), options).expect("simarm starts");
-        ready_tx.send(()).expect("test waits");
-        let _ = arm.run(|| flag.load(Ordering::Relaxed));
-    });
-    ready_rx
-        .recv_timeout(TIMEOUT)
-        .expect("simarm ready in time");
-    Driver {
-        stop,
-        handle: Some(handle),
-    }
-}
-
-fn arm(ctx: &Context) -> ActArrayClient {
-    ActArrayClient::connect_timeout(ctx, "simarm/actarray/0", TIMEOUT).expect("arm")
-}
+mod common;
+use common::{TIMEOUT, arm};
 
 fn position(a: &mut ActArrayClient, j: usize) -> f64 {
     a.wait_state(TIMEOUT).expect("a state").actuators[j].position
@@ -139,6 +88,10 @@ fn a_trajectory_of_three_joints_is_reached_within_its_goal_tolerance() {
     for (j, x) in q.iter().enumerate() {
         assert!((done.positions()[j] - (x + 0.4)).abs() <= 0.001, "{done}");
     }
+    // The state's feedback: the last trajectory ended reached, past its last point.
+    let fb = a.wait_state(TIMEOUT).unwrap().trajectory;
+    assert_eq!((fb.active, fb.result), (2, MotionResult::Reached.code()));
+    assert_eq!((fb.point, fb.points), (4, 4));
     // It holds at the goal.
     let p = holds(&mut a, 1, 3);
     assert!((p - (q[1] + 0.4)).abs() <= 0.001);
@@ -235,6 +188,8 @@ fn a_scaling_of_zero_pauses_it_and_one_resumes_it() {
     let pause = a.set_trajectory_scale(0.0).unwrap();
     assert_eq!(a.wait_outcome(pause, TIMEOUT).unwrap(), Status::Ok);
     position(&mut a, 0);
+    let fb = a.wait_state(TIMEOUT).unwrap().trajectory;
+    assert_eq!((fb.active, fb.scale, fb.points), (1, 0.0, 2), "{fb:?}");
     let paused = holds(&mut a, 0, 20);
     assert!(paused < from + 0.5);
     assert_eq!(a.done(ticket).unwrap(), None, "paused, not ended");
@@ -322,4 +277,15 @@ fn invalid_goals_are_refused_with_their_cause() {
         .follow_trajectory(&JointTrajectory::new(&[0]).unwrap())
         .unwrap_err();
     assert!(matches!(e, TrajectorySendError::Invalid(_)), "{e}");
+}
+
+/// simarm with these obstacles.
+fn start(domain: &Domain, obstacles: Obstacles) -> common::Driver {
+    common::start(
+        domain,
+        SimArmOptions {
+            obstacles,
+            ..SimArmOptions::default()
+        },
+    )
 }

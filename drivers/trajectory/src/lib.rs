@@ -34,7 +34,7 @@
 //! * **Cancel**: a STOP decelerates each joint from its desired velocity within its
 //!   [`JointLimit::max_deceleration`] (0 = hold at once).
 
-use limber_interfaces::actarray::{Interpolation, JointTrajectory, MAX_TRAJ_POINTS};
+use limber_interfaces::actarray::{Interpolation, JointTrajectory, MAX_TRAJ_POINTS, TrajFeedback};
 use limber_interfaces::prelude::*;
 
 mod spline;
@@ -238,6 +238,10 @@ pub struct Executor {
     max_error: f64,
     /// Each device joint's desired state when a STOP came.
     stop_from: [Knot; MAX_ACTUATORS],
+    /// How the last trajectory ended (`None` while one runs or before the first).
+    last_result: Option<MotionResult>,
+    /// A trajectory was accepted since the start.
+    ever: bool,
 }
 
 impl core::fmt::Debug for Executor {
@@ -284,6 +288,8 @@ impl Executor {
             goal: [f64::NAN; MAX_ACTUATORS],
             max_error: 0.0,
             stop_from: [Knot::default(); MAX_ACTUATORS],
+            last_result: None,
+            ever: false,
         })
     }
 
@@ -358,6 +364,28 @@ impl Executor {
         }
     }
 
+    /// The feedback as the actuator array's state carries it ([`TrajFeedback`]).
+    pub fn state_feedback(&self) -> TrajFeedback {
+        let running = self.running() != 0;
+        TrajFeedback {
+            active: match (self.ever, running) {
+                (false, _) => 0,
+                (true, true) => 1,
+                (true, false) => 2,
+            },
+            point: self.point as u32,
+            points: self.active.len() as u32,
+            result: if running {
+                0
+            } else {
+                self.last_result.map_or(0, MotionResult::code)
+            },
+            max_error: self.max_error,
+            time: self.tau,
+            scale: self.scale,
+        }
+    }
+
     /// Checks `traj` against the device and takes it: it replaces the running trajectory
     /// from its start time. `now_ns` is `CLOCK_MONOTONIC`; `actual` the device's joint
     /// positions (one per device joint). Nothing changes when it is refused.
@@ -399,6 +427,8 @@ impl Executor {
         self.check_goal(traj, &from, age)?;
         *self.next = traj.clone();
         self.next_pending = true;
+        self.ever = true;
+        self.last_result = None;
         self.next_start_ns = start_ns;
         for &j in traj.joints() {
             self.joints[j as usize] = JointRun::Running;
@@ -633,6 +663,7 @@ impl Executor {
             self.error[j] = self.actual[j] - self.goal[j];
         }
         self.phase = Phase::Holding;
+        self.last_result = Some(result);
         Tick::Ended(result)
     }
 
@@ -677,6 +708,9 @@ impl Executor {
     /// [`MotionResult::Stopped`]; each joint decelerates from its desired velocity within
     /// its limit and holds.
     pub fn stop(&mut self, now_ns: u64) {
+        if self.running() != 0 {
+            self.last_result = Some(MotionResult::Stopped);
+        }
         self.next_pending = false;
         for j in 0..MAX_ACTUATORS {
             if self.joints[j] == JointRun::Running {
@@ -694,6 +728,9 @@ impl Executor {
     /// a pending one) ends [`MotionResult::Preempted`], and the executor commands nothing
     /// more until the next trajectory.
     pub fn release(&mut self) {
+        if self.running() != 0 {
+            self.last_result = Some(MotionResult::Preempted);
+        }
         self.next_pending = false;
         for j in 0..MAX_ACTUATORS {
             if self.joints[j] == JointRun::Running {
@@ -707,6 +744,9 @@ impl Executor {
     /// Ends what runs with `result` because of `cause` (the link went down, the power went
     /// off, a collision): every joint holds where it is.
     pub fn abort(&mut self, result: MotionResult, cause: Status) {
+        if self.running() != 0 {
+            self.last_result = Some(result);
+        }
         self.next_pending = false;
         for j in 0..MAX_ACTUATORS {
             if self.joints[j] == JointRun::Running {

@@ -326,18 +326,7 @@ impl JointTrajectory {
                 expected: n,
             });
         }
-        for (column, &value) in tolerances.iter().enumerate() {
-            if !value.is_finite() {
-                return Err(TrajectoryError::NotFinite { point: 0, field });
-            }
-            if value < 0.0 {
-                return Err(TrajectoryError::BadTolerance {
-                    field,
-                    column,
-                    value,
-                });
-            }
-        }
+        check_tolerance(field, tolerances)?;
         let dst = if path {
             &mut self.path_tolerance
         } else {
@@ -480,18 +469,7 @@ impl JointTrajectory {
             ("path tolerance", &self.path_tolerance[..n]),
             ("goal tolerance", &self.goal_tolerance[..n]),
         ] {
-            for (column, &value) in v.iter().enumerate() {
-                if !value.is_finite() {
-                    return Err(TrajectoryError::NotFinite { point: 0, field });
-                }
-                if value < 0.0 {
-                    return Err(TrajectoryError::BadTolerance {
-                        field,
-                        column,
-                        value,
-                    });
-                }
-            }
+            check_tolerance(field, v)?;
         }
         Ok(())
     }
@@ -613,6 +591,23 @@ impl JointTrajectory {
         out.push(ActArrayCommand::Traj(header));
         Ok(out)
     }
+}
+
+/// Tolerances are finite and 0 (not enforced) or positive.
+fn check_tolerance(field: &'static str, values: &[f64]) -> Result<(), TrajectoryError> {
+    for (column, &value) in values.iter().enumerate() {
+        if !value.is_finite() {
+            return Err(TrajectoryError::NotFinite { point: 0, field });
+        }
+        if value < 0.0 {
+            return Err(TrajectoryError::BadTolerance {
+                field,
+                column,
+                value,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The driver's side of an upload: takes the `TRAJ_CHUNK`s of one client and, at its

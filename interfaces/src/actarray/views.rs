@@ -29,6 +29,19 @@ impl ActArrayData {
                 value: self.motor_state as i64,
             });
         }
+        let t = &self.trajectory;
+        if t.active > 2 {
+            return Err(DecodeError::UnknownCode {
+                field: "trajectory.active",
+                value: t.active as i64,
+            });
+        }
+        if t.result != 0 {
+            crate::control::MotionResult::try_from(t.result)?;
+        }
+        finite("trajectory.max_error", t.max_error)?;
+        finite("trajectory.time", t.time)?;
+        finite("trajectory.scale", t.scale)?;
         for a in self.actuators() {
             a.flags()?;
             finite("position", a.position)?;

@@ -24,8 +24,30 @@ wire_struct! {
 }
 
 wire_struct! {
+    /// The feedback of the device's joint trajectory (control_msgs': the current point,
+    /// the error), in its state.
+    pub struct TrajFeedback : "limber.v4.TrajFeedback", size = 40, align = 8 {
+        /// 0: no trajectory has run; 1: one runs (or waits for its start time); 2: the last
+        /// one ended (`result` says how).
+        pub active: u32,
+        /// The point it heads for (0-based; `points` once past the last).
+        pub point: u32,
+        /// Its points.
+        pub points: u32,
+        /// How the last one ended: a `RESULT` code (0 while one runs).
+        pub result: u32,
+        /// The largest |actual − desired| of its joints at the last tick, rad or m.
+        pub max_error: f64,
+        /// Trajectory time at the last tick, s (advancing at `scale` times real time).
+        pub time: f64,
+        /// The speed scaling: 0 paused, 1 nominal.
+        pub scale: f64,
+    }
+}
+
+wire_struct! {
     /// The state of an actuator array (channel `data`).
-    pub struct ActArrayData : "limber.v4.ActArrayData", size = 1336, align = 8 {
+    pub struct ActArrayData : "limber.v4.ActArrayData", size = 1376, align = 8 {
         /// Common header.
         pub header: StateHeader,
         /// Number of valid entries in `actuators`.
@@ -34,6 +56,8 @@ wire_struct! {
         pub motor_state: u32,
         /// The actuators.
         pub actuators: [ActuatorState; 32],
+        /// The joint trajectory's feedback (all zero on a device without trajectories).
+        pub trajectory: TrajFeedback,
     }
 }
 

@@ -265,6 +265,7 @@ impl RobotModel {
 
     /// Fills the arm actarray state.
     pub fn arm_state(&self, s: &mut ActArrayData, now: Instant) {
+        s.trajectory = self.traj.exec.state_feedback();
         let n = self
             .cal
             .as_ref()

@@ -109,6 +109,11 @@ pub struct ArmModel {
     /// ARMpacs whose status bytes make sense only in the other layout than the
     /// configured `armpac_layout` (see [`ArmPacket::suggests_other_layout`]).
     pub layout_mismatches: u64,
+    /// When each joint's target was set, and how many ticks it had to go: the time bound
+    /// of its motion (TIMED_OUT past it).
+    pub target_set: [Option<(Instant, u8)>; ARM_JOINTS],
+    /// The servo speed last commanded per joint, ms per step (0: the calibration's).
+    pub servo_ms: [u8; ARM_JOINTS],
 }
 
 impl Default for ArmModel {
@@ -129,6 +134,8 @@ impl Default for ArmModel {
             stamp_ns: 0,
             last_packet: None,
             layout_mismatches: 0,
+            target_set: [None; ARM_JOINTS],
+            servo_ms: [0; ARM_JOINTS],
         }
     }
 }
@@ -227,6 +234,7 @@ impl ArmModel {
         self.target[j] = Some(tick);
         self.goal[j] = None;
         self.short_since[j] = None;
+        self.target_set[j] = Some((Instant::now(), tick.abs_diff(self.ticks[j])));
     }
 }
 
@@ -482,6 +490,11 @@ impl RobotModel {
         if let Command::ArmPower(on) = *cmd {
             self.arm.power_commanded(on);
             self.dirty.arm = true;
+        }
+        if let Command::ArmSpeed { joint, ms_per_step } = *cmd
+            && let Some(ms) = self.arm.servo_ms.get_mut(joint.index())
+        {
+            *ms = ms_per_step;
         }
         Ok(())
     }

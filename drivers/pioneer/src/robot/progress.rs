@@ -12,6 +12,9 @@ use limber_services::Progress;
 
 use super::*;
 
+/// What a joint's move may take beyond its servo's stepping ([`RobotModel::travel_bound`]).
+pub const TRAVEL_MARGIN: Duration = Duration::from_secs(2);
+
 impl RobotModel {
     /// One tick of joint `j`, in radians (the servo's resolution: the tolerance).
     fn tick_rad(&self, j: usize) -> Option<f64> {
@@ -40,7 +43,8 @@ impl RobotModel {
     }
 
     /// How arm joint `j` (5: the arm gripper) is doing in a motion; `streaming`: a VECMOVE
-    /// is still being streamed to it.
+    /// is still being streamed to it. A joint still moving past its
+    /// [`RobotModel::travel_bound`] ends TIMED_OUT (cause TIMEOUT).
     pub fn joint_progress(&self, j: usize, streaming: bool, now: Instant) -> Progress {
         if j >= ARM_JOINTS {
             return Progress::UNKNOWN;
@@ -55,6 +59,20 @@ impl RobotModel {
         }
         let stall = Duration::from_millis(self.cfg.stall_timeout_ms);
         let flags = self.arm.flags(j, now, stall);
+        if !streaming
+            && flags.contains(ActuatorFlags::MOVING)
+            && let Some(bound) = self.travel_bound(j)
+            && let Some((since, _)) = self.arm.target_set[j]
+            && now.saturating_duration_since(since) > bound
+        {
+            return Progress::ended(
+                MotionResult::TimedOut,
+                Status::Timeout,
+                position,
+                error,
+                tolerance,
+            );
+        }
         if streaming || flags.contains(ActuatorFlags::MOVING) {
             return Progress::moving(position, error, tolerance);
         }
@@ -66,6 +84,20 @@ impl RobotModel {
             MotionResult::Stalled
         };
         Progress::ended(result, Status::Ok, position, error, tolerance)
+    }
+
+    /// How long joint `j`'s move to its target may take: its ticks to go at the servo's
+    /// speed (the last commanded, else the calibration's), twice, plus
+    /// [`TRAVEL_MARGIN`] (two ARMpac cycles and the link's latency, generously).
+    pub fn travel_bound(&self, j: usize) -> Option<Duration> {
+        let (_, ticks) = self.arm.target_set.get(j).copied().flatten()?;
+        let cal = self.cal.as_ref()?;
+        let default = cal.joint(ArmJoint::from_index(j).ok()?).ok()?.speed;
+        let ms = match self.arm.servo_ms[j] {
+            0 => default,
+            ms => ms,
+        };
+        Some(Duration::from_millis(2 * u64::from(ticks) * u64::from(ms.max(1))) + TRAVEL_MARGIN)
     }
 
     /// How part `part` of an arm actarray motion is doing (joint `part`).

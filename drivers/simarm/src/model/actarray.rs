@@ -271,6 +271,7 @@ impl ArmModel {
     /// current, and BRAKED (chain joints while the brakes are on) / STALLED (blocked, or
     /// pushed by a current and not moving) / MOVING / IDLE.
     pub fn arm_state(&self, s: &mut ActArrayData) {
+        s.trajectory = self.trajectory_state();
         s.actuators_count = self.actuators() as u32;
         s.motor_state = self.powered as u32;
         let currents = self.model_currents();

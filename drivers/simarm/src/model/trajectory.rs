@@ -269,7 +269,12 @@ impl ArmModel {
     }
 
     /// The feedback of the trajectory running (or last run), if any.
-    pub fn trajectory_feedback(&self) -> Option<Feedback> {
+    pub(super) fn trajectory_feedback(&self) -> Option<Feedback> {
         (self.traj.joints != 0).then(|| self.traj.exec.feedback())
+    }
+
+    /// The trajectory's feedback as the actuator array's state carries it.
+    pub fn trajectory_state(&self) -> TrajFeedback {
+        self.traj.exec.state_feedback()
     }
 }
