@@ -18,6 +18,9 @@ use nalgebra::Vector3;
 use super::ArmModel;
 use super::preemption::TOLERANCE;
 
+/// How far a joint of a path may be from where its trajectory wants it, rad (or m).
+pub const PATH_TOLERANCE: f64 = 0.01;
+
 /// A LINE's tool speed when neither the command nor the limb's SPEED request gives one,
 /// m/s.
 pub const DEFAULT_LINE_SPEED: f64 = 0.1;
@@ -137,6 +140,10 @@ impl ArmModel {
         let joints: Vec<u16> = (0..n as u16).collect();
         let mut traj = JointTrajectory::new(&joints).map_err(|e| e.status())?;
         traj.set_goal_tolerance(&[TOLERANCE; super::MAX_JOINTS][..n])
+            .map_err(|e| e.status())?;
+        // The joints follow exactly; one held off its path (a contact) ends the path
+        // PATH_TOLERANCE_VIOLATED where it is rather than waiting out the goal time.
+        traj.set_path_tolerance(&[PATH_TOLERANCE; super::MAX_JOINTS][..n])
             .map_err(|e| e.status())?;
         let mut t = 0.0;
         let mut prev = start;
