@@ -125,6 +125,11 @@ def _doubles(values: Sequence[float]) -> "Tuple[Any, int]":
     return (c_double * max(1, len(vs)))(*vs), len(vs)
 
 
+def _flat(rows: Optional[Sequence[Sequence[float]]]) -> Any:
+    """Rows of numbers as one row-major C array of doubles (None stays None: NULL)."""
+    return None if rows is None else _doubles([x for row in rows for x in row])[0]
+
+
 #: The state type of a client (``ActArrayData``, ``LimbData``, ``GripperData``).
 _D = TypeVar("_D", bound=ctypes.Structure)
 _C = TypeVar("_C", bound="_Client[Any]")
@@ -598,28 +603,13 @@ class ActArrayClient(_Client[L.ActArrayData]):
         tolerances per joint (0: not enforced). It replaces a running trajectory from its
         start time; :meth:`wait_done` returns its result. An invalid trajectory raises
         ``ValueError`` with the reason (nothing sent)."""
-
-        def rows(v: Optional[Sequence[Sequence[float]]]) -> Any:
-            return None if v is None else _doubles([x for row in v for x in row])[0]
-
-        ids = (c_uint32 * max(1, len(joints)))(*joints)
         ts, n = _doubles(times)
-        pos = rows(positions)
+        rows = [_flat(positions), _flat(velocities), _flat(accelerations)]
+        tols = [None if v is None else _doubles(v)[0] for v in (path_tolerance, goal_tolerance)]
+        ids = (c_uint32 * max(1, len(joints)))(*joints)
         rc = _c.limber_actarray_follow_trajectory(
-            self._h,
-            ids,
-            len(joints),
-            ts,
-            n,
-            pos,
-            rows(velocities),
-            rows(accelerations),
-            None if path_tolerance is None else _doubles(path_tolerance)[0],
-            None if goal_tolerance is None else _doubles(goal_tolerance)[0],
-            goal_time_tolerance,
-            start_ns,
-            self._ticket_ref,
-        )
+            self._h, ids, len(joints), ts, n, *rows, *tols, goal_time_tolerance, start_ns,
+            self._ticket_ref)
         return self._sent(rc)
 
     def set_trajectory_scale(self, scale: float) -> Ticket:

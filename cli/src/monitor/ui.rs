@@ -694,10 +694,13 @@ mod trajectory_tests {
         s.trajectory.point = 3;
         s.trajectory.points = 8;
         s.trajectory.max_error = 0.0125;
+        s.trajectory.scale = 1.0;
         assert_eq!(
             trajectory_progress(&s),
             " · trajectory point 3/8, max error 0.0125"
         );
+        s.trajectory.scale = 0.0;
+        assert!(trajectory_progress(&s).ends_with(", paused"));
         s.trajectory.active = 2;
         s.trajectory.result = MotionResult::PathToleranceViolated.code();
         assert_eq!(

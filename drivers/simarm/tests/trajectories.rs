@@ -289,3 +289,43 @@ fn start(domain: &Domain, obstacles: Obstacles) -> common::Driver {
         },
     )
 }
+
+#[test]
+fn the_model_runs_a_trajectory_given_as_a_value_to_its_goal() {
+    use limber_simarm::ArmModel;
+    // No transport: the trajectory value goes straight to the model, as a limb path
+    // sampled into joints does; time is the test's own.
+    let mut m = ArmModel::new(
+        limber_kinematics::chain::Chain::default_6dof(),
+        SimArmOptions::default(),
+    )
+    .unwrap();
+    let q = m.q();
+    let mut t = JointTrajectory::new(&[0, 2]).unwrap();
+    t.push(0.5, &[q[0] + 0.1, q[2] - 0.1], None, None).unwrap();
+    t.push(1.0, &[q[0] + 0.2, q[2] - 0.2], None, None).unwrap();
+    t.set_goal_tolerance(&[1e-9; 2]).unwrap();
+    let start = 1_000_000_000u64;
+    assert_eq!(m.run_trajectory(&t, start), Status::Ok);
+    assert_eq!(m.arm_progress(0).end, None);
+    let mut now = start;
+    while m.arm_progress(0).end.is_none() {
+        now += 10_000_000;
+        assert!(now < start + 5_000_000_000, "not ended");
+        m.step_trajectory(now);
+    }
+    assert_eq!(
+        m.arm_progress(0).end,
+        Some((MotionResult::Reached, Status::Ok))
+    );
+    assert_eq!(
+        m.arm_progress(2).end,
+        Some((MotionResult::Reached, Status::Ok))
+    );
+    let q1 = m.q();
+    assert!((q1[0] - (q[0] + 0.2)).abs() < 1e-9 && (q1[2] - (q[2] - 0.2)).abs() < 1e-9);
+    // Refused with the cause, nothing moving.
+    let mut beyond = JointTrajectory::new(&[2]).unwrap();
+    beyond.push(5.0, &[3.5], None, None).unwrap();
+    assert_eq!(m.run_trajectory(&beyond, now), Status::BeyondLimits);
+}

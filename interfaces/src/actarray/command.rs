@@ -348,12 +348,12 @@ impl Message for ActArrayCommand {
             }
             cmd::TRAJ_CHUNK => {
                 let c: ActArrayTrajChunkCmd = message::get(ch, k, b, n)?;
-                super::trajectory::check_chunk(&c)?;
+                super::upload::check_chunk(&c)?;
                 ActArrayCommand::TrajChunk(c)
             }
             cmd::TRAJ => {
                 let h: ActArrayTrajCmd = message::get(ch, k, b, n)?;
-                super::trajectory::check_header(&h)?;
+                super::upload::check_header(&h)?;
                 ActArrayCommand::Traj(h)
             }
             cmd::TRAJ_SCALE => {

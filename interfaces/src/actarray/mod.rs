@@ -18,15 +18,15 @@ use crate::manifest::{Constant, ConstantGroup};
 mod command;
 mod request;
 mod trajectory;
+mod upload;
 mod views;
 mod wire;
 
 pub use command::{ActArrayCommand, JointSel, JointValues};
 pub(crate) use request::on_off;
 pub use request::{ActArrayReply, ActArrayRequest};
-pub use trajectory::{
-    Interpolation, JointTrajectory, MAX_TRAJ_POINTS, TrajectoryError, TrajectoryUpload,
-};
+pub use trajectory::{Interpolation, JointTrajectory, MAX_TRAJ_POINTS, TrajectoryError};
+pub use upload::TrajectoryUpload;
 pub use wire::*;
 
 /// Command kinds (Player's `PLAYER_ACTARRAY_CMD_*` numbers).

@@ -34,7 +34,8 @@ const GOAL_TIME: f64 = 2.0;
 #[derive(Debug)]
 pub(crate) struct Trajectories {
     pub(super) exec: Box<Executor>,
-    upload: TrajectoryUpload,
+    /// Taken out while its trajectory starts (so the model can be borrowed meanwhile).
+    upload: Option<TrajectoryUpload>,
     /// Joints whose motion the host follows is a trajectory's.
     joints: u64,
     /// When each joint's last target went out (`CLOCK_MONOTONIC` ns).
@@ -45,7 +46,7 @@ impl Default for Trajectories {
     fn default() -> Self {
         Trajectories {
             exec: Executor::new(Config::new(ARM_JOINTS)),
-            upload: TrajectoryUpload::new(),
+            upload: Some(TrajectoryUpload::new()),
             joints: 0,
             sent_ns: [0; ARM_JOINTS],
         }
@@ -86,7 +87,9 @@ impl RobotModel {
     ) -> Option<Result<Status, Status>> {
         Some(match cmd {
             ActArrayCommand::TrajChunk(c) => {
-                self.traj.upload.chunk(from.client_id, c);
+                if let Some(u) = self.traj.upload.as_mut() {
+                    u.chunk(from.client_id, c);
+                }
                 Ok(Status::Ok)
             }
             ActArrayCommand::TrajScale(s) => Ok(self.traj.exec.set_scale(*s)),
@@ -96,24 +99,36 @@ impl RobotModel {
     }
 
     fn start_trajectory(&mut self, h: &ActArrayTrajCmd, from: &Origin) -> Result<(), Status> {
+        let Some(mut upload) = self.traj.upload.take() else {
+            return Err(Status::Busy);
+        };
+        let r = match upload.finish(from.client_id, h) {
+            Ok(traj) => self.run_trajectory(traj, from),
+            Err(e) => {
+                tracing::info!(reason = %e, "trajectory refused");
+                Err(e.status())
+            }
+        };
+        self.traj.upload = Some(upload);
+        r
+    }
+
+    /// Runs a validated joint trajectory, wherever it came from (an upload, a limb path
+    /// sampled into joints): checked against the servos (limits, speed), then streamed
+    /// from now; it replaces the running one from its start time. `Err` is why it was
+    /// refused (nothing moving); its result comes through [`RobotModel::arm_progress`].
+    pub fn run_trajectory(&mut self, traj: &JointTrajectory, from: &Origin) -> Result<(), Status> {
         let now = monotonic_ns();
-        let config = self.traj_config(h.joint_count as usize);
-        let actual = self.joint_angles();
-        let powered = self.require_power();
-        let t = &mut self.traj;
-        let traj = t.upload.finish(from.client_id, h).map_err(|e| {
-            tracing::info!(reason = %e, "trajectory refused");
-            e.status()
-        })?;
-        let (config, actual) = (config?, actual.ok_or(Status::NotCalibrated)?);
-        powered?;
-        t.exec.set_config(config);
-        t.exec.accept(traj, now, &actual).map_err(|e| {
+        let config = self.traj_config(traj.joints().len())?;
+        let actual = self.joint_angles().ok_or(Status::NotCalibrated)?;
+        self.require_power()?;
+        self.traj.exec.set_config(config);
+        self.traj.exec.accept(traj, now, &actual).map_err(|e| {
             tracing::info!(reason = %e, "trajectory refused");
             e.status()
         })?;
         let mask = Executor::joints_of(traj);
-        t.joints |= mask;
+        self.traj.joints |= mask;
         let last = traj.len() - 1;
         let goals: [f64; ARM_JOINTS] = core::array::from_fn(|j| {
             traj.joints()

@@ -6,7 +6,7 @@
 
 use limber_interfaces::prelude::*;
 use limber_services::Progress;
-use limber_trajectory::{Config, Executor, Feedback, JointLimit, Tick};
+use limber_trajectory::{Config, Executor, JointLimit, Tick};
 
 use super::ArmModel;
 
@@ -19,7 +19,8 @@ const STOP_TIME: f64 = 0.1;
 #[derive(Debug)]
 pub(super) struct Trajectories {
     exec: Box<Executor>,
-    upload: TrajectoryUpload,
+    /// Taken out while its trajectory starts (so the model can be borrowed meanwhile).
+    upload: Option<TrajectoryUpload>,
     /// Actuators whose motion the host follows is a trajectory's.
     joints: u64,
     /// The last tick's time, ns.
@@ -30,43 +31,11 @@ impl Trajectories {
     pub(super) fn new(actuators: usize) -> Self {
         Trajectories {
             exec: Executor::new(Config::new(actuators)),
-            upload: TrajectoryUpload::new(),
+            upload: Some(TrajectoryUpload::new()),
             joints: 0,
             last_ns: 0,
         }
     }
-}
-
-/// What [`accept`] checks a trajectory against.
-struct Arm<'a> {
-    config: Config,
-    actual: &'a [f64],
-    n: usize,
-    powered: bool,
-    brakes: bool,
-}
-
-/// Checks `traj` against the arm (power, brakes) and hands it to `exec`: the actuators it
-/// drives, or why it was refused.
-fn accept(
-    exec: &mut Executor,
-    traj: &JointTrajectory,
-    arm: &Arm<'_>,
-    now_ns: u64,
-) -> Result<u64, Status> {
-    if !arm.powered {
-        return Err(Status::PoweredOff);
-    }
-    let mask = Executor::joints_of(traj);
-    if arm.brakes && mask & ((1u64 << arm.n) - 1) != 0 {
-        return Err(Status::Braked);
-    }
-    exec.set_config(arm.config);
-    exec.accept(traj, now_ns, arm.actual).map_err(|e| {
-        tracing::info!(reason = %e, "trajectory refused");
-        e.status()
-    })?;
-    Ok(mask)
 }
 
 impl ArmModel {
@@ -116,7 +85,9 @@ impl ArmModel {
     ) -> Option<Status> {
         Some(match cmd {
             ActArrayCommand::TrajChunk(c) => {
-                self.traj.upload.chunk(client, c);
+                if let Some(u) = self.traj.upload.as_mut() {
+                    u.chunk(client, c);
+                }
                 Status::Ok
             }
             ActArrayCommand::TrajScale(s) => self.traj.exec.set_scale(*s),
@@ -126,50 +97,44 @@ impl ArmModel {
     }
 
     fn start_trajectory(&mut self, h: &ActArrayTrajCmd, client: u64, now_ns: u64) -> Status {
-        let config = self.traj_config();
-        let actual = self.actual();
-        let (n, actuators, powered, brakes) = (self.n, self.actuators(), self.powered, self.brakes);
-        let t = &mut self.traj;
-        let traj = match t.upload.finish(client, h) {
-            Ok(traj) => traj,
+        let Some(mut upload) = self.traj.upload.take() else {
+            return Status::Busy;
+        };
+        let status = match upload.finish(client, h) {
+            Ok(traj) => self.run_trajectory(traj, now_ns),
             Err(e) => {
                 tracing::info!(reason = %e, "trajectory refused");
-                return e.status();
+                e.status()
             }
         };
-        let arm = Arm {
-            config,
-            actual: &actual[..actuators],
-            n,
-            powered,
-            brakes,
-        };
-        match accept(&mut t.exec, traj, &arm, now_ns) {
-            Ok(mask) => self.trajectory_started(mask, now_ns),
-            Err(s) => s,
-        }
+        self.traj.upload = Some(upload);
+        status
     }
 
-    /// Hands `traj` to the executor at `now_ns` (`CLOCK_MONOTONIC`): the trajectory of a
-    /// limb path (LINE, PTP), run as an uploaded one is.
-    pub(super) fn run_trajectory(&mut self, traj: &JointTrajectory, now_ns: u64) -> Status {
+    /// Runs a validated joint trajectory from `now_ns` (`CLOCK_MONOTONIC`), wherever it
+    /// came from (an upload, a limb path sampled into joints): it replaces the running one
+    /// from its start time. The status is the command's outcome (`OK`, or why it was
+    /// refused, nothing moving); its result comes through
+    /// [`ArmModel::arm_progress`] like any motion's.
+    pub fn run_trajectory(&mut self, traj: &JointTrajectory, now_ns: u64) -> Status {
+        if !self.powered {
+            return Status::PoweredOff;
+        }
+        let mask = Executor::joints_of(traj);
+        if self.brakes && mask & ((1u64 << self.n) - 1) != 0 {
+            return Status::Braked;
+        }
         let config = self.traj_config();
         let actual = self.actual();
-        let arm = Arm {
-            config,
-            actual: &actual[..self.actuators()],
-            n: self.n,
-            powered: self.powered,
-            brakes: self.brakes,
-        };
-        match accept(&mut self.traj.exec, traj, &arm, now_ns) {
-            Ok(mask) => self.trajectory_started(mask, now_ns),
-            Err(s) => s,
+        self.traj.exec.set_config(config);
+        if let Err(e) = self
+            .traj
+            .exec
+            .accept(traj, now_ns, &actual[..self.actuators()])
+        {
+            tracing::info!(reason = %e, "trajectory refused");
+            return e.status();
         }
-    }
-
-    /// The executor took a trajectory of actuators `mask`: they are its from now on.
-    fn trajectory_started(&mut self, mask: u64, now_ns: u64) -> Status {
         // A new motion ends the COLLISION state, and may move away from the contact.
         self.collision = None;
         self.leaving_contact = self.contact().is_some();
@@ -269,7 +234,7 @@ impl ArmModel {
     }
 
     /// The feedback of the trajectory running (or last run), if any.
-    pub(super) fn trajectory_feedback(&self) -> Option<Feedback> {
+    pub(super) fn trajectory_feedback(&self) -> Option<limber_trajectory::Feedback> {
         (self.traj.joints != 0).then(|| self.traj.exec.feedback())
     }
 
