@@ -459,6 +459,36 @@ public:
         detail::Check(limber_limb_vec_move(h_, limber_vec3{x, y, z}, length, &t));
         return t;
     }
+    /// CMD LINE: the tool in a straight line to (x, y, z), its orientation kept, at most
+    /// `speed` m/s (0: the limb's own); refused before it moves when the line leaves the
+    /// reach or hits the world (the state's refused_at says where).
+    limber_ticket Line(double x, double y, double z, double speed = 0.0) {
+        limber_ticket t{};
+        detail::Check(limber_limb_line(h_, limber_vec3{x, y, z}, nullptr, nullptr, speed, &t));
+        return t;
+    }
+    /// CMD LINE: the tool in a straight line to `position`, turned evenly to `approach`
+    /// and `orientation`.
+    limber_ticket Line(limber_vec3 position, limber_vec3 approach, limber_vec3 orientation,
+                       double speed = 0.0) {
+        limber_ticket t{};
+        detail::Check(limber_limb_line(h_, position, &approach, &orientation, speed, &t));
+        return t;
+    }
+    /// CMD PTP: the joints interpolated to where the tool is at (x, y, z), its orientation
+    /// kept, the fastest joint at most `speed` rad/s (0: the joints' own).
+    limber_ticket Ptp(double x, double y, double z, double speed = 0.0) {
+        limber_ticket t{};
+        detail::Check(limber_limb_ptp(h_, limber_vec3{x, y, z}, nullptr, nullptr, speed, &t));
+        return t;
+    }
+    /// CMD PTP to `position` with `approach` and `orientation`.
+    limber_ticket Ptp(limber_vec3 position, limber_vec3 approach, limber_vec3 orientation,
+                      double speed = 0.0) {
+        limber_ticket t{};
+        detail::Check(limber_limb_ptp(h_, position, &approach, &orientation, speed, &t));
+        return t;
+    }
     /// REQ POWER.
     void SetPowerConfig(bool on, Duration timeout = kRequestTimeout) {
         detail::Check(limber_limb_power(h_, on, detail::Millis(timeout)));
@@ -487,6 +517,14 @@ public:
     limber_ticket Store() { return Send(limber_gripper_store); }
     /// CMD RETRIEVE.
     limber_ticket Retrieve() { return Send(limber_gripper_retrieve); }
+    /// CMD GOAL: the fingers to `gap` m, with at most `effort` N, at `speed` m/s (0: the
+    /// gripper's own); WaitDone gives REACHED or STALLED (status OBJECT_PRESENT when the
+    /// beams see an object).
+    limber_ticket Goal(double gap, double effort = 0.0, double speed = 0.0) {
+        limber_ticket t{};
+        detail::Check(limber_gripper_goal(h_, gap, effort, speed, &t));
+        return t;
+    }
 
 private:
     limber_ticket Send(limber_code (*cmd)(limber_gripper*, limber_ticket*)) {

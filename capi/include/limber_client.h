@@ -1030,6 +1030,22 @@ limber_code limber_gripper_open(limber_gripper *h, struct limber_ticket *ticket)
 limber_code limber_gripper_close(limber_gripper *h, struct limber_ticket *ticket);
 
 /*
+ CMD GOAL: moves the fingers to `gap` m with at most `effort` N at `speed` m/s (0: the
+ gripper's own effort, its configured speed). `limber_device_wait_done` gives the
+ result: REACHED, or STALLED on an object, with status `LIMBER_STATUS_OBJECT_PRESENT`
+ when the break beams see one. A gripper that cannot set one of them refuses the goal
+ (`LIMBER_STATUS_GAP_NOT_SETTABLE`, `..._EFFORT_...`, `..._SPEED_...`).
+
+ # Safety
+ `h` is NULL or a live handle; `ticket` is NULL or writable.
+ */
+limber_code limber_gripper_goal(limber_gripper *h,
+                                double gap,
+                                double effort,
+                                double speed,
+                                struct limber_ticket *ticket);
+
+/*
  CMD STOP: stops the gripper where it is.
 
  # Safety
@@ -1176,6 +1192,41 @@ limber_code limber_limb_vec_move(limber_limb *h,
                                  limber_vec3 direction,
                                  double length,
                                  struct limber_ticket *ticket);
+
+/*
+ CMD LINE: moves the tool in a straight line to `position` (m), its orientation kept
+ (`approach` or `orientation` NULL) or turned evenly to the given vectors, at most
+ `speed` m/s (0: the limb's own). A line that leaves the reach or hits the world is
+ refused before anything moves (`LIMBER_STATUS_OUT_OF_REACH`,
+ `LIMBER_STATUS_PATH_COLLIDES`, ...; the limb state's `refused_at` and
+ `refused_fraction` say where). `limber_device_wait_done` gives its result.
+
+ # Safety
+ `h` is NULL or a live handle; `approach`, `orientation` NULL or readable; `ticket`
+ NULL or writable.
+ */
+limber_code limber_limb_line(limber_limb *h,
+                             limber_vec3 position,
+                             const limber_vec3 *approach,
+                             const limber_vec3 *orientation,
+                             double speed,
+                             struct limber_ticket *ticket);
+
+/*
+ CMD PTP: moves the joints, interpolated, to where the tool is at `position` with its
+ orientation kept (`approach` or `orientation` NULL) or the given one, the fastest joint
+ at most `speed` rad/s (0: the joints' own); checked and refused as `limber_limb_line`.
+
+ # Safety
+ `h` is NULL or a live handle; `approach`, `orientation` NULL or readable; `ticket`
+ NULL or writable.
+ */
+limber_code limber_limb_ptp(limber_limb *h,
+                            limber_vec3 position,
+                            const limber_vec3 *approach,
+                            const limber_vec3 *orientation,
+                            double speed,
+                            struct limber_ticket *ticket);
 
 /*
  REQ POWER: power on (`on` true) or off; waits up to `timeout_ms` for the reply.

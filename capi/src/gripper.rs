@@ -41,6 +41,29 @@ pub unsafe extern "C" fn limber_gripper_close(
     })
 }
 
+/// CMD GOAL: moves the fingers to `gap` m with at most `effort` N at `speed` m/s (0: the
+/// gripper's own effort, its configured speed). `limber_device_wait_done` gives the
+/// result: REACHED, or STALLED on an object, with status `LIMBER_STATUS_OBJECT_PRESENT`
+/// when the break beams see one. A gripper that cannot set one of them refuses the goal
+/// (`LIMBER_STATUS_GAP_NOT_SETTABLE`, `..._EFFORT_...`, `..._SPEED_...`).
+///
+/// # Safety
+/// `h` is NULL or a live handle; `ticket` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_gripper_goal(
+    h: *mut LimberGripper,
+    gap: f64,
+    effort: f64,
+    speed: f64,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, ticket) = unsafe { (arg(h, "handle")?, ticket.as_mut()) };
+        sent(h.typed::<Gripper>()?.goal(gap, effort, speed), ticket)
+    })
+}
+
 /// CMD STOP: stops the gripper where it is.
 ///
 /// # Safety

@@ -237,8 +237,10 @@ pub extern "C" fn limber_status_text(status: u32) -> *const c_char {
             .map(|s| CString::new(s.describe()).unwrap_or_default())
             .collect()
     });
-    texts
-        .get(status as usize)
+    // By code, not by index: the codes have gaps (blocks given out per issue).
+    Status::try_from(status)
+        .ok()
+        .and_then(|s| texts.get(Status::ALL.iter().position(|x| *x == s)?))
         .map_or(c"unknown status".as_ptr(), |t| t.as_ptr())
 }
 

@@ -106,6 +106,85 @@ pub unsafe extern "C" fn limber_limb_vec_move(
     })
 }
 
+/// Sends a LINE (`line`) or a PTP: the orientation kept when `approach` or
+/// `orientation` is NULL, else the given vectors.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `approach`, `orientation` NULL or readable; `ticket`
+/// NULL or writable.
+unsafe fn send_path(
+    h: *mut LimberLimb,
+    line: bool,
+    position: Vec3,
+    approach: *const Vec3,
+    orientation: *const Vec3,
+    speed: f64,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    guard(|| {
+        // SAFETY: the caller's promise on the pointers, checked for NULL here.
+        let (h, ticket, a, o) = unsafe {
+            (
+                arg(h, "handle")?,
+                ticket.as_mut(),
+                approach.as_ref(),
+                orientation.as_ref(),
+            )
+        };
+        let o = a.zip(o).map(|(a, o)| (a.to_array(), o.to_array()));
+        let limb = h.typed::<Limb>()?;
+        let r = if line {
+            limb.line(position.to_array(), o, speed)
+        } else {
+            limb.ptp(position.to_array(), o, speed)
+        };
+        sent(r, ticket)
+    })
+}
+
+/// CMD LINE: moves the tool in a straight line to `position` (m), its orientation kept
+/// (`approach` or `orientation` NULL) or turned evenly to the given vectors, at most
+/// `speed` m/s (0: the limb's own). A line that leaves the reach or hits the world is
+/// refused before anything moves (`LIMBER_STATUS_OUT_OF_REACH`,
+/// `LIMBER_STATUS_PATH_COLLIDES`, ...; the limb state's `refused_at` and
+/// `refused_fraction` say where). `limber_device_wait_done` gives its result.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `approach`, `orientation` NULL or readable; `ticket`
+/// NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_line(
+    h: *mut LimberLimb,
+    position: Vec3,
+    approach: *const Vec3,
+    orientation: *const Vec3,
+    speed: f64,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    // SAFETY: the caller's promise, passed on.
+    unsafe { send_path(h, true, position, approach, orientation, speed, ticket) }
+}
+
+/// CMD PTP: moves the joints, interpolated, to where the tool is at `position` with its
+/// orientation kept (`approach` or `orientation` NULL) or the given one, the fastest joint
+/// at most `speed` rad/s (0: the joints' own); checked and refused as `limber_limb_line`.
+///
+/// # Safety
+/// `h` is NULL or a live handle; `approach`, `orientation` NULL or readable; `ticket`
+/// NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn limber_limb_ptp(
+    h: *mut LimberLimb,
+    position: Vec3,
+    approach: *const Vec3,
+    orientation: *const Vec3,
+    speed: f64,
+    ticket: *mut LimberTicket,
+) -> LimberCode {
+    // SAFETY: the caller's promise, passed on.
+    unsafe { send_path(h, false, position, approach, orientation, speed, ticket) }
+}
+
 /// REQ POWER: power on (`on` true) or off; waits up to `timeout_ms` for the reply.
 ///
 /// # Safety

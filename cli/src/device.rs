@@ -43,7 +43,7 @@ pub struct Common {
 }
 
 impl Common {
-    fn timeout(&self) -> Duration {
+    pub(crate) fn timeout(&self) -> Duration {
         Duration::from_secs_f64(self.timeout.clamp(0.0, 3600.0))
     }
 }
@@ -220,6 +220,11 @@ pub enum LimbVerb {
         #[arg(num_args = 4, required = true, allow_negative_numbers = true, value_names = ["DX", "DY", "DZ", "LEN"])]
         args: Vec<f64>,
     },
+    /// Move the tool in a straight line to x y z (m), checked whole before anything
+    /// moves: a line out of reach or into the world is refused (exit 5) with where.
+    Line(crate::path::PathArgs),
+    /// Move the joints, interpolated, to where the tool is at x y z (m), checked as line.
+    Ptp(crate::path::PathArgs),
     /// Power on or off (request).
     Power {
         /// on or off.
@@ -263,6 +268,19 @@ pub enum GripperVerb {
     Store,
     /// Retrieve a stored object.
     Retrieve,
+    /// Move the fingers to a gap, m. With --wait the result: reached, or stalled on an
+    /// object (exit 1), "an object is between the fingers" when the beams see one. A
+    /// gripper that cannot set the gap, the effort or the speed refuses (exit 5).
+    Goal {
+        /// The gap between the fingers, m (0: closed).
+        gap: f64,
+        /// The largest grip effort, N (0: the gripper's own).
+        #[arg(long, default_value_t = 0.0)]
+        effort: f64,
+        /// The fingers' speed, m/s (0: the configured speed).
+        #[arg(long, default_value_t = 0.0)]
+        speed: f64,
+    },
     /// Print the geometry (request).
     Geom,
 }
@@ -361,7 +379,7 @@ fn lease_err(e: LeaseError) -> CliError {
 }
 
 /// Sends a command and reports its outcome.
-fn finish<I: Interface>(
+pub(crate) fn finish<I: Interface>(
     c: &mut Client<I>,
     sent: Result<Ticket, CommandError>,
     common: &Common,
@@ -578,6 +596,8 @@ pub fn limb(a: LimbArgs) -> Result<(), CliError> {
         } => c.set_pose(v3(&position), v3(&approach), v3(&orient)),
         LimbVerb::Setposition { position } => c.set_position(v3(&position)),
         LimbVerb::Vecmove { args } => c.vec_move(v3(&args), args[3]),
+        LimbVerb::Line(p) => return crate::path::run(&mut c, p, true, &a.common),
+        LimbVerb::Ptp(p) => return crate::path::run(&mut c, p, false, &a.common),
         LimbVerb::Power { value } => return done(&mut c, |c| c.power(value.on())),
         LimbVerb::Brakes { value } => return done(&mut c, |c| c.brakes(value.on())),
         LimbVerb::Speed { speed } => return done(&mut c, |c| c.set_speed(speed)),
@@ -636,6 +656,7 @@ pub fn gripper(a: GripperArgs) -> Result<(), CliError> {
         GripperVerb::Stop => c.stop(),
         GripperVerb::Store => c.store(),
         GripperVerb::Retrieve => c.retrieve(),
+        GripperVerb::Goal { gap, effort, speed } => c.goal(gap, effort, speed),
         GripperVerb::Geom => {
             let g = c.geometry().map_err(request_err)?;
             let p = g.pose.position;

@@ -19,6 +19,7 @@ mod list;
 mod logging;
 mod monitor;
 mod out;
+mod path;
 pub mod pioneer;
 mod player_gateway;
 mod record;
@@ -297,7 +298,7 @@ impl CliError {
         }
     }
 
-    fn exit_code(&self) -> u8 {
+    pub(crate) fn exit_code(&self) -> u8 {
         self.code
     }
 }

@@ -410,3 +410,53 @@ fn the_monitor_shows_who_holds_a_device() {
         std::thread::sleep(Duration::from_millis(10));
     }
 }
+
+/// Issue 28: the limb's panel shows a running path and how far it got, and where a path
+/// was refused (against `limber simarm`).
+#[test]
+fn the_limb_panel_shows_a_running_path_and_a_refused_one() {
+    let domain = Domain::unique_for_test();
+    let mut sim = common::Bg::spawn(domain.name(), &["simarm"]);
+    sim.line(|l| l.ends_with("ready"));
+    let ctx = Context::new(&domain, Role::Client, "path-test").unwrap();
+    let mut limb =
+        LimbClient::connect_timeout(&ctx, "simarm/limb/0", Duration::from_secs(10)).unwrap();
+    let t = limb
+        .set_pose([0.4, 0.0, 0.3], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0])
+        .unwrap();
+    assert!(
+        limb.wait_done(t, Duration::from_secs(30))
+            .unwrap()
+            .reached()
+    );
+    // A slow line (2 cm/s over 15 cm): running while the monitor looks.
+    let t = limb.line([0.4, 0.15, 0.3], None, 0.02).unwrap();
+    assert_eq!(
+        limb.wait_outcome(t, Duration::from_secs(10)).unwrap(),
+        Status::Ok
+    );
+    let mut app = monitor(&domain);
+    let deadline = Instant::now() + Duration::from_secs(10);
+    let mut text = ui::render_text(&app, 140);
+    while !text.contains("  line ") && Instant::now() < deadline {
+        app.tick();
+        text = ui::render_text(&app, 140);
+    }
+    assert!(line_with(&text, "position").contains("  line "), "{text}");
+    limb.stop().unwrap();
+    // Out of reach: refused, and the panel says where.
+    let t = limb.line([2.0, 0.0, 0.3], None, 0.0).unwrap();
+    assert_ne!(
+        limb.wait_outcome(t, Duration::from_secs(10)).unwrap(),
+        Status::Ok
+    );
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while !text.contains("line refused at ") && Instant::now() < deadline {
+        app.tick();
+        text = ui::render_text(&app, 140);
+    }
+    assert!(
+        line_with(&text, "position").contains("line refused at "),
+        "{text}"
+    );
+}

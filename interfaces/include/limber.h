@@ -47,6 +47,12 @@ extern "C" {
 #define LIMBER_STATUS_INVALID_GOAL 21 /* a joint trajectory is malformed or incomplete */
 #define LIMBER_STATUS_OLD_TIMESTAMP 22 /* a joint trajectory's start time is too far in the past */
 #define LIMBER_STATUS_TOO_FAST 23 /* a joint trajectory is faster than the joints can move */
+#define LIMBER_STATUS_OBJECT_PRESENT 30 /* a gripper motion ended with an object between the fingers (the break beams) */
+#define LIMBER_STATUS_GAP_NOT_SETTABLE 31 /* the gripper only opens or closes fully: no goal gap in between */
+#define LIMBER_STATUS_EFFORT_NOT_SETTABLE 32 /* the gripper has no effort setting */
+#define LIMBER_STATUS_SPEED_NOT_SETTABLE 33 /* the gripper has no speed setting */
+#define LIMBER_STATUS_PATH_COLLIDES 34 /* the path would hit the floor or an obstacle (the limb state's refused_at says where) */
+#define LIMBER_STATUS_PATH_JUMPS 35 /* the joints would jump on the way (the limb state's refused_at says where) */
 
 /* Bits of StateHeader.flags */
 #define LIMBER_DEVICE_FLAG_LINK_UP 1 /* link to the hardware up */
@@ -106,6 +112,8 @@ extern "C" {
 #define LIMBER_LIMB_CMD_SETPOSE 3 /* LimbSetPoseCmd */
 #define LIMBER_LIMB_CMD_SETPOSITION 4 /* LimbSetPositionCmd */
 #define LIMBER_LIMB_CMD_VECMOVE 5 /* LimbVecMoveCmd */
+#define LIMBER_LIMB_CMD_LINE 6 /* LimbPathCmd: a straight line of the tool */
+#define LIMBER_LIMB_CMD_PTP 7 /* LimbPathCmd: a point-to-point move, the joints interpolated */
 
 /* limb request kinds (MsgMeta.kind on the req channel) */
 #define LIMBER_LIMB_REQ_POWER 1 /* LimbPowerReq; reply empty */
@@ -121,12 +129,17 @@ extern "C" {
 #define LIMBER_LIMB_STATE_OOR 4 /* last target out of reach */
 #define LIMBER_LIMB_STATE_COLL 5 /* blocked */
 
-/* gripper command kinds (MsgMeta.kind on the cmd channel); all have an empty body */
+/* LimbPathCmd.orient values */
+#define LIMBER_LIMB_PATH_ORIENT_KEEP 0 /* the tool keeps its orientation */
+#define LIMBER_LIMB_PATH_ORIENT_GIVEN 1 /* the tool ends with the given approach and orientation (LINE: turned evenly) */
+
+/* gripper command kinds (MsgMeta.kind on the cmd channel); all but GOAL have an empty body */
 #define LIMBER_GRIPPER_CMD_OPEN 1 /* open */
 #define LIMBER_GRIPPER_CMD_CLOSE 2 /* close */
 #define LIMBER_GRIPPER_CMD_STOP 3 /* stop */
 #define LIMBER_GRIPPER_CMD_STORE 4 /* store the held object */
 #define LIMBER_GRIPPER_CMD_RETRIEVE 5 /* retrieve a stored object */
+#define LIMBER_GRIPPER_CMD_GOAL 6 /* GripperGoalCmd: move the fingers to a gap, with at most an effort and a speed */
 
 /* gripper request kinds (MsgMeta.kind on the req channel) */
 #define LIMBER_GRIPPER_REQ_GET_GEOM 1 /* empty; reply GripperGeom */
@@ -617,7 +630,7 @@ LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_actarray_reply_msg) == 8, "limber_act
 LIMBER_STATIC_ASSERT(offsetof(limber_actarray_reply_msg, meta) == 0, "limber_actarray_reply_msg.meta offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_actarray_reply_msg, body) == 32, "limber_actarray_reply_msg.body offset");
 
-/* limber.v4.LimbData (size 136, align 8) */
+/* limber.v4.LimbData (size 184, align 8) */
 typedef struct limber_limb_data {
     limber_state_header header;
     limber_vec3 position;
@@ -626,9 +639,14 @@ typedef struct limber_limb_data {
     uint32_t state;
     uint32_t _pad;
     double orientation_adjustment;
+    double path_progress;
+    limber_vec3 refused_at;
+    double refused_fraction;
+    uint32_t path_kind;
+    uint32_t refused_kind;
 } limber_limb_data;
 #define LIMBER_LIMB_DATA_TYPE_NAME "limber.v4.LimbData"
-LIMBER_STATIC_ASSERT(sizeof(limber_limb_data) == 136, "limber_limb_data size");
+LIMBER_STATIC_ASSERT(sizeof(limber_limb_data) == 184, "limber_limb_data size");
 LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_limb_data) == 8, "limber_limb_data alignment");
 LIMBER_STATIC_ASSERT(offsetof(limber_limb_data, header) == 0, "limber_limb_data.header offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_limb_data, position) == 48, "limber_limb_data.position offset");
@@ -637,6 +655,11 @@ LIMBER_STATIC_ASSERT(offsetof(limber_limb_data, orientation) == 96, "limber_limb
 LIMBER_STATIC_ASSERT(offsetof(limber_limb_data, state) == 120, "limber_limb_data.state offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_limb_data, _pad) == 124, "limber_limb_data._pad offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_limb_data, orientation_adjustment) == 128, "limber_limb_data.orientation_adjustment offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_limb_data, path_progress) == 136, "limber_limb_data.path_progress offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_limb_data, refused_at) == 144, "limber_limb_data.refused_at offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_limb_data, refused_fraction) == 168, "limber_limb_data.refused_fraction offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_limb_data, path_kind) == 176, "limber_limb_data.path_kind offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_limb_data, refused_kind) == 180, "limber_limb_data.refused_kind offset");
 
 /* limber.v4.LimbSetPoseCmd (size 72, align 8) */
 typedef struct limber_limb_set_pose_cmd {
@@ -671,13 +694,32 @@ LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_limb_vec_move_cmd) == 8, "limber_limb
 LIMBER_STATIC_ASSERT(offsetof(limber_limb_vec_move_cmd, direction) == 0, "limber_limb_vec_move_cmd.direction offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_limb_vec_move_cmd, length) == 24, "limber_limb_vec_move_cmd.length offset");
 
-/* limber.v4.LimbCmdMsg (size 104, align 8) */
+/* limber.v4.LimbPathCmd (size 88, align 8) */
+typedef struct limber_limb_path_cmd {
+    limber_vec3 position;
+    limber_vec3 approach;
+    limber_vec3 orientation;
+    double speed;
+    uint32_t orient;
+    uint32_t _pad;
+} limber_limb_path_cmd;
+#define LIMBER_LIMB_PATH_CMD_TYPE_NAME "limber.v4.LimbPathCmd"
+LIMBER_STATIC_ASSERT(sizeof(limber_limb_path_cmd) == 88, "limber_limb_path_cmd size");
+LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_limb_path_cmd) == 8, "limber_limb_path_cmd alignment");
+LIMBER_STATIC_ASSERT(offsetof(limber_limb_path_cmd, position) == 0, "limber_limb_path_cmd.position offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_limb_path_cmd, approach) == 24, "limber_limb_path_cmd.approach offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_limb_path_cmd, orientation) == 48, "limber_limb_path_cmd.orientation offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_limb_path_cmd, speed) == 72, "limber_limb_path_cmd.speed offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_limb_path_cmd, orient) == 80, "limber_limb_path_cmd.orient offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_limb_path_cmd, _pad) == 84, "limber_limb_path_cmd._pad offset");
+
+/* limber.v4.LimbCmdMsg (size 120, align 8) */
 typedef struct limber_limb_cmd_msg {
     limber_msg_meta meta;
-    uint8_t body[72];
+    uint8_t body[88];
 } limber_limb_cmd_msg;
 #define LIMBER_LIMB_CMD_MSG_TYPE_NAME "limber.v4.LimbCmdMsg"
-LIMBER_STATIC_ASSERT(sizeof(limber_limb_cmd_msg) == 104, "limber_limb_cmd_msg size");
+LIMBER_STATIC_ASSERT(sizeof(limber_limb_cmd_msg) == 120, "limber_limb_cmd_msg size");
 LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_limb_cmd_msg) == 8, "limber_limb_cmd_msg alignment");
 LIMBER_STATIC_ASSERT(offsetof(limber_limb_cmd_msg, meta) == 0, "limber_limb_cmd_msg.meta offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_limb_cmd_msg, body) == 32, "limber_limb_cmd_msg.body offset");
@@ -793,13 +835,26 @@ LIMBER_STATIC_ASSERT(offsetof(limber_gripper_data, beams) == 52, "limber_gripper
 LIMBER_STATIC_ASSERT(offsetof(limber_gripper_data, stored) == 56, "limber_gripper_data.stored offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_gripper_data, _pad) == 60, "limber_gripper_data._pad offset");
 
-/* limber.v4.GripperCmdMsg (size 40, align 8) */
+/* limber.v4.GripperGoalCmd (size 24, align 8) */
+typedef struct limber_gripper_goal_cmd {
+    double gap;
+    double effort;
+    double speed;
+} limber_gripper_goal_cmd;
+#define LIMBER_GRIPPER_GOAL_CMD_TYPE_NAME "limber.v4.GripperGoalCmd"
+LIMBER_STATIC_ASSERT(sizeof(limber_gripper_goal_cmd) == 24, "limber_gripper_goal_cmd size");
+LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_gripper_goal_cmd) == 8, "limber_gripper_goal_cmd alignment");
+LIMBER_STATIC_ASSERT(offsetof(limber_gripper_goal_cmd, gap) == 0, "limber_gripper_goal_cmd.gap offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_gripper_goal_cmd, effort) == 8, "limber_gripper_goal_cmd.effort offset");
+LIMBER_STATIC_ASSERT(offsetof(limber_gripper_goal_cmd, speed) == 16, "limber_gripper_goal_cmd.speed offset");
+
+/* limber.v4.GripperCmdMsg (size 56, align 8) */
 typedef struct limber_gripper_cmd_msg {
     limber_msg_meta meta;
-    uint8_t body[8];
+    uint8_t body[24];
 } limber_gripper_cmd_msg;
 #define LIMBER_GRIPPER_CMD_MSG_TYPE_NAME "limber.v4.GripperCmdMsg"
-LIMBER_STATIC_ASSERT(sizeof(limber_gripper_cmd_msg) == 40, "limber_gripper_cmd_msg size");
+LIMBER_STATIC_ASSERT(sizeof(limber_gripper_cmd_msg) == 56, "limber_gripper_cmd_msg size");
 LIMBER_STATIC_ASSERT(LIMBER_ALIGNOF(limber_gripper_cmd_msg) == 8, "limber_gripper_cmd_msg alignment");
 LIMBER_STATIC_ASSERT(offsetof(limber_gripper_cmd_msg, meta) == 0, "limber_gripper_cmd_msg.meta offset");
 LIMBER_STATIC_ASSERT(offsetof(limber_gripper_cmd_msg, body) == 32, "limber_gripper_cmd_msg.body offset");

@@ -185,11 +185,28 @@ pub enum Status {
     /// A joint trajectory asks a joint to move faster than the device can (the driver's
     /// log names the joint, the segment and the speeds): an invalid goal.
     TooFast = 23,
+    /// A gripper motion ended with an object between the fingers (the break beams see
+    /// it): the cause a gripper goal's result carries, `STALLED` when the fingers stopped
+    /// on it short of the goal.
+    ObjectPresent = 30,
+    /// This gripper only opens fully or closes fully: a goal gap between the two is
+    /// refused (the Pioneer's paddles).
+    GapNotSettable = 31,
+    /// This gripper has no effort (force) setting: a goal with a maximum effort is refused.
+    EffortNotSettable = 32,
+    /// This gripper moves at one speed: a goal with a speed is refused.
+    SpeedNotSettable = 33,
+    /// The path (LINE, PTP) would bring the arm into the floor or an obstacle: refused
+    /// before it started (the limb state's `refused_at` says where).
+    PathCollides = 34,
+    /// The joints would jump on the way (the line passes a singularity or leaves the
+    /// configuration it started in): refused before it started (`refused_at` says where).
+    PathJumps = 35,
 }
 
 impl Status {
     /// Every status, in code order.
-    pub const ALL: [Status; 24] = [
+    pub const ALL: [Status; 30] = [
         Status::Ok,
         Status::Unsupported,
         Status::UnknownJoint,
@@ -214,6 +231,12 @@ impl Status {
         Status::InvalidGoal,
         Status::OldTimestamp,
         Status::TooFast,
+        Status::ObjectPresent,
+        Status::GapNotSettable,
+        Status::EffortNotSettable,
+        Status::SpeedNotSettable,
+        Status::PathCollides,
+        Status::PathJumps,
     ];
 
     /// The wire code.
@@ -271,6 +294,12 @@ impl Status {
             Status::InvalidGoal => "invalid trajectory",
             Status::OldTimestamp => "the trajectory's start time is too old",
             Status::TooFast => "the trajectory is faster than the joints can move",
+            Status::ObjectPresent => "an object is between the fingers",
+            Status::GapNotSettable => "this gripper only opens or closes fully",
+            Status::EffortNotSettable => "this gripper has no effort setting",
+            Status::SpeedNotSettable => "this gripper has no speed setting",
+            Status::PathCollides => "the path would hit the floor or an obstacle",
+            Status::PathJumps => "the joints would jump on the way (a singularity)",
         }
     }
 }
@@ -434,6 +463,36 @@ pub(crate) const STATUS_GROUP: ConstantGroup = ConstantGroup {
             name: "TOO_FAST",
             value: 23,
             doc: "a joint trajectory is faster than the joints can move",
+        },
+        Constant {
+            name: "OBJECT_PRESENT",
+            value: 30,
+            doc: "a gripper motion ended with an object between the fingers (the break beams)",
+        },
+        Constant {
+            name: "GAP_NOT_SETTABLE",
+            value: 31,
+            doc: "the gripper only opens or closes fully: no goal gap in between",
+        },
+        Constant {
+            name: "EFFORT_NOT_SETTABLE",
+            value: 32,
+            doc: "the gripper has no effort setting",
+        },
+        Constant {
+            name: "SPEED_NOT_SETTABLE",
+            value: 33,
+            doc: "the gripper has no speed setting",
+        },
+        Constant {
+            name: "PATH_COLLIDES",
+            value: 34,
+            doc: "the path would hit the floor or an obstacle (the limb state's refused_at says where)",
+        },
+        Constant {
+            name: "PATH_JUMPS",
+            value: 35,
+            doc: "the joints would jump on the way (the limb state's refused_at says where)",
         },
     ],
 };

@@ -158,8 +158,24 @@ impl Describe for LimbData {
         } else {
             String::new()
         };
+        let path = match limb_path_name(self.path_kind) {
+            Some(kind) => format!(" {kind} {:.0}%", self.path_progress * 100.0),
+            None => String::new(),
+        };
+        let refused = if let Some(kind) = limb_path_name(self.refused_kind) {
+            let r = self.refused_at;
+            format!(
+                " ({kind} refused at {:.0}%, ({:+.4}, {:+.4}, {:+.4}))",
+                self.refused_fraction * 100.0,
+                r.x,
+                r.y,
+                r.z
+            )
+        } else {
+            String::new()
+        };
         format!(
-            "{} {:<12} pos ({:+.4}, {:+.4}, {:+.4}) approach ({:+.3}, {:+.3}, {:+.3}) orient ({:+.3}, {:+.3}, {:+.3}){adjusted}",
+            "{} {:<12} pos ({:+.4}, {:+.4}, {:+.4}) approach ({:+.3}, {:+.3}, {:+.3}) orient ({:+.3}, {:+.3}, {:+.3}){adjusted}{path}{refused}",
             header_human(&self.header),
             limb_state_name(self.state),
             p.x,
@@ -182,7 +198,21 @@ impl Describe for LimbData {
             "state": self.state,
             "state_name": limb_state_name(self.state),
             "orientation_adjustment": self.orientation_adjustment,
+            "path": limb_path_name(self.path_kind),
+            "path_progress": self.path_progress,
+            "refused": limb_path_name(self.refused_kind),
+            "refused_at": vec3_json(self.refused_at),
+            "refused_fraction": self.refused_fraction,
         })
+    }
+}
+
+/// The name of a running limb path (`LimbData::path_kind`): `line`, `ptp`; `None` if none.
+pub fn limb_path_name(kind: u32) -> Option<&'static str> {
+    match kind {
+        crate::limb::cmd::LINE => Some("line"),
+        crate::limb::cmd::PTP => Some("ptp"),
+        _ => None,
     }
 }
 

@@ -30,6 +30,12 @@ pub enum ValueError {
         /// The array capacity.
         max: usize,
     },
+    /// A value that must not be negative is.
+    #[error("{field} is negative")]
+    Negative {
+        /// The offending field.
+        field: &'static str,
+    },
     /// A direction vector of (near) zero length.
     #[error("{field} has zero length")]
     ZeroVector {

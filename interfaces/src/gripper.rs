@@ -1,11 +1,14 @@
 //! `gripper`: a gripper with optional break beams and storage, Player interface 3.
 //!
 //! State: [`GripperData`]. Commands ([`GripperCommand`], envelope [`GripperCmdMsg`]):
-//! OPEN, CLOSE, STOP, STORE, RETRIEVE (all without body). Request ([`GripperRequest`]):
+//! OPEN, CLOSE, STOP, STORE, RETRIEVE (all without body), and limber's GOAL
+//! ([`GripperGoalCmd`]: a gap with a maximum effort and speed, whose result says
+//! REACHED or STALLED, with `OBJECT_PRESENT` when the break beams see an object).
+//! Request ([`GripperRequest`]):
 //! GET_GEOM, answered with [`GripperGeom`] in [`GripperReplyMsg`].
 
 use crate::common::{Bbox3, MsgMeta, Pose3, ReplyMeta, StateHeader, Status};
-use crate::error::DecodeError;
+use crate::error::{DecodeError, ValueError};
 use crate::manifest::{Constant, ConstantGroup};
 use crate::message::{self, Message, ReplyBody, envelope, reply_envelope};
 #[allow(unused_imports)]
@@ -23,6 +26,8 @@ pub mod cmd {
     pub const STORE: u32 = 4;
     /// Retrieve a stored object.
     pub const RETRIEVE: u32 = 5;
+    /// Move the fingers to a gap (limber's; [`GripperGoalCmd`](super::GripperGoalCmd)).
+    pub const GOAL: u32 = 6;
 }
 
 /// Request kinds (Player's `PLAYER_GRIPPER_REQ_*`).
@@ -80,12 +85,25 @@ wire_struct! {
 }
 
 wire_struct! {
-    /// The command envelope (channel `cmd`). Every gripper command has an empty body.
-    pub struct GripperCmdMsg : "limber.v4.GripperCmdMsg", size = 40, align = 8 {
-        /// Sender, sequence, time, kind, body length (0).
+    /// CMD GOAL: move the fingers to a gap, with at most an effort and a speed.
+    pub struct GripperGoalCmd : "limber.v4.GripperGoalCmd", size = 24, align = 8 {
+        /// The goal gap between the fingers, m (0: closed).
+        pub gap: f64,
+        /// The largest grip effort, N; 0: the gripper's own.
+        pub effort: f64,
+        /// The fingers' speed, m/s; 0: the gripper's configured speed.
+        pub speed: f64,
+    }
+}
+
+wire_struct! {
+    /// The command envelope (channel `cmd`). GOAL's body is a [`GripperGoalCmd`]; every
+    /// other gripper command has an empty body.
+    pub struct GripperCmdMsg : "limber.v4.GripperCmdMsg", size = 56, align = 8 {
+        /// Sender, sequence, time, kind, body length.
         pub meta: MsgMeta,
-        /// Reserved, zero.
-        pub body: [u8; 8],
+        /// The body (GOAL's `GripperGoalCmd`), zero-padded.
+        pub body: [u8; 24],
     }
 }
 
@@ -130,7 +148,7 @@ envelope!(GripperReqMsg);
 reply_envelope!(GripperReplyMsg);
 
 /// A typed gripper command.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum GripperCommand {
     /// Open.
     Open,
@@ -142,6 +160,31 @@ pub enum GripperCommand {
     Store,
     /// Retrieve a stored object.
     Retrieve,
+    /// Move the fingers to a gap (validated by [`GripperCommand::goal`]).
+    Goal {
+        /// The goal gap, m (finite, not negative).
+        gap: f64,
+        /// The largest effort, N (finite, not negative; 0: the gripper's own).
+        effort: f64,
+        /// The speed, m/s (finite, not negative; 0: the configured speed).
+        speed: f64,
+    },
+}
+
+impl GripperCommand {
+    /// GOAL, validated: every value finite and not negative (0 effort or speed: the
+    /// gripper's own). What the gripper can do with them is the driver's to say.
+    pub fn goal(gap: f64, effort: f64, speed: f64) -> Result<Self, ValueError> {
+        for (field, v) in [("gap", gap), ("effort", effort), ("speed", speed)] {
+            if !v.is_finite() {
+                return Err(ValueError::NotFinite { field });
+            }
+            if v < 0.0 {
+                return Err(ValueError::Negative { field });
+            }
+        }
+        Ok(GripperCommand::Goal { gap, effort, speed })
+    }
 }
 
 impl Message for GripperCommand {
@@ -155,13 +198,19 @@ impl Message for GripperCommand {
             GripperCommand::Stop => cmd::STOP,
             GripperCommand::Store => cmd::STORE,
             GripperCommand::Retrieve => cmd::RETRIEVE,
+            GripperCommand::Goal { .. } => cmd::GOAL,
         }
     }
 
     fn write(&self, raw: &mut GripperCmdMsg) {
         raw.body.fill(0);
         raw.meta.kind = self.kind();
-        raw.meta.body_len = 0;
+        raw.meta.body_len = match *self {
+            GripperCommand::Goal { gap, effort, speed } => {
+                message::put(&mut raw.body, &GripperGoalCmd { gap, effort, speed })
+            }
+            _ => 0,
+        };
     }
 
     fn read(raw: &GripperCmdMsg) -> Result<Self, DecodeError> {
@@ -172,6 +221,11 @@ impl Message for GripperCommand {
             cmd::STOP => GripperCommand::Stop,
             cmd::STORE => GripperCommand::Store,
             cmd::RETRIEVE => GripperCommand::Retrieve,
+            cmd::GOAL => {
+                let g: GripperGoalCmd =
+                    message::get(Self::CHANNEL, k, &raw.body, raw.meta.body_len)?;
+                return Ok(GripperCommand::goal(g.gap, g.effort, g.speed)?);
+            }
             _ => {
                 return Err(DecodeError::UnknownKind {
                     channel: Self::CHANNEL,
@@ -293,7 +347,7 @@ impl GripperData {
 pub(crate) const GROUPS: &[ConstantGroup] = &[
     ConstantGroup {
         name: "GRIPPER_CMD",
-        doc: "gripper command kinds (MsgMeta.kind on the cmd channel); all have an empty body",
+        doc: "gripper command kinds (MsgMeta.kind on the cmd channel); all but GOAL have an empty body",
         constants: &[
             Constant {
                 name: "OPEN",
@@ -319,6 +373,11 @@ pub(crate) const GROUPS: &[ConstantGroup] = &[
                 name: "RETRIEVE",
                 value: 5,
                 doc: "retrieve a stored object",
+            },
+            Constant {
+                name: "GOAL",
+                value: 6,
+                doc: "GripperGoalCmd: move the fingers to a gap, with at most an effort and a speed",
             },
         ],
     },

@@ -46,6 +46,11 @@ pub use wire::{WireField, WireStruct};
 /// [`actarray::ActArrayTrajScaleCmd`]) and their feedback in the state
 /// ([`actarray::TrajFeedback`]), the statuses `INVALID_GOAL`, `OLD_TIMESTAMP` and
 /// `TOO_FAST`, and the results `PATH_TOLERANCE_VIOLATED` and `GOAL_TOLERANCE_VIOLATED`.
+/// It also added the gripper's GOAL command ([`gripper::GripperGoalCmd`], a wider
+/// [`gripper::GripperCmdMsg`]) and the statuses `OBJECT_PRESENT`, `GAP_NOT_SETTABLE`,
+/// `EFFORT_NOT_SETTABLE` and `SPEED_NOT_SETTABLE`, and the limb's paths (LINE, PTP:
+/// [`limb::LimbPathCmd`], a wider [`limb::LimbCmdMsg`]; the limb state's path fields) with
+/// the statuses `PATH_COLLIDES` and `PATH_JUMPS`.
 pub const LAYOUT_VERSION: u32 = 4;
 
 /// Everything a driver or client author needs, in one `use`.
@@ -127,6 +132,7 @@ pub fn manifest() -> Manifest {
         LimbSetPoseCmd::LAYOUT,
         LimbSetPositionCmd::LAYOUT,
         LimbVecMoveCmd::LAYOUT,
+        limb::LimbPathCmd::LAYOUT,
         LimbCmdMsg::LAYOUT,
         LimbPowerReq::LAYOUT,
         LimbBrakesReq::LAYOUT,
@@ -138,6 +144,7 @@ pub fn manifest() -> Manifest {
         LimbReplyMsg::LAYOUT,
         // gripper
         GripperData::LAYOUT,
+        gripper::GripperGoalCmd::LAYOUT,
         GripperCmdMsg::LAYOUT,
         GripperReqMsg::LAYOUT,
         GripperGeom::LAYOUT,

@@ -24,6 +24,9 @@ use crate::message::{self, Message, ReplyBody, envelope, reply_envelope};
 #[allow(unused_imports)]
 use crate::wire::{ZeroCopySend, wire_struct};
 
+mod path;
+pub use path::{LimbPath, LimbPathCmd, PathOrientation, path_orient};
+
 /// Command kinds (Player's `PLAYER_LIMB_CMD_*`).
 pub mod cmd {
     /// Go to the home pose.
@@ -36,6 +39,10 @@ pub mod cmd {
     pub const SETPOSITION: u32 = 4;
     /// Move along a straight line.
     pub const VECMOVE: u32 = 5;
+    /// A straight line of the tool to a position (limber's; [`LimbPathCmd`](super::LimbPathCmd)).
+    pub const LINE: u32 = 6;
+    /// A point-to-point move, the joints interpolated (limber's; [`LimbPathCmd`](super::LimbPathCmd)).
+    pub const PTP: u32 = 7;
 }
 
 /// Request kinds (Player's `PLAYER_LIMB_REQ_*`).
@@ -89,7 +96,7 @@ impl TryFrom<u32> for LimbState {
 
 wire_struct! {
     /// The limb's state (channel `data`).
-    pub struct LimbData : "limber.v4.LimbData", size = 136, align = 8 {
+    pub struct LimbData : "limber.v4.LimbData", size = 184, align = 8 {
         /// Common header.
         pub header: StateHeader,
         /// End-effector position, robot coordinates, m.
@@ -106,6 +113,20 @@ wire_struct! {
         /// the joints can hold, rad (0 when it was held as asked; cleared by the next
         /// limb command).
         pub orientation_adjustment: f64,
+        /// How far the running LINE or PTP has got, 0 to 1 (the fraction of its
+        /// trajectory's time; valid when `path_kind` is not 0).
+        pub path_progress: f64,
+        /// Where the last LINE or PTP refused before it started first failed its check:
+        /// the tool point there, m (valid when `refused_kind` is not 0).
+        pub refused_at: Vec3,
+        /// That point's fraction of the path, 0 (start) to 1 (goal).
+        pub refused_fraction: f64,
+        /// The kind of the running path (`LIMB_CMD_LINE`, `LIMB_CMD_PTP`); 0 when none.
+        pub path_kind: u32,
+        /// The kind of the path the last limb command refused (`LIMB_CMD_LINE`,
+        /// `LIMB_CMD_PTP`) with `refused_at` saying where; 0 when it was not a refused
+        /// path (cleared by the next limb command).
+        pub refused_kind: u32,
     }
 }
 
@@ -141,11 +162,11 @@ wire_struct! {
 
 wire_struct! {
     /// The command envelope (channel `cmd`). HOME and STOP have an empty body.
-    pub struct LimbCmdMsg : "limber.v4.LimbCmdMsg", size = 104, align = 8 {
+    pub struct LimbCmdMsg : "limber.v4.LimbCmdMsg", size = 120, align = 8 {
         /// Sender, sequence, time, kind, body length.
         pub meta: MsgMeta,
         /// One of the `Limb*Cmd` structs.
-        pub body: [u8; 72],
+        pub body: [u8; 88],
     }
 }
 
@@ -289,6 +310,10 @@ pub enum LimbCommand {
         /// Distance, m (finite).
         length: f64,
     },
+    /// A straight line of the tool to a goal (limber's LINE).
+    Line(LimbPath),
+    /// A point-to-point move to a goal, the joints interpolated (limber's PTP).
+    Ptp(LimbPath),
 }
 
 impl LimbCommand {
@@ -305,6 +330,26 @@ impl LimbCommand {
         Ok(LimbCommand::SetPosition {
             position: point("position", position)?,
         })
+    }
+    /// LINE, validated ([`LimbPath::new`]): the tool in a straight line to `position`,
+    /// its orientation kept (`None`) or turned evenly to (approach, orientation), at most
+    /// `speed` m/s (0: the limb's own).
+    pub fn line(
+        position: Vec3,
+        orientation: Option<(Vec3, Vec3)>,
+        speed: f64,
+    ) -> Result<Self, ValueError> {
+        LimbPath::new(position, orientation, speed).map(LimbCommand::Line)
+    }
+    /// PTP, validated ([`LimbPath::new`]): the joints interpolated to where the tool is at
+    /// `position` with its orientation kept (`None`) or the given one, the fastest joint
+    /// at most `speed` rad/s (0: the joints' own).
+    pub fn ptp(
+        position: Vec3,
+        orientation: Option<(Vec3, Vec3)>,
+        speed: f64,
+    ) -> Result<Self, ValueError> {
+        LimbPath::new(position, orientation, speed).map(LimbCommand::Ptp)
     }
     /// VECMOVE, validated.
     pub fn vec_move(dir: Vec3, length: f64) -> Result<Self, ValueError> {
@@ -329,6 +374,8 @@ impl Message for LimbCommand {
             LimbCommand::SetPose { .. } => cmd::SETPOSE,
             LimbCommand::SetPosition { .. } => cmd::SETPOSITION,
             LimbCommand::VecMove { .. } => cmd::VECMOVE,
+            LimbCommand::Line(_) => cmd::LINE,
+            LimbCommand::Ptp(_) => cmd::PTP,
         }
     }
 
@@ -357,6 +404,7 @@ impl Message for LimbCommand {
             LimbCommand::VecMove { direction, length } => {
                 message::put(b, &LimbVecMoveCmd { direction, length })
             }
+            LimbCommand::Line(p) | LimbCommand::Ptp(p) => message::put(b, &p.to_wire()),
         };
         raw.meta.kind = self.kind();
         raw.meta.body_len = len;
@@ -385,6 +433,14 @@ impl Message for LimbCommand {
             cmd::VECMOVE => {
                 let c: LimbVecMoveCmd = message::get(ch, k, b, n)?;
                 LimbCommand::vec_move(c.direction, c.length)?
+            }
+            cmd::LINE => {
+                let c: LimbPathCmd = message::get(ch, k, b, n)?;
+                LimbCommand::Line(LimbPath::from_wire(&c)?)
+            }
+            cmd::PTP => {
+                let c: LimbPathCmd = message::get(ch, k, b, n)?;
+                LimbCommand::Ptp(LimbPath::from_wire(&c)?)
             }
             _ => {
                 return Err(DecodeError::UnknownKind {
@@ -659,6 +715,16 @@ pub(crate) const GROUPS: &[ConstantGroup] = &[
                 value: 5,
                 doc: "LimbVecMoveCmd",
             },
+            Constant {
+                name: "LINE",
+                value: 6,
+                doc: "LimbPathCmd: a straight line of the tool",
+            },
+            Constant {
+                name: "PTP",
+                value: 7,
+                doc: "LimbPathCmd: a point-to-point move, the joints interpolated",
+            },
         ],
     },
     ConstantGroup {
@@ -723,4 +789,5 @@ pub(crate) const GROUPS: &[ConstantGroup] = &[
             },
         ],
     },
+    path::PATH_ORIENT_GROUP,
 ];

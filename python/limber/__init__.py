@@ -1,6 +1,6 @@
 """limber for Python: clients of limber devices, a thin ctypes binding over liblimber.
 
-* :mod:`limber.client`: :class:`ActArrayClient`, :class:`LimbClient`, :class:`GripperClient`
+* :mod:`limber.client`: :class:`ActArrayClient`, :class:`LimbClient`; :mod:`limber.gripper`: :class:`GripperClient`
   (connect, state, commands with outcomes, requests, leases), :class:`Domain`,
   :class:`Status`, :func:`list_devices`, :class:`DriverStatsReader` and the errors. See
   ``python/README.md``.
@@ -42,7 +42,6 @@ from .client import (
     DriverStatsReader as DriverStatsReader,
     DriverStatus as DriverStatus,
     Freshness as Freshness,
-    GripperClient as GripperClient,
     IncompatibleError as IncompatibleError,
     LeaseHeldError as LeaseHeldError,
     LeaseHolder as LeaseHolder,
@@ -70,6 +69,7 @@ from .done import (
     Done as Done,
     MotionResult as MotionResult,
 )
+from .gripper import GripperClient as GripperClient
 from .ranger import (
     LaserClient as LaserClient,
     RangerClient as RangerClient,

@@ -36,6 +36,12 @@ STATUS_NOTHING_STORED = 20  # the gripper's store is empty
 STATUS_INVALID_GOAL = 21  # a joint trajectory is malformed or incomplete
 STATUS_OLD_TIMESTAMP = 22  # a joint trajectory's start time is too far in the past
 STATUS_TOO_FAST = 23  # a joint trajectory is faster than the joints can move
+STATUS_OBJECT_PRESENT = 30  # a gripper motion ended with an object between the fingers (the break beams)
+STATUS_GAP_NOT_SETTABLE = 31  # the gripper only opens or closes fully: no goal gap in between
+STATUS_EFFORT_NOT_SETTABLE = 32  # the gripper has no effort setting
+STATUS_SPEED_NOT_SETTABLE = 33  # the gripper has no speed setting
+STATUS_PATH_COLLIDES = 34  # the path would hit the floor or an obstacle (the limb state's refused_at says where)
+STATUS_PATH_JUMPS = 35  # the joints would jump on the way (the limb state's refused_at says where)
 
 # Bits of StateHeader.flags
 DEVICE_FLAG_LINK_UP = 1  # link to the hardware up
@@ -95,6 +101,8 @@ LIMB_CMD_STOP = 2  # empty body
 LIMB_CMD_SETPOSE = 3  # LimbSetPoseCmd
 LIMB_CMD_SETPOSITION = 4  # LimbSetPositionCmd
 LIMB_CMD_VECMOVE = 5  # LimbVecMoveCmd
+LIMB_CMD_LINE = 6  # LimbPathCmd: a straight line of the tool
+LIMB_CMD_PTP = 7  # LimbPathCmd: a point-to-point move, the joints interpolated
 
 # limb request kinds (MsgMeta.kind on the req channel)
 LIMB_REQ_POWER = 1  # LimbPowerReq; reply empty
@@ -110,12 +118,17 @@ LIMB_STATE_MOVING = 3  # moving
 LIMB_STATE_OOR = 4  # last target out of reach
 LIMB_STATE_COLL = 5  # blocked
 
-# gripper command kinds (MsgMeta.kind on the cmd channel); all have an empty body
+# LimbPathCmd.orient values
+LIMB_PATH_ORIENT_KEEP = 0  # the tool keeps its orientation
+LIMB_PATH_ORIENT_GIVEN = 1  # the tool ends with the given approach and orientation (LINE: turned evenly)
+
+# gripper command kinds (MsgMeta.kind on the cmd channel); all but GOAL have an empty body
 GRIPPER_CMD_OPEN = 1  # open
 GRIPPER_CMD_CLOSE = 2  # close
 GRIPPER_CMD_STOP = 3  # stop
 GRIPPER_CMD_STORE = 4  # store the held object
 GRIPPER_CMD_RETRIEVE = 5  # retrieve a stored object
+GRIPPER_CMD_GOAL = 6  # GripperGoalCmd: move the fingers to a gap, with at most an effort and a speed
 
 # gripper request kinds (MsgMeta.kind on the req channel)
 GRIPPER_REQ_GET_GEOM = 1  # empty; reply GripperGeom
@@ -202,6 +215,12 @@ DESCRIBE_STATUS = {
     21: "invalid trajectory",
     22: "the trajectory's start time is too old",
     23: "the trajectory is faster than the joints can move",
+    30: "an object is between the fingers",
+    31: "this gripper only opens or closes fully",
+    32: "this gripper has no effort setting",
+    33: "this gripper has no speed setting",
+    34: "the path would hit the floor or an obstacle",
+    35: "the joints would jump on the way (a singularity)",
 }
 
 
@@ -646,7 +665,7 @@ class ActArrayReplyMsg(ctypes.Structure):
 
 
 class LimbData(ctypes.Structure):
-    """limber.v4.LimbData (size 136, align 8)."""
+    """limber.v4.LimbData (size 184, align 8)."""
 
     _fields_ = [
         ("header", StateHeader),
@@ -656,6 +675,11 @@ class LimbData(ctypes.Structure):
         ("state", ctypes.c_uint32),
         ("_pad", ctypes.c_uint32),
         ("orientation_adjustment", ctypes.c_double),
+        ("path_progress", ctypes.c_double),
+        ("refused_at", Vec3),
+        ("refused_fraction", ctypes.c_double),
+        ("path_kind", ctypes.c_uint32),
+        ("refused_kind", ctypes.c_uint32),
     ]
 
     @staticmethod
@@ -702,12 +726,29 @@ class LimbVecMoveCmd(ctypes.Structure):
         return "limber.v4.LimbVecMoveCmd"
 
 
+class LimbPathCmd(ctypes.Structure):
+    """limber.v4.LimbPathCmd (size 88, align 8)."""
+
+    _fields_ = [
+        ("position", Vec3),
+        ("approach", Vec3),
+        ("orientation", Vec3),
+        ("speed", ctypes.c_double),
+        ("orient", ctypes.c_uint32),
+        ("_pad", ctypes.c_uint32),
+    ]
+
+    @staticmethod
+    def type_name() -> str:
+        return "limber.v4.LimbPathCmd"
+
+
 class LimbCmdMsg(ctypes.Structure):
-    """limber.v4.LimbCmdMsg (size 104, align 8)."""
+    """limber.v4.LimbCmdMsg (size 120, align 8)."""
 
     _fields_ = [
         ("meta", MsgMeta),
-        ("body", ctypes.c_uint8 * 72),
+        ("body", ctypes.c_uint8 * 88),
     ]
 
     @staticmethod
@@ -838,12 +879,26 @@ class GripperData(ctypes.Structure):
         return "limber.v4.GripperData"
 
 
+class GripperGoalCmd(ctypes.Structure):
+    """limber.v4.GripperGoalCmd (size 24, align 8)."""
+
+    _fields_ = [
+        ("gap", ctypes.c_double),
+        ("effort", ctypes.c_double),
+        ("speed", ctypes.c_double),
+    ]
+
+    @staticmethod
+    def type_name() -> str:
+        return "limber.v4.GripperGoalCmd"
+
+
 class GripperCmdMsg(ctypes.Structure):
-    """limber.v4.GripperCmdMsg (size 40, align 8)."""
+    """limber.v4.GripperCmdMsg (size 56, align 8)."""
 
     _fields_ = [
         ("meta", MsgMeta),
-        ("body", ctypes.c_uint8 * 8),
+        ("body", ctypes.c_uint8 * 24),
     ]
 
     @staticmethod
@@ -1113,6 +1168,7 @@ STRUCTS = [
     LimbSetPoseCmd,
     LimbSetPositionCmd,
     LimbVecMoveCmd,
+    LimbPathCmd,
     LimbCmdMsg,
     LimbPowerReq,
     LimbBrakesReq,
@@ -1123,6 +1179,7 @@ STRUCTS = [
     LimbReach,
     LimbReplyMsg,
     GripperData,
+    GripperGoalCmd,
     GripperCmdMsg,
     GripperReqMsg,
     GripperGeom,

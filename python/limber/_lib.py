@@ -221,6 +221,8 @@ PROTOTYPES: "dict[str, Tuple[Any, List[Any]]]" = {
     "limber_limb_stop": (_CODE, [_H, _P_TICKET]),
     "limber_limb_set_pose": (_CODE, [_H, _VEC3, _VEC3, _VEC3, _P_TICKET]),
     "limber_limb_set_position": (_CODE, [_H, _VEC3, _P_TICKET]),
+    "limber_limb_line": (_CODE, [_H, _VEC3, POINTER(_VEC3), POINTER(_VEC3), c_double, _P_TICKET]),
+    "limber_limb_ptp": (_CODE, [_H, _VEC3, POINTER(_VEC3), POINTER(_VEC3), c_double, _P_TICKET]),
     "limber_limb_vec_move": (_CODE, [_H, _VEC3, c_double, _P_TICKET]),
     "limber_limb_power": (_CODE, [_H, c_bool, c_uint64]),
     "limber_limb_brakes": (_CODE, [_H, c_bool, c_uint64]),
@@ -235,6 +237,7 @@ PROTOTYPES: "dict[str, Tuple[Any, List[Any]]]" = {
     "limber_gripper_stop": (_CODE, [_H, _P_TICKET]),
     "limber_gripper_store": (_CODE, [_H, _P_TICKET]),
     "limber_gripper_retrieve": (_CODE, [_H, _P_TICKET]),
+    "limber_gripper_goal": (_CODE, [_H, c_double, c_double, c_double, _P_TICKET]),
     # ranger
     "limber_ranger_point": (
         _CODE,

@@ -99,7 +99,6 @@ __all__ = [
     "UnexpectedReplyError",
     "ActArrayClient",
     "LimbClient",
-    "GripperClient",
 ]
 
 
@@ -107,6 +106,16 @@ def _vec3(v: Sequence[float]) -> "L.Vec3":
     """A 3-sequence as a ``limber_vec3`` (ValueError unless it has 3 components)."""
     x, y, z = v
     return L.Vec3(float(x), float(y), float(z))
+
+
+def _path_orientation(
+    o: "Optional[Tuple[Sequence[float], Sequence[float]]]",
+) -> "Tuple[Any, Any]":
+    """A path's orientation for C: two NULLs (kept) or pointers to the two vectors."""
+    if o is None:
+        return None, None
+    a, v = o
+    return byref(_vec3(a)), byref(_vec3(v))
 
 
 def _doubles(values: Sequence[float]) -> "Tuple[Any, int]":
@@ -134,7 +143,7 @@ _outcome = _c.limber_device_outcome
 
 class _Client(_Owned, Generic[_D]):
     """A connection to one device (a liblimber ``limber_device``). Use
-    :class:`ActArrayClient`, :class:`LimbClient` or :class:`GripperClient`."""
+    :class:`ActArrayClient`, :class:`LimbClient` or :class:`~limber.gripper.GripperClient`."""
 
     INTERFACE: ClassVar[str]
     #: ``LIMBER_INTERFACE_*``.
@@ -716,6 +725,33 @@ class LimbClient(_Client[L.LimbData]):
         d = _vec3(direction)
         return self._sent(_c.limber_limb_vec_move(self._h, d, length, self._ticket_ref))
 
+    def line(
+        self,
+        position: Sequence[float],
+        orientation: Optional[Tuple[Sequence[float], Sequence[float]]] = None,
+        speed: float = 0.0,
+    ) -> Ticket:
+        """CMD LINE: the tool in a straight line to ``position``, its orientation kept
+        (``None``) or turned evenly to ``(approach, orientation)``, at most ``speed`` m/s
+        (0: the limb's own). Refused before anything moves when the line leaves the reach
+        or hits the world (the state's ``refused_at`` says where)."""
+        a, o = _path_orientation(orientation)
+        p = _vec3(position)
+        return self._sent(_c.limber_limb_line(self._h, p, a, o, speed, self._ticket_ref))
+
+    def ptp(
+        self,
+        position: Sequence[float],
+        orientation: Optional[Tuple[Sequence[float], Sequence[float]]] = None,
+        speed: float = 0.0,
+    ) -> Ticket:
+        """CMD PTP: the joints interpolated to where the tool is at ``position`` with its
+        orientation kept (``None``) or the given ``(approach, orientation)``, the fastest
+        joint at most ``speed`` rad/s (0: the joints' own); refused as :meth:`line`."""
+        a, o = _path_orientation(orientation)
+        p = _vec3(position)
+        return self._sent(_c.limber_limb_ptp(self._h, p, a, o, speed, self._ticket_ref))
+
     def power(self, on: bool, *, timeout: Optional[float] = None) -> None:
         """REQ POWER."""
         self._replied(_c.limber_limb_power(self._h, bool(on), self._timeout_ms(timeout)))
@@ -752,46 +788,6 @@ class LimbClient(_Client[L.LimbData]):
 
 
 # ----- gripper ---------------------------------------------------------------------------
-
-
-class GripperClient(_Client[L.GripperData]):
-    """A client of a gripper (Player's ``GripperProxy``; Rust ``GripperClient``)."""
-
-    INTERFACE = "gripper"
-    INTERFACE_CODE = _lib.INTERFACE_GRIPPER
-    DATA = L.GripperData
-    GEOM = L.GripperGeom
-    _data_size = sizeof(L.GripperData)
-
-    def open(self) -> Ticket:
-        """CMD OPEN."""
-        return self._sent(_c.limber_gripper_open(self._h, self._ticket_ref))
-
-    def close_gripper(self) -> Ticket:
-        """CMD CLOSE. (Not ``close()``: on every client, :meth:`close` releases the
-        connection, so that a cleanup call can never move the hardware.)"""
-        return self._sent(_c.limber_gripper_close(self._h, self._ticket_ref))
-
-    def open_gripper(self) -> Ticket:
-        """CMD OPEN (the same as :meth:`open`, named to pair with :meth:`close_gripper`)."""
-        return self.open()
-
-    def stop(self) -> Ticket:
-        """CMD STOP."""
-        return self._sent(_c.limber_gripper_stop(self._h, self._ticket_ref))
-
-    def store(self) -> Ticket:
-        """CMD STORE."""
-        return self._sent(_c.limber_gripper_store(self._h, self._ticket_ref))
-
-    def retrieve(self) -> Ticket:
-        """CMD RETRIEVE."""
-        return self._sent(_c.limber_gripper_retrieve(self._h, self._ticket_ref))
-
-    def geometry(self, *, timeout: Optional[float] = None) -> "L.GripperGeom":
-        """REQ GET_GEOM: the geometry (a ``GripperGeom`` ctypes struct)."""
-        g: L.GripperGeom = self._geometry(timeout)
-        return g
 
 
 @atexit.register

@@ -228,6 +228,8 @@ impl DeviceHandler<Limb> for TestLimb {
                     p.z + direction.z / n * length,
                 )
             }
+            // No path checks here: the test limb has no kinematics.
+            LimbCommand::Line(_) | LimbCommand::Ptp(_) => return Status::Unsupported,
         };
         if target.norm() > REACH {
             state.state = LimbState::OutOfReach as u32;
@@ -268,7 +270,7 @@ impl DeviceHandler<Limb> for TestLimb {
     }
 }
 
-/// The test gripper: opens and closes at once; cannot store.
+/// The test gripper: opens and closes at once; cannot store nor go to a gap.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct TestGripper;
 
@@ -278,7 +280,9 @@ impl DeviceHandler<Gripper> for TestGripper {
             GripperCommand::Open => state.state = GripperState::Open as u32,
             GripperCommand::Close => state.state = GripperState::Closed as u32,
             GripperCommand::Stop => {}
-            GripperCommand::Store | GripperCommand::Retrieve => return Status::Unsupported,
+            GripperCommand::Store | GripperCommand::Retrieve | GripperCommand::Goal { .. } => {
+                return Status::Unsupported;
+            }
         }
         Status::Ok
     }

@@ -3,7 +3,8 @@
 //!
 //! One panel per driver (its statistics) followed by one panel per device of its robot:
 //! joints as bars between their limits, states coloured (idle green, moving yellow,
-//! stalled red, braked blue), the limb pose, the gripper and its beams. Dead drivers are
+//! stalled red, braked blue), the limb pose (with a running path and how far it got, or
+//! where a path was refused), the gripper and its beams. Dead drivers are
 //! greyed and marked DEAD.
 
 use std::fmt::Write as _;
@@ -576,6 +577,23 @@ fn limb_lines(s: Option<&LimbData>) -> Vec<Line<'static>> {
         return vec![Line::from("no state yet")];
     };
     let (state, colour) = limb_state(s.state);
+    let name = limber_interfaces::describe::limb_path_name;
+    // A running LINE or PTP and how far it got; a path refused before it started and where.
+    let path = match (name(s.path_kind), name(s.refused_kind)) {
+        (Some(kind), _) => Span::styled(
+            format!("  {kind} {:.0}%", s.path_progress * 100.0),
+            Style::new().fg(Color::Yellow),
+        ),
+        (None, Some(kind)) => Span::styled(
+            format!(
+                "  {kind} refused at {:.0}%, {}",
+                s.refused_fraction * 100.0,
+                v3(&s.refused_at)
+            ),
+            Style::new().fg(Color::Red),
+        ),
+        (None, None) => Span::raw(""),
+    };
     vec![
         Line::from(vec![
             Span::styled(
@@ -583,6 +601,7 @@ fn limb_lines(s: Option<&LimbData>) -> Vec<Line<'static>> {
                 Style::new().fg(colour).add_modifier(Modifier::BOLD),
             ),
             Span::raw(format!(" position {} m", v3(&s.position))),
+            path,
         ]),
         Line::from(format!("{:<12} approach {}", "", v3(&s.approach))),
         Line::from(format!("{:<12} orientation {}", "", v3(&s.orientation))),

@@ -2,6 +2,7 @@
 #![warn(missing_docs)]
 
 pub mod chain;
+pub mod path;
 pub mod pioneer;
 mod pose;
 

@@ -36,6 +36,30 @@ impl Client<Limb> {
     pub fn vec_move(&mut self, direction: [f64; 3], length: f64) -> Result<Ticket, CommandError> {
         self.send(&LimbCommand::vec_move(direction.into(), length)?)
     }
+    /// CMD LINE (limber's): the tool in a straight line to `position`, its orientation
+    /// kept (`None`) or turned evenly to (approach, orientation), at most `speed` m/s (0:
+    /// the limb's own). Checked whole before anything moves: a line that leaves the reach
+    /// or hits the world is refused (`OUT_OF_REACH`, `PATH_COLLIDES`, ...), the limb
+    /// state's `refused_at` saying where. `wait_done` gives its result.
+    pub fn line(
+        &mut self,
+        position: [f64; 3],
+        orientation: Option<([f64; 3], [f64; 3])>,
+        speed: f64,
+    ) -> Result<Ticket, CommandError> {
+        self.send(&LimbCommand::Line(path(position, orientation, speed)?))
+    }
+    /// CMD PTP (limber's): the joints interpolated to where the tool is at `position`
+    /// with its orientation kept (`None`) or the given one, the fastest joint at most
+    /// `speed` rad/s (0: the joints' own); checked and refused as [`line`](Self::line).
+    pub fn ptp(
+        &mut self,
+        position: [f64; 3],
+        orientation: Option<([f64; 3], [f64; 3])>,
+        speed: f64,
+    ) -> Result<Ticket, CommandError> {
+        self.send(&LimbCommand::Ptp(path(position, orientation, speed)?))
+    }
     /// REQ POWER.
     pub fn power(&mut self, on: bool) -> Result<(), RequestError> {
         self.request(&LimbRequest::Power(on)).map(|_| ())
@@ -63,4 +87,14 @@ impl Client<Limb> {
             LimbReply::Done | LimbReply::Geom(_) => Err(RequestError::Unexpected),
         }
     }
+}
+
+/// A path's goal from plain arrays, validated.
+fn path(
+    position: [f64; 3],
+    orientation: Option<([f64; 3], [f64; 3])>,
+    speed: f64,
+) -> Result<limber_interfaces::limb::LimbPath, ValueError> {
+    let o = orientation.map(|(a, o)| (a.into(), o.into()));
+    limber_interfaces::limb::LimbPath::new(position.into(), o, speed)
 }

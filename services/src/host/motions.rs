@@ -80,6 +80,11 @@ impl Tracked {
             self.result = combined;
             self.cause = cause;
             self.other = other;
+        } else if result == self.result && self.cause == Status::Ok {
+            // The same result with a cause where there was none (a gripper that reached
+            // its goal with an object between the fingers: `OBJECT_PRESENT`).
+            self.cause = cause;
+            self.other = other;
         }
     }
 

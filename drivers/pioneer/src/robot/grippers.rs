@@ -9,9 +9,44 @@ use limber_p2os::{ArmJoint, Command, GripperCommand as P2Gripper, JointSelection
 
 use super::*;
 
+/// What a Pioneer gripper (the P2OS paddles, the arm's gripper servo as Player drives it)
+/// does with a GOAL: it only opens fully or closes fully, at its one speed, with no effort
+/// setting (P2OS's GRIPpress sets a grip time in 20 ms steps, not a force). A gap of 0 is
+/// CLOSE, a gap of at least `open_gap` (the fingers' inner width) is OPEN ([`Status::Clamped`]
+/// above it); a gap in between, an effort or a speed is refused with the reason. Any other
+/// command is itself.
+fn open_or_close(cmd: &GripperCommand, open_gap: f64) -> Result<(GripperCommand, Status), Status> {
+    let GripperCommand::Goal { gap, effort, speed } = *cmd else {
+        return Ok((*cmd, Status::Ok));
+    };
+    if effort != 0.0 {
+        return Err(Status::EffortNotSettable);
+    }
+    if speed != 0.0 {
+        return Err(Status::SpeedNotSettable);
+    }
+    if gap == 0.0 {
+        Ok((GripperCommand::Close, Status::Ok))
+    } else if gap == open_gap {
+        Ok((GripperCommand::Open, Status::Ok))
+    } else if gap > open_gap {
+        Ok((GripperCommand::Open, Status::Clamped))
+    } else {
+        Err(Status::GapNotSettable)
+    }
+}
+
 impl RobotModel {
-    /// An arm-gripper command.
+    /// An arm-gripper command (a GOAL as [`open_or_close`] says).
     pub fn armgrip_command(&mut self, cmd: &GripperCommand, from: &Origin) -> Status {
+        let (cmd, carried) = match open_or_close(cmd, self.cfg.arm_gripper.inner[0]) {
+            Ok(c) => c,
+            Err(e) => {
+                tracing::info!(?cmd, status = %e, "arm gripper goal refused");
+                return e;
+            }
+        };
+        let cmd = &cmd;
         let r = (|| {
             let cal = *self.calibration()?;
             let joint = ArmJoint::GRIPPER;
@@ -31,14 +66,14 @@ impl RobotModel {
                     self.send(&Command::ArmStop(JointSelection::One(joint)), from)?;
                     self.arm.target[joint.index()] = None;
                 }
-                GripperCommand::Store | GripperCommand::Retrieve => {
+                GripperCommand::Store | GripperCommand::Retrieve | GripperCommand::Goal { .. } => {
                     return Err(Status::Unsupported);
                 }
             }
             self.armgrip_cmd = Some(*cmd);
             Ok(())
         })();
-        r.err().unwrap_or(Status::Ok)
+        r.err().unwrap_or(carried)
     }
 
     /// Fills the arm-gripper state.
@@ -73,21 +108,30 @@ impl RobotModel {
 
     // ----- body gripper and lift ---------------------------------------------------------
 
-    /// A body-gripper command.
+    /// A body-gripper command (a GOAL as [`open_or_close`] says).
     pub fn gripper_command(&mut self, cmd: &GripperCommand, from: &Origin) -> Status {
         if !self.body_gripper {
             return Status::Unsupported;
         }
+        let (cmd, carried) = match open_or_close(cmd, self.cfg.gripper.inner[0]) {
+            Ok(c) => c,
+            Err(e) => {
+                tracing::info!(?cmd, status = %e, "gripper goal refused");
+                return e;
+            }
+        };
         let p2 = match cmd {
             GripperCommand::Open => P2Gripper::Open,
             GripperCommand::Close => P2Gripper::Close,
             GripperCommand::Stop => P2Gripper::Stop,
-            GripperCommand::Store | GripperCommand::Retrieve => return Status::Unsupported,
+            GripperCommand::Store | GripperCommand::Retrieve | GripperCommand::Goal { .. } => {
+                return Status::Unsupported;
+            }
         };
         match self.send(&Command::Gripper(p2), from) {
             Ok(()) => {
-                self.gripper_cmd = Some(*cmd);
-                Status::Ok
+                self.gripper_cmd = Some(cmd);
+                carried
             }
             Err(e) => e,
         }

@@ -74,6 +74,9 @@ impl RobotModel {
             self.require_power()?;
         }
         match *cmd {
+            // LINE and PTP run on the joint trajectory executor; the Pioneer's streams it
+            // (i28-traj), not wired to the limb here yet: unsupported, nothing sent.
+            LimbCommand::Line(_) | LimbCommand::Ptp(_) => Err(Status::Unsupported),
             LimbCommand::Home => {
                 self.vecmove = None;
                 self.home(JointSel::All, from)

@@ -120,7 +120,9 @@ impl RobotModel {
     }
 
     /// How the body gripper is doing: moving while its paddles are between their end
-    /// switches; reached at either (its position is not measured).
+    /// switches; reached at either (its position is not measured), except a CLOSE that
+    /// stopped with an object between the paddles (the break beams): stalled on it. With
+    /// the beams broken the result's cause is [`Status::ObjectPresent`].
     pub fn gripper_progress(&self) -> Progress {
         if !self.link.up {
             return Progress::ended(
@@ -131,14 +133,23 @@ impl RobotModel {
                 0.0,
             );
         }
-        let moving = self.sip.as_ref().is_some_and(|s| {
-            s.gripper_reading(self.cfg.gripper_byte).paddles == PaddleState::Moving
-        });
-        if moving {
-            Progress::UNKNOWN
-        } else {
-            Progress::ended(MotionResult::Reached, Status::Ok, f64::NAN, f64::NAN, 0.0)
+        let Some(r) = self
+            .sip
+            .as_ref()
+            .map(|s| s.gripper_reading(self.cfg.gripper_byte))
+        else {
+            return Progress::UNKNOWN;
+        };
+        if r.paddles == PaddleState::Moving {
+            return Progress::UNKNOWN;
         }
+        let object = r.outer_beam || r.inner_beam;
+        let end = match (object, self.gripper_cmd) {
+            (true, Some(GripperCommand::Close)) => (MotionResult::Stalled, Status::ObjectPresent),
+            (true, _) => (MotionResult::Reached, Status::ObjectPresent),
+            (false, _) => (MotionResult::Reached, Status::Ok),
+        };
+        Progress::ended(end.0, end.1, f64::NAN, f64::NAN, 0.0)
     }
 
     /// How the lift is doing: moving until it reaches its end or its goal.

@@ -7,70 +7,24 @@
 //! Points, not link volumes: the origin of every joint frame after the first (the first
 //! sits on the base) and the tool point.
 
-use limber_kinematics::Pose;
-use limber_kinematics::chain::MAX_JOINTS;
-
 use super::ArmModel;
 #[allow(unused_imports)]
 use super::SimArmOptions;
 
-/// An obstacle the arm may hit: a box, axis-aligned in the robot frame (m).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SimObstacle {
-    /// The corner with the smallest x, y, z.
-    pub min: [f64; 3],
-    /// The corner with the largest x, y, z.
-    pub max: [f64; 3],
-}
-
-impl SimObstacle {
-    fn contains(&self, p: [f64; 3]) -> bool {
-        (0..3).all(|k| p[k] > self.min[k] && p[k] < self.max[k])
-    }
-}
-
-/// What the arm can collide with (default: nothing).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Obstacles {
-    /// The floor's height in the robot frame (m); `None`: no floor.
-    pub floor: Option<f64>,
-    /// The obstacles.
-    pub boxes: Vec<SimObstacle>,
-}
-
+/// An obstacle the arm may hit: a box, axis-aligned in the robot frame (m) (the
+/// kinematics' [`Box3`](limber_kinematics::path::Box3): the rule is the path checks').
+pub use limber_kinematics::path::Box3 as SimObstacle;
 /// What the arm touched.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Contact {
-    /// The floor.
-    Floor,
-    /// Obstacle `i` of [`Obstacles::boxes`].
-    Obstacle(usize),
-}
+pub use limber_kinematics::path::Contact;
+/// What the arm can collide with (default: nothing): the kinematics'
+/// [`Scene`](limber_kinematics::path::Scene), which the path checks use too.
+pub use limber_kinematics::path::Scene as Obstacles;
 
 impl ArmModel {
     /// The first contact of the arm (a joint frame after the first, or the tool point)
     /// with the floor or an obstacle, in its current configuration.
     pub fn contact(&self) -> Option<Contact> {
-        let o = &self.options.obstacles;
-        if o.floor.is_none() && o.boxes.is_empty() {
-            return None;
-        }
-        let q = self.q();
-        let mut frames = [Pose::identity(); MAX_JOINTS];
-        let tool = self.chain.fk_frames(&q, &mut frames[..self.n]).ok()?;
-        let points = frames[1..self.n]
-            .iter()
-            .chain(core::iter::once(&tool))
-            .map(|f| [f.position.x, f.position.y, f.position.z]);
-        for p in points {
-            if o.floor.is_some_and(|z| p[2] < z) {
-                return Some(Contact::Floor);
-            }
-            if let Some(i) = o.boxes.iter().position(|b| b.contains(p)) {
-                return Some(Contact::Obstacle(i));
-            }
-        }
-        None
+        self.options.obstacles.contact(&self.chain, &self.q())
     }
 
     /// The contact that stopped the limb, until the next limb command.

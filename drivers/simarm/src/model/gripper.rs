@@ -6,6 +6,11 @@ use nalgebra::Vector3;
 
 use super::ArmModel;
 
+/// The largest grip effort of the simulated fingers, N (a GOAL's `effort` above it is
+/// clamped to it; 0 asks for it). The fingers are rigid: they hold the object at any
+/// effort, and stop on it whatever the effort.
+pub const GRIPPER_MAX_EFFORT: f64 = 10.0;
+
 /// What the gripper was last told.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum GripperCmd {
@@ -54,7 +59,7 @@ impl ArmModel {
         }
     }
     /// Carries out or refuses a gripper command: OPEN and CLOSE move the fingers at the
-    /// gripper speed, STOP stops them, STORE and RETRIEVE use the gripper's store
+    /// gripper speed (a GOAL to the whole stroke or to 0), GOAL to its gap, STOP stops them, STORE and RETRIEVE use the gripper's store
     /// (`store`).
     pub fn gripper_command(&mut self, cmd: &GripperCommand) -> Status {
         match cmd {
@@ -62,25 +67,15 @@ impl ArmModel {
                 if let Err(e) = self.powered() {
                     return e;
                 }
-                self.preempt_trajectory(1 << self.n);
                 let open = *cmd == GripperCommand::Open;
                 let target = if open { self.gripper_stroke } else { 0.0 };
-                let speed = self.gripper_config_speed;
-                self.gripper.go(target, speed);
-                self.gripper_cmd = if open {
-                    GripperCmd::Open
-                } else {
-                    GripperCmd::Close
-                };
-                // Already closed on the object: stays stalled on it.
-                if !open && self.held {
-                    let w = self.object.map(|o| o.width).unwrap_or(0.0);
-                    if self.gripper.pos <= w + 1e-6 {
-                        self.gripper.stop();
-                        self.gripper.stalled = true;
-                    }
+                self.gripper_goal(target, 0.0, 0.0)
+            }
+            GripperCommand::Goal { gap, effort, speed } => {
+                if let Err(e) = self.powered() {
+                    return e;
                 }
-                Status::Ok
+                self.gripper_goal(*gap, *effort, *speed)
             }
             GripperCommand::Stop => {
                 self.gripper.stop();
@@ -88,6 +83,52 @@ impl ArmModel {
             }
             GripperCommand::Store => self.store_object().err().unwrap_or(Status::Ok),
             GripperCommand::Retrieve => self.retrieve_object().err().unwrap_or(Status::Ok),
+        }
+    }
+
+    /// A GOAL: the fingers to `gap` (clamped to the stroke) at `speed` (0: the configured
+    /// speed; clamped to the maximum), gripping with at most `effort` (clamped to
+    /// [`GRIPPER_MAX_EFFORT`]); [`Status::Clamped`] when any of them was.
+    fn gripper_goal(&mut self, gap: f64, effort: f64, speed: f64) -> Status {
+        self.preempt_trajectory(1 << self.n);
+        let clamped = gap > self.gripper_stroke
+            || speed > self.gripper_max_speed
+            || effort > GRIPPER_MAX_EFFORT;
+        let target = gap.min(self.gripper_stroke);
+        let speed = if speed == 0.0 {
+            self.gripper_config_speed
+        } else {
+            speed.min(self.gripper_max_speed)
+        };
+        self.gripper.go(target, speed);
+        self.gripper_cmd = if target >= self.gripper_stroke {
+            GripperCmd::Open
+        } else if target == 0.0 {
+            GripperCmd::Close
+        } else {
+            GripperCmd::None
+        };
+        // Already closed on the object, asked to close further: stays stalled on it.
+        if self.held {
+            let w = self.object.map(|o| o.width).unwrap_or(0.0);
+            if target < w && self.gripper.pos <= w + 1e-6 {
+                self.gripper.stop();
+                self.gripper.stalled = true;
+            }
+        }
+        if clamped {
+            tracing::info!(
+                gap,
+                effort,
+                speed,
+                stroke = self.gripper_stroke,
+                max_speed = self.gripper_max_speed,
+                max_effort = GRIPPER_MAX_EFFORT,
+                "gripper goal clamped to the gripper's limits"
+            );
+            Status::Clamped
+        } else {
+            Status::Ok
         }
     }
 

@@ -6,8 +6,8 @@ use limber_interfaces::limb_outcome::adjustment_reported;
 use limber_interfaces::prelude::*;
 use nalgebra::Vector3;
 
-use limber_kinematics::chain::{ChainIkError, IkTarget, JointKind, JointVec, NearestSolution};
-use limber_kinematics::{Pose, fit_angle_to_limits, unit_direction};
+use limber_kinematics::chain::{ChainIkError, IkTarget, JointVec, NearestSolution};
+use limber_kinematics::{Pose, unit_direction};
 
 use super::{ArmModel, MAX_WAYPOINTS};
 
@@ -16,7 +16,7 @@ use super::{ArmModel, MAX_WAYPOINTS};
 const MAX_WAYPOINT_JUMP: f64 = 0.5;
 
 /// Tolerance (rad) on the perpendicularity of SETPOSE's approach and orientation.
-const PERPENDICULAR_TOLERANCE: f64 = 0.05;
+pub(super) const PERPENDICULAR_TOLERANCE: f64 = 0.05;
 
 /// The VECMOVE being streamed.
 #[derive(Debug)]
@@ -39,13 +39,18 @@ impl ArmModel {
         // A new command ends the COLLISION state, and may move away from the contact.
         self.collision = None;
         self.leaving_contact = self.contact().is_some();
+        self.clear_refused_path();
         let r = self.limb_command_inner(cmd);
         let s = self.limb.settle(r);
         if s.is_carried_out() {
-            if *cmd == LimbCommand::Stop {
-                self.stop_trajectory();
-            } else {
-                self.preempt_trajectory((1u64 << self.n) - 1);
+            match cmd {
+                LimbCommand::Stop => self.stop_trajectory(),
+                // A path's trajectory replaces the running one in the executor.
+                LimbCommand::Line(_) | LimbCommand::Ptp(_) => {}
+                _ => {
+                    self.end_path();
+                    self.preempt_trajectory((1u64 << self.n) - 1);
+                }
             }
         }
         s
@@ -91,24 +96,13 @@ impl ArmModel {
     }
 
     fn nearest_turns(&self, q: JointVec, seed: &[f64]) -> Result<JointVec, Status> {
-        let mut q = q;
         // Take the turn of each revolute joint nearest to the seed (less travel).
-        for ((v, j), s) in q.iter_mut().zip(self.chain.joints()).zip(seed) {
-            if j.kind == JointKind::Rotary
-                && let Some(w) = fit_angle_to_limits(*v, j.min, j.max, *s, 0.0)
-            {
-                *v = w;
-            }
-        }
-        if !self.chain.within_limits(&q) {
-            return Err(Status::BeyondLimits);
-        }
-        Ok(q)
+        limber_kinematics::path::nearest_turns(&self.chain, q, seed).ok_or(Status::BeyondLimits)
     }
 
     /// The cause of an IK failure: beyond the reach; a position reached but not the
     /// orientation (the joints cannot hold it); or neither within the joint limits.
-    fn ik_status(&self, e: &ChainIkError) -> Status {
+    pub(super) fn ik_status(&self, e: &ChainIkError) -> Status {
         let ik = &self.options.ik;
         match *e {
             ChainIkError::NonFinite => Status::NotFinite,
@@ -185,6 +179,8 @@ impl ArmModel {
                 self.powered()?;
                 self.plan_vecmove(&dir, length)
             }
+            LimbCommand::Line(ref p) => self.start_path(true, p),
+            LimbCommand::Ptp(ref p) => self.start_path(false, p),
         }
     }
 
@@ -319,6 +315,7 @@ impl ArmModel {
         s.approach = Vec3::new(a.x, a.y, a.z);
         s.orientation = Vec3::new(o.x, o.y, o.z);
         s.orientation_adjustment = self.limb.adjustment;
+        self.path_state(s);
         s.state = if self.brakes {
             LimbState::Braked
         } else if self.limb.out_of_reach {

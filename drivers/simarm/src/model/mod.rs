@@ -26,6 +26,7 @@ mod gripper;
 mod limb;
 mod motion;
 mod options;
+mod paths;
 mod preemption;
 mod store;
 mod trajectory;
@@ -77,6 +78,8 @@ pub struct ArmModel {
     limb: limber_interfaces::limb_outcome::LimbOutcome,
     powered: bool,
     vecmove: VecMovePlan,
+    /// LINE and PTP: their executor and what runs.
+    path: paths::PathRun,
     object: Option<SimObject>,
     held: bool,
     /// The contact that stopped the limb (COLLISION until the next limb command).
@@ -147,6 +150,7 @@ impl ArmModel {
             limb_speed: None,
             limb: Default::default(),
             powered: true,
+            path: paths::PathRun::default(),
             vecmove: VecMovePlan {
                 waypoints: Vec::with_capacity(MAX_WAYPOINTS),
                 scratch: Vec::with_capacity(MAX_WAYPOINTS),

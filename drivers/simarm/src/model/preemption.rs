@@ -129,7 +129,15 @@ impl ArmModel {
 
     /// How the gripper is doing (stalled: closed on an object).
     pub fn gripper_progress(&self) -> Progress {
-        self.actuator_progress(self.n)
+        let mut p = self.actuator_progress(self.n);
+        // The beam's "object present" in the result: the cause of a reached or stalled
+        // end with the object between the fingers.
+        if let Some((r @ (MotionResult::Reached | MotionResult::Stalled), Status::Ok)) = p.end
+            && self.object_between_fingers()
+        {
+            p.end = Some((r, Status::ObjectPresent));
+        }
+        p
     }
 
     /// The deadman's stop of the actarray: every joint and the gripper stop where they are.

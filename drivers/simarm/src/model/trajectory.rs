@@ -228,6 +228,16 @@ impl ArmModel {
         })
     }
 
+    /// The actuators a trajectory still drives toward its goal.
+    pub(super) fn trajectory_running(&self) -> u64 {
+        self.traj.exec.running()
+    }
+
+    /// The feedback of the trajectory running (or last run), if any.
+    pub(super) fn trajectory_feedback(&self) -> Option<limber_trajectory::Feedback> {
+        (self.traj.joints != 0).then(|| self.traj.exec.feedback())
+    }
+
     /// The trajectory's feedback as the actuator array's state carries it.
     pub fn trajectory_state(&self) -> TrajFeedback {
         self.traj.exec.state_feedback()
