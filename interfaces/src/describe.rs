@@ -198,9 +198,11 @@ impl Describe for LimbData {
             "state": self.state,
             "state_name": limb_state_name(self.state),
             "orientation_adjustment": self.orientation_adjustment,
-            "path": limb_path_name(self.path_kind),
+            "path_kind": self.path_kind,
+            "path_kind_name": limb_path_name(self.path_kind),
             "path_progress": self.path_progress,
-            "refused": limb_path_name(self.refused_kind),
+            "refused_kind": self.refused_kind,
+            "refused_kind_name": limb_path_name(self.refused_kind),
             "refused_at": vec3_json(self.refused_at),
             "refused_fraction": self.refused_fraction,
         })
