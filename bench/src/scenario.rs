@@ -39,6 +39,34 @@ pub const READY_TIMEOUT: Duration = Duration::from_secs(15);
 /// How long one exchange may take before the run is declared hung.
 pub const SAMPLE_TIMEOUT: Duration = Duration::from_secs(2);
 
+/// One command round trip as the bench's client scenarios time it: joint 0 of `client`'s
+/// device to +0.25 rad for an even `i`, -0.25 for an odd one, then a blocking wait for the
+/// outcome; the time from the send to the outcome, ns. A refusal, or no outcome within
+/// [`SAMPLE_TIMEOUT`], is an error naming command `i` (of `what`).
+pub(crate) fn timed_command(
+    client: &mut limber_services::ActArrayClient,
+    i: u64,
+    what: &str,
+) -> Result<u64, BenchError> {
+    use limber_interfaces::prelude::Status;
+    let target = if i.is_multiple_of(2) { 0.25 } else { -0.25 };
+    let t0 = limber_services::monotonic_ns();
+    let ticket = client
+        .move_to(0, target)
+        .map_err(|e| BenchError::transport(format!("move_to ({what})"), e))?;
+    let status = client
+        .wait_outcome(ticket, SAMPLE_TIMEOUT)
+        .map_err(|e| BenchError::transport(format!("outcome of command {i} ({what})"), e))?;
+    let t1 = limber_services::monotonic_ns();
+    if status != Status::Ok {
+        return Err(BenchError::Transport {
+            context: format!("command {i} ({what})"),
+            reason: format!("refused: {status}"),
+        });
+    }
+    Ok(t1.saturating_sub(t0))
+}
+
 /// How a floor's exchanges are spaced: back to back (the floor scenario), or at the rate
 /// of the path it is the floor of, so that each exchange starts with a wake-up after the
 /// same idle time as the path's (on a VM a wake-up after an idle millisecond costs more

@@ -21,14 +21,13 @@ use std::process::Command;
 use std::time::Duration;
 
 use hdrhistogram::Histogram;
-use limber_interfaces::prelude::*;
+use limber_services::Role;
 use limber_services::prelude::*;
-use limber_services::{Role, monotonic_ns};
 
 use super::command::{DEVICE, start_event_driver};
 use super::floor::BYTES;
 use super::lang::run_bounded;
-use super::{READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario, zenoh_floor};
+use super::{READY_TIMEOUT, RunCtx, Scenario, timed_command, zenoh_floor};
 use crate::BenchError;
 use crate::child::ChildProc;
 use crate::cpu::{self, CpuCost};
@@ -248,18 +247,9 @@ fn round_trips(
     let mut rtt = new_histogram()?;
     let progress = Progress::new(ctx.progress, what, warm + n);
     for i in 1..=warm + n {
-        let target = if i % 2 == 0 { 0.25 } else { -0.25 };
-        let t0 = monotonic_ns();
-        let ticket = client.move_to(0, target).map_err(|e| err("move_to", e))?;
-        let status = client
-            .wait_outcome(ticket, SAMPLE_TIMEOUT)
-            .map_err(|e| err(&format!("outcome of command {i} ({what})"), e))?;
-        let t1 = monotonic_ns();
-        if status != Status::Ok {
-            return Err(err("command", format!("refused: {status}")));
-        }
+        let took = timed_command(client, i, what)?;
         if i > warm {
-            rtt.saturating_record(t1.saturating_sub(t0));
+            rtt.saturating_record(took);
         }
         progress.tick(i);
     }

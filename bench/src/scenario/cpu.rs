@@ -10,13 +10,12 @@
 
 use std::time::{Duration, Instant};
 
-use limber_interfaces::prelude::*;
+use limber_services::Role;
 use limber_services::prelude::*;
-use limber_services::{Role, monotonic_ns};
 
 use super::command::DEVICE;
 use super::floor::BYTES;
-use super::{Pace, READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario};
+use super::{Pace, READY_TIMEOUT, RunCtx, Scenario, timed_command};
 use crate::BenchError;
 use crate::child::{ChildProc, ChildSpec};
 use crate::cpu::{self, CpuCost, Window};
@@ -155,17 +154,7 @@ fn measure(
     while start.elapsed() < window {
         i += 1;
         pace.wait_turn(start, i);
-        let target = if i.is_multiple_of(2) { 0.25 } else { -0.25 };
-        let t0 = monotonic_ns();
-        let ticket = client.move_to(0, target).map_err(|e| err("move_to", e))?;
-        let status = client
-            .wait_outcome(ticket, SAMPLE_TIMEOUT)
-            .map_err(|e| err(&format!("outcome of command {i}"), e))?;
-        let t1 = monotonic_ns();
-        if status != Status::Ok {
-            return Err(err("command", format!("refused: {status}")));
-        }
-        rtt.saturating_record(t1.saturating_sub(t0));
+        rtt.saturating_record(timed_command(client, i, "cpu")?);
     }
     let loaded = w.end().map_err(cpu_err)?;
     let rtt_id = format!("cpu.{}.rtt", mode.key());

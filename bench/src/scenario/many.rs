@@ -18,12 +18,11 @@
 use std::time::{Duration, Instant};
 
 use hdrhistogram::Histogram;
-use limber_interfaces::prelude::*;
 use limber_services::prelude::*;
 use limber_services::{Role, list_devices, monotonic_ns};
 
 use super::floor::BYTES;
-use super::{Pace, READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario};
+use super::{Pace, READY_TIMEOUT, RunCtx, Scenario, timed_command};
 use crate::BenchError;
 use crate::child::{ChildProc, ChildSpec};
 use crate::progress::Progress;
@@ -222,18 +221,9 @@ fn round_trips(
     let start = Instant::now();
     for i in 1..=warm + count {
         pace.wait_turn(start, i);
-        let target = if i.is_multiple_of(2) { 0.25 } else { -0.25 };
-        let t0 = monotonic_ns();
-        let ticket = client.move_to(0, target).map_err(|e| err("move_to", e))?;
-        let status = client
-            .wait_outcome(ticket, SAMPLE_TIMEOUT)
-            .map_err(|e| err(&format!("outcome of command {i}"), e))?;
-        let t1 = monotonic_ns();
-        if status != Status::Ok {
-            return Err(err("command", format!("refused: {status}")));
-        }
+        let took = timed_command(client, i, "many")?;
         if i > warm {
-            rtt.saturating_record(t1.saturating_sub(t0));
+            rtt.saturating_record(took);
         }
         progress.tick(i);
     }

@@ -1,5 +1,5 @@
 //! Paths of the tool, checked before anything moves (issue 28, item 3): a straight line of
-//! the tool point ([`line`]: the position interpolated, the orientation kept or
+//! the tool point ([`line()`]: the position interpolated, the orientation kept or
 //! interpolated) and a point-to-point move ([`ptp`]: the joints interpolated). Each is
 //! sampled; every sample must be reachable (the inverse kinematics within the limits,
 //! without a jump of the joints between samples) and clear of the [`Scene`] (the floor and
@@ -110,7 +110,7 @@ pub fn nearest_turns(chain: &Chain, q: JointVec, seed: &[f64]) -> Option<JointVe
     chain.within_limits(&q).then_some(q)
 }
 
-/// The tool's orientation along a [`line`].
+/// The tool's orientation along a [`line()`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Orientation {
     /// Kept as it is at the start (the goal's orientation is not used): VECMOVE's.

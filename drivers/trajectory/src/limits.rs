@@ -52,7 +52,7 @@ impl Config {
     }
 }
 
-/// Why a trajectory was refused before it ran ([`Executor::accept`]).
+/// Why a trajectory was refused before it ran ([`Executor::accept`](crate::Executor::accept)).
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum Refusal {
     /// The trajectory itself is malformed.

@@ -37,7 +37,7 @@ fn open_or_close(cmd: &GripperCommand, open_gap: f64) -> Result<(GripperCommand,
 }
 
 impl RobotModel {
-    /// An arm-gripper command (a GOAL as [`open_or_close`] says).
+    /// An arm-gripper command (a GOAL as `open_or_close` says).
     pub fn armgrip_command(&mut self, cmd: &GripperCommand, from: &Origin) -> Status {
         let (cmd, carried) = match open_or_close(cmd, self.cfg.arm_gripper.inner[0]) {
             Ok(c) => c,
@@ -108,7 +108,7 @@ impl RobotModel {
 
     // ----- body gripper and lift ---------------------------------------------------------
 
-    /// A body-gripper command (a GOAL as [`open_or_close`] says).
+    /// A body-gripper command (a GOAL as `open_or_close` says).
     pub fn gripper_command(&mut self, cmd: &GripperCommand, from: &Origin) -> Status {
         if !self.body_gripper {
             return Status::Unsupported;

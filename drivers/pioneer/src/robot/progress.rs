@@ -88,7 +88,7 @@ impl RobotModel {
 
     /// How long joint `j`'s move to its target may take: its ticks to go at the servo's
     /// speed (the last commanded, else the calibration's), twice, plus
-    /// [`TRAVEL_MARGIN`] (two ARMpac cycles and the link's latency, generously).
+    /// `TRAVEL_MARGIN` (two ARMpac cycles and the link's latency, generously).
     pub fn travel_bound(&self, j: usize) -> Option<Duration> {
         let (_, ticks) = self.arm.target_set.get(j).copied().flatten()?;
         let cal = self.cal.as_ref()?;
