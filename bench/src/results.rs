@@ -8,6 +8,13 @@ use std::path::{Path, PathBuf};
 use crate::BenchError;
 use crate::report::Report;
 
+/// A line into the page being built: writing to a `String` cannot fail.
+macro_rules! out {
+    ($($arg:tt)*) => {
+        writeln!($($arg)*).expect("writing to a String cannot fail")
+    };
+}
+
 /// The page's file name in the results directory.
 pub const PAGE: &str = "latest.md";
 /// The JSON's file name in the results directory.
@@ -82,35 +89,37 @@ fn utc(unix_s: u64) -> String {
 pub fn page(report: &Report, command: &str) -> String {
     let m = &report.machine;
     let mut t = String::new();
-    let _ = writeln!(t, "# limber bench: the latest run\n");
-    let _ = writeln!(
+    out!(t, "# limber bench: the latest run\n");
+    out!(
         t,
         "Written by `limber bench --results DIR`; every ratio and goal below compares \
          series of this one run.\n"
     );
-    let _ = writeln!(t, "| | |\n|---|---|");
-    let _ = writeln!(t, "| when | {} |", utc(m.started_unix_s));
-    let _ = writeln!(t, "| CPU | {} |", m.cpu);
-    let _ = writeln!(t, "| cores | {} |", m.cores);
-    let _ = writeln!(t, "| kernel | {} |", m.kernel);
-    let _ = writeln!(
+    out!(t, "| | |\n|---|---|");
+    out!(t, "| when | {} |", utc(m.started_unix_s));
+    out!(t, "| CPU | {} |", m.cpu);
+    out!(t, "| cores | {} |", m.cores);
+    out!(t, "| kernel | {} |", m.kernel);
+    out!(
         t,
         "| load average at the start | {:.2} {:.2} {:.2} |",
-        m.load_avg[0], m.load_avg[1], m.load_avg[2]
+        m.load_avg[0],
+        m.load_avg[1],
+        m.load_avg[2]
     );
-    let _ = writeln!(t, "| build | {} |", m.build);
-    let _ = writeln!(t, "| pinning | {} |", m.pinning);
-    let _ = writeln!(t, "| counts | {} |", m.mode);
+    out!(t, "| build | {} |", m.build);
+    out!(t, "| pinning | {} |", m.pinning);
+    out!(t, "| counts | {} |", m.mode);
     let failed = report.failed();
     if failed > 0 {
-        let _ = writeln!(t, "| scenarios failed | {failed} |");
+        out!(t, "| scenarios failed | {failed} |");
     }
-    let _ = writeln!(t, "\nThe command:\n");
-    let _ = writeln!(
+    out!(t, "\nThe command:\n");
+    out!(
         t,
         "<!-- not run by tests: * | a benchmark run, minutes long, recorded as it ran -->"
     );
-    let _ = writeln!(t, "```sh\n{command}\n```\n");
+    out!(t, "```sh\n{command}\n```\n");
     let missed: Vec<String> = report
         .ratios
         .iter()
@@ -132,16 +141,16 @@ pub fn page(report: &Report, command: &str) -> String {
         )
         .collect();
     if missed.is_empty() {
-        let _ = writeln!(t, "Every goal of this run was met.\n");
+        out!(t, "Every goal of this run was met.\n");
     } else {
-        let _ = writeln!(t, "Goals **not met** in this run:\n");
+        out!(t, "Goals **not met** in this run:\n");
         for m in &missed {
-            let _ = writeln!(t, "* {m}");
+            out!(t, "* {m}");
         }
-        let _ = writeln!(t);
+        out!(t);
     }
-    let _ = writeln!(t, "The table, ratios, goals and CPU costs as printed:\n");
-    let _ = writeln!(t, "```text{}```", report.table());
+    out!(t, "The table, ratios, goals and CPU costs as printed:\n");
+    out!(t, "```text{}```", report.table());
     t
 }
 

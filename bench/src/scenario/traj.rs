@@ -108,7 +108,9 @@ fn driver_period(ctx: &mut RunCtx) -> Result<(), BenchError> {
         let options = limber_simarm::SimArmOptions::default();
         let arm = limber_simarm::SimArm::new(&c, chain, options).map_err(|e| e.to_string());
         let ready = arm.is_ok();
-        let _ = tx.send(ready);
+        if tx.send(ready).is_err() {
+            tracing::warn!("traj: the scenario stopped waiting for simarm to start");
+        }
         arm?.run(|| flag.load(Ordering::Relaxed))
             .map(|_| ())
             .map_err(|e| e.to_string())

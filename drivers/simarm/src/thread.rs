@@ -55,13 +55,17 @@ impl SimArmThread {
             match started {
                 Ok((_ctx, mut arm)) => {
                     // The starter may have given up waiting: it then stops us on drop.
-                    let _ = ready_tx.send(Ok(()));
+                    if ready_tx.send(Ok(())).is_err() {
+                        tracing::warn!("simarm on its thread: the starter stopped waiting");
+                    }
                     if let Err(e) = arm.run(|| flag.load(Ordering::Relaxed)) {
                         tracing::error!(error = %e, "simarm on its thread stopped");
                     }
                 }
                 Err(e) => {
-                    let _ = ready_tx.send(Err(e));
+                    if let Err(unsent) = ready_tx.send(Err(e)) {
+                        tracing::error!(error = ?unsent.0, "simarm on its thread did not start");
+                    }
                 }
             }
         });
