@@ -159,11 +159,12 @@ pub fn table(costs: &[CpuCost], latency: impl Fn(&str) -> Option<(u64, u64)>) ->
             (Some(g), Some(m)) => format!("  goal <= {g} %: {}", if m { "met" } else { "NOT met" }),
             _ => String::new(),
         };
-        let _ = writeln!(
+        writeln!(
             t,
             "  {:<14} {:<16} {:<14} {:>7.2} % ({:.1} s){latency}{goal}",
             c.mode, c.load, c.process, c.percent, c.window_s
-        );
+        )
+        .expect("writing to a String cannot fail");
     }
     t
 }
