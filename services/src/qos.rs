@@ -85,8 +85,12 @@ pub const DATA_PUBLISHERS: usize = 2;
 pub const DATA_BUFFER: usize = 16;
 /// Samples a `data` subscriber may hold at once (the client keeps the latest one).
 pub const DATA_BORROWED: usize = 2;
-/// Commands buffered per client for the driver: a burst this long is never lost.
+/// Commands buffered per client for the driver: a burst this long is never lost. Also
+/// the most commands the driver takes in one call before it answers requests and ticks.
 pub const CMD_BUFFER: usize = 256;
+/// Commands of one client the driver holds at once: the most it takes of one client in
+/// one round of its fair draining (`DeviceHost::process_commands`).
+pub const CMD_BORROWED: usize = 2;
 /// Outcomes buffered per client (every client sees every outcome of the device and keeps
 /// its own): this many commands of all clients may be decided between two looks of a
 /// waiting client before its outcome is overwritten (safe overflow).

@@ -206,15 +206,16 @@ impl<I: Interface> Client<I> {
                 priority: ctx.priority(),
             }
         };
+        let no_driver = || ConnectError::NoDriver {
+            device: dev.clone(),
+            domain: domain.clone(),
+            elsewhere: crate::domain::dir::elsewhere_note(&domain),
+        };
         let map = |channel: &'static str, e: Iox2Error| -> ConnectError {
             if e.is_full() {
                 full()
             } else if e.is_missing_service() {
-                ConnectError::NoDriver {
-                    device: dev.clone(),
-                    domain: domain.clone(),
-                    elsewhere: crate::domain::dir::elsewhere_note(&domain),
-                }
+                no_driver()
             } else if e.is_permission_denied() {
                 let hint = match ctx.domain().group().ok().flatten() {
                     Some(g) => format!(
@@ -259,11 +260,7 @@ impl<I: Interface> Client<I> {
         // Services that another client keeps open outlive their driver: a device whose
         // driver died (or ended) is not offered, whoever still holds its files.
         if !driver_may_be_alive(&data_svc, ctx.domain()) {
-            return Err(ConnectError::NoDriver {
-                device: dev.clone(),
-                domain: domain.clone(),
-                elsewhere: crate::domain::dir::elsewhere_note(&domain),
-            });
+            return Err(no_driver());
         }
         if let Some((max, reserved)) = advertised_capacity(&data_svc) {
             capacity.set((max, reserved));
@@ -309,20 +306,28 @@ impl<I: Interface> Client<I> {
             .notifier_builder()
             .create()
             .map_err(|e| map("wake", e.into()))?;
-        let outcome_sub = node
-            .service_builder(&device.service_name(Channel::Outcome))
-            .publish_subscribe::<OutcomeMsg>()
-            .open_with_attributes(&layout)
-            .map_err(|e| map("outcome", e.into()))?
-            .subscriber_builder()
-            .buffer_size(qos::OUTCOME_BUFFER)
-            .create()
-            .map_err(|e| map("outcome", e.into()))?;
         let notify_svc = node
             .service_builder(&device.service_name(Channel::Notify))
             .event()
             .open_with_attributes(&layout)
             .map_err(|e| map("notify", e.into()))?;
+        // Last: the driver makes its `outcome` publisher after every other port (see
+        // `DeviceHost::new`). Without it the driver is still starting: no driver yet
+        // (`connect_timeout` tries again), rather than a client whose first request or
+        // lease would go to a server that is not there yet.
+        let outcome_svc = node
+            .service_builder(&device.service_name(Channel::Outcome))
+            .publish_subscribe::<OutcomeMsg>()
+            .open_with_attributes(&layout)
+            .map_err(|e| map("outcome", e.into()))?;
+        if outcome_svc.dynamic_config().number_of_publishers() == 0 {
+            return Err(no_driver());
+        }
+        let outcome_sub = outcome_svc
+            .subscriber_builder()
+            .buffer_size(qos::OUTCOME_BUFFER)
+            .create()
+            .map_err(|e| map("outcome", e.into()))?;
         // Group mode: open the files these ports made to the group at once (the watch of
         // crate::widen would, a little later).
         ctx.domain().widen_now();

@@ -4,105 +4,151 @@
 
 use core::mem::MaybeUninit;
 
+use iceoryx2::port::ReceiveError;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::prelude::*;
 use iceoryx2::sample_mut_uninit::SampleMutUninit;
 use limber_interfaces::prelude::*;
 
 use super::arbiter::{CmdRef, Told};
-use super::{DeviceHandler, DeviceHost, HostStats, Origin, ProcessError, loan_ahead};
+use super::{CmdSample, DeviceHandler, DeviceHost, HostStats, Origin, ProcessError, loan_ahead};
 use crate::context::monotonic_ns;
 use crate::error::Iox2Error;
 use crate::naming::DeviceName;
+use crate::qos;
 
 impl<I: Interface> DeviceHost<I> {
-    /// Drains every pending command. A command that does not decode is refused with the
-    /// matching status without reaching the handler.
+    /// Takes the pending commands fairly, in rounds: each round at most
+    /// [`CMD_BORROWED`](qos::CMD_BORROWED) commands of each client (each client's in its
+    /// sending order), until none is left or [`CMD_BUFFER`](qos::CMD_BUFFER) were taken in
+    /// this call (the rest waits for the next call). A client that never stops sending
+    /// neither holds the loop nor delays another client's command by more than a round. A
+    /// command that does not decode is refused with the matching status without reaching
+    /// the handler. Returns how many commands were handled.
+    ///
+    /// Why rounds: the transport hands out the samples of its first connection that has
+    /// data, so draining sample by sample served a flooding client before every client
+    /// that connected after it, for as long as the flood lasted. A connection whose
+    /// borrowed samples reach the service's limit is passed over until they are released:
+    /// a round holds its samples until it has taken one of every client.
     pub fn process_commands<H: DeviceHandler<I>>(
         &mut self,
         handler: &mut H,
     ) -> Result<usize, ProcessError> {
-        let mut n = 0;
-        loop {
-            let sample = match self.commands.receive() {
-                Ok(Some(s)) => s,
-                Ok(None) => break,
-                Err(e) => return Err(ProcessError::Receive(e)),
-            };
-            let raw: &I::CmdMsg = &sample;
-            let meta = *raw.meta();
-            // Who sent it, as the transport says: the node of its publisher.
-            let sender = self
-                .cmd_senders
-                .publisher(sample.header().publisher_id().value(), &self.cmd_svc);
-            let node = sender.node;
-            if !super::senders::client_of_process(meta.client_id, sender.pid) {
-                // Another process's client id: its outcome would go to that client (who
-                // never sent it, and would take it for one of its own). Dropped, counted.
-                drop(sample);
-                self.forged_command(meta.client_id, sender.pid);
-                continue;
-            }
-            let origin = Origin {
-                client_id: meta.client_id,
-                seq: meta.seq,
-                sent_ns: meta.stamp_ns,
-                received_ns: monotonic_ns(),
-            };
-            let cmd = CmdRef {
-                client_id: meta.client_id,
-                seq: meta.seq,
-                kind: meta.kind,
-            };
-            self.stats.overflows += self.arbiter.arrived(cmd);
-            let status = match I::Command::read(raw) {
-                Ok(decoded) => {
-                    drop(sample);
-                    if self.arbiter.refusing(cmd.client_id, node).is_some() {
-                        self.stats.leased_refusals += 1;
-                        Status::Leased
-                    } else {
-                        self.apply(handler, &decoded, &origin, cmd)
-                    }
+        let mut round = core::mem::take(&mut self.cmd_round);
+        let handled = self.process_rounds(handler, &mut round);
+        round.clear();
+        self.cmd_round = round;
+        handled
+    }
+
+    /// The rounds of [`DeviceHost::process_commands`], in `round` (empty, its capacity
+    /// one round's most: no allocation).
+    fn process_rounds<H: DeviceHandler<I>>(
+        &mut self,
+        handler: &mut H,
+        round: &mut Vec<CmdSample<I>>,
+    ) -> Result<usize, ProcessError> {
+        let (mut n, mut taken) = (0, 0);
+        while taken < qos::CMD_BUFFER {
+            while round.len() < round.capacity() && taken + round.len() < qos::CMD_BUFFER {
+                match self.commands.receive() {
+                    Ok(Some(s)) => round.push(s),
+                    Ok(None) | Err(ReceiveError::ExceedsMaxBorrows) => break,
+                    Err(e) => return Err(ProcessError::Receive(e)),
                 }
-                Err(e) => e.status(),
-            };
-            self.outcome = CmdOutcome {
-                client_id: meta.client_id,
-                cmd_seq: meta.seq,
-                kind: meta.kind,
-                status: status.code(),
-            };
-            // The state that shows the command goes out before its outcome: a client that
-            // has seen the outcome and then takes the state sees the command's effect.
-            // (Clients are notified after both.)
-            let state_sent = self.publish_each_outcome.then(|| self.send_state());
-            let told = self.arbiter.outcome(cmd, node, status);
-            publish_outcome(
-                &self.outcomes,
-                &mut self.outcome_loan,
-                &mut self.stats,
-                &self.device,
-                told,
-            );
-            self.stats.commands += 1;
-            if !status.is_carried_out() {
-                self.stats.refused += 1;
             }
-            n += 1;
-            if let Some(sent) = state_sent {
-                sent?;
-                self.state_sent();
+            if round.is_empty() {
+                break;
             }
-            // A command that drives nothing that runs on has its result now, after its
-            // outcome (so do the motions it preempted or stopped).
-            self.publish_results();
-            // The next command's outcome sample, loaned now rather than on its path.
-            if self.outcome_loan.is_none() {
-                self.outcome_loan = loan_ahead(&self.outcomes, &self.device, "outcome");
+            taken += round.len();
+            for sample in round.drain(..) {
+                if self.process_command(handler, sample)? {
+                    n += 1;
+                }
             }
         }
         Ok(n)
+    }
+
+    /// Handles one command sample; `false` if it was dropped uncounted (a forged client id).
+    fn process_command<H: DeviceHandler<I>>(
+        &mut self,
+        handler: &mut H,
+        sample: CmdSample<I>,
+    ) -> Result<bool, ProcessError> {
+        let raw: &I::CmdMsg = &sample;
+        let meta = *raw.meta();
+        // Who sent it, as the transport says: the node of its publisher.
+        let sender = self
+            .cmd_senders
+            .publisher(sample.header().publisher_id().value(), &self.cmd_svc);
+        let node = sender.node;
+        if !super::senders::client_of_process(meta.client_id, sender.pid) {
+            // Another process's client id: its outcome would go to that client (who
+            // never sent it, and would take it for one of its own). Dropped, counted.
+            drop(sample);
+            self.forged_command(meta.client_id, sender.pid);
+            return Ok(false);
+        }
+        let origin = Origin {
+            client_id: meta.client_id,
+            seq: meta.seq,
+            sent_ns: meta.stamp_ns,
+            received_ns: monotonic_ns(),
+        };
+        let cmd = CmdRef {
+            client_id: meta.client_id,
+            seq: meta.seq,
+            kind: meta.kind,
+        };
+        self.stats.overflows += self.arbiter.arrived(cmd);
+        let status = match I::Command::read(raw) {
+            Ok(decoded) => {
+                drop(sample);
+                if self.arbiter.refusing(cmd.client_id, node).is_some() {
+                    self.stats.leased_refusals += 1;
+                    Status::Leased
+                } else {
+                    self.apply(handler, &decoded, &origin, cmd)
+                }
+            }
+            Err(e) => e.status(),
+        };
+        self.outcome = CmdOutcome {
+            client_id: meta.client_id,
+            cmd_seq: meta.seq,
+            kind: meta.kind,
+            status: status.code(),
+        };
+        // The state that shows the command goes out before its outcome: a client that
+        // has seen the outcome and then takes the state sees the command's effect.
+        // (Clients are notified after both.)
+        let state_sent = self.publish_each_outcome.then(|| self.send_state());
+        let told = self.arbiter.outcome(cmd, node, status);
+        publish_outcome(
+            &self.outcomes,
+            &mut self.outcome_loan,
+            &mut self.stats,
+            &self.device,
+            told,
+        );
+        self.stats.commands += 1;
+        if !status.is_carried_out() {
+            self.stats.refused += 1;
+        }
+        if let Some(sent) = state_sent {
+            sent?;
+            self.state_sent();
+        }
+        // A command that drives nothing that runs on has its result now, after its
+        // outcome (so do the motions it preempted or stopped).
+        self.publish_results();
+        // The next command's outcome sample, loaned now rather than on its path.
+        if self.outcome_loan.is_none() {
+            self.outcome_loan = loan_ahead(&self.outcomes, &self.device, "outcome");
+        }
+        Ok(true)
     }
 
     /// A command whose client id is another process's: counted as refused, and logged

@@ -70,6 +70,9 @@ pub(crate) fn loan_ahead<T: core::fmt::Debug + ZeroCopySend>(
     }
 }
 
+/// A command as the transport hands it to the driver, read in place.
+type CmdSample<I> = iceoryx2::sample::Sample<ipc::Service, <I as Interface>::CmdMsg, ()>;
+
 /// Offers one device of interface `I`: publishes its state, drains its commands in
 /// arrival order, answers its requests, and wakes its clients.
 ///
@@ -81,6 +84,9 @@ pub struct DeviceHost<I: Interface> {
         iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, I::Data, ()>,
     publisher: Publisher<ipc::Service, I::Data, ()>,
     commands: Subscriber<ipc::Service, I::CmdMsg, ()>,
+    /// One round of commands taken fairly (see `commands.rs`): allocated once, for every
+    /// client's [`qos::CMD_BORROWED`].
+    cmd_round: Vec<CmdSample<I>>,
     /// The `cmd` service, whose registry says which node each command's publisher is.
     cmd_svc: iceoryx2::service::port_factory::publish_subscribe::PortFactory<
         ipc::Service,

@@ -116,7 +116,7 @@ impl<I: Interface> DeviceHost<I> {
             .publish_subscribe::<I::CmdMsg>()
             .history_size(0)
             .subscriber_max_buffer_size(qos::CMD_BUFFER)
-            .subscriber_max_borrowed_samples(2)
+            .subscriber_max_borrowed_samples(qos::CMD_BORROWED)
             .max_publishers(ports)
             .max_subscribers(qos::CMD_SUBSCRIBERS)
             .max_nodes(nodes)
@@ -171,6 +171,25 @@ impl<I: Interface> DeviceHost<I> {
             .create()
             .map_err(|e| transport("notify", e.into()))?;
 
+        let lease_svc = node
+            .service_builder(&device.service_name(Channel::Lease))
+            .request_response::<LeaseReq, LeaseReply>()
+            .max_clients(ports)
+            .max_servers(qos::REQ_SERVERS)
+            .max_nodes(nodes)
+            .max_active_requests_per_client(qos::MAX_ACTIVE_REQUESTS)
+            .max_response_buffer_size(2)
+            .enable_fire_and_forget_requests(false)
+            .open_or_create_with_attributes(&verifier)
+            .map_err(|e| transport("lease", e.into()))?;
+        let lease_server = lease_svc
+            .server_builder()
+            .create()
+            .map_err(|e| transport("lease", e.into()))?;
+
+        // Last: a client connects only once it has opened the `outcome` channel (the last
+        // it opens), so it finds every other port of this driver made: its first request
+        // or lease never goes to a server that is not there yet.
         let outcomes = node
             .service_builder(&device.service_name(Channel::Outcome))
             .publish_subscribe::<OutcomeMsg>()
@@ -188,22 +207,6 @@ impl<I: Interface> DeviceHost<I> {
             .create()
             .map_err(|e| transport("outcome", e.into()))?;
 
-        let lease_svc = node
-            .service_builder(&device.service_name(Channel::Lease))
-            .request_response::<LeaseReq, LeaseReply>()
-            .max_clients(ports)
-            .max_servers(qos::REQ_SERVERS)
-            .max_nodes(nodes)
-            .max_active_requests_per_client(qos::MAX_ACTIVE_REQUESTS)
-            .max_response_buffer_size(2)
-            .enable_fire_and_forget_requests(false)
-            .open_or_create_with_attributes(&verifier)
-            .map_err(|e| transport("lease", e.into()))?;
-        let lease_server = lease_svc
-            .server_builder()
-            .create()
-            .map_err(|e| transport("lease", e.into()))?;
-
         // Group mode: this device's files open to the group at once.
         ctx.domain().widen_now();
         Ok(DeviceHost {
@@ -212,6 +215,7 @@ impl<I: Interface> DeviceHost<I> {
             data_svc,
             publisher,
             commands,
+            cmd_round: Vec::with_capacity(ports * qos::CMD_BORROWED),
             cmd_svc,
             req_svc,
             cmd_senders: super::senders::PortNodes::new(ports),
