@@ -2,7 +2,7 @@
 //! against a floor), and the goals in time on single series. Reported by
 //! [`crate::report::Report`].
 
-use crate::report::{Goal, Pct, RatioDef, TimeGoalDef};
+use crate::report::{Goal, Pct, RatioDef, RatioFloor, TimeGoalDef};
 
 /// The ratios reported, like with like (spin with spin, blocking with blocking).
 pub const RATIOS: &[RatioDef] = &[
@@ -12,6 +12,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "many.1.rtt",
         pct: Pct::P50,
         goal: Some(Goal::AtMost(1.2)),
+        floor: None,
     },
     RatioDef {
         label: "command round trip with 16 drivers / with 1 driver (many, 64 clients)",
@@ -19,6 +20,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "many.1.rtt",
         pct: Pct::P99,
         goal: Some(Goal::AtMost(1.2)),
+        floor: None,
     },
     RatioDef {
         label: "command through the bridge pair / raw Zenoh put ping-pong (bridge)",
@@ -26,6 +28,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "bridge.raw.put.rtt",
         pct: Pct::P50,
         goal: Some(Goal::AtMost(1.3)),
+        floor: None,
     },
     RatioDef {
         label: "command through the bridge pair / raw Zenoh put ping-pong (bridge)",
@@ -33,6 +36,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "bridge.raw.put.rtt",
         pct: Pct::P99,
         goal: Some(Goal::AtMost(1.3)),
+        floor: None,
     },
     RatioDef {
         label: "raw Zenoh get→reply / raw Zenoh put ping-pong (bridge)",
@@ -40,6 +44,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "bridge.raw.put.rtt",
         pct: Pct::P50,
         goal: None,
+        floor: None,
     },
     RatioDef {
         label: "state → 1 subscriber / iceoryx2 event wake paced at 1 kHz (one-way)",
@@ -47,6 +52,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "state.paced.event.oneway",
         pct: Pct::P50,
         goal: Some(Goal::AtMost(1.3)),
+        floor: None,
     },
     RatioDef {
         label: "state → 1 subscriber / iceoryx2 event wake paced at 1 kHz (one-way)",
@@ -54,6 +60,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "state.paced.event.oneway",
         pct: Pct::P99,
         goal: Some(Goal::AtMost(2.0)),
+        floor: None,
     },
     RatioDef {
         label: "state → 1 subscriber / futex wake paced at 1 kHz (one-way)",
@@ -61,6 +68,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "state.paced.futex.oneway",
         pct: Pct::P50,
         goal: None,
+        floor: None,
     },
     RatioDef {
         label: "state → 4 subscribers / state → 1 subscriber",
@@ -68,6 +76,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "state.1.oneway",
         pct: Pct::P50,
         goal: None,
+        floor: None,
     },
     RatioDef {
         label: "state → 16 subscribers / state → 1 subscriber",
@@ -75,6 +84,35 @@ pub const RATIOS: &[RatioDef] = &[
         den: "state.1.oneway",
         pct: Pct::P50,
         goal: Some(Goal::AtMost(2.0)),
+        floor: Some(RatioFloor {
+            num: "state.raw.16.oneway",
+            den: "state.raw.1.oneway",
+            what: "raw iceoryx2's own fan-out, 16 listeners / 1",
+        }),
+    },
+    RatioDef {
+        label: "state → 4 subscribers / iceoryx2 sample + notify → 4 listeners",
+        num: "state.4.oneway",
+        den: "state.raw.4.oneway",
+        pct: Pct::P50,
+        goal: None,
+        floor: None,
+    },
+    RatioDef {
+        label: "state → 16 subscribers / iceoryx2 sample + notify → 16 listeners",
+        num: "state.16.oneway",
+        den: "state.raw.16.oneway",
+        pct: Pct::P50,
+        goal: None,
+        floor: None,
+    },
+    RatioDef {
+        label: "iceoryx2 sample + notify → 16 listeners / → 1 listener",
+        num: "state.raw.16.oneway",
+        den: "state.raw.1.oneway",
+        pct: Pct::P50,
+        goal: None,
+        floor: None,
     },
     RatioDef {
         label: "command spin one-way / floor spin one-way",
@@ -82,6 +120,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "floor.spin.oneway",
         pct: Pct::P50,
         goal: Some(Goal::AtMost(1.5)),
+        floor: None,
     },
     RatioDef {
         label: "command spin one-way / floor spin one-way",
@@ -89,6 +128,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "floor.spin.oneway",
         pct: Pct::P99,
         goal: Some(Goal::AtMost(2.0)),
+        floor: None,
     },
     RatioDef {
         label: "command spin round trip / floor spin round trip",
@@ -96,6 +136,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "floor.spin.rtt",
         pct: Pct::P50,
         goal: Some(Goal::AtMost(1.2)),
+        floor: None,
     },
     RatioDef {
         label: "command spin round trip / cache-line ping-pong round trip",
@@ -103,6 +144,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "floor.cacheline.rtt",
         pct: Pct::P50,
         goal: None,
+        floor: None,
     },
     RatioDef {
         label: "command event round trip / futex ping-pong round trip",
@@ -110,6 +152,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "floor.futex.rtt",
         pct: Pct::P50,
         goal: Some(Goal::AtMost(1.5)),
+        floor: None,
     },
     RatioDef {
         label: "driver wake-up (command event one-way) / futex wake-up (one-way)",
@@ -117,6 +160,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "floor.futex.oneway",
         pct: Pct::P50,
         goal: Some(Goal::AtMost(1.5)),
+        floor: None,
     },
     RatioDef {
         label: "command event round trip / UDS blocking round trip",
@@ -124,6 +168,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "peers.uds.blocking.rtt",
         pct: Pct::P50,
         goal: Some(Goal::AtMost(0.8)),
+        floor: None,
     },
     RatioDef {
         label: "iceoryx2 event round trip / futex ping-pong round trip",
@@ -131,6 +176,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "floor.futex.rtt",
         pct: Pct::P50,
         goal: None,
+        floor: None,
     },
     RatioDef {
         label: "iceoryx2 spin round trip / cache-line ping-pong round trip",
@@ -138,6 +184,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "floor.cacheline.rtt",
         pct: Pct::P50,
         goal: None,
+        floor: None,
     },
     RatioDef {
         label: "futex round trip / cache-line round trip (physical cost of blocking)",
@@ -145,6 +192,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "floor.cacheline.rtt",
         pct: Pct::P50,
         goal: None,
+        floor: None,
     },
     RatioDef {
         label: "command event round trip / floor event round trip",
@@ -152,6 +200,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "floor.event.rtt",
         pct: Pct::P50,
         goal: Some(Goal::AtMost(1.2)),
+        floor: None,
     },
     RatioDef {
         label: "command event round trip / floor WaitSet-echo round trip",
@@ -159,6 +208,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "floor.waitset.rtt",
         pct: Pct::P50,
         goal: None,
+        floor: None,
     },
     RatioDef {
         label: "floor WaitSet-echo round trip / floor event round trip",
@@ -166,6 +216,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "floor.event.rtt",
         pct: Pct::P50,
         goal: None,
+        floor: None,
     },
     RatioDef {
         label: "command event one-way / floor event one-way",
@@ -173,6 +224,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "floor.event.oneway",
         pct: Pct::P50,
         goal: None,
+        floor: None,
     },
     RatioDef {
         label: "TCP spin round trip / command spin round trip",
@@ -180,6 +232,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "command.spin.rtt",
         pct: Pct::P50,
         goal: Some(Goal::AtLeast(10.0)),
+        floor: None,
     },
     RatioDef {
         label: "UDS spin round trip / command spin round trip",
@@ -187,6 +240,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "command.spin.rtt",
         pct: Pct::P50,
         goal: Some(Goal::AtLeast(5.0)),
+        floor: None,
     },
     RatioDef {
         label: "TCP blocking round trip / command event round trip",
@@ -194,6 +248,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "command.event.rtt",
         pct: Pct::P50,
         goal: Some(Goal::AtLeast(10.0)),
+        floor: None,
     },
     RatioDef {
         label: "UDS blocking round trip / command event round trip",
@@ -201,6 +256,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "command.event.rtt",
         pct: Pct::P50,
         goal: Some(Goal::AtLeast(5.0)),
+        floor: None,
     },
     RatioDef {
         label: "Pioneer GET_GEOM request / command event round trip",
@@ -208,6 +264,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "command.event.rtt",
         pct: Pct::P50,
         goal: None,
+        floor: None,
     },
     RatioDef {
         label: "floor event round trip / floor spin round trip (cost of blocking)",
@@ -215,6 +272,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "floor.spin.rtt",
         pct: Pct::P50,
         goal: None,
+        floor: None,
     },
     RatioDef {
         label: "C command round trip / Rust command round trip (lang)",
@@ -222,6 +280,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "lang.rust.rtt",
         pct: Pct::P50,
         goal: None,
+        floor: None,
     },
     RatioDef {
         label: "Python command round trip / Rust command round trip (lang)",
@@ -229,6 +288,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "lang.rust.rtt",
         pct: Pct::P50,
         goal: Some(Goal::AtMost(2.0)),
+        floor: None,
     },
     RatioDef {
         label: "Python state read / Rust state read (lang)",
@@ -236,6 +296,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "lang.rust.state",
         pct: Pct::P50,
         goal: Some(Goal::AtMost(2.0)),
+        floor: None,
     },
     RatioDef {
         label: "Python state read / one ctypes call into liblimber (lang)",
@@ -243,6 +304,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "lang.python.ffi",
         pct: Pct::P50,
         goal: None,
+        floor: None,
     },
     RatioDef {
         label: "command round trip through the Zenoh bridge pair / direct (bridge)",
@@ -250,6 +312,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "bridge.direct.rtt",
         pct: Pct::P50,
         goal: None,
+        floor: None,
     },
     RatioDef {
         label: "command round trip through the Zenoh bridge pair / direct (bridge)",
@@ -257,6 +320,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "bridge.direct.rtt",
         pct: Pct::P99,
         goal: None,
+        floor: None,
     },
     RatioDef {
         label: "command round trip through the Zenoh bridge pair / TCP loopback blocking round trip",
@@ -264,6 +328,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "peers.tcp.blocking.rtt",
         pct: Pct::P50,
         goal: None,
+        floor: None,
     },
     RatioDef {
         label: "GET_GEOM through the Player gateway / direct (gateway)",
@@ -271,6 +336,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "request.pioneer.rtt",
         pct: Pct::P50,
         goal: None,
+        floor: None,
     },
     RatioDef {
         label: "GET_GEOM through the Player gateway / TCP loopback blocking round trip",
@@ -278,6 +344,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "peers.tcp.blocking.rtt",
         pct: Pct::P50,
         goal: None,
+        floor: None,
     },
     RatioDef {
         label: "spinning driver's cost (arrival → bytes on the pty) / bare pty write(2)",
@@ -285,6 +352,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "loop.spin.pty_write",
         pct: Pct::P50,
         goal: None,
+        floor: None,
     },
 ];
 

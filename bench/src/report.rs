@@ -64,6 +64,20 @@ pub struct RatioDef {
     pub pct: Pct,
     /// The goal, if any.
     pub goal: Option<Goal>,
+    /// The same ratio between the floors of the two series, where it is measured: a goal
+    /// tighter than the floors' own ratio is below its floor, and the report says so.
+    pub floor: Option<RatioFloor>,
+}
+
+/// The floors' own ratio beside a ratio (see [`RatioDef::floor`]).
+#[derive(Debug, Clone, Copy)]
+pub struct RatioFloor {
+    /// Numerator measurement id.
+    pub num: &'static str,
+    /// Denominator measurement id.
+    pub den: &'static str,
+    /// What the floors' ratio is, in words.
+    pub what: &'static str,
 }
 
 /// A goal in time on one series of a run (issue 16's absolute goals): unlike the ratios they
@@ -174,6 +188,32 @@ pub struct Ratio {
     pub goal: Option<Goal>,
     /// Whether the goal was met (None without a goal).
     pub met: Option<bool>,
+    /// The floors' own ratio at the same percentile, and what it is (see
+    /// [`RatioDef::floor`]), when both floors were measured.
+    pub floor: Option<(f64, &'static str)>,
+}
+
+impl Ratio {
+    /// Whether the goal is tighter than the floors' own ratio: not reachable over them.
+    pub fn below_floor(&self) -> bool {
+        match (self.goal, self.floor) {
+            (Some(Goal::AtMost(x)), Some((f, _))) => f > x,
+            (Some(Goal::AtLeast(x)), Some((f, _))) => f < x,
+            _ => false,
+        }
+    }
+
+    /// What the report adds after the goal: the floors' ratio, and whether the goal is
+    /// below it (empty without a floor).
+    pub fn floor_note(&self) -> String {
+        match self.floor {
+            Some((f, what)) if self.below_floor() => {
+                format!(" (the goal is below its floor: {what} = {f:.2})")
+            }
+            Some((f, what)) => format!(" ({what} = {f:.2})"),
+            None => String::new(),
+        }
+    }
 }
 
 /// A whole report.
@@ -298,16 +338,22 @@ impl Report {
                 }
             })
             .collect();
+        let value_of = |num: &str, den: &str, pct: Pct| {
+            let (a, b) = (find(num)?, find(den)?);
+            let (sa, sb) = (Summary::of(&a.hist), Summary::of(&b.hist));
+            let d = pct.of(&sb);
+            if d == 0 || sa.count == 0 {
+                return None;
+            }
+            Some((pct.of(&sa) as f64 / d as f64, a, b))
+        };
         let ratios = RATIOS
             .iter()
             .filter_map(|r| {
-                let (a, b) = (find(r.num)?, find(r.den)?);
-                let (sa, sb) = (Summary::of(&a.hist), Summary::of(&b.hist));
-                let den = r.pct.of(&sb);
-                if den == 0 || sa.count == 0 {
-                    return None;
-                }
-                let value = r.pct.of(&sa) as f64 / den as f64;
+                let (value, a, b) = value_of(r.num, r.den, r.pct)?;
+                let floor = r
+                    .floor
+                    .and_then(|f| value_of(f.num, f.den, r.pct).map(|(v, _, _)| (v, f.what)));
                 let met = r.goal.map(|g| match g {
                     Goal::AtMost(x) => value <= x,
                     Goal::AtLeast(x) => value >= x,
@@ -326,6 +372,7 @@ impl Report {
                     value,
                     goal: r.goal,
                     met,
+                    floor,
                 })
             })
             .collect();
@@ -466,7 +513,13 @@ impl Report {
                 } else {
                     format!("{:.2}", r.value)
                 };
-                let _ = writeln!(t, "  {:<72} {:<15} {value:>8}  {goal}", r.label, r.strategy);
+                let _ = writeln!(
+                    t,
+                    "  {:<72} {:<15} {value:>8}  {goal}{}",
+                    r.label,
+                    r.strategy,
+                    r.floor_note()
+                );
             }
         }
         if !self.time_goals.is_empty() {

@@ -124,7 +124,7 @@ pub fn page(report: &Report, command: &str) -> String {
         .ratios
         .iter()
         .filter(|r| r.met == Some(false))
-        .map(|r| format!("{} = {:.2}", r.label, r.value))
+        .map(|r| format!("{} = {:.2}{}", r.label, r.value, r.floor_note()))
         .chain(
             report
                 .time_goals

@@ -39,6 +39,7 @@ pub fn run_role(role: &str, args: &BenchArgs) -> Result<(), BenchError> {
         "waitset-echo" => floor::echo_role(args, floor::Echo::WaitSet),
         "state-pub" => state::publisher_role(args),
         "state-sub" => state::subscriber_role(args),
+        crate::scenario::fanout_floor::ROLE => crate::scenario::fanout_floor::subscriber_role(args),
         "pioneer-driver" => crate::scenario::request::driver_role(args, LoopMode::Event),
         "pioneer-driver-spin" => crate::scenario::request::driver_role(args, LoopMode::Spin),
         "cmd-driver-spin" => command::driver_role(args, true),

@@ -10,6 +10,7 @@
 pub mod bridge;
 pub mod command;
 pub mod cpu;
+pub mod fanout_floor;
 pub mod floor;
 pub mod gateway;
 pub mod ik;

@@ -331,13 +331,16 @@ fn gateway_measures_a_request_through_the_player_gateway() {
 fn state_measures_the_fanouts_beside_floors_paced_at_their_rate() {
     let dir = std::env::temp_dir().join(format!("limber-bench-state-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let (_, ids, v, _) = run_only("state", &dir.join("state.json"), None);
+    let (_, ids, v, text) = run_only("state", &dir.join("state.json"), None);
     for id in [
         "state.paced.futex.oneway",
         "state.paced.event.oneway",
         "state.1.oneway",
         "state.4.oneway",
         "state.16.oneway",
+        "state.raw.1.oneway",
+        "state.raw.4.oneway",
+        "state.raw.16.oneway",
     ] {
         assert!(ids.iter().any(|i| i == id), "{id} missing from {ids:?}");
     }
@@ -361,6 +364,29 @@ fn state_measures_the_fanouts_beside_floors_paced_at_their_rate() {
         2.0
     );
     assert_eq!(goal("state.16.oneway", "state.1.oneway", "p50"), 2.0);
+    // The fan-out's goal carries its floor: raw iceoryx2's own 16 / 1 of the same run, and
+    // the text says the goal is below it exactly when that ratio alone exceeds the goal.
+    let find = |num: &str, den: &str| {
+        ratios
+            .iter()
+            .find(|r| r["num"] == num && r["den"] == den && r["pct"] == "p50")
+            .unwrap_or_else(|| panic!("no ratio {num} / {den} in {ratios:?}"))
+    };
+    let raw = find("state.raw.16.oneway", "state.raw.1.oneway")["value"]
+        .as_f64()
+        .unwrap();
+    let fan = find("state.16.oneway", "state.1.oneway");
+    assert_eq!(fan["floor"][0].as_f64(), Some(raw), "{fan}");
+    assert!(fan["floor"][1].as_str().unwrap().contains("raw iceoryx2"));
+    let line = text
+        .lines()
+        .find(|l| l.contains("state → 16 subscribers / state → 1 subscriber"))
+        .unwrap_or_else(|| panic!("no fan-out ratio line in {text}"));
+    assert_eq!(
+        line.contains("the goal is below its floor"),
+        raw > 2.0,
+        "{line}"
+    );
     std::fs::remove_dir_all(&dir).expect("remove the test's directory");
 }
 
@@ -477,7 +503,7 @@ fn cpu_reports_what_each_mode_costs_beside_its_latency() {
 
 /// What a `--quick --scale 0.2 --only <scenario>` run gave: its one scenario's status
 /// entry, the ids of its measurements (each checked to have samples), the whole report,
-/// and its stderr. `env`, if given, is set for the run.
+/// and what it printed (stdout, then stderr). `env`, if given, is set for the run.
 fn run_only(
     scenario: &str,
     json: &std::path::Path,
@@ -517,5 +543,11 @@ fn run_only(
             m["id"].as_str().unwrap().to_string()
         })
         .collect();
-    (s, ids, v, String::from_utf8_lossy(&out.stderr).into_owned())
+    // What it printed: the table (stdout), then its notes (stderr).
+    let printed = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (s, ids, v, printed)
 }

@@ -8,7 +8,9 @@
 //! Its floors run first, at the same rate (`state.paced.futex.*`, `state.paced.event.*`):
 //! the physical futex ping-pong and the raw iceoryx2 event ping-pong of `floor`, one
 //! exchange per millisecond from a sleeping sender, so that the echo's wake-up
-//! (`*.oneway`) comes after the idle millisecond a subscriber's does.
+//! (`*.oneway`) comes after the idle millisecond a subscriber's does. Before each fan-out,
+//! its floor: the same publication and notify in raw iceoryx2 to as many listener
+//! processes (`state.raw.<N>.oneway`, [`super::fanout_floor`]).
 
 use std::time::{Duration, Instant};
 
@@ -40,7 +42,7 @@ impl Scenario for StateFanout {
         "state"
     }
     fn description(&self) -> &'static str {
-        "driver publishes the arm state at 1 kHz; 1, 4, 16 subscriber processes block on the notify event (one-way); beside it its floors paced at the same 1 kHz: a futex wake and a raw iceoryx2 event wake"
+        "driver publishes the arm state at 1 kHz; 1, 4, 16 subscriber processes block on the notify event (one-way); beside it its floors paced at the same 1 kHz: a futex wake and a raw iceoryx2 event wake, and before each fan-out raw iceoryx2's own (a sample and a notify to as many listener processes)"
     }
     fn run(&self, ctx: &mut RunCtx) -> Result<(), BenchError> {
         if !ctx.blocking_enabled() {
@@ -58,6 +60,7 @@ impl Scenario for StateFanout {
         physical::ping_pong(ctx, physical::Wait::Futex, pace)?;
         floor::ping_pong(ctx, Echo::Listener, pace)?;
         for fan in FANOUTS {
+            super::fanout_floor::fanout(ctx, fan)?;
             fanout(ctx, fan)?;
         }
         Ok(())
