@@ -307,6 +307,19 @@ for _name, (_res, _args) in PROTOTYPES.items():
     _f.argtypes = _args
 
 
+def unchecked(name: str) -> Any:
+    """A second handle on the C function ``name``, with its ``restype`` but no ``argtypes``:
+    ctypes then passes each argument as it is instead of converting it, and a call costs a
+    half to a third of one through the checked prototype (measured with ctypes on CPython
+    3.11: 0.72 -> 0.35 us for ``limber_actarray_move_to``). For the hot path only, and only
+    with arguments of the exact C types: ctypes values (``c_double``, ``c_uint64``,
+    ``c_size_t``, a struct passed by value, ``byref``), a handle (``c_void_p`` or ``None``),
+    or a Python int for a 32-bit integer that the caller has checked for range."""
+    f = lib[name]
+    f.restype = PROTOTYPES[name][0]
+    return f
+
+
 def last_error() -> str:
     """``limber_last_error()``: the detail of the last failure on this thread."""
     raw: Optional[bytes] = lib.limber_last_error()

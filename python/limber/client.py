@@ -32,7 +32,18 @@ from __future__ import annotations
 import atexit
 import ctypes
 import math
-from ctypes import byref, c_bool, c_double, c_int32, c_uint32, c_uint64, c_void_p, sizeof
+from ctypes import (
+    byref,
+    c_bool,
+    c_double,
+    c_int32,
+    c_size_t,
+    c_uint32,
+    c_uint64,
+    c_void_p,
+    sizeof,
+)
+from operator import index as _index
 from typing import (
     Any,
     ClassVar,
@@ -135,10 +146,15 @@ _C = TypeVar("_C", bound="_Client[Any]")
 
 _connect = _c.limber_device_connect_checked
 _disconnect = _c.limber_device_disconnect
-_state = _c.limber_device_state
-_last_state = _c.limber_device_last_state
 _wait_state = _c.limber_device_wait_state
-_outcome = _c.limber_device_outcome
+# The calls of a control loop, unchecked (see `_lib.unchecked`): every argument below is
+# passed as a ctypes value of its C type.
+_state = _lib.unchecked("limber_device_state")
+_last_state = _lib.unchecked("limber_device_last_state")
+_outcome = _lib.unchecked("limber_device_outcome")
+_NO_WAIT = c_uint64(0)
+# Equal to no timeout a caller passes (None included): the first one is converted.
+_NO_TIMEOUT_YET = object()
 
 
 class _Client(_Owned, Generic[_D]):
@@ -161,6 +177,10 @@ class _Client(_Owned, Generic[_D]):
         self._tk = _lib.Ticket()
         self._out = _lib.Outcome()
         self._out_ref = byref(self._out)
+        # The last timeout of wait_outcome and its milliseconds (a loop passes the same one).
+        self._wait_timeout: object = _NO_TIMEOUT_YET
+        self._wait_ms = c_uint64(0)
+        self._size = c_size_t(self._data_size)
         self._flag = c_bool(False)
         self._flag_ref = byref(self._flag)
         self._u64 = c_uint64(0)
@@ -304,7 +324,7 @@ class _Client(_Owned, Generic[_D]):
         struct (``ActArrayData``, ``LimbData``, ``GripperData``; same fields as in Rust), or
         ``None`` if no sample arrived yet."""
         d = self.DATA()
-        rc = _state(self._h, 0, byref(d), self._data_size)
+        rc = _state(self._h, _NO_WAIT, byref(d), self._size)
         if rc:
             if rc == _lib.CODE_TIMEOUT:
                 return None
@@ -314,7 +334,7 @@ class _Client(_Owned, Generic[_D]):
     def last_state(self) -> Optional[_D]:
         """The latest state already taken (a copy), without looking for a newer one."""
         d = self.DATA()
-        rc = _last_state(self._h, byref(d), self._data_size)
+        rc = _last_state(self._h, byref(d), self._size)
         if rc:
             if rc == _lib.CODE_TIMEOUT:
                 return None
@@ -371,15 +391,24 @@ class _Client(_Owned, Generic[_D]):
         :class:`DriverGoneError`."""
         tk = self._tk
         tk.seq, tk.receivers = ticket
-        s = float(timeout)
-        if not 0.0 <= s <= 1e9:
-            raise ValueError(f"timeout must be a finite number of seconds >= 0, not {timeout!r}")
-        rc = _outcome(self._h, tk, math.ceil(s * 1000.0), self._out_ref)
+        rc = _outcome(self._h, tk, self._outcome_ms(timeout), self._out_ref)
         if rc:
             if rc == _lib.CODE_OUTCOME_MISSED and self._h is not None:
                 raise _error(rc, newer_seq=self._out.seq)
             raise self._fail(rc)
         return _STATUS.get(self._out.status, Status.INVALID_ARGUMENT)
+
+    def _outcome_ms(self, timeout: float) -> c_uint64:
+        """``timeout`` (s) in whole milliseconds, rounded up, as the C call takes it; the last
+        one is kept, since a control loop passes the same timeout every time."""
+        if timeout == self._wait_timeout:
+            return self._wait_ms
+        s = float(timeout)
+        if not 0.0 <= s <= 1e9:
+            raise ValueError(f"timeout must be a finite number of seconds >= 0, not {timeout!r}")
+        self._wait_ms = c_uint64(math.ceil(s * 1000.0))
+        self._wait_timeout = timeout
+        return self._wait_ms
 
     def outcome(self, ticket: Ticket, timeout: float) -> Outcome:
         """As :meth:`wait_outcome`, with the other client involved (the holder of the device
@@ -387,10 +416,7 @@ class _Client(_Owned, Generic[_D]):
         tk = self._tk
         tk.seq = ticket.seq
         tk.receivers = ticket.receivers
-        s = float(timeout)
-        if not 0.0 <= s <= 1e9:
-            raise ValueError(f"timeout must be a finite number of seconds >= 0, not {timeout!r}")
-        rc = _outcome(self._h, tk, math.ceil(s * 1000.0), self._out_ref)
+        rc = _outcome(self._h, tk, self._outcome_ms(timeout), self._out_ref)
         o = self._out
         if rc:
             if rc == _lib.CODE_OUTCOME_MISSED and self._h is not None:
@@ -552,7 +578,7 @@ class _Client(_Owned, Generic[_D]):
 
 # ----- actarray --------------------------------------------------------------------------
 
-_aa_move_to = _c.limber_actarray_move_to
+_aa_move_to = _lib.unchecked("limber_actarray_move_to")
 
 
 class ActArrayClient(_Client[L.ActArrayData]):
@@ -571,9 +597,10 @@ class ActArrayClient(_Client[L.ActArrayData]):
 
     def move_to(self, joint: int, position: float) -> Ticket:
         """CMD POS: move ``joint`` to ``position`` (rad or m)."""
-        if joint < 0:
+        j = _index(joint)
+        if not 0 <= j <= 0xFFFF_FFFF:
             raise ValueError(f"joint {joint} is not a valid joint index")
-        rc = _aa_move_to(self._h, joint, position, self._ticket_ref)
+        rc = _aa_move_to(self._h, j, c_double(position), self._ticket_ref)
         if rc:
             raise self._fail(rc)
         t = self._ticket

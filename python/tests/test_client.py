@@ -354,6 +354,8 @@ def test_invalid_values_raise_and_send_nothing(own_driver):
             lambda: arm.move_to(0, float("inf")),
             lambda: arm.move_to(32, 0.0),
             lambda: arm.move_to(-1, 0.0),
+            lambda: arm.move_to(2**32, 0.0),
+            lambda: arm.move_to(2**64 + 1, 0.0),
             lambda: arm.move_to_multi([0.0] * 33),
             lambda: arm.move_to_multi([0.0, float("nan")]),
             lambda: arm.move_at_speed(40, 0.1),
@@ -375,9 +377,22 @@ def test_invalid_values_raise_and_send_nothing(own_driver):
             with pytest.raises(ValueError):
                 f()
         # Nothing was numbered either: the next command is the client's first.
+        # Not an index: TypeError, as for any Python sequence.
+        for joint in (0.5, "0", None):
+            with pytest.raises(TypeError):
+                arm.move_to(joint, 0.0)  # type: ignore[arg-type]
+        # Nothing was numbered either: the next command is the client's first.
         t = arm.move_to(0, 0.5)
         assert t.seq == 1
         assert arm.wait_outcome(t, T) is Status.OK
+        # The timeout a loop passes again is converted once; a bad one is refused each
+        # time, whatever came before (None too, after a valid one).
+        assert arm.wait_outcome(t, T) is Status.OK
+        for timeout in (float("nan"), -1.0, float("inf")):
+            with pytest.raises(ValueError):
+                arm.wait_outcome(t, timeout)
+        with pytest.raises(TypeError):
+            arm.wait_outcome(t, None)  # type: ignore[arg-type]
         client_id = arm.client_id
     assert d.commands() == [(client_id, 1, L.ACTARRAY_CMD_POS)]
 
