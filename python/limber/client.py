@@ -237,13 +237,10 @@ class _Client(_Owned, Generic[_D]):
             byref(h),
         )
         if rc:
-            err = _error(rc)
-            if rc == _lib.CODE_INCOMPATIBLE and "layout version" in str(err):
-                err = IncompatibleError(
-                    f"{device} is incompatible: limber/_layout.py does not match liblimber "
-                    f"({_lib.path}): {err}"
-                )
-            raise err
+            # This package's layout and the library's were compared above
+            # (`_check_layout`): an incompatibility here is the driver's, as the library
+            # says it.
+            raise _error(rc)
         self = cls()
         self._h = h
         self._device = DeviceName.parse(device)
