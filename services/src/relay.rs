@@ -59,22 +59,18 @@ impl<I: Interface> DeviceHost<I> {
         self.publish_verbatim()
     }
 
-    /// Takes every pending command without decoding it, in arrival order.
+    /// Takes the pending commands without decoding them, fairly across clients as the
+    /// driver does ([`DeviceHost::process_commands`]: a flooding client delays no
+    /// other client's command by more than a round, and one call takes at most
+    /// [`CMD_BUFFER`](crate::qos::CMD_BUFFER)).
     pub fn relay_commands(
         &mut self,
         mut each: impl FnMut(&I::CmdMsg),
     ) -> Result<usize, ProcessError> {
-        let mut n = 0;
-        loop {
-            match self.commands_port().receive() {
-                Ok(Some(sample)) => {
-                    each(&sample);
-                    n += 1;
-                }
-                Ok(None) => return Ok(n),
-                Err(e) => return Err(ProcessError::Receive(e)),
-            }
-        }
+        self.take_commands_fairly(|_, sample| {
+            each(&sample);
+            Ok(true)
+        })
     }
 
     /// Takes one pending request, to answer with [`DeviceHost::relay_answer`].

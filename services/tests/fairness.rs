@@ -96,3 +96,33 @@ fn every_client_is_served_in_rounds_and_one_call_takes_a_bounded_number() {
     assert_eq!(total, flood_sent + 3);
     assert_eq!(handler.from.len(), flood_sent + 3);
 }
+
+/// The bridge's mirror relays its local clients' commands the same way: in rounds.
+#[test]
+fn the_relay_takes_commands_in_rounds_too() {
+    let domain = Domain::unique_for_test();
+    let ctx = Context::new(&domain, Role::Driver, "fair-relay").unwrap();
+    let mut host = DeviceHost::<ActArray>::new(&ctx, &DEVICE.parse().unwrap(), "t").unwrap();
+    host.state_mut().actuators_count = 2;
+    host.publish().unwrap();
+    let cctx = Context::new(&domain, Role::Client, "fair-relay-clients").unwrap();
+    let mut flood = ActArrayClient::connect_timeout(&cctx, DEVICE, T).unwrap();
+    let mut other = ActArrayClient::connect_timeout(&cctx, DEVICE, T).unwrap();
+    for _ in 0..100 {
+        flood.move_to(0, 0.1).unwrap();
+        other.move_to(1, 0.1).unwrap();
+    }
+    let mut from = Vec::new();
+    let n = host
+        .relay_commands(|raw| from.push(raw.meta.client_id))
+        .unwrap();
+    assert_eq!(n, 200);
+    // Whoever connected first, the first round has the commands of both.
+    let first_round = &from[..2 * limber_services::qos::CMD_BORROWED];
+    for c in [flood.client_id(), other.client_id()] {
+        assert!(
+            first_round.contains(&c),
+            "client {c} missing from the first round {first_round:?}"
+        );
+    }
+}

@@ -21,54 +21,69 @@ impl<I: Interface> DeviceHost<I> {
     /// Takes the pending commands fairly, in rounds: each round at most
     /// [`CMD_BORROWED`](qos::CMD_BORROWED) commands of each client (each client's in its
     /// sending order), until none is left or [`CMD_BUFFER`](qos::CMD_BUFFER) were taken in
-    /// this call (the rest waits for the next call). A client that never stops sending
-    /// neither holds the loop nor delays another client's command by more than a round. A
-    /// command that does not decode is refused with the matching status without reaching
-    /// the handler. Returns how many commands were handled.
+    /// this call (the rest waits for the next call); a client that never stops sending
+    /// neither holds the loop nor delays another client's command by more than a round.
+    /// Handles each: a command that does not decode is refused with the matching status
+    /// without reaching the handler. Returns how many commands were handled.
+    pub fn process_commands<H: DeviceHandler<I>>(
+        &mut self,
+        handler: &mut H,
+    ) -> Result<usize, ProcessError> {
+        self.take_commands_fairly(|host, sample| host.process_command(handler, sample))
+    }
+
+    /// The rounds of [`DeviceHost::process_commands`] (and of the relay's): `each` handles
+    /// one command and says whether it counts; returns how many counted.
     ///
     /// Why rounds: the transport hands out the samples of its first connection that has
     /// data, so draining sample by sample served a flooding client before every client
     /// that connected after it, for as long as the flood lasted. A connection whose
     /// borrowed samples reach the service's limit is passed over until they are released:
     /// a round holds its samples until it has taken one of every client.
-    pub fn process_commands<H: DeviceHandler<I>>(
+    pub(crate) fn take_commands_fairly(
         &mut self,
-        handler: &mut H,
+        mut each: impl FnMut(&mut Self, CmdSample<I>) -> Result<bool, ProcessError>,
     ) -> Result<usize, ProcessError> {
+        // The round's storage, allocated once for every client's CMD_BORROWED.
         let mut round = core::mem::take(&mut self.cmd_round);
-        let handled = self.process_rounds(handler, &mut round);
-        round.clear();
-        self.cmd_round = round;
-        handled
-    }
-
-    /// The rounds of [`DeviceHost::process_commands`], in `round` (empty, its capacity
-    /// one round's most: no allocation).
-    fn process_rounds<H: DeviceHandler<I>>(
-        &mut self,
-        handler: &mut H,
-        round: &mut Vec<CmdSample<I>>,
-    ) -> Result<usize, ProcessError> {
         let (mut n, mut taken) = (0, 0);
-        while taken < qos::CMD_BUFFER {
+        let result = loop {
+            if taken >= qos::CMD_BUFFER {
+                break Ok(n);
+            }
             while round.len() < round.capacity() && taken + round.len() < qos::CMD_BUFFER {
                 match self.commands.receive() {
                     Ok(Some(s)) => round.push(s),
                     Ok(None) | Err(ReceiveError::ExceedsMaxBorrows) => break,
-                    Err(e) => return Err(ProcessError::Receive(e)),
+                    Err(e) => {
+                        round.clear();
+                        self.cmd_round = round;
+                        return Err(ProcessError::Receive(e));
+                    }
                 }
             }
             if round.is_empty() {
-                break;
+                break Ok(n);
             }
             taken += round.len();
+            let mut failed = None;
             for sample in round.drain(..) {
-                if self.process_command(handler, sample)? {
-                    n += 1;
+                match each(self, sample) {
+                    Ok(true) => n += 1,
+                    Ok(false) => {}
+                    Err(e) => {
+                        failed = Some(e);
+                        break;
+                    }
                 }
             }
-        }
-        Ok(n)
+            if let Some(e) = failed {
+                break Err(e);
+            }
+        };
+        round.clear();
+        self.cmd_round = round;
+        result
     }
 
     /// Handles one command sample; `false` if it was dropped uncounted (a forged client id).

@@ -73,8 +73,9 @@ pub(crate) fn loan_ahead<T: core::fmt::Debug + ZeroCopySend>(
 /// A command as the transport hands it to the driver, read in place.
 type CmdSample<I> = iceoryx2::sample::Sample<ipc::Service, <I as Interface>::CmdMsg, ()>;
 
-/// Offers one device of interface `I`: publishes its state, drains its commands in
-/// arrival order, answers its requests, and wakes its clients.
+/// Offers one device of interface `I`: publishes its state, takes its clients' commands
+/// fairly (in rounds across clients, each client's in its sending order), answers its
+/// requests, and wakes its clients.
 ///
 /// Steady state allocates nothing: state samples are loaned from shared memory and written
 /// in place, commands and requests are read in place.
@@ -286,10 +287,6 @@ impl<I: Interface> DeviceHost<I> {
         self.state_loan = loan_ahead(&self.publisher, &self.device, "state");
     }
 
-    pub(crate) fn commands_port(&self) -> &Subscriber<ipc::Service, I::CmdMsg, ()> {
-        &self.commands
-    }
-
     pub(crate) fn server_port(&self) -> &Server<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()> {
         &self.server
     }
@@ -331,7 +328,8 @@ impl<I: Interface> DeviceHost<I> {
         }
     }
 
-    /// Drains every pending command (in arrival order, per client in sending order) and
+    /// Takes the pending commands (fairly, in rounds across clients, each client's in its
+    /// sending order: [`DeviceHost::process_commands`]) and
     /// answers every pending request, calling `handler`. Never blocks.
     pub fn process<H: DeviceHandler<I>>(
         &mut self,
