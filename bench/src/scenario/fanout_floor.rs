@@ -14,12 +14,10 @@ use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PsFactory
 use limber_interfaces::prelude::*;
 use limber_services::monotonic_ns;
 
-use super::floor::BYTES;
-use super::state::{FANOUTS, PERIOD, STOP_MARK};
-use super::{Pace, READY_TIMEOUT, RunCtx};
-use crate::child::{ChildProc, ChildSpec, read_histogram};
+use super::state::{FANOUTS, PERIOD, STOP_MARK, Subscribers};
+use super::{Pace, RunCtx};
 use crate::roles;
-use crate::stats::{Measurement, Metric, Strategy, new_histogram};
+use crate::stats::new_histogram;
 use crate::{BenchArgs, BenchError};
 
 /// The child role of a raw subscriber.
@@ -75,23 +73,7 @@ pub fn fanout(ctx: &mut RunCtx, fan: usize) -> Result<(), BenchError> {
     };
     let (warm, n) = pace.counts(ctx, ((0, 0), (0, 0)));
     let deadline = pace.deadline(ctx, warm + n, PERIOD);
-    let mut subs = Vec::with_capacity(fan);
-    let mut outs = Vec::with_capacity(fan);
-    for i in 0..fan {
-        let out = ctx.tmp_file(&format!("state-raw-{fan}-{i}.hdr"));
-        subs.push(ChildProc::spawn(&ChildSpec {
-            role: ROLE.into(),
-            domain: Some(domain.name().to_string()),
-            out: Some(out.clone()),
-            warmup: warm,
-            deadline,
-            ..Default::default()
-        })?);
-        outs.push(out);
-    }
-    for s in &mut subs {
-        s.expect("ready", READY_TIMEOUT)?;
-    }
+    let mut subs = Subscribers::spawn(ctx, &domain, ROLE, fan, warm, deadline)?;
     let publish = |seq: u64, mark: u32| -> Result<(), BenchError> {
         let loan = publisher
             .loan_uninit()
@@ -116,29 +98,15 @@ pub fn fanout(ctx: &mut RunCtx, fan: usize) -> Result<(), BenchError> {
     // The stop sample, again until every subscriber has gone (one may be between a wait
     // and its next receive).
     let until = Instant::now() + deadline;
-    while !subs.iter_mut().all(|s| s.exited()) && Instant::now() < until {
+    while !subs.all_exited() && Instant::now() < until {
         publish(warm + n + 1, STOP_MARK)?;
         std::thread::sleep(Duration::from_millis(10));
     }
-    let mut merged = new_histogram()?;
-    for s in subs {
-        s.finish(Duration::from_secs(5))?;
-    }
-    for out in &outs {
-        merged
-            .add(read_histogram(out)?)
-            .map_err(|e| BenchError::Histogram(e.to_string()))?;
-    }
-    ctx.push(Measurement {
-        scenario: "state",
-        id: format!("state.raw.{fan}.oneway"),
-        label: format!("iceoryx2 → {fan} listener(s), 1 kHz"),
-        strategy: Strategy::Blocking,
-        metric: Metric::OneWay,
-        bytes: Some((0, BYTES.1)),
-        hist: merged,
-    });
-    Ok(())
+    subs.merge_into(
+        ctx,
+        format!("state.raw.{fan}.oneway"),
+        format!("iceoryx2 → {fan} listener(s), 1 kHz"),
+    )
 }
 
 /// The raw subscriber child (`fanout-sub`): blocks on the event, takes every sample, and

@@ -88,23 +88,7 @@ fn fanout(ctx: &mut RunCtx, fan: usize) -> Result<(), BenchError> {
         ..Default::default()
     })?;
     publisher.expect("ready", READY_TIMEOUT)?;
-    let mut subs = Vec::with_capacity(fan);
-    let mut outs = Vec::with_capacity(fan);
-    for i in 0..fan {
-        let out = ctx.tmp_file(&format!("state-{fan}-{i}.hdr"));
-        subs.push(ChildProc::spawn(&ChildSpec {
-            role: "state-sub".into(),
-            domain: Some(domain.name().to_string()),
-            out: Some(out.clone()),
-            warmup: warm,
-            deadline,
-            ..Default::default()
-        })?);
-        outs.push(out);
-    }
-    for s in &mut subs {
-        s.expect("ready", READY_TIMEOUT)?;
-    }
+    let mut subs = Subscribers::spawn(ctx, &domain, "state-sub", fan, warm, deadline)?;
     if ctx.progress {
         eprintln!(
             "  state fan-out {fan}: {} samples at {} Hz",
@@ -114,32 +98,90 @@ fn fanout(ctx: &mut RunCtx, fan: usize) -> Result<(), BenchError> {
     }
     publisher.send_line("go")?;
     let until = Instant::now() + deadline;
-    while !subs.iter_mut().all(|s| s.exited()) && Instant::now() < until {
+    while !subs.all_exited() && Instant::now() < until {
         std::thread::sleep(Duration::from_millis(10));
     }
     if let Err(e) = publisher.send_line("quit") {
         tracing::warn!("cannot tell the publisher child to quit: {e}");
     }
-    let mut merged = new_histogram()?;
-    for s in subs {
-        s.finish(Duration::from_secs(5))?;
-    }
     publisher.finish(Duration::from_secs(5))?;
-    for out in &outs {
-        merged
-            .add(read_histogram(out)?)
-            .map_err(|e| BenchError::Histogram(e.to_string()))?;
+    subs.merge_into(
+        ctx,
+        format!("state.{fan}.oneway"),
+        format!("state → {fan} subscriber(s), 1 kHz"),
+    )
+}
+
+/// The subscriber children of one fan-out, each writing its histogram of one-way times.
+pub(super) struct Subscribers {
+    procs: Vec<ChildProc>,
+    outs: Vec<std::path::PathBuf>,
+}
+
+impl Subscribers {
+    /// Spawns `fan` children of `role` in `domain` and waits for each one's "ready".
+    pub(super) fn spawn(
+        ctx: &RunCtx,
+        domain: &Domain,
+        role: &str,
+        fan: usize,
+        warm: u64,
+        deadline: Duration,
+    ) -> Result<Self, BenchError> {
+        let mut subs = Subscribers {
+            procs: Vec::with_capacity(fan),
+            outs: Vec::with_capacity(fan),
+        };
+        for i in 0..fan {
+            let out = ctx.tmp_file(&format!("{role}-{fan}-{i}.hdr"));
+            subs.procs.push(ChildProc::spawn(&ChildSpec {
+                role: role.into(),
+                domain: Some(domain.name().to_string()),
+                out: Some(out.clone()),
+                warmup: warm,
+                deadline,
+                ..Default::default()
+            })?);
+            subs.outs.push(out);
+        }
+        for s in &mut subs.procs {
+            s.expect("ready", READY_TIMEOUT)?;
+        }
+        Ok(subs)
     }
-    ctx.push(Measurement {
-        scenario: "state",
-        id: format!("state.{fan}.oneway"),
-        label: format!("state → {fan} subscriber(s), 1 kHz"),
-        strategy: Strategy::Blocking,
-        metric: Metric::OneWay,
-        bytes: Some((0, BYTES.1)),
-        hist: merged,
-    });
-    Ok(())
+
+    /// Whether every subscriber has exited.
+    pub(super) fn all_exited(&mut self) -> bool {
+        self.procs.iter_mut().all(|s| s.exited())
+    }
+
+    /// Waits for the subscribers to end and adds their merged histograms as `id`.
+    pub(super) fn merge_into(
+        self,
+        ctx: &mut RunCtx,
+        id: String,
+        label: String,
+    ) -> Result<(), BenchError> {
+        let mut merged = new_histogram()?;
+        for s in self.procs {
+            s.finish(Duration::from_secs(5))?;
+        }
+        for out in &self.outs {
+            merged
+                .add(read_histogram(out)?)
+                .map_err(|e| BenchError::Histogram(e.to_string()))?;
+        }
+        ctx.push(Measurement {
+            scenario: "state",
+            id,
+            label,
+            strategy: Strategy::Blocking,
+            metric: Metric::OneWay,
+            bytes: Some((0, BYTES.1)),
+            hist: merged,
+        });
+        Ok(())
+    }
 }
 
 /// The publishing driver child (`state-pub`).
