@@ -12,13 +12,31 @@ use limber_services::{Domain, Role};
 use limber_simarm::{SimArm, SimArmOptions, SimObject};
 use limber_world::{Block, LaserConfig, World, WorldDriver, WorldOptions};
 
+/// The drivers of a test, on threads of this process: [`Drivers::stop`] ends them and waits
+/// for them, so that their ports are closed before the test's domain removes its files (a
+/// thread still running when the test returns ends with the process, and leaves the files
+/// of a dead process behind).
+struct Drivers {
+    stop: Arc<AtomicBool>,
+    threads: Vec<std::thread::JoinHandle<()>>,
+}
+
+impl Drivers {
+    fn stop(self) {
+        self.stop.store(true, Ordering::Relaxed);
+        for t in self.threads {
+            t.join().expect("a driver thread panicked");
+        }
+    }
+}
+
 /// simarm with a block at `block` (its grasp point at 0.17 m) and the world's laser, each
-/// on a thread of its own, until the returned flag is set.
-fn start(domain: &Domain, block: [f64; 2]) -> (Arc<AtomicBool>, Arc<Mutex<World>>) {
+/// on a thread of its own, until [`Drivers::stop`].
+fn start(domain: &Domain, block: [f64; 2]) -> (Drivers, Arc<Mutex<World>>) {
     let stop = Arc::new(AtomicBool::new(false));
     let (arm_tx, arm_rx) = mpsc::channel();
     let (d, s) = (domain.clone(), stop.clone());
-    std::thread::spawn(move || {
+    let arm = std::thread::spawn(move || {
         let ctx = Context::new(&d, Role::Driver, "simarm").unwrap();
         let options = SimArmOptions {
             object: Some(SimObject::block([block[0], block[1], 0.17], 0.04)),
@@ -32,7 +50,7 @@ fn start(domain: &Domain, block: [f64; 2]) -> (Arc<AtomicBool>, Arc<Mutex<World>
     arm_rx.recv_timeout(Duration::from_secs(30)).unwrap();
     let (tx, rx) = mpsc::channel();
     let (d, s) = (domain.clone(), stop.clone());
-    std::thread::spawn(move || {
+    let laser = std::thread::spawn(move || {
         let world = World {
             blocks: vec![Block::at(block[0], block[1])],
             ..World::default()
@@ -49,13 +67,17 @@ fn start(domain: &Domain, block: [f64; 2]) -> (Arc<AtomicBool>, Arc<Mutex<World>
         world.run(|| s.load(Ordering::Relaxed)).unwrap();
     });
     let world = rx.recv_timeout(Duration::from_secs(30)).unwrap();
-    (stop, world)
+    let drivers = Drivers {
+        stop,
+        threads: vec![arm, laser],
+    };
+    (drivers, world)
 }
 
 #[test]
 fn listing_2_finds_the_block_with_the_laser_and_moves_it_on_simarm() {
     let d = Domain::unique_for_test();
-    let (stop, world) = start(&d, [0.40, 0.06]);
+    let (drivers, world) = start(&d, [0.40, 0.06]);
     let ctx = Context::new(&d, Role::Client, "ex").unwrap();
     let t = Duration::from_secs(5);
     let mut dev = Devices::connect_with_laser(
@@ -90,13 +112,14 @@ fn listing_2_finds_the_block_with_the_laser_and_moves_it_on_simarm() {
     let b = world.lock().unwrap_or_else(PoisonError::into_inner).blocks[0];
     assert!((b.x - 0.38).hypot(b.y + 0.10) < 0.03, "{b:?}");
     assert_eq!(b.lifted, 0.0);
-    stop.store(true, Ordering::Relaxed);
+    drop(dev);
+    drivers.stop();
 }
 
 #[test]
 fn a_laser_that_sees_nothing_stops_the_program_before_it_moves() {
     let d = Domain::unique_for_test();
-    let (stop, world) = start(&d, [0.40, 0.06]);
+    let (drivers, world) = start(&d, [0.40, 0.06]);
     world
         .lock()
         .unwrap_or_else(PoisonError::into_inner)
@@ -136,5 +159,6 @@ fn a_laser_that_sees_nothing_stops_the_program_before_it_moves() {
     assert_eq!(e, PickError::NothingSeen);
     // The laser is read before the first step: nothing moved.
     assert!(started.is_empty(), "{started:?}");
-    stop.store(true, Ordering::Relaxed);
+    drop(dev);
+    drivers.stop();
 }
