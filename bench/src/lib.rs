@@ -323,15 +323,15 @@ pub fn run_cli(args: BenchArgs) -> Result<(), BenchError> {
     print!("{}", report.table());
     if let Some(path) = &args.json {
         report.write_json(path)?;
-        eprintln!("wrote {}", path.display());
+        progress::line(format_args!("wrote {}", path.display()));
     }
     if let Some(path) = &args.plot {
         plot::draw(path, &report)?;
-        eprintln!("wrote {}", path.display());
+        progress::line(format_args!("wrote {}", path.display()));
     }
     if let Some(dir) = &args.results {
         results::write(dir, &report, &results::invocation())?;
-        eprintln!("wrote {}", results::paths(dir).0.display());
+        progress::line(format_args!("wrote {}", results::paths(dir).0.display()));
     }
     match report.failed() {
         0 => Ok(()),

@@ -3,6 +3,17 @@
 
 use std::io::{IsTerminal, Write};
 
+/// Writes one status line on stderr: the one place the bench speaks to its user while it
+/// runs (progress, the files it wrote, a scenario that failed; the report goes to stdout).
+/// A stderr that cannot be written (closed) loses the line, said at debug level: the run
+/// goes on.
+pub fn line(args: std::fmt::Arguments<'_>) {
+    let mut e = std::io::stderr().lock();
+    if let Err(err) = e.write_fmt(args).and_then(|()| e.write_all(b"\n")) {
+        tracing::debug!(error = %err, "cannot write a status line on stderr");
+    }
+}
+
 /// The progress of one series.
 #[derive(Debug)]
 pub struct Progress {
@@ -25,7 +36,7 @@ impl Progress {
             tty,
         };
         if enabled && !tty {
-            eprintln!("  {label}: {total} samples");
+            line(format_args!("  {label}: {total} samples"));
         }
         p
     }
@@ -48,7 +59,7 @@ impl Progress {
     /// Ends the series.
     pub fn finish(&self) {
         if self.enabled && self.tty {
-            eprintln!("\r  {:<40} done ", self.label);
+            line(format_args!("\r  {:<40} done ", self.label));
         }
     }
 }

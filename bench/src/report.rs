@@ -513,13 +513,12 @@ impl Report {
                 } else {
                     format!("{:.2}", r.value)
                 };
-                let _ = writeln!(
-                    t,
-                    "  {:<72} {:<15} {value:>8}  {goal}{}",
+                t.push_str(&format!(
+                    "  {:<72} {:<15} {value:>8}  {goal}{}\n",
                     r.label,
                     r.strategy,
                     r.floor_note()
-                );
+                ));
             }
         }
         if !self.time_goals.is_empty() {

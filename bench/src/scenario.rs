@@ -217,12 +217,12 @@ pub fn run_one(s: &dyn Scenario, ctx: &mut RunCtx) -> ScenarioOutcome {
         Err(why) => ("not_available", why),
         Ok(()) => {
             if ctx.progress {
-                eprintln!("{}: {}", s.name(), s.description());
+                crate::progress::line(format_args!("{}: {}", s.name(), s.description()));
             }
             match s.run(ctx) {
                 Ok(()) => ("ok", std::mem::take(&mut ctx.notes).join("; ")),
                 Err(e) => {
-                    eprintln!("{}: FAILED: {e}", s.name());
+                    crate::progress::line(format_args!("{}: FAILED: {e}", s.name()));
                     ("failed", e.to_string())
                 }
             }
@@ -322,7 +322,14 @@ impl RunCtx {
         ((base as f64 * self.scale) as u64).max(10)
     }
 
-    /// A fresh domain, so that runs (and scenarios) never collide.
+    /// A progress line on stderr, unless progress is off (`--no-progress`).
+    pub fn say(&self, args: std::fmt::Arguments<'_>) {
+        if self.progress {
+            crate::progress::line(args);
+        }
+    }
+
+    /// A fresh domain, so that runs (and scenarios) never collide: each call another.
     pub fn domain(&self) -> Domain {
         Domain::unique_for_test()
     }

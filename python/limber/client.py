@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import atexit
 import ctypes
-import math
 from ctypes import (
     byref,
     c_bool,
@@ -400,10 +399,7 @@ class _Client(_Owned, Generic[_D]):
         one is kept, since a control loop passes the same timeout every time."""
         if timeout == self._wait_timeout:
             return self._wait_ms
-        s = float(timeout)
-        if not 0.0 <= s <= 1e9:
-            raise ValueError(f"timeout must be a finite number of seconds >= 0, not {timeout!r}")
-        self._wait_ms = c_uint64(math.ceil(s * 1000.0))
+        self._wait_ms = c_uint64(_ms("timeout", timeout))
         self._wait_timeout = timeout
         return self._wait_ms
 

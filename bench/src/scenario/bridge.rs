@@ -192,9 +192,7 @@ fn idle_cost(
     mirror: &ChildProc,
 ) -> Result<(), BenchError> {
     let window = ctx.window(Duration::from_secs(5), Duration::from_secs(1));
-    if ctx.progress {
-        eprintln!("  bridge idle: CPU over {window:?}");
-    }
+    ctx.say(format_args!("  bridge idle: CPU over {window:?}"));
     let shares = cpu::idle(
         &[
             ("bridge expose", expose.pid()),

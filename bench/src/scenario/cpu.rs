@@ -139,9 +139,10 @@ fn measure(
         .current(READY_TIMEOUT)
         .map_err(|e| err("first state", e))?;
     let procs = [("driver", child.pid()), ("client", std::process::id())];
-    if ctx.progress {
-        eprintln!("  cpu {}: idle, then 1 kHz, {window:?} each", mode.name());
-    }
+    ctx.say(format_args!(
+        "  cpu {}: idle, then 1 kHz, {window:?} each",
+        mode.name()
+    ));
     let idle = cpu::idle(&procs, window).map_err(cpu_err)?;
     let pace = Pace::Paced {
         period: PERIOD,

@@ -84,9 +84,7 @@ fn run(ctx: &mut RunCtx, n: usize, clients: usize) -> Result<(), BenchError> {
     let domain = ctx.domain();
     let (warm, count) = (ctx.count(200, 50), ctx.count(2_000, 300));
     let deadline = Duration::from_secs(120) + Duration::from_millis(warm + count) * 3;
-    if ctx.progress {
-        eprintln!("  many: {n} driver(s), {clients} clients");
-    }
+    ctx.say(format_args!("  many: {n} driver(s), {clients} clients"));
     let mut drivers = Vec::with_capacity(n);
     for i in 0..n {
         drivers.push(ChildProc::spawn(&ChildSpec {

@@ -89,13 +89,11 @@ fn fanout(ctx: &mut RunCtx, fan: usize) -> Result<(), BenchError> {
     })?;
     publisher.expect("ready", READY_TIMEOUT)?;
     let mut subs = Subscribers::spawn(ctx, &domain, "state-sub", fan, warm, deadline)?;
-    if ctx.progress {
-        eprintln!(
-            "  state fan-out {fan}: {} samples at {} Hz",
-            warm + n,
-            1_000_000_000 / PERIOD.as_nanos().max(1)
-        );
-    }
+    ctx.say(format_args!(
+        "  state fan-out {fan}: {} samples at {} Hz",
+        warm + n,
+        1_000_000_000 / PERIOD.as_nanos().max(1)
+    ));
     publisher.send_line("go")?;
     let until = Instant::now() + deadline;
     while !subs.all_exited() && Instant::now() < until {
