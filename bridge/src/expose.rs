@@ -490,7 +490,9 @@ fn expose_device<I: Interface>(
     device: &DeviceName,
     tx: &Sender<Event>,
 ) -> Result<Box<dyn ExposedDevice>, String> {
-    let client = Client::<I>::connect(ctx, &device.to_string()).map_err(|e| e.to_string())?;
+    let mut client = Client::<I>::connect(ctx, &device.to_string()).map_err(|e| e.to_string())?;
+    // The outcomes of every client: those of the remote clients' commands go back to them.
+    client.watch_outcomes().map_err(|e| e.to_string())?;
     let listener = client.relay_listener().map_err(|e| e.to_string())?;
     // The same test as the one that withdraws it: a driver found dead is not exposed.
     if !client.relay_driver_alive() {

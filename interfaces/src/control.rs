@@ -13,7 +13,7 @@ wire_struct! {
     /// client (each keeps its own, by `client_id`): one sample when the command is applied
     /// or refused, and one more with `STATUS_PREEMPTED` when another client's command
     /// cuts short the motion it started.
-    pub struct OutcomeMsg : "limber.v4.OutcomeMsg", size = 608, align = 8 {
+    pub struct OutcomeMsg : "limber.v5.OutcomeMsg", size = 608, align = 8 {
         /// The client that sent the command.
         pub client_id: u64,
         /// That client's sequence number of the command.
@@ -198,7 +198,7 @@ pub(crate) const RESULT_GROUP: ConstantGroup = ConstantGroup {
 
 wire_struct! {
     /// A request on a device's `lease` channel (`op` is a `LEASE_OP` code).
-    pub struct LeaseReq : "limber.v4.LeaseReq", size = 80, align = 8 {
+    pub struct LeaseReq : "limber.v5.LeaseReq", size = 80, align = 8 {
         /// The requesting client's id (the one its commands carry).
         pub client_id: u64,
         /// The client's sequence number of this request.
@@ -222,7 +222,7 @@ wire_struct! {
 
 wire_struct! {
     /// The answer to a [`LeaseReq`]: the status and who holds the device now.
-    pub struct LeaseReply : "limber.v4.LeaseReply", size = 80, align = 8 {
+    pub struct LeaseReply : "limber.v5.LeaseReply", size = 80, align = 8 {
         /// The holder's client id (0: nobody holds the device).
         pub holder_client: u64,
         /// The request's sequence number.

@@ -51,7 +51,9 @@ pub use wire::{WireField, WireStruct};
 /// `EFFORT_NOT_SETTABLE` and `SPEED_NOT_SETTABLE`, and the limb's paths (LINE, PTP:
 /// [`limb::LimbPathCmd`], a wider [`limb::LimbCmdMsg`]; the limb state's path fields) with
 /// the statuses `PATH_COLLIDES` and `PATH_JUMPS`.
-pub const LAYOUT_VERSION: u32 = 4;
+/// Version 5 added the `told` channel: each client's own outcomes, on a stream of its own
+/// ([`protocol::TOLD_BUFFER`]); the `outcome` channel is for those who watch every outcome.
+pub const LAYOUT_VERSION: u32 = 5;
 
 /// Everything a driver or client author needs, in one `use`.
 pub mod prelude {

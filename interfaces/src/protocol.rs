@@ -1,5 +1,5 @@
-//! Protocol numbers beside the wire layouts: name limits, event ids and the outcome buffer
-//! every client opens. `limber-services` uses them, and the manifest carries them so the
+//! Protocol numbers beside the wire layouts: name limits, event ids and the outcome
+//! buffers. `limber-services` uses them, and the manifest carries them so the
 //! C header and the Python module are generated with the same values.
 
 use crate::manifest::{Constant, ConstantGroup};
@@ -20,9 +20,14 @@ pub const NOTIFY_STATE: usize = 1;
 /// Event id on `notify`: a reply was sent.
 pub const NOTIFY_REPLY: usize = 2;
 
-/// Outcomes buffered per client on the `outcome` channel (every client sees every outcome
-/// of the device and keeps its own).
+/// Outcomes buffered per watcher on the `outcome` channel (a bridge, a recorder: it sees
+/// every outcome of the device).
 pub const OUTCOME_BUFFER: usize = 256;
+
+/// Outcomes buffered per client on its own stream of the `told` channel (only the outcomes
+/// and results of its own commands: this many may be decided between two looks of the
+/// client before the oldest is overwritten).
+pub const TOLD_BUFFER: usize = 64;
 
 pub(crate) const NAME_GROUP: ConstantGroup = ConstantGroup {
     name: "NAME",
@@ -83,9 +88,16 @@ pub(crate) const NOTIFY_GROUP: ConstantGroup = ConstantGroup {
 pub(crate) const QOS_GROUP: ConstantGroup = ConstantGroup {
     name: "QOS",
     doc: "Buffer sizes a client opens its ports with",
-    constants: &[Constant {
-        name: "OUTCOME_BUFFER",
-        value: OUTCOME_BUFFER as i64,
-        doc: "outcomes buffered per client on the outcome channel",
-    }],
+    constants: &[
+        Constant {
+            name: "OUTCOME_BUFFER",
+            value: OUTCOME_BUFFER as i64,
+            doc: "outcomes buffered per watcher on the outcome channel",
+        },
+        Constant {
+            name: "TOLD_BUFFER",
+            value: TOLD_BUFFER as i64,
+            doc: "outcomes of its own commands buffered per client on the told channel",
+        },
+    ],
 };

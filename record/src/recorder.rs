@@ -310,6 +310,7 @@ impl InterfaceVisitor for Open<'_> {
         let dev = self.name.to_string();
         // No wait: a named device that is not there yet is looked for again next round.
         let mut client = Client::<I>::connect(self.ctx, &dev).map_err(|e| e.to_string())?;
+        client.watch_outcomes().map_err(|e| e.to_string())?;
         let listener = client.relay_listener().map_err(|e| e.to_string())?;
         let iface = I::KIND.name();
         let meta = |kind: &'static str| {

@@ -63,11 +63,14 @@ pub enum Channel {
     Wake,
     /// Wake-up of the clients (event, driver → clients: new state, reply ready).
     Notify,
-    /// The outcome of every command, driver → clients (publish-subscribe; each client
-    /// keeps its own).
+    /// The outcome of every command, driver → whoever watches them all (publish-subscribe:
+    /// a bridge, `limber record`); a client reads its own on [`Channel::Told`].
     Outcome,
     /// The control lease: acquire, renew, release, query (request-response).
     Lease,
+    /// Each client's own outcomes, driver → that client (request-response: a client asks
+    /// once, with its client id, and the driver answers with every outcome of its commands).
+    Told,
 }
 
 impl Channel {
@@ -81,6 +84,7 @@ impl Channel {
             Channel::Notify => "notify",
             Channel::Outcome => "outcome",
             Channel::Lease => "lease",
+            Channel::Told => "told",
         }
     }
 }

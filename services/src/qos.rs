@@ -91,10 +91,16 @@ pub const CMD_BUFFER: usize = 256;
 /// Commands of one client the driver holds at once: the most it takes of one client in
 /// one round of its fair draining (`DeviceHost::process_commands`).
 pub const CMD_BORROWED: usize = 2;
-/// Outcomes buffered per client (every client sees every outcome of the device and keeps
-/// its own): this many commands of all clients may be decided between two looks of a
-/// waiting client before its outcome is overwritten (safe overflow).
+/// Outcomes buffered per watcher of the `outcome` channel (a bridge, a recorder: every
+/// outcome of the device); when full the oldest is replaced (safe overflow).
 pub const OUTCOME_BUFFER: usize = limber_interfaces::protocol::OUTCOME_BUFFER;
+/// Outcomes buffered per client on its own stream (`told`): only its own commands' outcomes
+/// and results, so this many of its own may be decided between two looks before the
+/// oldest is replaced (safe overflow); nobody else's traffic takes its room.
+pub const TOLD_BUFFER: usize = limber_interfaces::protocol::TOLD_BUFFER;
+/// Streams a client may have open on `told` at once: its stream, and the one that replaces
+/// it when a restarted driver is met (the old one closes).
+pub const TOLD_STREAMS: usize = 2;
 /// Subscribers of `cmd`: the driver, a dead driver not yet cleaned up, and observers.
 pub const CMD_SUBSCRIBERS: usize = 4;
 /// Servers of `req`: the driver plus one dead driver not yet cleaned up.

@@ -96,15 +96,10 @@ impl<I: Interface> DeviceHost<I> {
         sent.map_err(AnswerError::Undelivered)
     }
 
-    /// Publishes one outcome exactly as given (its `client_id` picks the client).
+    /// Publishes one outcome exactly as given but for its stamp (its `client_id` picks
+    /// the client: on that client's stream, and to every watcher), and wakes the clients.
     pub fn relay_outcome(&mut self, msg: &OutcomeMsg) -> Result<(), PublishError> {
-        let loan = self
-            .outcome_port()
-            .loan_uninit()
-            .map_err(PublishError::Loan)?;
-        loan.write_payload(*msg)
-            .send()
-            .map_err(PublishError::Send)?;
+        self.relay_outcome_message(msg)?;
         self.notify_clients_of(qos::EVENT_STATE);
         Ok(())
     }
@@ -222,14 +217,19 @@ impl<I: Interface> Client<I> {
         }
     }
 
-    /// Takes every outcome that arrived, of every client.
+    /// Takes every outcome that arrived, of every client, since [`Client::watch_outcomes`]
+    /// (called by the first call if not before).
     pub fn relay_outcomes(
         &mut self,
         mut each: impl FnMut(&OutcomeMsg),
     ) -> Result<usize, Iox2Error> {
+        self.watch_outcomes()?;
+        let Some(sub) = &self.outcome_sub else {
+            return Ok(0);
+        };
         let mut n = 0;
         loop {
-            match self.outcome_sub.receive() {
+            match sub.receive() {
                 Ok(Some(s)) => {
                     each(&s);
                     n += 1;

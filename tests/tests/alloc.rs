@@ -26,9 +26,11 @@ impl Rig {
     /// One control cycle: 4 commands sent (4 samples), the driver publishes 3 states,
     /// one outcome state per command and one sample on the `outcome` channel per command
     /// (11 samples), and the result of each motion a command of this cycle ends (the
-    /// previous cycle's motion on the same joints, preempted: 4 samples); the client reads
-    /// 3 states, its 4 outcomes and the 4 results.
-    const SAMPLES_PER_CYCLE: u64 = 19;
+    /// previous cycle's motion on the same joints, preempted: 4 samples); each outcome and
+    /// result also goes to the client on its own stream (8 responses, one allocation of
+    /// iceoryx2's each as a sample's); the client reads 3 states, its 4 outcomes and the 4
+    /// results.
+    const SAMPLES_PER_CYCLE: u64 = 27;
 
     fn cycle(&mut self, i: u64) {
         let p = (i % 100) as f64 * 1e-3;

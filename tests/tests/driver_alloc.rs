@@ -1,7 +1,7 @@
 //! The Pioneer driver's loop allocates nothing of its own in steady state: counted on the
 //! driver's thread while the emulator streams SIPs and ARMpacs and a client (on another
 //! thread) commands the arm. iceoryx2 0.10 itself allocates one small `Rc` per sample
-//! published (see `alloc.rs`) and two small buffers (16 and 24 bytes) per WaitSet
+//! published and per response sent (an outcome on its client's stream: see `alloc.rs`) and two small buffers (16 and 24 bytes) per WaitSet
 //! wake-up (`wait_and_process_once_with_timeout`, `handle_all_attachments`), so the count
 //! may not exceed samples published plus twice the wake-ups (plus the one-time set-up of
 //! the wait set when the measured run starts). Traced with backtraces: no

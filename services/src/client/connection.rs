@@ -5,11 +5,13 @@ use core::time::Duration;
 use std::time::Instant;
 
 use iceoryx2::node::NodeView;
+use iceoryx2::pending_response::PendingResponse;
 use iceoryx2::port::client::Client as IoxClient;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::prelude::*;
 use iceoryx2::sample::Sample;
 use iceoryx2::service::attribute::{AttributeKey, AttributeValue};
@@ -30,6 +32,21 @@ use crate::qos;
 pub const GROUP_PERMISSION_WAIT: Duration = Duration::from_secs(2);
 
 pub(super) const OUTCOME_SLOTS: usize = 16;
+
+/// A client's own outcomes: its port on the device's `told` channel and the stream it
+/// opened there (see `crate::host` `told.rs`).
+pub(crate) struct ToldSide {
+    pub(super) port: IoxClient<ipc::Service, u64, (), OutcomeMsg, ()>,
+    /// Open while the driver that took it keeps it (a restarted driver needs a new one).
+    pub(super) stream: Option<ToldStream>,
+}
+
+/// A client's outcome stream: its request on `told`, answered with every outcome of its
+/// commands.
+type ToldStream = PendingResponse<ipc::Service, u64, (), OutcomeMsg, ()>;
+
+type OutcomeSvc =
+    iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, OutcomeMsg, ()>;
 
 /// The lease port of a client and the lease it holds.
 pub(crate) struct LeaseSide {
@@ -68,7 +85,11 @@ pub struct Client<I: Interface> {
     pub(super) notify: Option<Listener<ipc::Service>>,
     pub(super) cmd_seq: u64,
     pub(super) req_seq: u64,
-    pub(crate) outcome_sub: Subscriber<ipc::Service, OutcomeMsg, ()>,
+    /// This client's own outcomes (see [`ToldSide`]).
+    pub(super) told: ToldSide,
+    pub(crate) outcome_svc: OutcomeSvc,
+    /// Every outcome of the device, once [`Client::watch_outcomes`] asked for them.
+    pub(crate) outcome_sub: Option<Subscriber<ipc::Service, OutcomeMsg, ()>>,
     pub(super) outcomes: [Outcome; OUTCOME_SLOTS],
     pub(super) preemptions: [Outcome; OUTCOME_SLOTS],
     /// The motion results of this client's last commands (by sequence number).
@@ -311,6 +332,15 @@ impl<I: Interface> Client<I> {
             .event()
             .open_with_attributes(&layout)
             .map_err(|e| map("notify", e.into()))?;
+        let told = node
+            .service_builder(&device.service_name(Channel::Told))
+            .request_response::<u64, OutcomeMsg>()
+            .enable_fire_and_forget_requests(false)
+            .open_with_attributes(&layout)
+            .map_err(|e| map("told", e.into()))?
+            .client_builder()
+            .create()
+            .map_err(|e| map("told", e.into()))?;
         // Last: the driver makes its `outcome` publisher after every other port (see
         // `DeviceHost::new`). Without it the driver is still starting: no driver yet
         // (`connect_timeout` tries again), rather than a client whose first request or
@@ -323,11 +353,12 @@ impl<I: Interface> Client<I> {
         if outcome_svc.dynamic_config().number_of_publishers() == 0 {
             return Err(no_driver());
         }
-        let outcome_sub = outcome_svc
-            .subscriber_builder()
-            .buffer_size(qos::OUTCOME_BUFFER)
-            .create()
-            .map_err(|e| map("outcome", e.into()))?;
+        let client_id = ctx.new_client_id();
+        // This client's outcome stream, asked for before any command can be sent.
+        let stream = open_told_stream(&told, client_id).map_err(|e| map("told", e))?;
+        if stream.is_none() {
+            return Err(no_driver());
+        }
         // Group mode: open the files these ports made to the group at once (the watch of
         // crate::widen would, a little later).
         ctx.domain().widen_now();
@@ -339,7 +370,7 @@ impl<I: Interface> Client<I> {
         Ok(Client {
             ctx: ctx.clone(),
             device: device.clone(),
-            client_id: ctx.new_client_id(),
+            client_id,
             data_svc,
             states,
             latest: None,
@@ -352,7 +383,9 @@ impl<I: Interface> Client<I> {
             notify: None,
             cmd_seq: 0,
             req_seq: 0,
-            outcome_sub,
+            told: ToldSide { port: told, stream },
+            outcome_svc,
+            outcome_sub: None,
             outcomes: [Outcome::NONE; OUTCOME_SLOTS],
             preemptions: [Outcome::NONE; OUTCOME_SLOTS],
             results: [None; OUTCOME_SLOTS],
@@ -438,6 +471,59 @@ impl<I: Interface> Client<I> {
             DriverStatus::Absent => {}
         }
         status
+    }
+}
+
+/// Asks the driver of `port` for the outcomes of client `client_id`: the stream, or `None`
+/// when no driver took the request.
+fn open_told_stream(
+    port: &IoxClient<ipc::Service, u64, (), OutcomeMsg, ()>,
+    client_id: u64,
+) -> Result<Option<ToldStream>, Iox2Error> {
+    let pending = port.loan_uninit()?.write_payload(client_id).send()?;
+    Ok((pending.number_of_server_connections() > 0).then_some(pending))
+}
+
+impl<I: Interface> Client<I> {
+    /// Makes sure this client's outcome stream is open: a driver that restarted (or took
+    /// over the device) knows nothing of the stream the client opened with the one before
+    /// it, so a closed one is asked for again. Called before each command (so the driver
+    /// finds the stream of the client whose command it takes) and on the waits' liveness
+    /// checks.
+    pub(super) fn keep_told_stream(&mut self) {
+        if let Err(e) = self.told.port.update_connections() {
+            tracing::debug!(device = %self.device, error = %e, "cannot connect the outcome stream's port");
+        }
+        if self.told.stream.as_ref().is_some_and(|s| s.is_connected()) {
+            return;
+        }
+        // Dropped first: its slot is free for the new one.
+        self.told.stream = None;
+        match open_told_stream(&self.told.port, self.client_id) {
+            Ok(s) => {
+                if s.is_some() {
+                    tracing::debug!(device = %self.device, "outcome stream opened again");
+                }
+                self.told.stream = s;
+            }
+            Err(e) => {
+                tracing::warn!(device = %self.device, error = %e, "cannot open the outcome stream");
+            }
+        }
+    }
+
+    /// Watches every outcome of the device, of every client, from now on (for a bridge or a
+    /// recorder: [`Client::relay_outcomes`]); a client reads its own without it.
+    pub fn watch_outcomes(&mut self) -> Result<(), Iox2Error> {
+        if self.outcome_sub.is_none() {
+            self.outcome_sub = Some(
+                self.outcome_svc
+                    .subscriber_builder()
+                    .buffer_size(qos::OUTCOME_BUFFER)
+                    .create()?,
+            );
+        }
+        Ok(())
     }
 }
 

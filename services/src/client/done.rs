@@ -162,6 +162,7 @@ impl<I: Interface> Client<I> {
                 if self.driver_status() != DriverStatus::Alive {
                     return Err(WaitError::DriverGone.into());
                 }
+                self.keep_told_stream();
             }
             self.pause(deadline.min(next_check))
                 .map_err(WaitError::Transport)?;

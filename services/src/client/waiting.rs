@@ -105,30 +105,32 @@ impl<I: Interface> Client<I> {
         }
     }
 
-    /// Takes the outcomes that arrived, keeping this client's own.
+    /// Takes the outcomes of this client's commands that arrived on its stream.
     fn take_outcomes(&mut self) -> Result<(), WaitError> {
         loop {
-            match self.outcome_sub.receive() {
-                Ok(Some(s)) => {
-                    let m: &OutcomeMsg = &s;
-                    if m.client_id != self.client_id {
-                        continue;
-                    }
-                    if m.result != 0 {
-                        self.result_arrived(m);
-                        continue;
-                    }
-                    let o = Outcome::from_msg(m);
-                    let slot = (m.cmd_seq as usize) % OUTCOME_SLOTS;
-                    if m.status == Status::Preempted.code() {
-                        self.preemptions[slot] = o;
-                    } else {
-                        self.outcomes[slot] = o;
-                        self.max_seen_seq = self.max_seen_seq.max(m.cmd_seq);
-                    }
-                }
+            let Some(stream) = &self.told.stream else {
+                return Ok(());
+            };
+            let m: OutcomeMsg = match stream.receive() {
+                Ok(Some(r)) => *r.payload(),
                 Ok(None) => return Ok(()),
                 Err(e) => return Err(WaitError::Transport(e.into())),
+            };
+            // Only its own come on its stream; a driver of another kind may say otherwise.
+            if m.client_id != self.client_id {
+                continue;
+            }
+            if m.result != 0 {
+                self.result_arrived(&m);
+                continue;
+            }
+            let o = Outcome::from_msg(&m);
+            let slot = (m.cmd_seq as usize) % OUTCOME_SLOTS;
+            if m.status == Status::Preempted.code() {
+                self.preemptions[slot] = o;
+            } else {
+                self.outcomes[slot] = o;
+                self.max_seen_seq = self.max_seen_seq.max(m.cmd_seq);
             }
         }
     }
@@ -316,6 +318,7 @@ impl<I: Interface> Client<I> {
                 if self.driver_status() != DriverStatus::Alive {
                     return Err(WaitError::DriverGone);
                 }
+                self.keep_told_stream();
             }
             self.pause(deadline.min(next_check))
                 .map_err(WaitError::Transport)?;

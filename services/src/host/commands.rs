@@ -2,18 +2,13 @@
 //! carried out by the handler, and its outcome (and those of the motions it preempted)
 //! published.
 
-use core::mem::MaybeUninit;
-
 use iceoryx2::port::ReceiveError;
-use iceoryx2::port::publisher::Publisher;
-use iceoryx2::prelude::*;
-use iceoryx2::sample_mut_uninit::SampleMutUninit;
 use limber_interfaces::prelude::*;
 
 use super::arbiter::{CmdRef, Told};
-use super::{CmdSample, DeviceHandler, DeviceHost, HostStats, Origin, ProcessError, loan_ahead};
+use super::told::Outcomes;
+use super::{CmdSample, DeviceHandler, DeviceHost, HostStats, Origin, ProcessError};
 use crate::context::monotonic_ns;
-use crate::error::Iox2Error;
 use crate::naming::DeviceName;
 use crate::qos;
 
@@ -141,13 +136,7 @@ impl<I: Interface> DeviceHost<I> {
         // (Clients are notified after both.)
         let state_sent = self.publish_each_outcome.then(|| self.send_state());
         let told = self.arbiter.outcome(cmd, node, status);
-        publish_outcome(
-            &self.outcomes,
-            &mut self.outcome_loan,
-            &mut self.stats,
-            &self.device,
-            told,
-        );
+        publish_outcome(&mut self.out, &mut self.stats, &self.device, told);
         self.stats.commands += 1;
         if !status.is_carried_out() {
             self.stats.refused += 1;
@@ -160,9 +149,7 @@ impl<I: Interface> DeviceHost<I> {
         // outcome (so do the motions it preempted or stopped).
         self.publish_results();
         // The next command's outcome sample, loaned now rather than on its path.
-        if self.outcome_loan.is_none() {
-            self.outcome_loan = loan_ahead(&self.outcomes, &self.device, "outcome");
-        }
+        self.out.loan_ahead(&self.device);
         Ok(true)
     }
 
@@ -198,30 +185,19 @@ impl<I: Interface> DeviceHost<I> {
             return status;
         }
         self.motion_started(cmd, motion);
-        let (outcomes, loan, stats, device) = (
-            &self.outcomes,
-            &mut self.outcome_loan,
-            &mut self.stats,
-            &self.device,
-        );
+        let (out, stats, device) = (&mut self.out, &mut self.stats, &self.device);
         self.arbiter.carried_out(cmd, motion, |told| {
             stats.preempted += 1;
-            publish_outcome(outcomes, loan, stats, device, told);
+            publish_outcome(out, stats, device, told);
         });
         status
     }
 }
 
-/// Publishes one outcome on the `outcome` channel (in the sample loaned ahead, if any); a
-/// failure is counted and logged (that client then waits up to its timeout), never fatal to
-/// the loop.
-fn publish_outcome(
-    outcomes: &Publisher<ipc::Service, OutcomeMsg, ()>,
-    loan_ahead: &mut Option<SampleMutUninit<ipc::Service, MaybeUninit<OutcomeMsg>, ()>>,
-    stats: &mut HostStats,
-    device: &DeviceName,
-    told: Told,
-) {
+/// Sends one outcome to the client it names and to the watchers ([`Outcomes::publish`]);
+/// a failure is counted and logged (that client then waits up to its timeout), never fatal
+/// to the loop.
+fn publish_outcome(out: &mut Outcomes, stats: &mut HostStats, device: &DeviceName, told: Told) {
     let mut msg = OutcomeMsg {
         client_id: told.cmd.client_id,
         cmd_seq: told.cmd.seq,
@@ -233,33 +209,5 @@ fn publish_outcome(
     if let Some(n) = told.other_name {
         msg.other_name = n;
     }
-    publish_message(outcomes, loan_ahead, stats, device, msg);
-}
-
-/// Publishes one sample on the `outcome` channel (an outcome or a motion's result),
-/// stamped now; see [`publish_outcome`].
-pub(super) fn publish_message(
-    outcomes: &Publisher<ipc::Service, OutcomeMsg, ()>,
-    loan_ahead: &mut Option<SampleMutUninit<ipc::Service, MaybeUninit<OutcomeMsg>, ()>>,
-    stats: &mut HostStats,
-    device: &DeviceName,
-    mut msg: OutcomeMsg,
-) {
-    let loan = match loan_ahead.take() {
-        Some(l) => Ok(l),
-        None => outcomes.loan_uninit(),
-    };
-    msg.stamp_ns = monotonic_ns();
-    let sent = match loan {
-        Ok(loan) => loan.write_payload(msg).send().map_err(Iox2Error::from),
-        Err(e) => Err(e.into()),
-    };
-    match sent {
-        Ok(_) => stats.outcomes += 1,
-        Err(e) => {
-            stats.failed_outcomes += 1;
-            tracing::warn!(device = %device, client = msg.client_id, seq = msg.cmd_seq,
-                result = msg.result, error = %e, "cannot publish an outcome");
-        }
-    }
+    out.publish(stats, device, msg);
 }

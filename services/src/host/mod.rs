@@ -39,6 +39,7 @@ mod open;
 mod requests;
 mod senders;
 pub mod stats;
+mod told;
 
 use arbiter::Arbiter;
 pub use arbiter::{HOLDER_CHECK_NS, Holder, MAX_LEASE_TIMEOUT_NS, MIN_LEASE_TIMEOUT_NS};
@@ -111,7 +112,8 @@ pub struct DeviceHost<I: Interface> {
     server: Server<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()>,
     wake: Option<Listener<ipc::Service>>,
     notify: Notifier<ipc::Service>,
-    outcomes: Publisher<ipc::Service, OutcomeMsg, ()>,
+    /// The outcome ports: each client's stream, and every outcome for watchers.
+    out: told::Outcomes,
     lease_svc: iceoryx2::service::port_factory::request_response::PortFactory<
         ipc::Service,
         LeaseReq,
@@ -136,8 +138,6 @@ pub struct DeviceHost<I: Interface> {
     spin_calls: u32,
     /// A state sample loaned ahead, for the next publication (see `loan_ahead`).
     state_loan: Option<SampleMutUninit<ipc::Service, MaybeUninit<I::Data>, ()>>,
-    /// An outcome sample loaned ahead, for the next command's outcome.
-    outcome_loan: Option<SampleMutUninit<ipc::Service, MaybeUninit<OutcomeMsg>, ()>>,
     _i: PhantomData<I>,
     /// The domain (group mode decides whose dead processes this host may clean up). Last:
     /// dropped after the ports, so a test's domain whose last handle this is finds them gone.
@@ -292,7 +292,15 @@ impl<I: Interface> DeviceHost<I> {
     }
 
     pub(crate) fn outcome_port(&self) -> &Publisher<ipc::Service, OutcomeMsg, ()> {
-        &self.outcomes
+        &self.out.all
+    }
+
+    /// Sends an outcome as given to the client it names and to the watchers (a relay's).
+    pub(crate) fn relay_outcome_message(&mut self, msg: &OutcomeMsg) -> Result<(), PublishError> {
+        let told = self.out.send(&self.device, msg)?;
+        self.stats.outcomes += 1;
+        self.stats.told += u64::from(told);
+        Ok(())
     }
 
     pub(crate) fn data_port(&self) -> &Publisher<ipc::Service, I::Data, ()> {
@@ -322,7 +330,7 @@ impl<I: Interface> DeviceHost<I> {
             self.stats.failed_connection_updates += 1;
             tracing::debug!(device = %self.device, error = %e, "cannot connect new clients");
         }
-        if let Err(e) = self.outcomes.update_connections() {
+        if let Err(e) = self.out.update_connections() {
             self.stats.failed_connection_updates += 1;
             tracing::debug!(device = %self.device, error = %e, "cannot connect new clients");
         }
@@ -388,5 +396,6 @@ impl<I: Interface> DeviceHost<I> {
     pub fn cleanup_dead(&self) {
         self.domain.cleanup_dead_nodes(&self.data_svc);
         self.domain.cleanup_dead_nodes(&self.lease_svc);
+        self.domain.cleanup_dead_nodes(&self.out.told_svc);
     }
 }

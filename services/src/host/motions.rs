@@ -290,13 +290,7 @@ impl<I: Interface> DeviceHost<I> {
 
     /// Publishes the result of one motion.
     fn publish_one(&mut self, t: &Tracked) {
-        super::commands::publish_message(
-            &self.outcomes,
-            &mut self.outcome_loan,
-            &mut self.stats,
-            &self.device,
-            t.message(),
-        );
+        self.out.publish(&mut self.stats, &self.device, t.message());
         self.stats.results += 1;
     }
 }

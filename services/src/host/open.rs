@@ -187,10 +187,28 @@ impl<I: Interface> DeviceHost<I> {
             .create()
             .map_err(|e| transport("lease", e.into()))?;
 
+        // Each client's own outcomes: one stream per client (see `told.rs`).
+        let told_svc = node
+            .service_builder(&device.service_name(Channel::Told))
+            .request_response::<u64, OutcomeMsg>()
+            .max_clients(ports)
+            .max_servers(qos::REQ_SERVERS)
+            .max_nodes(nodes)
+            .max_active_requests_per_client(qos::TOLD_STREAMS)
+            .max_response_buffer_size(qos::TOLD_BUFFER)
+            .enable_safe_overflow_for_responses(true)
+            .enable_fire_and_forget_requests(false)
+            .open_or_create_with_attributes(&verifier)
+            .map_err(|e| transport("told", e.into()))?;
+        let told = told_svc
+            .server_builder()
+            .create()
+            .map_err(|e| transport("told", e.into()))?;
+
         // Last: a client connects only once it has opened the `outcome` channel (the last
         // it opens), so it finds every other port of this driver made: its first request
         // or lease never goes to a server that is not there yet.
-        let outcomes = node
+        let all_outcomes = node
             .service_builder(&device.service_name(Channel::Outcome))
             .publish_subscribe::<OutcomeMsg>()
             .history_size(0)
@@ -225,7 +243,7 @@ impl<I: Interface> DeviceHost<I> {
             server,
             wake: Some(wake),
             notify,
-            outcomes,
+            out: super::told::Outcomes::new(all_outcomes, told_svc, told, ports),
             lease_svc,
             lease_server,
             // A tag of its own: of the hosts that share a lease, the one that granted it
@@ -241,7 +259,6 @@ impl<I: Interface> DeviceHost<I> {
             publish_each_outcome: true,
             spin_calls: 0,
             state_loan: None,
-            outcome_loan: None,
             _i: PhantomData,
         })
     }

@@ -97,13 +97,25 @@ impl PortNodes {
         Req: core::fmt::Debug + ZeroCopySend,
         Res: core::fmt::Debug + ZeroCopySend,
     {
+        self.client_sender(port, svc).node
+    }
+
+    /// The sender of the client `port` of the request-response service `svc`.
+    pub(crate) fn client_sender<Req, Res>(
+        &mut self,
+        port: u128,
+        svc: &request_response::PortFactory<ipc::Service, Req, (), Res, ()>,
+    ) -> Sender
+    where
+        Req: core::fmt::Debug + ZeroCopySend,
+        Res: core::fmt::Debug + ZeroCopySend,
+    {
         self.node_of(port, |add| {
             svc.dynamic_config().list_clients(|d| {
                 add(d.client_id.value(), sender(&d.node_id));
                 CallbackProgression::Continue
             });
         })
-        .node
     }
 }
 

@@ -19,6 +19,8 @@ pub struct HostStats {
     pub published: u64,
     /// Outcome samples published (one per command, and one per preemption).
     pub outcomes: u64,
+    /// Outcomes (and results) also sent on the stream of the client they name (`told`).
+    pub told: u64,
     /// Notifications to waiting clients that failed (new state or reply ready; a client
     /// waiting with a timeout re-checks anyway, so each is a delay, not a loss).
     pub failed_notifies: u64,
@@ -49,6 +51,7 @@ impl core::ops::AddAssign for HostStats {
         self.undelivered_replies += o.undelivered_replies;
         self.published += o.published;
         self.outcomes += o.outcomes;
+        self.told += o.told;
         self.failed_notifies += o.failed_notifies;
         self.failed_connection_updates += o.failed_connection_updates;
         self.failed_outcomes += o.failed_outcomes;

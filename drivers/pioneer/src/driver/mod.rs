@@ -440,7 +440,7 @@ impl PioneerDriver {
     /// iceoryx2 one small allocation, see `tests/tests/alloc.rs`), and statistics samples.
     pub fn samples_published(&self) -> u64 {
         let h = self.hosts.stats();
-        self.stats.header.seq + h.published + h.outcomes
+        self.stats.header.seq + h.published + h.outcomes + h.told
     }
 
     /// The loop's timing: periods, jitter, command-to-wire latencies.

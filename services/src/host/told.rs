@@ -1,0 +1,204 @@
+//! Where outcomes go: each to the client it names, on that client's own stream of the `told`
+//! channel, and every one on the `outcome` channel for those who watch them all (a bridge,
+//! `limber record`).
+//!
+//! Why a stream per client: on one channel that every client reads, a client's buffer
+//! holds the outcomes of everybody's commands, and a client descheduled while others flood
+//! the device found its own overwritten by theirs (safe overflow) and waited out its
+//! timeout. A client opens its stream at connect with one request on `told` (request-
+//! response: iceoryx2 routes each response to the client that asked, into a buffer of its
+//! own); the driver keeps the request and sends every outcome of that client as a response
+//! to it. Only the client's own commands can fill its buffer.
+//!
+//! Who a stream is for comes from the transport: the request names a client id, and the
+//! process that sent it (iceoryx2's registry of the service's clients) must be the one the
+//! id belongs to (`senders::client_of_process`), so no process takes or displaces another
+//! process's stream.
+
+use core::mem::MaybeUninit;
+
+use iceoryx2::active_request::ActiveRequest;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::server::Server;
+use iceoryx2::port::update_connections::{ConnectionFailure, UpdateConnections};
+use iceoryx2::prelude::*;
+use iceoryx2::sample_mut_uninit::SampleMutUninit;
+use limber_interfaces::prelude::*;
+
+use super::senders::{PortNodes, client_of_process};
+use super::{HostStats, PublishError};
+use crate::context::monotonic_ns;
+use crate::error::Iox2Error;
+use crate::naming::DeviceName;
+
+/// The `told` service: a client id asks, outcomes answer.
+pub(crate) type ToldSvc = iceoryx2::service::port_factory::request_response::PortFactory<
+    ipc::Service,
+    u64,
+    (),
+    OutcomeMsg,
+    (),
+>;
+
+type Stream = ActiveRequest<ipc::Service, u64, (), OutcomeMsg, ()>;
+
+/// The outcome ports of a device: the `outcome` publisher and the `told` streams.
+pub(crate) struct Outcomes {
+    /// Every outcome, for whoever watches them all.
+    pub(super) all: Publisher<ipc::Service, OutcomeMsg, ()>,
+    /// A sample of `all` loaned ahead, for the next outcome.
+    pub(super) loan: Option<SampleMutUninit<ipc::Service, MaybeUninit<OutcomeMsg>, ()>>,
+    pub(super) told_svc: ToldSvc,
+    told: Server<ipc::Service, u64, (), OutcomeMsg, ()>,
+    senders: PortNodes,
+    /// (client id, its stream); room for every client slot, allocated once.
+    streams: Vec<(u64, Stream)>,
+    /// Stream requests refused: a client id of another process than the sender's.
+    forged: u64,
+}
+
+impl Outcomes {
+    /// The outcome ports of a device whose clients have `ports` slots.
+    pub(super) fn new(
+        all: Publisher<ipc::Service, OutcomeMsg, ()>,
+        told_svc: ToldSvc,
+        told: Server<ipc::Service, u64, (), OutcomeMsg, ()>,
+        ports: usize,
+    ) -> Self {
+        Outcomes {
+            all,
+            loan: None,
+            told_svc,
+            told,
+            senders: PortNodes::new(ports),
+            streams: Vec::with_capacity(ports),
+            forged: 0,
+        }
+    }
+
+    /// Sends `msg`, stamped now, to the client it names and to every watcher
+    /// ([`Outcomes::send`]); a failure is counted and logged, never fatal to the loop.
+    pub(super) fn publish(&mut self, stats: &mut HostStats, device: &DeviceName, msg: OutcomeMsg) {
+        let mut msg = msg;
+        msg.stamp_ns = monotonic_ns();
+        match self.send(device, &msg) {
+            Ok(told) => {
+                stats.outcomes += 1;
+                stats.told += u64::from(told);
+            }
+            Err(e) => {
+                stats.failed_outcomes += 1;
+                tracing::warn!(device = %device, client = msg.client_id, seq = msg.cmd_seq,
+                    result = msg.result, error = %e, "cannot publish an outcome");
+            }
+        }
+    }
+
+    /// Sends `msg` as given on the stream of the client it names (if that client opened
+    /// one: see [`Outcomes::tell`]) and on the `outcome` channel; fails if the latter does.
+    /// Returns whether it went on the client's stream.
+    pub(crate) fn send(
+        &mut self,
+        device: &DeviceName,
+        msg: &OutcomeMsg,
+    ) -> Result<bool, PublishError> {
+        let told = self.tell(device, msg);
+        let loan = match self.loan.take() {
+            Some(l) => l,
+            None => self.all.loan_uninit().map_err(PublishError::Loan)?,
+        };
+        loan.write_payload(*msg)
+            .send()
+            .map_err(PublishError::Send)?;
+        Ok(told)
+    }
+
+    /// Loans the next outcome's sample, off the clients' path.
+    pub(super) fn loan_ahead(&mut self, device: &DeviceName) {
+        if self.loan.is_none() {
+            self.loan = super::loan_ahead(&self.all, device, "outcome");
+        }
+    }
+
+    /// Connects the `outcome` publisher to watchers that came since the last call.
+    pub(super) fn update_connections(&self) -> Result<(), ConnectionFailure> {
+        self.all.update_connections()
+    }
+
+    /// Sends `msg` on the stream of the client it names. A client whose stream is not
+    /// known yet may have asked since the last look: the requests are taken first (a
+    /// client asks before it sends its first command, so the request of a client whose
+    /// command was taken is there).
+    fn tell(&mut self, device: &DeviceName, msg: &OutcomeMsg) -> bool {
+        let i = match self.find(msg.client_id) {
+            Some(i) => i,
+            None => {
+                self.accept(device);
+                match self.find(msg.client_id) {
+                    Some(i) => i,
+                    // A client of another kind (a bridge relaying the commands of remote
+                    // clients reads the `outcome` channel).
+                    None => return false,
+                }
+            }
+        };
+        let sent = match self.streams[i].1.loan_uninit() {
+            Ok(loan) => loan.write_payload(*msg).send().map_err(Iox2Error::from),
+            Err(e) => Err(e.into()),
+        };
+        if let Err(e) = sent {
+            // The client closed its stream or died: forgotten (a client that is alive
+            // asks again).
+            tracing::debug!(device = %device, client = msg.client_id, error = %e,
+                "cannot send an outcome on the client's stream: stream closed");
+            self.streams.swap_remove(i);
+            return false;
+        }
+        true
+    }
+
+    fn find(&self, client_id: u64) -> Option<usize> {
+        self.streams.iter().position(|(c, _)| *c == client_id)
+    }
+
+    /// Takes the stream requests that arrived: each replaces that client's earlier stream;
+    /// a request whose client id is another process's is refused (dropped, which closes it).
+    fn accept(&mut self, device: &DeviceName) {
+        loop {
+            let active = match self.told.receive() {
+                Ok(Some(a)) => a,
+                Ok(None) => return,
+                Err(e) => {
+                    tracing::warn!(device = %device, error = %e, "cannot take the clients' outcome streams");
+                    return;
+                }
+            };
+            let client_id = *active.payload();
+            let sender = self
+                .senders
+                .client_sender(active.origin().value(), &self.told_svc);
+            if !client_of_process(client_id, sender.pid) {
+                self.forged += 1;
+                if self.forged % 1000 == 1 {
+                    tracing::warn!(device = %device, client_id, sender_pid = sender.pid,
+                        forged = self.forged,
+                        "an outcome stream asked for another process's client id: refused");
+                }
+                continue;
+            }
+            if let Some(i) = self.find(client_id) {
+                self.streams[i].1 = active;
+                continue;
+            }
+            if self.streams.len() == self.streams.capacity() {
+                self.streams.retain(|(_, s)| s.is_connected());
+            }
+            if self.streams.len() < self.streams.capacity() {
+                self.streams.push((client_id, active));
+            } else {
+                tracing::warn!(device = %device, client_id,
+                    "every outcome stream is taken: this client reads its outcomes from the `outcome` channel only");
+            }
+        }
+    }
+}

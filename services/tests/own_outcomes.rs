@@ -1,0 +1,159 @@
+//! A client's own outcomes do not depend on anybody else's traffic: each client reads them on
+//! a stream of its own (the `told` channel), which only its own commands fill.
+//!
+//! Before, every client read every outcome of the device on one `outcome` channel, 256
+//! buffered per client: a client that did not look while others' commands were decided (a
+//! CLI descheduled for ~10 ms beside a client sending 24 commands a millisecond) found its
+//! own outcome overwritten and waited out its timeout (`limber-cli::ownership`'s contention
+//! test, which failed the outside CI).
+
+use std::time::Duration;
+
+use limber_interfaces::prelude::*;
+use limber_services::prelude::*;
+use limber_services::testing::TestArm;
+use limber_services::{Channel, WaitError};
+
+const T: Duration = Duration::from_secs(5);
+const DEVICE: &str = "own/actarray/0";
+
+fn host(domain: &Domain) -> (Context, DeviceHost<ActArray>) {
+    let ctx = Context::new(domain, Role::Driver, "own").unwrap();
+    let mut host = DeviceHost::<ActArray>::new(&ctx, &DEVICE.parse().unwrap(), "t").unwrap();
+    host.state_mut().actuators_count = 2;
+    host.publish().unwrap();
+    (ctx, host)
+}
+
+#[test]
+fn a_clients_outcome_outlives_any_number_of_other_clients_outcomes() {
+    let domain = Domain::unique_for_test();
+    let (_dctx, mut host) = host(&domain);
+    let mut arm = TestArm::new(2);
+    let cctx = Context::new(&domain, Role::Client, "own-clients").unwrap();
+    let mut mine = ActArrayClient::connect_timeout(&cctx, DEVICE, T).unwrap();
+    let mut flood = ActArrayClient::connect_timeout(&cctx, DEVICE, T).unwrap();
+
+    let ticket = mine.move_to(0, 0.3).unwrap();
+    host.process(&mut arm).unwrap();
+    // While `mine` does not look, the other client's commands are decided: more than twice
+    // as many as any buffer of the old shared channel held.
+    let others = 2 * limber_services::qos::OUTCOME_BUFFER + limber_services::qos::CMD_BUFFER;
+    let mut sent = 0;
+    while sent < others {
+        for _ in 0..limber_services::qos::CMD_BUFFER {
+            flood.move_to(1, (sent % 10) as f64 * 0.01).unwrap();
+            sent += 1;
+        }
+        while host.process(&mut arm).unwrap().commands > 0 {}
+    }
+    assert_eq!(host.stats().commands, 1 + others as u64);
+    // Old code: Timeout (its outcome overwritten by the others', and so were the states
+    // that showed its command).
+    assert_eq!(
+        mine.wait_outcome(ticket, Duration::from_secs(2)).unwrap(),
+        Status::Ok
+    );
+    // The flooding client's own buffer holds its latest outcomes; its oldest were
+    // overwritten by its own, and are said missed, not waited for.
+    let last = flood.move_to(1, 0.2).unwrap();
+    host.process(&mut arm).unwrap();
+    assert_eq!(flood.wait_outcome(last, T).unwrap(), Status::Ok);
+    let first = limber_services::Ticket {
+        seq: 1,
+        receivers: 1,
+    };
+    assert!(matches!(
+        flood.wait_outcome(first, T),
+        Err(WaitError::Missed { .. })
+    ));
+}
+
+const FORGE_ENV: &str = "LIMBER_TEST_FORGE_STREAM";
+
+/// Run by `a_stream_asked_for_with_another_processs_client_id_gets_nothing` as a process of
+/// its own (a no-op otherwise): asks the driver for the outcome stream of the victim whose
+/// client id it was given, reports what it received, and holds its request until told.
+#[test]
+fn stream_forger_process() {
+    let Ok(spec) = std::env::var(FORGE_ENV) else {
+        return;
+    };
+    let (domain, victim) = spec.split_once(' ').unwrap();
+    let domain = Domain::new(domain).unwrap();
+    let ctx = Context::new(&domain, Role::Client, "mallory").unwrap();
+    let device: DeviceName = DEVICE.parse().unwrap();
+    let port = ctx
+        .node()
+        .service_builder(&device.service_name(Channel::Told))
+        .request_response::<u64, OutcomeMsg>()
+        .open()
+        .unwrap()
+        .client_builder()
+        .create()
+        .unwrap();
+    let pending = port.send_copy(victim.parse().unwrap()).unwrap();
+    println!("ASKED");
+    // The parent has the victim's command decided, then closes our stdin.
+    let mut line = String::new();
+    let _ = std::io::stdin().read_line(&mut line);
+    let mut got = 0;
+    while let Ok(Some(_)) = pending.receive() {
+        got += 1;
+    }
+    println!("RECEIVED {got}");
+}
+
+/// Who a stream is for comes from the transport: a process that asks for the outcome
+/// stream of another process's client id receives none of that client's outcomes and does
+/// not take the victim's stream from it.
+#[test]
+fn a_stream_asked_for_with_another_processs_client_id_gets_nothing() {
+    use std::io::{BufRead, BufReader, Write};
+    let domain = Domain::unique_for_test();
+    let (_dctx, mut host) = host(&domain);
+    let mut arm = TestArm::new(2);
+    let vctx = Context::new(&domain, Role::Client, "victim").unwrap();
+    let mut victim = ActArrayClient::connect_timeout(&vctx, DEVICE, T).unwrap();
+    let mut child = std::process::Command::new(std::env::current_exe().unwrap())
+        .args(["--exact", "stream_forger_process", "--nocapture"])
+        .env(
+            FORGE_ENV,
+            format!("{} {}", domain.name(), victim.client_id()),
+        )
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut line = String::new();
+    loop {
+        line.clear();
+        assert!(
+            out.read_line(&mut line).unwrap() > 0,
+            "the forger ended early"
+        );
+        if line.starts_with("ASKED") {
+            break;
+        }
+    }
+    // The driver meets the forged request (after the victim's own) when it sends the
+    // victim's outcome.
+    let ticket = victim.move_to(0, 0.4).unwrap();
+    host.process(&mut arm).unwrap();
+    assert_eq!(victim.wait_outcome(ticket, T).unwrap(), Status::Ok);
+    let again = victim.move_to(0, 0.5).unwrap();
+    host.process(&mut arm).unwrap();
+    assert_eq!(victim.wait_outcome(again, T).unwrap(), Status::Ok);
+    child.stdin.take().unwrap().write_all(b"\n").unwrap();
+    let mut rest = String::new();
+    loop {
+        line.clear();
+        if out.read_line(&mut line).unwrap() == 0 {
+            break;
+        }
+        rest.push_str(&line);
+    }
+    assert!(child.wait().unwrap().success());
+    assert!(rest.contains("RECEIVED 0"), "the forger's output: {rest}");
+}
