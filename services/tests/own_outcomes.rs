@@ -69,6 +69,58 @@ fn a_clients_outcome_outlives_any_number_of_other_clients_outcomes() {
     ));
 }
 
+/// A driver of the test arm on a thread of this process until `stop`.
+fn driver_thread(
+    domain: &Domain,
+    stop: &std::sync::Arc<std::sync::atomic::AtomicBool>,
+) -> std::thread::JoinHandle<()> {
+    let (domain, stop) = (domain.clone(), std::sync::Arc::clone(stop));
+    std::thread::spawn(move || {
+        let (_ctx, mut host) = host(&domain);
+        let mut arm = TestArm::new(2);
+        while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+            host.process(&mut arm).unwrap();
+            std::thread::yield_now();
+        }
+    })
+}
+
+/// A driver that replaces another knows nothing of the streams its clients opened with the
+/// one before: a client asks again when it finds its stream closed, and gets the outcomes
+/// of the commands it sent meanwhile.
+#[test]
+fn a_client_of_a_restarted_driver_gets_its_outcomes_on_a_new_stream() {
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let domain = Domain::unique_for_test();
+    let stop = Arc::new(AtomicBool::new(false));
+    let first = driver_thread(&domain, &stop);
+    let cctx = Context::new(&domain, Role::Client, "own-restart").unwrap();
+    let mut arm = ActArrayClient::connect_timeout(&cctx, DEVICE, T).unwrap();
+    let t = arm.move_to(0, 0.2).unwrap();
+    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
+
+    stop.store(true, Ordering::Relaxed);
+    first.join().unwrap();
+    let stop = Arc::new(AtomicBool::new(false));
+    let second = driver_thread(&domain, &stop);
+    // Another client holds the new driver's device: the client's command is refused as
+    // LEASED, an outcome only its stream carries (a state shows the refusal without the
+    // holder, and is not taken for the outcome). The new driver takes the command before
+    // the client has a stream with it.
+    let hctx = Context::new(&domain, Role::Client, "own-holder").unwrap();
+    let mut holder = ActArrayClient::connect_timeout(&hctx, DEVICE, T).unwrap();
+    holder.set_request_timeout(T);
+    holder.acquire("holder", Duration::from_secs(30)).unwrap();
+    let t = arm.move_to(0, 0.4).unwrap();
+    let told = arm.wait_outcome_detail(t, T);
+    stop.store(true, Ordering::Relaxed);
+    second.join().unwrap();
+    let told = told.unwrap();
+    assert_eq!(told.status, Status::Leased);
+    assert_eq!(told.other_client, holder.client_id());
+}
+
 const FORGE_ENV: &str = "LIMBER_TEST_FORGE_STREAM";
 
 /// Run by `a_stream_asked_for_with_another_processs_client_id_gets_nothing` as a process of

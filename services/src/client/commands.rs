@@ -26,8 +26,6 @@ impl<I: Interface> Client<I> {
     /// Sends a typed command. Returns at once (commands are not acknowledged; see
     /// [`Client::wait_outcome`]).
     pub fn send(&mut self, cmd: &I::Command) -> Result<Ticket, CommandError> {
-        // The driver tells this command's outcome on this client's stream: open it first.
-        self.keep_told_stream();
         let loan = match self.cmd_loan.take() {
             Some(l) => l,
             None => self

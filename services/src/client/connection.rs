@@ -487,9 +487,10 @@ fn open_told_stream(
 impl<I: Interface> Client<I> {
     /// Makes sure this client's outcome stream is open: a driver that restarted (or took
     /// over the device) knows nothing of the stream the client opened with the one before
-    /// it, so a closed one is asked for again. Called before each command (so the driver
-    /// finds the stream of the client whose command it takes) and on the waits' liveness
-    /// checks.
+    /// it, so a closed one is asked for again, and the driver woken to take it (it sends
+    /// the outcomes of this client's commands it decided meanwhile, up to 64 of all
+    /// clients without a stream, on the new stream). Called on the waits' liveness checks
+    /// (not on the command's path: it costs a look at the port's connections).
     pub(super) fn keep_told_stream(&mut self) {
         if let Err(e) = self.told.port.update_connections() {
             tracing::debug!(device = %self.device, error = %e, "cannot connect the outcome stream's port");
@@ -503,6 +504,7 @@ impl<I: Interface> Client<I> {
             Ok(s) => {
                 if s.is_some() {
                     tracing::debug!(device = %self.device, "outcome stream opened again");
+                    self.wake_driver_with(qos::EVENT_REQUEST);
                 }
                 self.told.stream = s;
             }

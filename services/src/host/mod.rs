@@ -326,6 +326,9 @@ impl<I: Interface> DeviceHost<I> {
     /// Connects the state publisher to clients that came since the last call, so they
     /// get the latest state (history 1) now; a failure is counted and logged.
     fn update_connections(&mut self) {
+        // New streams too: a client that found its stream closed (a restarted driver) asks
+        // again, without a command to bring the driver to it.
+        self.accept_streams();
         if let Err(e) = self.publisher.update_connections() {
             self.stats.failed_connection_updates += 1;
             tracing::debug!(device = %self.device, error = %e, "cannot connect new clients");
@@ -350,6 +353,11 @@ impl<I: Interface> DeviceHost<I> {
         let commands = self.process_commands(handler)?;
         let requests = self.process_requests(handler)? + self.process_leases()?;
         Ok(Activity { commands, requests })
+    }
+
+    /// Takes the clients' outcome streams that were asked for (see `told.rs`).
+    fn accept_streams(&mut self) {
+        self.out.accept(&self.device);
     }
 
     /// For a busy-polling loop: drains the commands on every call, and looks for requests

@@ -208,7 +208,7 @@ impl<I: Interface> DeviceHost<I> {
         // Last: a client connects only once it has opened the `outcome` channel (the last
         // it opens), so it finds every other port of this driver made: its first request
         // or lease never goes to a server that is not there yet.
-        let all_outcomes = node
+        let outcome_svc = node
             .service_builder(&device.service_name(Channel::Outcome))
             .publish_subscribe::<OutcomeMsg>()
             .history_size(0)
@@ -219,7 +219,8 @@ impl<I: Interface> DeviceHost<I> {
             .max_nodes(nodes)
             .enable_safe_overflow(true)
             .open_or_create_with_attributes(&verifier)
-            .map_err(|e| transport("outcome", e.into()))?
+            .map_err(|e| transport("outcome", e.into()))?;
+        let all_outcomes = outcome_svc
             .publisher_builder()
             .max_loaned_samples(2)
             .create()
@@ -243,7 +244,7 @@ impl<I: Interface> DeviceHost<I> {
             server,
             wake: Some(wake),
             notify,
-            out: super::told::Outcomes::new(all_outcomes, told_svc, told, ports),
+            out: super::told::Outcomes::new(outcome_svc, all_outcomes, told_svc, told, ports),
             lease_svc,
             lease_server,
             // A tag of its own: of the hosts that share a lease, the one that granted it

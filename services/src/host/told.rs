@@ -40,10 +40,15 @@ pub(crate) type ToldSvc = iceoryx2::service::port_factory::request_response::Por
     (),
 >;
 
+/// The `outcome` service.
+type OutcomeSvc =
+    iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, OutcomeMsg, ()>;
+
 type Stream = ActiveRequest<ipc::Service, u64, (), OutcomeMsg, ()>;
 
 /// The outcome ports of a device: the `outcome` publisher and the `told` streams.
 pub(crate) struct Outcomes {
+    all_svc: OutcomeSvc,
     /// Every outcome, for whoever watches them all.
     pub(super) all: Publisher<ipc::Service, OutcomeMsg, ()>,
     /// A sample of `all` loaned ahead, for the next outcome.
@@ -55,17 +60,27 @@ pub(crate) struct Outcomes {
     streams: Vec<(u64, Stream)>,
     /// Stream requests refused: a client id of another process than the sender's.
     forged: u64,
+    /// The latest outcomes of clients without a stream (yet), oldest first from `untold_at`:
+    /// sent on a client's stream when it opens (a client that met a restarted driver asks
+    /// for its stream again after its command went out). Allocated once.
+    untold: Box<[OutcomeMsg]>,
+    untold_at: usize,
 }
+
+/// Outcomes kept for clients whose stream is not open yet ([`Outcomes::accept`]).
+const UNTOLD: usize = 64;
 
 impl Outcomes {
     /// The outcome ports of a device whose clients have `ports` slots.
     pub(super) fn new(
+        all_svc: OutcomeSvc,
         all: Publisher<ipc::Service, OutcomeMsg, ()>,
         told_svc: ToldSvc,
         told: Server<ipc::Service, u64, (), OutcomeMsg, ()>,
         ports: usize,
     ) -> Self {
         Outcomes {
+            all_svc,
             all,
             loan: None,
             told_svc,
@@ -73,6 +88,8 @@ impl Outcomes {
             senders: PortNodes::new(ports),
             streams: Vec::with_capacity(ports),
             forged: 0,
+            untold: vec![OutcomeMsg::default(); UNTOLD].into_boxed_slice(),
+            untold_at: 0,
         }
     }
 
@@ -95,7 +112,8 @@ impl Outcomes {
     }
 
     /// Sends `msg` as given on the stream of the client it names (if that client opened
-    /// one: see [`Outcomes::tell`]) and on the `outcome` channel; fails if the latter does.
+    /// one: see [`Outcomes::tell`]) and on the `outcome` channel if anybody watches it;
+    /// fails if the latter fails.
     /// Returns whether it went on the client's stream.
     pub(crate) fn send(
         &mut self,
@@ -103,6 +121,10 @@ impl Outcomes {
         msg: &OutcomeMsg,
     ) -> Result<bool, PublishError> {
         let told = self.tell(device, msg);
+        // Nobody watches (the usual case): no sample to write.
+        if self.all_svc.dynamic_config().number_of_subscribers() == 0 {
+            return Ok(told);
+        }
         let loan = match self.loan.take() {
             Some(l) => l,
             None => self.all.loan_uninit().map_err(PublishError::Loan)?,
@@ -136,17 +158,18 @@ impl Outcomes {
                 self.accept(device);
                 match self.find(msg.client_id) {
                     Some(i) => i,
-                    // A client of another kind (a bridge relaying the commands of remote
-                    // clients reads the `outcome` channel).
-                    None => return false,
+                    // Kept for the client's stream to come (a client that met a restarted
+                    // driver), or for nobody (a bridge relaying the commands of remote
+                    // clients reads the `outcome` channel): overwritten in time.
+                    None => {
+                        self.untold[self.untold_at] = *msg;
+                        self.untold_at = (self.untold_at + 1) % UNTOLD;
+                        return false;
+                    }
                 }
             }
         };
-        let sent = match self.streams[i].1.loan_uninit() {
-            Ok(loan) => loan.write_payload(*msg).send().map_err(Iox2Error::from),
-            Err(e) => Err(e.into()),
-        };
-        if let Err(e) = sent {
+        if let Err(e) = send_on(&self.streams[i].1, msg) {
             // The client closed its stream or died: forgotten (a client that is alive
             // asks again).
             tracing::debug!(device = %device, client = msg.client_id, error = %e,
@@ -161,9 +184,12 @@ impl Outcomes {
         self.streams.iter().position(|(c, _)| *c == client_id)
     }
 
-    /// Takes the stream requests that arrived: each replaces that client's earlier stream;
-    /// a request whose client id is another process's is refused (dropped, which closes it).
-    fn accept(&mut self, device: &DeviceName) {
+    /// Takes the stream requests that arrived: each replaces that client's earlier stream
+    /// and is sent the client's outcomes kept since it had none; a request whose client id
+    /// is another process's is refused (dropped, which closes it). The host looks on each
+    /// `process` call (a waiting client asks again when it finds its stream closed), and
+    /// when it meets a client without a stream.
+    pub(super) fn accept(&mut self, device: &DeviceName) {
         loop {
             let active = match self.told.receive() {
                 Ok(Some(a)) => a,
@@ -186,6 +212,7 @@ impl Outcomes {
                 }
                 continue;
             }
+            self.send_untold(device, client_id, &active);
             if let Some(i) = self.find(client_id) {
                 self.streams[i].1 = active;
                 continue;
@@ -201,4 +228,25 @@ impl Outcomes {
             }
         }
     }
+
+    /// Sends `client_id`'s kept outcomes on its new stream, oldest first, and forgets them.
+    fn send_untold(&mut self, device: &DeviceName, client_id: u64, stream: &Stream) {
+        for k in 0..UNTOLD {
+            let m = &mut self.untold[(self.untold_at + k) % UNTOLD];
+            if m.client_id != client_id || m.cmd_seq == 0 {
+                continue;
+            }
+            if let Err(e) = send_on(stream, m) {
+                tracing::debug!(device = %device, client = client_id, error = %e,
+                    "cannot send a kept outcome on the client's new stream");
+            }
+            *m = OutcomeMsg::default();
+        }
+    }
+}
+
+/// Sends `msg` on one client's stream.
+fn send_on(stream: &Stream, msg: &OutcomeMsg) -> Result<(), Iox2Error> {
+    stream.loan_uninit()?.write_payload(*msg).send()?;
+    Ok(())
 }
