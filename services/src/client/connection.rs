@@ -1,4 +1,4 @@
-//! The connection to one device: the iceoryx2 ports of its five channels, opened by
+//! The connection to one device: the iceoryx2 ports of its channels (data, cmd, req, wake, notify, told, outcome; lease when asked), opened by
 //! [`Client::connect`], and the driver's liveness.
 
 use core::time::Duration;

@@ -2,7 +2,7 @@
 //! typed conveniences for each ([`ActArrayClient`], [`LimbClient`], [`GripperClient`],
 //! [`RangerClient`]).
 //!
-//! Read in this order: `connection.rs` opens the five channels of a device, `waiting.rs` reads states and waits for outcomes, `commands.rs` and
+//! Read in this order: `connection.rs` opens the channels of a device, `waiting.rs` reads states and waits for outcomes, `commands.rs` and
 //! `requests.rs` send, and `actarray.rs`, `limb.rs`, `gripper.rs`, `ranger.rs` are the typed proxies.
 //! The errors of each operation are in `error.rs`.
 
