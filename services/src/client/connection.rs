@@ -1,4 +1,5 @@
-//! The connection to one device: the iceoryx2 ports of its channels (data, cmd, req, wake, notify, told, outcome; lease when asked), opened by
+//! The connection to one device: the iceoryx2 ports of its channels (data, cmd, req, wake,
+//! notify, told; outcome when watching every client's, lease when asked), opened by
 //! [`Client::connect`], and the driver's liveness.
 
 use core::time::Duration;
