@@ -56,7 +56,7 @@ pub(crate) struct Outcomes {
     pub(super) told_svc: ToldSvc,
     told: Server<ipc::Service, u64, (), OutcomeMsg, ()>,
     senders: PortNodes,
-    /// (client id, its stream); room for every client slot, allocated once.
+    /// (client id, its stream); room for every stream the service admits, allocated once.
     streams: Vec<(u64, Stream)>,
     /// Stream requests refused: a client id of another process than the sender's.
     forged: u64,
@@ -86,7 +86,9 @@ impl Outcomes {
             told_svc,
             told,
             senders: PortNodes::new(ports),
-            streams: Vec::with_capacity(ports),
+            // Room for every request the service admits: a process cannot crowd out
+            // another's stream by opening more.
+            streams: Vec::with_capacity(ports * crate::qos::TOLD_STREAMS),
             forged: 0,
             untold: vec![OutcomeMsg::default(); UNTOLD].into_boxed_slice(),
             untold_at: 0,
@@ -224,7 +226,7 @@ impl Outcomes {
                 self.streams.push((client_id, active));
             } else {
                 tracing::warn!(device = %device, client_id,
-                    "every outcome stream is taken: this client reads its outcomes from the `outcome` channel only");
+                    "every outcome stream is taken: this client's outcomes go to the `outcome` channel only");
             }
         }
     }
