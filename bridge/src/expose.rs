@@ -675,44 +675,40 @@ impl Exposer<'_> {
                 .iter()
                 .map(|(n, d)| (n.clone(), d.listener()))
                 .collect();
-            with_waitset(
-                inbox.source(),
-                &attached,
-                |wait| -> Result<(), ExposeError> {
-                    loop {
-                        // Devices came or went: the WaitSet is built anew.
-                        if self.timers(report) {
-                            return Ok(());
-                        }
-                        if stop() {
-                            return Ok(());
-                        }
-                        let due = self
-                            .devices
-                            .values()
-                            .filter_map(|d| d.next_deadline())
-                            .fold(self.next_discovery.min(self.next_liveness), Instant::min);
-                        let woken = wait(due.saturating_duration_since(Instant::now()))?;
-                        for name in &woken.devices {
-                            if let Some(d) = self.devices.get_mut(name) {
-                                d.poll(self.session);
-                            }
-                        }
-                        if woken.mail {
-                            for ev in inbox.drain() {
-                                self.handle(ev);
-                            }
-                        }
-                        // Relayed requests whose time is up are answered "timeout".
-                        let now = Instant::now();
-                        for d in self.devices.values_mut() {
-                            if d.next_deadline().is_some_and(|t| t <= now) {
-                                d.poll(self.session);
-                            }
+            with_waitset(inbox, &attached, |wait| -> Result<(), ExposeError> {
+                loop {
+                    // Devices came or went: the WaitSet is built anew.
+                    if self.timers(report) {
+                        return Ok(());
+                    }
+                    if stop() {
+                        return Ok(());
+                    }
+                    let due = self
+                        .devices
+                        .values()
+                        .filter_map(|d| d.next_deadline())
+                        .fold(self.next_discovery.min(self.next_liveness), Instant::min);
+                    let woken = wait(due.saturating_duration_since(Instant::now()))?;
+                    for name in &woken.devices {
+                        if let Some(d) = self.devices.get_mut(name) {
+                            d.poll(self.session);
                         }
                     }
-                },
-            )??;
+                    if woken.mail {
+                        for ev in inbox.drain() {
+                            self.handle(ev);
+                        }
+                    }
+                    // Relayed requests whose time is up are answered "timeout".
+                    let now = Instant::now();
+                    for d in self.devices.values_mut() {
+                        if d.next_deadline().is_some_and(|t| t <= now) {
+                            d.poll(self.session);
+                        }
+                    }
+                }
+            })??;
         }
         Ok(())
     }

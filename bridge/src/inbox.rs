@@ -99,6 +99,12 @@ impl<T> Inbox<T> {
         &self.source
     }
 
+    /// Whether something was sent since the last [`Inbox::drain`] (a look without a
+    /// system call, for a loop that lingers).
+    pub(crate) fn has_mail(&self) -> bool {
+        self.wake.pending.load(Ordering::SeqCst)
+    }
+
     /// Takes everything that arrived, oldest first, and consumes the wake-ups.
     pub(crate) fn drain(&self) -> Vec<T> {
         // In this order: the socket is read empty, then `pending` cleared, then the channel
@@ -164,7 +170,7 @@ mod tests {
             }
         });
         let mut got = Vec::with_capacity(N as usize);
-        crate::waiting::with_waitset(inbox.source(), &Vec::new(), |wait| {
+        crate::waiting::with_waitset(&inbox, &Vec::new(), |wait| {
             while got.len() < N as usize {
                 let woken = wait(std::time::Duration::from_secs(10)).expect("a wait");
                 assert!(

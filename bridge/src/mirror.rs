@@ -666,33 +666,29 @@ impl Mirrorer<'_> {
                 .iter()
                 .map(|(remote, (_, d))| (remote.clone(), d.listener()))
                 .collect();
-            let ended = with_waitset(
-                inbox.source(),
-                &attached,
-                |wait| -> Result<(), MirrorError> {
-                    loop {
-                        if stop() {
-                            return Ok(());
-                        }
-                        let woken = wait(IDLE_WAIT)?;
-                        let timeout = self.config.request_timeout;
-                        for remote in &woken.devices {
-                            if let Some((_, d)) = self.devices.get_mut(remote) {
-                                d.relay(self.session, timeout);
-                            }
-                        }
-                        let mut changed = false;
-                        if woken.mail {
-                            for ev in inbox.drain() {
-                                changed |= self.handle(ev, report);
-                            }
-                        }
-                        if changed {
-                            return Ok(());
+            let ended = with_waitset(inbox, &attached, |wait| -> Result<(), MirrorError> {
+                loop {
+                    if stop() {
+                        return Ok(());
+                    }
+                    let woken = wait(IDLE_WAIT)?;
+                    let timeout = self.config.request_timeout;
+                    for remote in &woken.devices {
+                        if let Some((_, d)) = self.devices.get_mut(remote) {
+                            d.relay(self.session, timeout);
                         }
                     }
-                },
-            );
+                    let mut changed = false;
+                    if woken.mail {
+                        for ev in inbox.drain() {
+                            changed |= self.handle(ev, report);
+                        }
+                    }
+                    if changed {
+                        return Ok(());
+                    }
+                }
+            });
             drop(attached);
             // No longer waited on (nor offered) before anybody is told so.
             for local in self.gone.drain(..) {
