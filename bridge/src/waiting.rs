@@ -32,20 +32,7 @@ pub(crate) const LINGER_ENV: &str = "LIMBER_BRIDGE_LINGER_US";
 /// else [`LINGER`].
 pub(crate) fn linger() -> Duration {
     static LINGER_SET: std::sync::OnceLock<Duration> = std::sync::OnceLock::new();
-    *LINGER_SET.get_or_init(|| {
-        let Some(v) = std::env::var_os(LINGER_ENV) else {
-            return LINGER;
-        };
-        match v.to_str().and_then(|s| s.trim().parse::<u64>().ok()) {
-            Some(us) => Duration::from_micros(us.min(1_000_000)),
-            None => {
-                tracing::warn!(
-                    "{LINGER_ENV}={v:?} is not a number of microseconds: using the default"
-                );
-                LINGER
-            }
-        }
-    })
+    *LINGER_SET.get_or_init(|| limber_services::qos::micros_from_env(LINGER_ENV).unwrap_or(LINGER))
 }
 
 /// What woke the loop.
@@ -55,6 +42,13 @@ pub(crate) struct Woken {
     pub mail: bool,
     /// These devices' listeners were notified (their events are consumed).
     pub devices: Vec<DeviceName>,
+}
+
+impl Woken {
+    /// Something woke the loop (not its timeout).
+    fn any(&self) -> bool {
+        self.mail || !self.devices.is_empty()
+    }
 }
 
 /// The listeners a WaitSet is built over, each with the device it belongs to.
@@ -92,46 +86,56 @@ pub(crate) fn with_waitset<T, R>(
     let linger = linger();
     let mut linger_until: Option<Instant> = None;
     let mut wait = |timeout: Duration| -> Result<Woken, LoopError> {
-        if let Some(until) = linger_until.take() {
-            let until = until.min(Instant::now() + timeout);
-            loop {
-                let woken = look(inbox, listeners);
-                if woken.mail || !woken.devices.is_empty() {
-                    linger_until = (!linger.is_zero()).then(|| Instant::now() + linger);
-                    return Ok(woken);
-                }
-                if Instant::now() >= until {
-                    break;
-                }
-                std::thread::yield_now();
-            }
-        }
-        let mut woken = Woken::default();
-        ws.wait_and_process_once_with_timeout(
-            |id| {
-                if id.has_event_from(&inbox_guard) {
-                    woken.mail = true;
-                }
-                for ((device, l), g) in listeners.iter().zip(&guards) {
-                    if id.has_event_from(g) {
-                        // Unconsumed, they would wake the loop again at once.
-                        if let Err(e) = l.try_wait(|_| {}) {
-                            tracing::warn!(device = %device, error = %e, "cannot consume notifications");
+        let lingered = linger_until
+            .take()
+            .and_then(|until| linger_look(inbox, listeners, until.min(Instant::now() + timeout)));
+        let woken = match lingered {
+            Some(w) => w,
+            None => {
+                let mut woken = Woken::default();
+                ws.wait_and_process_once_with_timeout(
+                    |id| {
+                        if id.has_event_from(&inbox_guard) {
+                            woken.mail = true;
                         }
-                        woken.devices.push(device.clone());
-                    }
-                }
-                CallbackProgression::Continue
-            },
-            whole_ms(timeout),
-        )
-        .map_err(LoopError::Wait)?;
-        if woken.mail || !woken.devices.is_empty() {
-            linger_until = (!linger.is_zero()).then(|| Instant::now() + linger);
+                        for ((device, l), g) in listeners.iter().zip(&guards) {
+                            if id.has_event_from(g) {
+                                // Unconsumed, they would wake the loop again at once.
+                                if let Err(e) = l.try_wait(|_| {}) {
+                                    tracing::warn!(device = %device, error = %e, "cannot consume notifications");
+                                }
+                                woken.devices.push(device.clone());
+                            }
+                        }
+                        CallbackProgression::Continue
+                    },
+                    whole_ms(timeout),
+                )
+                .map_err(LoopError::Wait)?;
+                woken
+            }
+        };
+        if woken.any() && !linger.is_zero() {
+            linger_until = Some(Instant::now() + linger);
         }
         Ok(woken)
     };
     Ok(body(&mut wait))
+}
+
+/// Looks without sleeping (yielding the CPU between looks) until something came or `until`:
+/// what came, or `None`.
+fn linger_look<T>(inbox: &Inbox<T>, listeners: &Attached, until: Instant) -> Option<Woken> {
+    loop {
+        let woken = look(inbox, listeners);
+        if woken.any() {
+            return Some(woken);
+        }
+        if Instant::now() >= until {
+            return None;
+        }
+        std::thread::yield_now();
+    }
 }
 
 /// One look without sleeping: mail waiting in the inbox, and the listeners notified (their

@@ -138,13 +138,8 @@ pub const SPIN_BUDGET_ENV: &str = "LIMBER_SPIN_US";
 pub fn default_spin_budget() -> core::time::Duration {
     static BUDGET: std::sync::OnceLock<core::time::Duration> = std::sync::OnceLock::new();
     *BUDGET.get_or_init(|| {
-        if let Some(v) = std::env::var_os(SPIN_BUDGET_ENV) {
-            match v.to_str().and_then(|s| s.trim().parse::<u64>().ok()) {
-                Some(us) => return core::time::Duration::from_micros(us.min(1_000_000)),
-                None => tracing::warn!(
-                    "{SPIN_BUDGET_ENV}={v:?} is not a number of microseconds: using the default"
-                ),
-            }
+        if let Some(d) = micros_from_env(SPIN_BUDGET_ENV) {
+            return d;
         }
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
         if cores >= 2 {
@@ -153,6 +148,20 @@ pub fn default_spin_budget() -> core::time::Duration {
             core::time::Duration::ZERO
         }
     })
+}
+
+/// A time in µs from the environment variable `var` (at most 1 s): `None` when it is not
+/// set, or not a number (said in a warning: the caller's default applies). The rule of
+/// every µs knob (`LIMBER_SPIN_US`, the bridge's `LIMBER_BRIDGE_LINGER_US`).
+pub fn micros_from_env(var: &str) -> Option<core::time::Duration> {
+    let v = std::env::var_os(var)?;
+    match v.to_str().and_then(|s| s.trim().parse::<u64>().ok()) {
+        Some(us) => Some(core::time::Duration::from_micros(us.min(1_000_000))),
+        None => {
+            tracing::warn!("{var}={v:?} is not a number of microseconds: using the default");
+            None
+        }
+    }
 }
 
 /// How long a driver in event mode keeps polling its clients after activity before it goes

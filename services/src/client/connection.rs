@@ -24,6 +24,7 @@ use super::{
 };
 use crate::context::Context;
 use crate::error::Iox2Error;
+use crate::host::told::OutcomeSvc;
 use crate::naming::{Channel, DRIVER_NODE_PREFIX, DeviceName, attr};
 use crate::qos;
 
@@ -45,9 +46,6 @@ pub(crate) struct ToldSide {
 /// A client's outcome stream: its request on `told`, answered with every outcome of its
 /// commands.
 type ToldStream = PendingResponse<ipc::Service, u64, (), OutcomeMsg, ()>;
-
-type OutcomeSvc =
-    iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, OutcomeMsg, ()>;
 
 /// The lease port of a client and the lease it holds.
 pub(crate) struct LeaseSide {

@@ -39,7 +39,7 @@ mod open;
 mod requests;
 mod senders;
 pub mod stats;
-mod told;
+pub(crate) mod told;
 
 use arbiter::Arbiter;
 pub use arbiter::{HOLDER_CHECK_NS, Holder, MAX_LEASE_TIMEOUT_NS, MIN_LEASE_TIMEOUT_NS};
@@ -297,10 +297,7 @@ impl<I: Interface> DeviceHost<I> {
 
     /// Sends an outcome as given to the client it names and to the watchers (a relay's).
     pub(crate) fn relay_outcome_message(&mut self, msg: &OutcomeMsg) -> Result<(), PublishError> {
-        let told = self.out.send(&self.device, msg)?;
-        self.stats.outcomes += 1;
-        self.stats.told += u64::from(told);
-        Ok(())
+        self.out.send(&mut self.stats, &self.device, msg)
     }
 
     pub(crate) fn data_port(&self) -> &Publisher<ipc::Service, I::Data, ()> {
@@ -328,7 +325,7 @@ impl<I: Interface> DeviceHost<I> {
     fn update_connections(&mut self) {
         // New streams too: a client that found its stream closed (a restarted driver) asks
         // again, without a command to bring the driver to it.
-        self.accept_streams();
+        self.out.accept(&self.device);
         if let Err(e) = self.publisher.update_connections() {
             self.stats.failed_connection_updates += 1;
             tracing::debug!(device = %self.device, error = %e, "cannot connect new clients");
@@ -353,11 +350,6 @@ impl<I: Interface> DeviceHost<I> {
         let commands = self.process_commands(handler)?;
         let requests = self.process_requests(handler)? + self.process_leases()?;
         Ok(Activity { commands, requests })
-    }
-
-    /// Takes the clients' outcome streams that were asked for (see `told.rs`).
-    fn accept_streams(&mut self) {
-        self.out.accept(&self.device);
     }
 
     /// For a busy-polling loop: drains the commands on every call, and looks for requests

@@ -41,7 +41,7 @@ pub(crate) type ToldSvc = iceoryx2::service::port_factory::request_response::Por
 >;
 
 /// The `outcome` service.
-type OutcomeSvc =
+pub(crate) type OutcomeSvc =
     iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, OutcomeMsg, ()>;
 
 type Stream = ActiveRequest<ipc::Service, u64, (), OutcomeMsg, ()>;
@@ -97,44 +97,43 @@ impl Outcomes {
 
     /// Sends `msg`, stamped now, to the client it names and to every watcher
     /// ([`Outcomes::send`]); a failure is counted and logged, never fatal to the loop.
-    pub(super) fn publish(&mut self, stats: &mut HostStats, device: &DeviceName, msg: OutcomeMsg) {
-        let mut msg = msg;
+    pub(super) fn publish(
+        &mut self,
+        stats: &mut HostStats,
+        device: &DeviceName,
+        mut msg: OutcomeMsg,
+    ) {
         msg.stamp_ns = monotonic_ns();
-        match self.send(device, &msg) {
-            Ok(told) => {
-                stats.outcomes += 1;
-                stats.told += u64::from(told);
-            }
-            Err(e) => {
-                stats.failed_outcomes += 1;
-                tracing::warn!(device = %device, client = msg.client_id, seq = msg.cmd_seq,
-                    result = msg.result, error = %e, "cannot publish an outcome");
-            }
+        if let Err(e) = self.send(stats, device, &msg) {
+            stats.failed_outcomes += 1;
+            tracing::warn!(device = %device, client = msg.client_id, seq = msg.cmd_seq,
+                result = msg.result, error = %e, "cannot publish an outcome");
         }
     }
 
     /// Sends `msg` as given on the stream of the client it names (if that client opened
     /// one: see [`Outcomes::tell`]) and on the `outcome` channel if anybody watches it;
-    /// fails if the latter fails.
-    /// Returns whether it went on the client's stream.
+    /// fails if the latter fails. Counts it in `stats` when sent.
     pub(crate) fn send(
         &mut self,
+        stats: &mut HostStats,
         device: &DeviceName,
         msg: &OutcomeMsg,
-    ) -> Result<bool, PublishError> {
+    ) -> Result<(), PublishError> {
         let told = self.tell(device, msg);
-        // Nobody watches (the usual case): no sample to write.
-        if self.all_svc.dynamic_config().number_of_subscribers() == 0 {
-            return Ok(told);
+        // A sample only for watchers (usually nobody).
+        if self.all_svc.dynamic_config().number_of_subscribers() != 0 {
+            let loan = match self.loan.take() {
+                Some(l) => l,
+                None => self.all.loan_uninit().map_err(PublishError::Loan)?,
+            };
+            loan.write_payload(*msg)
+                .send()
+                .map_err(PublishError::Send)?;
         }
-        let loan = match self.loan.take() {
-            Some(l) => l,
-            None => self.all.loan_uninit().map_err(PublishError::Loan)?,
-        };
-        loan.write_payload(*msg)
-            .send()
-            .map_err(PublishError::Send)?;
-        Ok(told)
+        stats.outcomes += 1;
+        stats.told += u64::from(told);
+        Ok(())
     }
 
     /// Loans the next outcome's sample, off the clients' path.
