@@ -63,6 +63,14 @@ pub const RATIOS: &[RatioDef] = &[
         floor: None,
     },
     RatioDef {
+        label: "state → 1 subscriber / futex broadcast → 1 waiter, 1 kHz",
+        num: "state.1.oneway",
+        den: "state.futex.1.oneway",
+        pct: Pct::P50,
+        goal: None,
+        floor: None,
+    },
+    RatioDef {
         label: "state → 1 subscriber / futex wake paced at 1 kHz (one-way)",
         num: "state.1.oneway",
         den: "state.paced.futex.oneway",
@@ -84,11 +92,29 @@ pub const RATIOS: &[RatioDef] = &[
         den: "state.1.oneway",
         pct: Pct::P50,
         goal: Some(Goal::AtMost(2.0)),
+        // limber's state waiters sleep on a futex (the device's wake word): the kernel's
+        // own fan-out is the floor.
         floor: Some(RatioFloor {
-            num: "state.raw.16.oneway",
-            den: "state.raw.1.oneway",
-            what: "raw iceoryx2's own fan-out, 16 listeners / 1",
+            num: "state.futex.16.oneway",
+            den: "state.futex.1.oneway",
+            what: "a futex broadcast's own fan-out, 16 waiters / 1",
         }),
+    },
+    RatioDef {
+        label: "futex broadcast → 16 waiters / → 1 waiter",
+        num: "state.futex.16.oneway",
+        den: "state.futex.1.oneway",
+        pct: Pct::P50,
+        goal: None,
+        floor: None,
+    },
+    RatioDef {
+        label: "state → 16 subscribers / futex broadcast → 16 waiters",
+        num: "state.16.oneway",
+        den: "state.futex.16.oneway",
+        pct: Pct::P50,
+        goal: None,
+        floor: None,
     },
     RatioDef {
         label: "state → 4 subscribers / iceoryx2 sample + notify → 4 listeners",

@@ -8,6 +8,8 @@
 //! | `waitset-echo` | floor | the same, blocking in a WaitSet with the listener attached |
 //! | `state-pub` | state | a `DeviceHost` publishing the arm state at 1 kHz after `go` |
 //! | `state-sub` | state | an `ActArrayClient` blocking in `wait_state`, recording one-way latency |
+//! | `fanout-sub` | state | raw iceoryx2: a subscriber blocking on an event listener (the fan-out's floor) |
+//! | `futex-fanout-sub` | state | no middleware: a waiter in `FUTEX_WAIT` on a shared page (the fan-out's physical floor) |
 //! | `cmd-driver-spin` / `cmd-driver-event` | command | a `DeviceHost` driver, busy-polling or in `event_loop::run` |
 //! | `pioneer-driver` | request, loop | the emulator on a pty and the Pioneer driver on it |
 //! | `pioneer-driver-spin` | loop | the same, the driver busy-polling |
@@ -33,6 +35,7 @@ pub fn run_role(role: &str, args: &BenchArgs) -> Result<(), BenchError> {
     }
     let r = match role {
         "futex-echo" => physical::echo_role(args, physical::Wait::Futex),
+        physical::FANOUT_ROLE => physical::fanout_role(args),
         "cacheline-echo" => physical::echo_role(args, physical::Wait::Spin),
         "pubsub-echo" => floor::echo_role(args, floor::Echo::Spin),
         "event-echo" => floor::echo_role(args, floor::Echo::Listener),

@@ -326,7 +326,8 @@ fn gateway_measures_a_request_through_the_player_gateway() {
 }
 
 /// `--only state`: the fan-outs at 1 kHz beside their floors paced at the same rate (a futex
-/// wake and a raw iceoryx2 event wake), and the goals stated against them in the ratios.
+/// wake and a raw iceoryx2 event wake; raw iceoryx2's and the kernel's own fan-outs), and
+/// the goals stated against them in the ratios.
 #[test]
 fn state_measures_the_fanouts_beside_floors_paced_at_their_rate() {
     let dir = std::env::temp_dir().join(format!("limber-bench-state-{}", std::process::id()));
@@ -341,6 +342,9 @@ fn state_measures_the_fanouts_beside_floors_paced_at_their_rate() {
         "state.raw.1.oneway",
         "state.raw.4.oneway",
         "state.raw.16.oneway",
+        "state.futex.1.oneway",
+        "state.futex.4.oneway",
+        "state.futex.16.oneway",
     ] {
         assert!(ids.iter().any(|i| i == id), "{id} missing from {ids:?}");
     }
@@ -364,20 +368,28 @@ fn state_measures_the_fanouts_beside_floors_paced_at_their_rate() {
         2.0
     );
     assert_eq!(goal("state.16.oneway", "state.1.oneway", "p50"), 2.0);
-    // The fan-out's goal carries its floor: raw iceoryx2's own 16 / 1 of the same run, and
-    // the text says the goal is below it exactly when that ratio alone exceeds the goal.
+    // The fan-out's goal carries its floor: the kernel's own 16 / 1 of the same run (one
+    // futex wake of 16 waiters: limber's state waiters sleep on a futex), and the text says
+    // the goal is below it exactly when that ratio alone exceeds the goal.
     let find = |num: &str, den: &str| {
         ratios
             .iter()
             .find(|r| r["num"] == num && r["den"] == den && r["pct"] == "p50")
             .unwrap_or_else(|| panic!("no ratio {num} / {den} in {ratios:?}"))
     };
-    let raw = find("state.raw.16.oneway", "state.raw.1.oneway")["value"]
+    let raw = find("state.futex.16.oneway", "state.futex.1.oneway")["value"]
         .as_f64()
         .unwrap();
     let fan = find("state.16.oneway", "state.1.oneway");
     assert_eq!(fan["floor"][0].as_f64(), Some(raw), "{fan}");
-    assert!(fan["floor"][1].as_str().unwrap().contains("raw iceoryx2"));
+    assert!(
+        fan["floor"][1]
+            .as_str()
+            .unwrap()
+            .contains("futex broadcast")
+    );
+    // Raw iceoryx2's own fan-out stays beside it.
+    find("state.raw.16.oneway", "state.raw.1.oneway");
     let line = text
         .lines()
         .find(|l| l.contains("state → 16 subscribers / state → 1 subscriber"))

@@ -4,8 +4,8 @@
 //! does, skipping devices that a mirror hosts), and per device:
 //! publishes each state sample on `.../state`; takes commands from `.../cmd` and sends them
 //! to the driver under a client id of its own per remote client (so the driver tells
-//! remote clients apart: their outcomes and preemptions come back to each one on
-//! `.../outcome/<origin>`); answers queries on `.../req` with the driver's reply, or with
+//! remote clients apart: their outcomes and preemptions, which the driver sends on this
+//! process's own outcome stream, come back to each one on `.../outcome/<origin>`); answers queries on `.../req` with the driver's reply, or with
 //! an error carrying a status code when the driver does not answer in time; and holds a
 //! liveliness token `.../alive` while the driver lives.
 //!
@@ -198,6 +198,9 @@ impl Ids {
     }
 }
 
+/// While relaying a burst of commands, their outcomes are taken after every this many.
+const DRAIN_EVERY: usize = limber_services::qos::TOLD_BUFFER / 4;
+
 /// One device put on Zenoh.
 struct Exposed<I: Interface> {
     device: DeviceName,
@@ -206,6 +209,8 @@ struct Exposed<I: Interface> {
     names: TypeNames,
     allow: Allow,
     ids: Ids,
+    /// Commands relayed since the outcomes were last taken.
+    relayed: usize,
     pending: Vec<(Query, PendingRelay<I>, Instant, u64)>,
     /// The last liveness check found the driver dead.
     doubted: bool,
@@ -229,6 +234,27 @@ trait ExposedDevice {
     fn alive(&self) -> bool;
     fn doubted(&self) -> bool;
     fn set_doubted(&mut self, on: bool);
+}
+
+impl<I: Interface> Exposed<I> {
+    /// Sends the outcomes of the remote clients' commands that arrived back to each one.
+    fn forward_outcomes(&mut self, session: &Session) {
+        self.relayed = 0;
+        let mut outcomes = Vec::new();
+        if let Err(e) = self.client.relay_own_outcomes(|o| outcomes.push(*o)) {
+            tracing::warn!(device = %self.device, error = %e, "cannot take the outcomes");
+        }
+        for mut o in outcomes {
+            let Some((origin, remote)) = self.ids.to_remote.get(&o.client_id).cloned() else {
+                continue; // an id forgotten (more than MAX_REMOTE_CLIENTS)
+            };
+            o.client_id = remote;
+            if let Some((_, other)) = self.ids.to_remote.get(&o.other_client) {
+                o.other_client = *other;
+            }
+            put_outcome(session, &self.device, &origin, &o);
+        }
+    }
 }
 
 impl<I: Interface> ExposedDevice for Exposed<I> {
@@ -264,6 +290,12 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
         meta.client_id = self.ids.local(origin, meta.client_id);
         if let Err(e) = self.client.relay_send(&cmd) {
             tracing::warn!(device = %self.device, origin, error = %e, "cannot relay a command");
+        }
+        // A burst of relayed commands: their outcomes taken between them, so that this
+        // process's outcome stream (TOLD_BUFFER deep) does not overflow behind it.
+        self.relayed += 1;
+        if self.relayed >= DRAIN_EVERY {
+            self.forward_outcomes(session);
         }
     }
 
@@ -360,20 +392,7 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
         }) {
             tracing::warn!(device = %self.device, error = %e, "cannot take the states");
         }
-        let mut outcomes = Vec::new();
-        if let Err(e) = self.client.relay_outcomes(|o| outcomes.push(*o)) {
-            tracing::warn!(device = %self.device, error = %e, "cannot take the outcomes");
-        }
-        for mut o in outcomes {
-            let Some((origin, remote)) = self.ids.to_remote.get(&o.client_id).cloned() else {
-                continue; // a local client's
-            };
-            o.client_id = remote;
-            if let Some((_, other)) = self.ids.to_remote.get(&o.other_client) {
-                o.other_client = *other;
-            }
-            put_outcome(session, &self.device, &origin, &o);
-        }
+        self.forward_outcomes(session);
         let now = Instant::now();
         let names = self.names;
         self.pending.retain(|(query, p, deadline, remote)| {
@@ -491,8 +510,11 @@ fn expose_device<I: Interface>(
     tx: &Sender<Event>,
 ) -> Result<Box<dyn ExposedDevice>, String> {
     let mut client = Client::<I>::connect(ctx, &device.to_string()).map_err(|e| e.to_string())?;
-    // The outcomes of every client: those of the remote clients' commands go back to them.
-    client.watch_outcomes().map_err(|e| e.to_string())?;
+    // The outcomes of the remote clients' commands (relayed under ids of this process), on
+    // this process's own stream: nobody else's commands fill it.
+    if !client.relay_open_stream(true) {
+        return Err("its driver does not take an outcome stream".into());
+    }
     let listener = client.relay_listener().map_err(|e| e.to_string())?;
     // The same test as the one that withdraws it: a driver found dead is not exposed.
     if !client.relay_driver_alive() {
@@ -565,6 +587,7 @@ fn expose_device<I: Interface>(
             to_local: HashMap::new(),
             to_remote: HashMap::new(),
         },
+        relayed: 0,
         pending: Vec::new(),
         doubted: false,
         leases: Vec::new(),

@@ -125,6 +125,17 @@ impl core::fmt::Debug for Context {
 
 static CLIENT_SEQ: AtomicU32 = AtomicU32::new(1);
 
+/// The low 32 bits of the id of a process's outcome stream: it names no client but every
+/// client of its process that has no stream of its own (the remote clients whose commands
+/// a bridge relays). Never given to a client.
+pub(crate) const EVERY_CLIENT_OF_PROCESS: u32 = u32::MAX;
+
+/// The id of the outcome stream that carries the outcomes of every client of `client_id`'s
+/// process without a stream of its own (see `crate::host` `told.rs`).
+pub(crate) fn process_stream_id(client_id: u64) -> u64 {
+    client_id | u64::from(EVERY_CLIENT_OF_PROCESS)
+}
+
 impl Context {
     /// Joins `domain` as a driver or a client named `name` (shown by `limber list`).
     ///
@@ -267,9 +278,13 @@ impl Context {
     /// A new client id, unique in the domain while this process lives: the process id in
     /// the high 32 bits (as iceoryx2 records it in this process's node id, so that a driver
     /// can tell a client id of another process from the sender's own: see the host's
-    /// `senders`), a per-process counter in the low 32 bits. Never 0.
+    /// `senders`), a per-process counter in the low 32 bits. Never 0, never a process's
+    /// outcome stream id (the low 32 bits all ones).
     pub fn new_client_id(&self) -> u64 {
-        let n = CLIENT_SEQ.fetch_add(1, Ordering::Relaxed);
+        let mut n = CLIENT_SEQ.fetch_add(1, Ordering::Relaxed);
+        while n == EVERY_CLIENT_OF_PROCESS || n == 0 {
+            n = CLIENT_SEQ.fetch_add(1, Ordering::Relaxed);
+        }
         let pid = self
             .node()
             .id()

@@ -15,6 +15,7 @@ pub mod qos;
 pub mod relay;
 pub mod signals;
 pub mod testing;
+pub(crate) mod wake;
 
 /// The old path of [`domain::cleanup`].
 pub use domain::cleanup;

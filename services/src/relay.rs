@@ -1,9 +1,11 @@
 //! Relaying: the raw side of a [`DeviceHost`] and of a [`Client`], for a bridge that carries
 //! a device's channels to another domain (e.g. over a network) without decoding them.
 //!
-//! A bridge on the driver's side uses a [`Client`] to take every state sample and every
-//! outcome (of all clients) and to send commands and requests whose metadata it fills in
-//! itself; a bridge on the far side hosts the device with a [`DeviceHost`] whose state and
+//! A bridge on the driver's side uses a [`Client`] to take every state sample and the
+//! outcomes of the commands it relayed (on its process's own stream,
+//! [`Client::relay_own_outcomes`]; a recorder takes every client's,
+//! [`Client::relay_outcomes`]) and to send commands and requests whose metadata it fills
+//! in itself; a bridge on the far side hosts the device with a [`DeviceHost`] whose state and
 //! outcomes come from the relay and whose commands and requests go to it. The messages are
 //! the fixed layouts of the interfaces, unchanged.
 
@@ -210,6 +212,79 @@ impl<I: Interface> Client<I> {
                 Ok(Some(s)) => {
                     each(&s);
                     n += 1;
+                }
+                Ok(None) => return Ok(n),
+                Err(e) => return Err(e.into()),
+            }
+        }
+    }
+
+    /// Opens this process's outcome stream (if it is not open, or its driver no longer
+    /// keeps it: a driver that started again), on which the driver sends the outcomes of
+    /// every client id of this process that has no stream of its own: those of the
+    /// commands relayed with [`Client::relay_send`] under ids of
+    /// [`crate::Context::new_client_id`]. Only those commands fill it: another client
+    /// flooding the device cannot push their outcomes out. Looks at most once per
+    /// [`crate::client::LIVENESS_PERIOD`] unless `now`; returns whether it is open.
+    pub fn relay_open_stream(&mut self, now: bool) -> bool {
+        let t = std::time::Instant::now();
+        let open = self.told.process.is_some();
+        if open
+            && !now
+            && self
+                .told
+                .process_checked
+                .is_some_and(|c| t < c + crate::client::LIVENESS_PERIOD)
+        {
+            return true;
+        }
+        self.told.process_checked = Some(t);
+        if let Err(e) = self.told.port.update_connections() {
+            tracing::debug!(device = %self.device, error = %e, "cannot connect the outcome stream's port");
+        }
+        if self.told.process.as_ref().is_some_and(|s| s.is_connected()) {
+            return true;
+        }
+        // Dropped first: its slot is free for the new one.
+        self.told.process = None;
+        let id = crate::context::process_stream_id(self.client_id());
+        match crate::client::open_told_stream(&self.told.port, id) {
+            Ok(s) => {
+                if s.is_some() {
+                    // The driver takes it at once (and sends what it kept meanwhile).
+                    self.wake_driver_with(qos::EVENT_REQUEST);
+                }
+                self.told.process = s;
+            }
+            Err(e) => {
+                tracing::warn!(device = %self.device, error = %e, "cannot open this process's outcome stream");
+            }
+        }
+        self.told.process.is_some()
+    }
+
+    /// Takes the outcomes of the commands this process relayed that arrived on its outcome
+    /// stream ([`Client::relay_open_stream`], opened or opened again here), oldest first.
+    pub fn relay_own_outcomes(
+        &mut self,
+        mut each: impl FnMut(&OutcomeMsg),
+    ) -> Result<usize, Iox2Error> {
+        self.relay_open_stream(false);
+        let Some(stream) = &self.told.process else {
+            return Ok(0);
+        };
+        let mine = self.client_id();
+        let mut n = 0;
+        loop {
+            match stream.receive() {
+                Ok(Some(r)) => {
+                    let m: &OutcomeMsg = r.payload();
+                    // Only this process's come on it; a driver of another kind may say
+                    // otherwise.
+                    if m.client_id >> 32 == mine >> 32 && m.client_id != mine {
+                        each(m);
+                        n += 1;
+                    }
                 }
                 Ok(None) => return Ok(n),
                 Err(e) => return Err(e.into()),

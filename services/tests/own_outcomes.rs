@@ -209,3 +209,81 @@ fn a_stream_asked_for_with_another_processs_client_id_gets_nothing() {
     assert!(child.wait().unwrap().success());
     assert!(rest.contains("RECEIVED 0"), "the forger's output: {rest}");
 }
+
+/// A bridge relays its remote clients' commands under client ids of its own process and
+/// reads their outcomes on its process's stream: only the commands it relayed fill it.
+/// Before, it read them on the shared `outcome` channel (256 deep), where a local client
+/// flooding the device pushed them out, and the remote client waited out its timeout.
+#[test]
+fn a_relayed_commands_outcome_outlives_a_local_clients_flood() {
+    let domain = Domain::unique_for_test();
+    let (_dctx, mut host) = host(&domain);
+    let mut arm = TestArm::new(2);
+    let bctx = Context::new(&domain, Role::Client, "own-bridge").unwrap();
+    let mut bridge = ActArrayClient::connect_timeout(&bctx, DEVICE, T).unwrap();
+    assert!(bridge.relay_open_stream(true));
+    let lctx = Context::new(&domain, Role::Client, "own-local").unwrap();
+    let mut flood = ActArrayClient::connect_timeout(&lctx, DEVICE, T).unwrap();
+
+    // A remote client's command, as the bridge relays it: a client id of the bridge's
+    // process of its own.
+    let remote = bctx.new_client_id();
+    let mut cmd = ActArrayCmdMsg::default();
+    ActArrayCommand::Position {
+        joint: 0,
+        position: 0.3,
+    }
+    .write(&mut cmd);
+    cmd.meta_mut().client_id = remote;
+    cmd.meta_mut().seq = 1;
+    assert_eq!(bridge.relay_send(&cmd).unwrap(), 1);
+    host.process(&mut arm).unwrap();
+    // A local client's flood is decided before the bridge looks.
+    let others = 2 * limber_services::qos::OUTCOME_BUFFER + limber_services::qos::CMD_BUFFER;
+    let mut sent = 0;
+    while sent < others {
+        for _ in 0..limber_services::qos::CMD_BUFFER {
+            flood.move_to(1, (sent % 10) as f64 * 0.01).unwrap();
+            sent += 1;
+        }
+        while host.process(&mut arm).unwrap().commands > 0 {}
+    }
+    let mut got = Vec::new();
+    bridge.relay_own_outcomes(|o| got.push(*o)).unwrap();
+    // Exactly the relayed command's: none of the flood's, none of the bridge's own.
+    assert_eq!(got.len(), 1, "{got:?}");
+    assert_eq!((got[0].client_id, got[0].cmd_seq), (remote, 1));
+    assert_eq!(got[0].status, Status::Ok.code());
+
+    // The old way, the `outcome` channel, lost it under the same flood.
+    bridge.watch_outcomes().unwrap();
+    let remote2 = bctx.new_client_id();
+    cmd.meta_mut().client_id = remote2;
+    bridge.relay_send(&cmd).unwrap();
+    host.process(&mut arm).unwrap();
+    let mut sent = 0;
+    while sent < others {
+        for _ in 0..limber_services::qos::CMD_BUFFER {
+            flood.move_to(1, (sent % 10) as f64 * 0.01).unwrap();
+            sent += 1;
+        }
+        while host.process(&mut arm).unwrap().commands > 0 {}
+    }
+    let mut watched = Vec::new();
+    bridge.relay_outcomes(|o| watched.push(*o)).unwrap();
+    assert!(!watched.iter().any(|o| o.client_id == remote2));
+    let mut got = Vec::new();
+    bridge.relay_own_outcomes(|o| got.push(*o)).unwrap();
+    // Its outcome, and the result of the first relayed command's motion, which it cut short
+    // (told to that remote client as it would be to a local one).
+    assert!(
+        got.iter()
+            .any(|o| o.client_id == remote2 && o.result == 0 && o.status == Status::Ok.code()),
+        "{got:?}"
+    );
+    assert!(
+        got.iter()
+            .all(|o| o.client_id == remote2 || (o.client_id == remote && o.other_client == remote2)),
+        "{got:?}"
+    );
+}

@@ -73,7 +73,7 @@ pub fn fanout(ctx: &mut RunCtx, fan: usize) -> Result<(), BenchError> {
     };
     let (warm, n) = pace.counts(ctx, ((0, 0), (0, 0)));
     let deadline = pace.deadline(ctx, warm + n, PERIOD);
-    let mut subs = Subscribers::spawn(ctx, &domain, ROLE, fan, warm, deadline)?;
+    let mut subs = Subscribers::spawn(ctx, &domain, ROLE, fan, warm, deadline, None)?;
     let publish = |seq: u64, mark: u32| -> Result<(), BenchError> {
         let loan = publisher
             .loan_uninit()

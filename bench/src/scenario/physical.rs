@@ -155,12 +155,17 @@ fn page_path(ctx: &RunCtx, wait: Wait) -> PathBuf {
 
 /// Publishes `seq` (with a fresh stamp) on `line`, waking a futex waiter.
 fn publish(line: &Line, seq: u32, wait: Wait) {
+    publish_to(line, seq, wait, 1);
+}
+
+/// Publishes `seq` (with a fresh stamp) on `line`, waking up to `sleepers` futex waiters.
+fn publish_to(line: &Line, seq: u32, wait: Wait, sleepers: u32) {
     line.stamp.store(monotonic_ns(), Ordering::Relaxed);
     line.seq.store(seq, Ordering::Release);
     if wait == Wait::Futex {
         // The number of woken waiters does not matter; an error cannot happen for a valid
         // address, and the other side re-checks with a timeout anyway.
-        if let Err(e) = futex::wake(&line.seq, futex::Flags::empty(), 1) {
+        if let Err(e) = futex::wake(&line.seq, futex::Flags::empty(), sleepers) {
             tracing::debug!("futex wake: {e}");
         }
     }
@@ -319,6 +324,95 @@ fn run(
         });
     }
     Ok(())
+}
+
+/// The child role of a futex fan-out waiter.
+pub const FANOUT_ROLE: &str = "futex-fanout-sub";
+
+/// The futex floor of the `state` fan-out (limber's state waiters sleep on a futex, the
+/// device's wake word): the bench process publishes a stamped sequence number on one page
+/// at 1 kHz and wakes every sleeper with one `FUTEX_WAKE`; `fan` child processes sleep in
+/// `FUTEX_WAIT` and record each number's age (`state.futex.<fan>.oneway`, merged as
+/// `state.<fan>.oneway` is): what the kernel alone pays to wake that many processes.
+pub fn fanout(ctx: &mut RunCtx, fan: usize) -> Result<(), BenchError> {
+    let path = page_path(ctx, Wait::Futex);
+    let shared = Shared::map(&path, true)?;
+    let result = run_fanout(ctx, fan, &shared, &path);
+    if let Err(e) = std::fs::remove_file(&path) {
+        tracing::warn!("cannot remove {}: {e}", path.display());
+    }
+    result
+}
+
+fn run_fanout(
+    ctx: &mut RunCtx,
+    fan: usize,
+    shared: &Shared,
+    path: &Path,
+) -> Result<(), BenchError> {
+    use super::state::{PERIOD, Subscribers};
+    let page = shared.page();
+    let pace = Pace::Paced {
+        period: PERIOD,
+        scenario: "state",
+    };
+    let (warm, n) = pace.counts(ctx, ((0, 0), (0, 0)));
+    let deadline = pace.deadline(ctx, warm + n, PERIOD);
+    let subs = Subscribers::spawn(
+        ctx,
+        &ctx.domain(),
+        FANOUT_ROLE,
+        fan,
+        warm,
+        deadline,
+        Some(path),
+    )?;
+    let total = u32::try_from(warm + n)
+        .ok()
+        .filter(|t| *t < STOP)
+        .ok_or_else(|| BenchError::Args("too many samples for the futex fan-out".into()))?;
+    let all = u32::try_from(fan).unwrap_or(u32::MAX);
+    let start = Instant::now();
+    for seq in 1..=total {
+        pace.wait_turn(start, u64::from(seq));
+        publish_to(&page.ping, seq, Wait::Futex, all);
+    }
+    publish_to(&page.ping, STOP, Wait::Futex, all);
+    subs.merge_into(
+        ctx,
+        format!("state.futex.{fan}.oneway"),
+        format!("futex broadcast → {fan} waiter(s), 1 kHz"),
+    )
+}
+
+/// The futex fan-out's waiter child (`futex-fanout-sub`): sleeps until the number
+/// changes, records its age after the warm-up, until STOP.
+pub fn fanout_role(args: &BenchArgs) -> Result<(), BenchError> {
+    let path = args
+        .shm
+        .as_ref()
+        .ok_or_else(|| BenchError::Args("--shm is required for this role".into()))?;
+    let deadline = crate::roles::child_deadline(args);
+    let shared = Shared::map(path, false)?;
+    let page = shared.page();
+    let mut oneway = new_histogram()?;
+    crate::roles::announce("ready");
+    let mut last = 0u32;
+    loop {
+        let Some((now, seq, stamp)) = await_change(&page.ping, last, Wait::Futex, deadline) else {
+            return Err(BenchError::Timeout {
+                what: "futex fan-out: the publisher stopped".into(),
+                timeout: Duration::from_millis(args.deadline_ms),
+            });
+        };
+        if seq == STOP {
+            return crate::roles::write_histogram(args, &oneway);
+        }
+        if u64::from(seq) > args.warmup {
+            oneway.saturating_record(now.saturating_sub(stamp));
+        }
+        last = seq;
+    }
 }
 
 /// The echo child (`futex-echo`, `cacheline-echo`).

@@ -1,16 +1,19 @@
 //! `state`: a driver process (`DeviceHost<ActArray>`) publishes the 1376 B arm state at
 //! 1 kHz; 1, 4 and 16 subscriber processes (`ActArrayClient`, `WaitMode::Event`) block in
-//! `wait_state` on the driver's notify event — never more spinning processes than
-//! cores, so nobody spins here. One-way latency: the state's `header.stamp_ns` (taken
-//! just before `publish`) against the subscriber's clock when `wait_state` returned.
-//! Samples of all subscribers of one fan-out are merged into one histogram.
+//! `wait_state`, asleep on the device's wake word (a futex the driver bumps with every
+//! state) — never more spinning processes than cores, so nobody spins here. One-way
+//! latency: the state's `header.stamp_ns` (taken just before `publish`) against the
+//! subscriber's clock when `wait_state` returned. Samples of all subscribers of one
+//! fan-out are merged into one histogram.
 //!
 //! Its floors run first, at the same rate (`state.paced.futex.*`, `state.paced.event.*`):
 //! the physical futex ping-pong and the raw iceoryx2 event ping-pong of `floor`, one
 //! exchange per millisecond from a sleeping sender, so that the echo's wake-up
 //! (`*.oneway`) comes after the idle millisecond a subscriber's does. Before each fan-out,
-//! its floor: the same publication and notify in raw iceoryx2 to as many listener
-//! processes (`state.raw.<N>.oneway`, [`super::fanout_floor`]).
+//! its floors: the same publication and notify in raw iceoryx2 to as many listener
+//! processes (`state.raw.<N>.oneway`, [`super::fanout_floor`]), and a stamped number on a
+//! shared page with one `FUTEX_WAKE` to as many waiter processes
+//! (`state.futex.<N>.oneway`, [`physical::fanout`]).
 
 use std::time::{Duration, Instant};
 
@@ -42,7 +45,7 @@ impl Scenario for StateFanout {
         "state"
     }
     fn description(&self) -> &'static str {
-        "driver publishes the arm state at 1 kHz; 1, 4, 16 subscriber processes block on the notify event (one-way); beside it its floors paced at the same 1 kHz: a futex wake and a raw iceoryx2 event wake, and before each fan-out raw iceoryx2's own (a sample and a notify to as many listener processes)"
+        "driver publishes the arm state at 1 kHz; 1, 4, 16 subscriber processes block in wait_state on the device's wake word (one-way); beside it its floors paced at the same 1 kHz: a futex wake and a raw iceoryx2 event wake, and before each fan-out raw iceoryx2's own (a sample and a notify to as many listener processes) and the kernel's (one futex wake of as many waiter processes)"
     }
     fn run(&self, ctx: &mut RunCtx) -> Result<(), BenchError> {
         if !ctx.blocking_enabled() {
@@ -61,6 +64,7 @@ impl Scenario for StateFanout {
         floor::ping_pong(ctx, Echo::Listener, pace)?;
         for fan in FANOUTS {
             super::fanout_floor::fanout(ctx, fan)?;
+            physical::fanout(ctx, fan)?;
             fanout(ctx, fan)?;
         }
         Ok(())
@@ -88,7 +92,7 @@ fn fanout(ctx: &mut RunCtx, fan: usize) -> Result<(), BenchError> {
         ..Default::default()
     })?;
     publisher.expect("ready", READY_TIMEOUT)?;
-    let mut subs = Subscribers::spawn(ctx, &domain, "state-sub", fan, warm, deadline)?;
+    let mut subs = Subscribers::spawn(ctx, &domain, "state-sub", fan, warm, deadline, None)?;
     ctx.say(format_args!(
         "  state fan-out {fan}: {} samples at {} Hz",
         warm + n,
@@ -118,6 +122,7 @@ pub(super) struct Subscribers {
 
 impl Subscribers {
     /// Spawns `fan` children of `role` in `domain` and waits for each one's "ready".
+    /// `shm`: the page a futex waiter maps ([`physical::fanout`]).
     pub(super) fn spawn(
         ctx: &RunCtx,
         domain: &Domain,
@@ -125,6 +130,7 @@ impl Subscribers {
         fan: usize,
         warm: u64,
         deadline: Duration,
+        shm: Option<&std::path::Path>,
     ) -> Result<Self, BenchError> {
         let mut subs = Subscribers {
             procs: Vec::with_capacity(fan),
@@ -136,6 +142,7 @@ impl Subscribers {
                 role: role.into(),
                 domain: Some(domain.name().to_string()),
                 out: Some(out.clone()),
+                shm: shm.map(std::path::Path::to_path_buf),
                 warmup: warm,
                 deadline,
                 ..Default::default()

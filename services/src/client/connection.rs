@@ -38,14 +38,18 @@ pub(super) const OUTCOME_SLOTS: usize = 16;
 /// A client's own outcomes: its port on the device's `told` channel and the stream it
 /// opened there (see `crate::host` `told.rs`).
 pub(crate) struct ToldSide {
-    pub(super) port: IoxClient<ipc::Service, u64, (), OutcomeMsg, ()>,
+    pub(crate) port: IoxClient<ipc::Service, u64, (), OutcomeMsg, ()>,
     /// Open while the driver that took it keeps it (a restarted driver needs a new one).
     pub(super) stream: Option<ToldStream>,
+    /// This process's stream, for a relay (`Client::relay_own_outcomes`), and when it was
+    /// last looked at.
+    pub(crate) process: Option<ToldStream>,
+    pub(crate) process_checked: Option<Instant>,
 }
 
 /// A client's outcome stream: its request on `told`, answered with every outcome of its
 /// commands.
-type ToldStream = PendingResponse<ipc::Service, u64, (), OutcomeMsg, ()>;
+pub(crate) type ToldStream = PendingResponse<ipc::Service, u64, (), OutcomeMsg, ()>;
 
 /// The lease port of a client and the lease it holds.
 pub(crate) struct LeaseSide {
@@ -82,10 +86,15 @@ pub struct Client<I: Interface> {
     pub(super) wake_retry_at: core::cell::Cell<Option<std::time::Instant>>,
     pub(crate) notify_svc: iceoryx2::service::port_factory::event::PortFactory<ipc::Service>,
     pub(super) notify: Option<Listener<ipc::Service>>,
+    /// The device's wake word, on which [`Client::wait_state`] sleeps ([`crate::wake`]),
+    /// opened at its first wait.
+    pub(super) state_wake: Option<crate::wake::WakeWord>,
+    /// When opening the wake word last failed (tried again a liveness period later).
+    pub(super) state_wake_tried: Option<Instant>,
     pub(super) cmd_seq: u64,
     pub(super) req_seq: u64,
     /// This client's own outcomes (see [`ToldSide`]).
-    pub(super) told: ToldSide,
+    pub(crate) told: ToldSide,
     pub(crate) outcome_svc: OutcomeSvc,
     /// Every outcome of the device, once [`Client::watch_outcomes`] asked for them.
     pub(crate) outcome_sub: Option<Subscriber<ipc::Service, OutcomeMsg, ()>>,
@@ -380,9 +389,16 @@ impl<I: Interface> Client<I> {
             wake_retry_at: core::cell::Cell::new(None),
             notify_svc,
             notify: None,
+            state_wake: None,
+            state_wake_tried: None,
             cmd_seq: 0,
             req_seq: 0,
-            told: ToldSide { port: told, stream },
+            told: ToldSide {
+                port: told,
+                stream,
+                process: None,
+                process_checked: None,
+            },
             outcome_svc,
             outcome_sub: None,
             outcomes: [Outcome::NONE; OUTCOME_SLOTS],
@@ -475,7 +491,7 @@ impl<I: Interface> Client<I> {
 
 /// Asks the driver of `port` for the outcomes of client `client_id`: the stream, or `None`
 /// when no driver took the request.
-fn open_told_stream(
+pub(crate) fn open_told_stream(
     port: &IoxClient<ipc::Service, u64, (), OutcomeMsg, ()>,
     client_id: u64,
 ) -> Result<Option<ToldStream>, Iox2Error> {

@@ -241,6 +241,8 @@ impl<I: Interface> Client<I> {
         let mut next_check = start + LIVENESS_PERIOD;
         let mut polls = 0u32;
         loop {
+            // Read before looking: a state published after the look changes it.
+            let seen = self.state_wake_seen();
             if self.refresh()? {
                 break;
             }
@@ -257,10 +259,36 @@ impl<I: Interface> Client<I> {
                     return Err(WaitError::DriverGone);
                 }
             }
-            self.pause(deadline.min(next_check))
+            self.pause_on(deadline.min(next_check), seen)
                 .map_err(WaitError::Transport)?;
         }
         Ok(self.latest.as_deref().expect("refresh returned a sample"))
+    }
+
+    /// In event mode, the device's wake word as it is now (opened on the first call; when
+    /// it cannot be, tried again a liveness period later), or None: wait on the event.
+    fn state_wake_seen(&mut self) -> Option<u32> {
+        if self.wait_mode != WaitMode::Event {
+            return None;
+        }
+        if self.state_wake.is_none() {
+            let now = Instant::now();
+            if self
+                .state_wake_tried
+                .is_some_and(|t| now < t + LIVENESS_PERIOD)
+            {
+                return None;
+            }
+            self.state_wake_tried = Some(now);
+            match crate::wake::WakeWord::open(self.ctx.domain(), &self.device) {
+                Ok(w) => self.state_wake = Some(w),
+                Err(e) => {
+                    tracing::debug!(device = %self.device, error = %e, "no wake word: waiting for a state on the notify event");
+                    return None;
+                }
+            }
+        }
+        self.state_wake.as_ref().map(crate::wake::WakeWord::seen)
     }
 
     /// Waits for the outcome of the command of `ticket`, as published by the driver.
@@ -343,6 +371,12 @@ impl<I: Interface> Client<I> {
 
     /// Blocks (event mode) or spins once (spin mode) until `until` or a notification.
     pub(super) fn pause(&mut self, until: Instant) -> Result<(), Iox2Error> {
+        self.pause_on(until, None)
+    }
+
+    /// [`Client::pause`]; with `state_seen` (the wake word as read before looking for a
+    /// state), the block is a sleep on the wake word until it changes.
+    fn pause_on(&mut self, until: Instant, state_seen: Option<u32>) -> Result<(), Iox2Error> {
         match self.wait_mode {
             WaitMode::Spin => {
                 core::hint::spin_loop();
@@ -358,6 +392,13 @@ impl<I: Interface> Client<I> {
                         return Ok(());
                     }
                     self.spin_until = None;
+                }
+                if let (Some(seen), Some(word)) = (state_seen, &self.state_wake) {
+                    let left = until.saturating_duration_since(Instant::now());
+                    if !left.is_zero() {
+                        word.wait(seen, left);
+                    }
+                    return Ok(());
                 }
                 if self.notify.is_none() {
                     let l = self.notify_svc.listener_builder().create()?;

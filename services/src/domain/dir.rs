@@ -41,7 +41,8 @@ pub const RUNTIME_DIR_ENV: &str = "LIMBER_RUNTIME_DIR";
 /// group whose members share the domains (docs/guide/security.md).
 pub const GROUP_ENV: &str = "LIMBER_GROUP";
 /// Where POSIX shared memory lives on Linux.
-const SHM_DIR: &str = "/dev/shm";
+/// Where iceoryx2 (and the wake words, [`crate::wake`]) keep a domain's shared memory.
+pub(crate) const SHM_DIR: &str = "/dev/shm";
 /// The suffix iceoryx2 gives its per-domain node counter.
 const GLOBAL_MGMT_SUFFIX: &str = ".global_mgmt";
 
@@ -381,6 +382,20 @@ fn trusted(md: &fs::Metadata, group: Option<&Group>) -> bool {
     md.uid() == euid() || group.is_some_and(|g| md.gid() == g.gid && md.mode() & 0o002 == 0)
 }
 
+/// A file found in a domain (`path`, its metadata `md`) that may be used ([`trusted`]), or
+/// the error that says whose it is.
+pub(crate) fn check_trusted(
+    path: &Path,
+    md: &fs::Metadata,
+    group: Option<&Group>,
+) -> Result<(), DomainError> {
+    if trusted(md, group) {
+        Ok(())
+    } else {
+        Err(untrusted(path, md, group))
+    }
+}
+
 /// The error for a file that is not [`trusted`].
 fn untrusted(path: &Path, md: &fs::Metadata, group: Option<&Group>) -> DomainError {
     match group {
@@ -446,9 +461,7 @@ fn read_token(path: PathBuf, group: Option<&Group>) -> Result<String, DomainErro
     if !md.file_type().is_file() {
         return Err(DomainError::BadToken(path));
     }
-    if !trusted(&md, group) {
-        return Err(untrusted(&path, &md, group));
-    }
+    check_trusted(&path, &md, group)?;
     let text = fs::read_to_string(&path).map_err(io_err("read", &path))?;
     let t = text.trim();
     if !valid_token(t) {
@@ -525,9 +538,7 @@ pub fn domain_names() -> Result<Vec<String>, DomainError> {
     if !md.file_type().is_dir() {
         return Err(DomainError::NotADirectory(dir));
     }
-    if !trusted(&md, group.as_ref()) {
-        return Err(untrusted(&dir, &md, group.as_ref()));
-    }
+    check_trusted(&dir, &md, group.as_ref())?;
     let mut names: Vec<String> = fs::read_dir(&dir)
         .map_err(io_err("list", &dir))?
         .map(|e| e.map_err(io_err("list", &dir)))

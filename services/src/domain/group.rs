@@ -30,9 +30,7 @@ use std::sync::Mutex;
 use iceoryx2::node::NodeView;
 use rustix::fs::inotify;
 
-use super::dir::{DomainError, GROUP_DIR_MODE, Group, IoError, euid};
-
-const SHM_DIR: &str = "/dev/shm";
+use super::dir::{DomainError, GROUP_DIR_MODE, Group, IoError, SHM_DIR, euid};
 
 /// The mode a file of ours should have in group mode, or None to leave it as it is.
 /// `in_shm`: the file is in `/dev/shm` (else in the iceoryx2 root path).

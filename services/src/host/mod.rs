@@ -85,6 +85,9 @@ pub struct DeviceHost<I: Interface> {
     data_svc:
         iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, I::Data, ()>,
     publisher: Publisher<ipc::Service, I::Data, ()>,
+    /// Bumped with every state published: the clients in `wait_state` sleep on it
+    /// ([`crate::wake`]); None if it could not be made.
+    state_wake: Option<crate::wake::WakeWord>,
     commands: Subscriber<ipc::Service, I::CmdMsg, ()>,
     /// One round of commands taken fairly (see `commands.rs`): allocated once, for every
     /// client's [`qos::CMD_BORROWED`].
@@ -282,6 +285,10 @@ impl<I: Interface> DeviceHost<I> {
     /// After a state was sent (and the outcome or reply it goes with): notifies waiting
     /// clients, then loans the sample of the next publication, off the clients' path.
     fn state_sent(&mut self) {
+        // The clients asleep in `wait_state` first: one system call wakes them all.
+        if let Some(w) = &self.state_wake {
+            w.bump();
+        }
         // A client that waits with a timeout re-checks anyway: counted, not fatal.
         self.notify_clients(qos::EVENT_STATE);
         self.state_loan = loan_ahead(&self.publisher, &self.device, "state");

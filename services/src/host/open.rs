@@ -226,9 +226,19 @@ impl<I: Interface> DeviceHost<I> {
             .create()
             .map_err(|e| transport("outcome", e.into()))?;
 
+        // The clients that wait for a state sleep on it (a client without it waits on the
+        // notify event: slower, not wrong).
+        let state_wake = match crate::wake::WakeWord::create(ctx.domain(), device) {
+            Ok(w) => Some(w),
+            Err(e) => {
+                tracing::warn!(device = %dev, error = %e, "no wake word: clients waiting for a state wait on the notify event");
+                None
+            }
+        };
         // Group mode: this device's files open to the group at once.
         ctx.domain().widen_now();
         Ok(DeviceHost {
+            state_wake,
             domain: ctx.domain().clone(),
             device: device.clone(),
             data_svc,

@@ -14,6 +14,13 @@
 //! process that sent it (iceoryx2's registry of the service's clients) must be the one the
 //! id belongs to (`senders::client_of_process`), so no process takes or displaces another
 //! process's stream.
+//!
+//! A process may also ask for its *process stream* (`context::process_stream_id`): the
+//! outcomes of every client id of that process that has no stream of its own. A bridge
+//! relays its remote clients' commands under client ids of its own process
+//! (`Client::relay_send`) and reads their outcomes there (`Client::relay_own_outcomes`):
+//! only the commands it relayed fill it, so a local client flooding the device cannot push
+//! a remote client's outcome out, as it could on the shared `outcome` channel.
 
 use core::mem::MaybeUninit;
 
@@ -27,7 +34,7 @@ use limber_interfaces::prelude::*;
 
 use super::senders::{PortNodes, client_of_process};
 use super::{HostStats, PublishError};
-use crate::context::monotonic_ns;
+use crate::context::{monotonic_ns, process_stream_id};
 use crate::error::Iox2Error;
 use crate::naming::DeviceName;
 
@@ -153,11 +160,11 @@ impl Outcomes {
     /// client asks before it sends its first command, so the request of a client whose
     /// command was taken is there).
     fn tell(&mut self, device: &DeviceName, msg: &OutcomeMsg) -> bool {
-        let i = match self.find(msg.client_id) {
+        let i = match self.stream_for(msg.client_id) {
             Some(i) => i,
             None => {
                 self.accept(device);
-                match self.find(msg.client_id) {
+                match self.stream_for(msg.client_id) {
                     Some(i) => i,
                     // Kept for the client's stream to come (a client that met a restarted
                     // driver), or for nobody (a bridge relaying the commands of remote
@@ -183,6 +190,12 @@ impl Outcomes {
 
     fn find(&self, client_id: u64) -> Option<usize> {
         self.streams.iter().position(|(c, _)| *c == client_id)
+    }
+
+    /// The stream of `client_id`: its own, else its process's.
+    fn stream_for(&self, client_id: u64) -> Option<usize> {
+        self.find(client_id)
+            .or_else(|| self.find(process_stream_id(client_id)))
     }
 
     /// Takes the stream requests that arrived: each replaces that client's earlier stream
@@ -230,11 +243,13 @@ impl Outcomes {
         }
     }
 
-    /// Sends `client_id`'s kept outcomes on its new stream, oldest first, and forgets them.
+    /// Sends the kept outcomes of `client_id` (of a process stream: of every client id of
+    /// its process) on its new stream, oldest first, and forgets them.
     fn send_untold(&mut self, device: &DeviceName, client_id: u64, stream: &Stream) {
         for k in 0..UNTOLD {
             let m = &mut self.untold[(self.untold_at + k) % UNTOLD];
-            if m.client_id != client_id || m.cmd_seq == 0 {
+            let for_it = m.client_id == client_id || process_stream_id(m.client_id) == client_id;
+            if !for_it || m.cmd_seq == 0 {
                 continue;
             }
             if let Err(e) = send_on(stream, m) {
