@@ -28,7 +28,15 @@ pub const RATIOS: &[RatioDef] = &[
         den: "bridge.raw.put.rtt",
         pct: Pct::P50,
         goal: Some(Goal::AtMost(1.3)),
-        floor: None,
+        // A command through the pair crosses Zenoh once each way and iceoryx2 twice each way
+        // (client to mirror, expose to driver, and back): raw Zenoh's round trip plus two raw
+        // iceoryx2 event round trips (paced, so each wakes after idle time as the hops do).
+        floor: Some(RatioFloor {
+            num: "bridge.raw.put.rtt",
+            plus: &[("state.paced.event.rtt", 2)],
+            den: "bridge.raw.put.rtt",
+            what: "raw Zenoh's put ping-pong plus two raw iceoryx2 event round trips, over raw Zenoh's",
+        }),
     },
     RatioDef {
         label: "command through the bridge pair / raw Zenoh put ping-pong (bridge)",
@@ -95,6 +103,7 @@ pub const RATIOS: &[RatioDef] = &[
         // limber's state waiters sleep on a futex (the device's wake word): the kernel's
         // own fan-out is the floor.
         floor: Some(RatioFloor {
+            plus: &[],
             num: "state.futex.16.oneway",
             den: "state.futex.1.oneway",
             what: "a futex broadcast's own fan-out, 16 waiters / 1",

@@ -74,6 +74,11 @@ pub struct RatioDef {
 pub struct RatioFloor {
     /// Numerator measurement id.
     pub num: &'static str,
+    /// Further series added to the numerator at the same percentile, each so many times:
+    /// a floor made of several hops, each measured alone (a sum of medians is at most the
+    /// median of the sum for these right-skewed latencies, so the floor is not overstated;
+    /// used at p50 only).
+    pub plus: &'static [(&'static str, u32)],
     /// Denominator measurement id.
     pub den: &'static str,
     /// What the floors' ratio is, in words.
@@ -351,9 +356,15 @@ impl Report {
             .iter()
             .filter_map(|r| {
                 let (value, a, b) = value_of(r.num, r.den, r.pct)?;
-                let floor = r
-                    .floor
-                    .and_then(|f| value_of(f.num, f.den, r.pct).map(|(v, _, _)| (v, f.what)));
+                let floor = r.floor.and_then(|f| {
+                    let (v, _, b) = value_of(f.num, f.den, r.pct)?;
+                    let d = r.pct.of(&Summary::of(&b.hist)) as f64;
+                    let mut extra = 0.0;
+                    for (id, times) in f.plus {
+                        extra += f64::from(*times) * r.pct.of(&Summary::of(&find(id)?.hist)) as f64;
+                    }
+                    Some((v + extra / d, f.what))
+                });
                 let met = r.goal.map(|g| match g {
                     Goal::AtMost(x) => value <= x,
                     Goal::AtLeast(x) => value >= x,
@@ -558,5 +569,77 @@ impl Report {
         let text = serde_json::to_string_pretty(self)
             .map_err(|e| BenchError::io(path.display().to_string(), std::io::Error::other(e)))?;
         std::fs::write(path, text).map_err(|e| BenchError::io(path.display().to_string(), e))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stats::{Metric, Strategy, new_histogram};
+
+    fn constant(id: &str, ns: u64) -> Measurement {
+        let mut hist = new_histogram().expect("a histogram");
+        for _ in 0..100 {
+            hist.record(ns).expect("in range");
+        }
+        Measurement {
+            scenario: "test",
+            id: id.to_string(),
+            label: id.to_string(),
+            strategy: Strategy::Blocking,
+            metric: Metric::RoundTrip,
+            bytes: None,
+            hist,
+        }
+    }
+
+    /// The bridge's goal carries a floor made of its hops: raw Zenoh's round trip plus two
+    /// raw iceoryx2 event round trips, over raw Zenoh's.
+    #[test]
+    fn a_floor_of_several_hops_adds_them_at_the_percentile() {
+        let report = Report::new(
+            Machine::probe("off".into(), "test".into()),
+            &BenchArgs::default(),
+            Vec::new(),
+            vec![
+                constant("bridge.zenoh.rtt", 300_000),
+                constant("bridge.raw.put.rtt", 100_000),
+                constant("state.paced.event.rtt", 25_000),
+            ],
+        );
+        let r = report
+            .ratios
+            .iter()
+            .find(|r| {
+                r.num == "bridge.zenoh.rtt" && r.den == "bridge.raw.put.rtt" && r.pct == Pct::P50
+            })
+            .expect("the bridge's p50 goal");
+        let (floor, what) = r.floor.expect("its floor");
+        assert!((floor - 1.5).abs() < 0.01, "{floor}");
+        assert!(what.contains("two raw iceoryx2 event round trips"));
+        assert!(r.below_floor());
+        assert!(
+            r.floor_note().contains("the goal is below its floor"),
+            "{}",
+            r.floor_note()
+        );
+        // Without the iceoryx2 series in the run, no floor is claimed.
+        let report = Report::new(
+            Machine::probe("off".into(), "test".into()),
+            &BenchArgs::default(),
+            Vec::new(),
+            vec![
+                constant("bridge.zenoh.rtt", 300_000),
+                constant("bridge.raw.put.rtt", 100_000),
+            ],
+        );
+        let r = report
+            .ratios
+            .iter()
+            .find(|r| {
+                r.num == "bridge.zenoh.rtt" && r.pct == Pct::P50 && r.den == "bridge.raw.put.rtt"
+            })
+            .expect("the bridge's p50 goal");
+        assert!(r.floor.is_none());
     }
 }
