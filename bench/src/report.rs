@@ -593,27 +593,32 @@ mod tests {
         }
     }
 
-    /// The bridge's goal carries a floor made of its hops: raw Zenoh's round trip plus two
-    /// raw iceoryx2 event round trips, over raw Zenoh's.
-    #[test]
-    fn a_floor_of_several_hops_adds_them_at_the_percentile() {
+    /// The report of a run of `measurements`, and its bridge p50 goal.
+    fn bridge_goal(measurements: Vec<Measurement>) -> Ratio {
         let report = Report::new(
             Machine::probe("off".into(), "test".into()),
             &BenchArgs::default(),
             Vec::new(),
-            vec![
-                constant("bridge.zenoh.rtt", 300_000),
-                constant("bridge.raw.put.rtt", 100_000),
-                constant("state.paced.event.rtt", 25_000),
-            ],
+            measurements,
         );
-        let r = report
+        report
             .ratios
-            .iter()
+            .into_iter()
             .find(|r| {
                 r.num == "bridge.zenoh.rtt" && r.den == "bridge.raw.put.rtt" && r.pct == Pct::P50
             })
-            .expect("the bridge's p50 goal");
+            .expect("the bridge's p50 goal")
+    }
+
+    /// The bridge's goal carries a floor made of its hops: raw Zenoh's round trip plus two
+    /// raw iceoryx2 event round trips, over raw Zenoh's.
+    #[test]
+    fn a_floor_of_several_hops_adds_them_at_the_percentile() {
+        let r = bridge_goal(vec![
+            constant("bridge.zenoh.rtt", 300_000),
+            constant("bridge.raw.put.rtt", 100_000),
+            constant("state.paced.event.rtt", 25_000),
+        ]);
         let (floor, what) = r.floor.expect("its floor");
         assert!((floor - 1.5).abs() < 0.01, "{floor}");
         assert!(what.contains("two raw iceoryx2 event round trips"));
@@ -624,22 +629,10 @@ mod tests {
             r.floor_note()
         );
         // Without the iceoryx2 series in the run, no floor is claimed.
-        let report = Report::new(
-            Machine::probe("off".into(), "test".into()),
-            &BenchArgs::default(),
-            Vec::new(),
-            vec![
-                constant("bridge.zenoh.rtt", 300_000),
-                constant("bridge.raw.put.rtt", 100_000),
-            ],
-        );
-        let r = report
-            .ratios
-            .iter()
-            .find(|r| {
-                r.num == "bridge.zenoh.rtt" && r.pct == Pct::P50 && r.den == "bridge.raw.put.rtt"
-            })
-            .expect("the bridge's p50 goal");
+        let r = bridge_goal(vec![
+            constant("bridge.zenoh.rtt", 300_000),
+            constant("bridge.raw.put.rtt", 100_000),
+        ]);
         assert!(r.floor.is_none());
     }
 }

@@ -38,15 +38,7 @@ fn a_clients_outcome_outlives_any_number_of_other_clients_outcomes() {
     host.process(&mut arm).unwrap();
     // While `mine` does not look, the other client's commands are decided: more than twice
     // as many as any buffer of the old shared channel held.
-    let others = 2 * limber_services::qos::OUTCOME_BUFFER + limber_services::qos::CMD_BUFFER;
-    let mut sent = 0;
-    while sent < others {
-        for _ in 0..limber_services::qos::CMD_BUFFER {
-            flood.move_to(1, (sent % 10) as f64 * 0.01).unwrap();
-            sent += 1;
-        }
-        while host.process(&mut arm).unwrap().commands > 0 {}
-    }
+    let others = flood_decided(&mut flood, &mut host, &mut arm);
     assert_eq!(host.stats().commands, 1 + others as u64);
     // Old code: Timeout (its outcome overwritten by the others', and so were the states
     // that showed its command).
@@ -67,6 +59,25 @@ fn a_clients_outcome_outlives_any_number_of_other_clients_outcomes() {
         flood.wait_outcome(first, T),
         Err(WaitError::Missed { .. })
     ));
+}
+
+/// `flood` sends more commands than any buffer of the old shared channel held (twice its
+/// depth and a round more), each decided by `host` as it goes; returns how many.
+fn flood_decided(
+    flood: &mut ActArrayClient,
+    host: &mut DeviceHost<ActArray>,
+    arm: &mut TestArm,
+) -> usize {
+    let others = 2 * limber_services::qos::OUTCOME_BUFFER + limber_services::qos::CMD_BUFFER;
+    let mut sent = 0;
+    while sent < others {
+        for _ in 0..limber_services::qos::CMD_BUFFER {
+            flood.move_to(1, (sent % 10) as f64 * 0.01).unwrap();
+            sent += 1;
+        }
+        while host.process(arm).unwrap().commands > 0 {}
+    }
+    sent
 }
 
 /// A driver of the test arm on a thread of this process until `stop`.
@@ -239,15 +250,7 @@ fn a_relayed_commands_outcome_outlives_a_local_clients_flood() {
     assert_eq!(bridge.relay_send(&cmd).unwrap(), 1);
     host.process(&mut arm).unwrap();
     // A local client's flood is decided before the bridge looks.
-    let others = 2 * limber_services::qos::OUTCOME_BUFFER + limber_services::qos::CMD_BUFFER;
-    let mut sent = 0;
-    while sent < others {
-        for _ in 0..limber_services::qos::CMD_BUFFER {
-            flood.move_to(1, (sent % 10) as f64 * 0.01).unwrap();
-            sent += 1;
-        }
-        while host.process(&mut arm).unwrap().commands > 0 {}
-    }
+    flood_decided(&mut flood, &mut host, &mut arm);
     let mut got = Vec::new();
     bridge.relay_own_outcomes(|o| got.push(*o)).unwrap();
     // Exactly the relayed command's: none of the flood's, none of the bridge's own.
@@ -261,14 +264,7 @@ fn a_relayed_commands_outcome_outlives_a_local_clients_flood() {
     cmd.meta_mut().client_id = remote2;
     bridge.relay_send(&cmd).unwrap();
     host.process(&mut arm).unwrap();
-    let mut sent = 0;
-    while sent < others {
-        for _ in 0..limber_services::qos::CMD_BUFFER {
-            flood.move_to(1, (sent % 10) as f64 * 0.01).unwrap();
-            sent += 1;
-        }
-        while host.process(&mut arm).unwrap().commands > 0 {}
-    }
+    flood_decided(&mut flood, &mut host, &mut arm);
     let mut watched = Vec::new();
     bridge.relay_outcomes(|o| watched.push(*o)).unwrap();
     assert!(!watched.iter().any(|o| o.client_id == remote2));

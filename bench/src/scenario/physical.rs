@@ -388,35 +388,17 @@ fn run_fanout(
 /// The futex fan-out's waiter child (`futex-fanout-sub`): sleeps until the number
 /// changes, records its age after the warm-up, until STOP.
 pub fn fanout_role(args: &BenchArgs) -> Result<(), BenchError> {
-    let path = args
-        .shm
-        .as_ref()
-        .ok_or_else(|| BenchError::Args("--shm is required for this role".into()))?;
-    let deadline = crate::roles::child_deadline(args);
-    let shared = Shared::map(path, false)?;
-    let page = shared.page();
-    let mut oneway = new_histogram()?;
-    crate::roles::announce("ready");
-    let mut last = 0u32;
-    loop {
-        let Some((now, seq, stamp)) = await_change(&page.ping, last, Wait::Futex, deadline) else {
-            return Err(BenchError::Timeout {
-                what: "futex fan-out: the publisher stopped".into(),
-                timeout: Duration::from_millis(args.deadline_ms),
-            });
-        };
-        if seq == STOP {
-            return crate::roles::write_histogram(args, &oneway);
-        }
-        if u64::from(seq) > args.warmup {
-            oneway.saturating_record(now.saturating_sub(stamp));
-        }
-        last = seq;
-    }
+    follow(args, Wait::Futex, false)
 }
 
 /// The echo child (`futex-echo`, `cacheline-echo`).
 pub fn echo_role(args: &BenchArgs, wait: Wait) -> Result<(), BenchError> {
+    follow(args, wait, true)
+}
+
+/// Waits for each new number on the ping line, records its age after the warm-up, and
+/// (`echo`) answers it on the pong line, until STOP.
+fn follow(args: &BenchArgs, wait: Wait, echo: bool) -> Result<(), BenchError> {
     let path = args
         .shm
         .as_ref()
@@ -430,7 +412,7 @@ pub fn echo_role(args: &BenchArgs, wait: Wait) -> Result<(), BenchError> {
     loop {
         let Some((now, seq, stamp)) = await_change(&page.ping, last, wait, deadline) else {
             return Err(BenchError::Timeout {
-                what: "echo: the ping side stopped".into(),
+                what: "the ping side stopped".into(),
                 timeout: Duration::from_millis(args.deadline_ms),
             });
         };
@@ -440,7 +422,9 @@ pub fn echo_role(args: &BenchArgs, wait: Wait) -> Result<(), BenchError> {
         if u64::from(seq) > args.warmup {
             oneway.saturating_record(now.saturating_sub(stamp));
         }
-        publish(&page.pong, seq, wait);
+        if echo {
+            publish(&page.pong, seq, wait);
+        }
         last = seq;
     }
 }
