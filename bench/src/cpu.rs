@@ -96,6 +96,11 @@ impl Window {
         })
     }
 
+    /// How long the window has been open.
+    pub fn elapsed(&self) -> Duration {
+        self.started.elapsed()
+    }
+
     /// Ends the window: each process's share of one core, percent, in the order given.
     pub fn end(self) -> Result<Vec<(String, f64)>, CpuError> {
         let wall = self.started.elapsed().as_secs_f64().max(1e-9);

@@ -712,7 +712,7 @@ impl Exposer<'_> {
                         .values()
                         .filter_map(|d| d.next_deadline())
                         .fold(self.next_discovery.min(self.next_liveness), Instant::min);
-                    let woken = wait(due.saturating_duration_since(Instant::now()))?;
+                    let woken = wait(due.saturating_duration_since(Instant::now()), None)?;
                     for name in &woken.devices {
                         if let Some(d) = self.devices.get_mut(name) {
                             d.poll(self.session);

@@ -172,7 +172,7 @@ mod tests {
         let mut got = Vec::with_capacity(N as usize);
         crate::waiting::with_waitset(&inbox, &Vec::new(), |wait| {
             while got.len() < N as usize {
-                let woken = wait(std::time::Duration::from_secs(10)).expect("a wait");
+                let woken = wait(std::time::Duration::from_secs(10), None).expect("a wait");
                 assert!(
                     woken.mail,
                     "no wake-up within 10 s with {} of {N} items received",

@@ -209,8 +209,9 @@ struct Mirrored<I: Interface> {
 trait MirroredDevice {
     fn state(&mut self, payload: &[u8]);
     fn outcome(&mut self, payload: &[u8]);
-    /// Relays what the local clients sent: commands, requests, lease requests.
-    fn relay(&mut self, session: &Session, timeout: Duration);
+    /// Relays what the local clients sent: commands, requests, lease requests; says whether
+    /// it put anything on Zenoh that an answer comes back for.
+    fn relay(&mut self, session: &Session, timeout: Duration) -> bool;
     fn reply(&mut self, exchange: Exchange, id: u64, reply: &Reply);
     fn done(&mut self, exchange: Exchange, id: u64);
     fn listener(&self) -> Rc<Listener<ipc::Service>>;
@@ -316,7 +317,7 @@ impl<I: Interface> MirroredDevice for Mirrored<I> {
         }
     }
 
-    fn relay(&mut self, session: &Session, timeout: Duration) {
+    fn relay(&mut self, session: &Session, timeout: Duration) -> bool {
         self.host.relay_housekeeping();
         let mut commands = Vec::new();
         if let Err(e) = self
@@ -325,6 +326,7 @@ impl<I: Interface> MirroredDevice for Mirrored<I> {
         {
             tracing::warn!(device = %self.local, error = %e, "cannot take the commands");
         }
+        let mut asked = !commands.is_empty();
         for c in commands {
             if let Err(e) = session
                 .put(&self.cmd_key, c)
@@ -355,6 +357,7 @@ impl<I: Interface> MirroredDevice for Mirrored<I> {
             ) {
                 Ok(()) => {
                     self.requests.insert(id, (req, deadline));
+                    asked = true;
                 }
                 Err(e) => {
                     tracing::warn!(device = %self.local, error = %e, "cannot relay a request");
@@ -386,6 +389,7 @@ impl<I: Interface> MirroredDevice for Mirrored<I> {
             ) {
                 Ok(()) => {
                     self.leases.insert(id, (req, deadline));
+                    asked = true;
                 }
                 Err(e) => {
                     tracing::warn!(device = %self.local, error = %e, "cannot relay a lease request");
@@ -396,6 +400,7 @@ impl<I: Interface> MirroredDevice for Mirrored<I> {
                 }
             }
         }
+        asked
     }
 
     fn reply(&mut self, exchange: Exchange, id: u64, reply: &Reply) {
@@ -630,6 +635,9 @@ pub fn mirror(
         devices: HashMap::new(),
         stats: HashMap::new(),
         gone: Vec::new(),
+        owed: None,
+        asked_at: None,
+        last_answer: None,
     };
     let result = mirrorer.run(&inbox, stop, report);
     drop(mirrorer);
@@ -650,9 +658,37 @@ struct Mirrorer<'a> {
     stats: HashMap<String, StatsPublisher>,
     /// Devices no longer hosted, reported once the loop no longer waits on them.
     gone: Vec<DeviceName>,
+    /// An answer (an outcome, a reply) is owed to what was put on Zenoh: looked for without
+    /// sleeping until then (`waiting::await_linger`).
+    owed: Option<Instant>,
+    /// When the oldest thing still unanswered was put on Zenoh.
+    asked_at: Option<Instant>,
+    /// How long the last answer took: no looking without sleeping for answers that come
+    /// later than `await_linger` (a network slower than the loopback), which would only
+    /// burn the CPU.
+    last_answer: Option<Duration>,
 }
 
 impl Mirrorer<'_> {
+    /// Something that is answered was put on Zenoh: its answer is looked for without
+    /// sleeping for up to `await_linger`, unless answers came later than that last time.
+    fn asked(&mut self) {
+        let now = Instant::now();
+        self.asked_at.get_or_insert(now);
+        let owe = crate::waiting::await_linger();
+        if !owe.is_zero() && self.last_answer.is_none_or(|d| d <= owe) {
+            self.owed = Some(now + owe);
+        }
+    }
+
+    /// An answer came (an outcome, a reply): how long it took, and nothing owed now.
+    fn answered(&mut self) {
+        if let Some(t) = self.asked_at.take() {
+            self.last_answer = Some(t.elapsed());
+        }
+        self.owed = None;
+    }
+
     /// The loop, until `stop`; the WaitSet is built anew whenever devices come or go.
     fn run(
         &mut self,
@@ -671,11 +707,13 @@ impl Mirrorer<'_> {
                     if stop() {
                         return Ok(());
                     }
-                    let woken = wait(IDLE_WAIT)?;
+                    let woken = wait(IDLE_WAIT, self.owed)?;
                     let timeout = self.config.request_timeout;
                     for remote in &woken.devices {
-                        if let Some((_, d)) = self.devices.get_mut(remote) {
-                            d.relay(self.session, timeout);
+                        if let Some((_, d)) = self.devices.get_mut(remote)
+                            && d.relay(self.session, timeout)
+                        {
+                            self.asked();
                         }
                     }
                     let mut changed = false;
@@ -819,6 +857,7 @@ impl Mirrorer<'_> {
                 if let Some((_, d)) = self.devices.get_mut(&device) {
                     d.outcome(&payload);
                 }
+                self.answered();
                 false
             }
             Event::Reply {
@@ -830,6 +869,7 @@ impl Mirrorer<'_> {
                 if let Some((_, d)) = self.devices.get_mut(&device) {
                     d.reply(exchange, id, &reply);
                 }
+                self.answered();
                 false
             }
             Event::Done {

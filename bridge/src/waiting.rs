@@ -10,6 +10,14 @@
 //! outcome, a client's next command) usually comes within that time, and is then taken
 //! without the wake-up of a sleeping thread (10-25 us each on a 2-core VM; a command through
 //! the bridge pair crosses several).
+//!
+//! A loop that is owed an answer lingers until it comes: the mirror, once it has put a
+//! local client's command or request on Zenoh, looks for its outcome or reply without
+//! sleeping for up to [`await_linger`] (1 ms unless `LIMBER_BRIDGE_AWAIT_US` says
+//! otherwise), unless the last answer took longer: on the loopback or a fast network the
+//! answer comes back through the exposing bridge and the driver after a few hundred
+//! microseconds, and is then taken without a sleeping thread's wake-up. It costs the CPU of
+//! that wait, only while an answer is owed.
 
 use std::rc::Rc;
 use std::time::{Duration, Instant};
@@ -35,6 +43,20 @@ pub(crate) fn linger() -> Duration {
     *LINGER_SET.get_or_init(|| limber_services::qos::micros_from_env(LINGER_ENV).unwrap_or(LINGER))
 }
 
+/// The environment variable that sets, in µs, how long a mirror looks without sleeping for
+/// the answer to what it put on Zenoh (`0`: it sleeps after its linger).
+pub(crate) const AWAIT_ENV: &str = "LIMBER_BRIDGE_AWAIT_US";
+
+/// How long a loop owed an answer looks for it without sleeping when nothing else is
+/// configured.
+pub(crate) const AWAIT: Duration = Duration::from_millis(1);
+
+/// `LIMBER_BRIDGE_AWAIT_US` if set (µs, at most 1 s), else [`AWAIT`].
+pub(crate) fn await_linger() -> Duration {
+    static AWAIT_SET: std::sync::OnceLock<Duration> = std::sync::OnceLock::new();
+    *AWAIT_SET.get_or_init(|| limber_services::qos::micros_from_env(AWAIT_ENV).unwrap_or(AWAIT))
+}
+
 /// What woke the loop.
 #[derive(Debug, Default)]
 pub(crate) struct Woken {
@@ -42,6 +64,10 @@ pub(crate) struct Woken {
     pub mail: bool,
     /// These devices' listeners were notified (their events are consumed).
     pub devices: Vec<DeviceName>,
+    /// It was found by looking without sleeping (the linger), not by the WaitSet (what the
+    /// tests look at; the loops need not know).
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub looked: bool,
 }
 
 impl Woken {
@@ -60,13 +86,18 @@ fn whole_ms(d: Duration) -> Duration {
     Duration::from_millis(d.as_nanos().div_ceil(1_000_000).min(u64::MAX as u128) as u64)
 }
 
+/// The function a loop waits with: up to `timeout`; `owed`: an answer is owed until then
+/// (keep looking without sleeping until it, see the module's text).
+pub(crate) type Wait<'a> = dyn FnMut(Duration, Option<Instant>) -> Result<Woken, LoopError> + 'a;
+
 /// Builds a WaitSet over `inbox` and `listeners`, then runs `body` with a function that
 /// waits up to the given time for either and says what woke it (lingering first after
-/// activity: see the module's text). Rebuild (call again) when the set of devices changes.
+/// activity and while an answer is owed: see the module's text). Rebuild (call again) when
+/// the set of devices changes.
 pub(crate) fn with_waitset<T, R>(
     inbox: &Inbox<T>,
     listeners: &Attached,
-    body: impl FnOnce(&mut dyn FnMut(Duration) -> Result<Woken, LoopError>) -> R,
+    body: impl FnOnce(&mut Wait<'_>) -> R,
 ) -> Result<R, LoopError> {
     let ws = WaitSetBuilder::new()
         // The bridge's `stop` decides when it ends; a signal only interrupts the wait.
@@ -85,10 +116,13 @@ pub(crate) fn with_waitset<T, R>(
     }
     let linger = linger();
     let mut linger_until: Option<Instant> = None;
-    let mut wait = |timeout: Duration| -> Result<Woken, LoopError> {
-        let lingered = linger_until
-            .take()
-            .and_then(|until| linger_look(inbox, listeners, until.min(Instant::now() + timeout)));
+    let mut wait = |timeout: Duration, owed: Option<Instant>| -> Result<Woken, LoopError> {
+        let now = Instant::now();
+        let until = match (linger_until.take(), owed.filter(|o| *o > now)) {
+            (Some(a), Some(b)) => Some(a.max(b)),
+            (a, b) => a.or(b),
+        };
+        let lingered = until.and_then(|u| linger_look(inbox, listeners, u.min(now + timeout)));
         let woken = match lingered {
             Some(w) => w,
             None => {
@@ -144,6 +178,7 @@ fn look<T>(inbox: &Inbox<T>, listeners: &Attached) -> Woken {
     let mut woken = Woken {
         mail: inbox.has_mail(),
         devices: Vec::new(),
+        looked: true,
     };
     for (device, l) in listeners {
         let mut notified = false;
@@ -183,15 +218,39 @@ mod tests {
         with_waitset(&inbox, &attached, |wait| {
             // Activity: mail wakes the loop, which then lingers.
             assert!(tx.send(1).is_ok());
-            assert!(wait(Duration::from_secs(10)).unwrap().mail);
+            assert!(wait(Duration::from_secs(10), None).unwrap().mail);
             assert_eq!(inbox.drain(), vec![1]);
             notifier.notify().unwrap();
-            let woken = wait(Duration::from_secs(10)).unwrap();
+            let woken = wait(Duration::from_secs(10), None).unwrap();
             assert_eq!(woken.devices, vec![device.clone()]);
             // Consumed: nothing more within a short wait (the lingering look and the
             // WaitSet both find nothing).
-            let again = wait(Duration::from_millis(20)).unwrap();
+            let again = wait(Duration::from_millis(20), None).unwrap();
             assert!(!again.mail && again.devices.is_empty(), "{again:?}");
+        })
+        .unwrap();
+    }
+
+    /// A loop owed an answer takes it by looking, long after its linger after activity
+    /// would have ended; one owed nothing, idle, takes it from the WaitSet.
+    #[test]
+    fn an_owed_answer_is_looked_for_without_sleeping() {
+        let (inbox, tx) = Inbox::<u32>::new().unwrap();
+        with_waitset(&inbox, &Vec::new(), |wait| {
+            // Idle, nothing owed: the WaitSet.
+            assert!(tx.send(1).is_ok());
+            let w = wait(Duration::from_secs(10), None).unwrap();
+            assert!(w.mail && !w.looked, "{w:?}");
+            assert_eq!(inbox.drain(), vec![1]);
+            // Nothing came within the linger that followed.
+            let quiet = wait(Duration::from_millis(20), None).unwrap();
+            assert!(!quiet.mail, "{quiet:?}");
+            // Owed an answer for an hour: the answer is taken by looking.
+            assert!(tx.send(2).is_ok());
+            let owed = Instant::now() + Duration::from_secs(3600);
+            let w = wait(Duration::from_secs(10), Some(owed)).unwrap();
+            assert!(w.mail && w.looked, "{w:?}");
+            assert_eq!(inbox.drain(), vec![2]);
         })
         .unwrap();
     }

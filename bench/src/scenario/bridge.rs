@@ -153,7 +153,28 @@ fn run(ctx: &mut RunCtx, exe: &Path) -> Result<(), BenchError> {
             .map_err(|e| err("client context in B", e))?;
         let mut remote = ActArrayClient::connect_timeout(&cctx_b, DEVICE, READY_TIMEOUT)
             .map_err(|e| err("connect in B", e))?;
+        // What the pair costs while it carries them, beside the latency.
+        let busy = cpu::Window::start(&[
+            ("bridge expose", expose.pid()),
+            ("bridge mirror", mirror.pid()),
+            ("driver", driver.pid()),
+        ])
+        .map_err(|e| err("cpu time", e))?;
         let rtt_bridge = round_trips(ctx, &mut remote, "bridge zenoh", warm, n)?;
+        let window = busy.elapsed();
+        for (process, percent) in busy.end().map_err(|e| err("cpu time", e))? {
+            ctx.push_cpu(CpuCost {
+                id: format!("bridge.busy.{}", process.replace(' ', "_")),
+                scenario: "bridge",
+                mode: "bridge pair".into(),
+                load: "commands back to back".into(),
+                process,
+                percent,
+                window_s: window.as_secs_f64(),
+                latency_id: Some("bridge.zenoh.rtt".into()),
+                at_most_percent: None,
+            });
+        }
         drop(remote);
         mirror.terminate(Duration::from_secs(10))?;
         expose.terminate(Duration::from_secs(10))?;
