@@ -42,7 +42,7 @@ use crate::inbox::{Inbox, InboxError, Sender};
 use crate::keys::{self, TypeNames};
 use crate::malformed;
 use crate::session::{self, NetConfig, SessionError};
-use crate::waiting::{Attached, with_waitset};
+use crate::waiting::{Attached, Owed, with_waitset};
 
 /// How often each exposed device's driver is checked for life (a dead driver's token is
 /// withdrawn after two checks in a row find it dead, within a second). A check probes every
@@ -227,7 +227,9 @@ trait ExposedDevice {
     fn command(&mut self, session: &Session, origin: &str, payload: &[u8]);
     fn query(&mut self, query: Query, timeout: Duration);
     fn lease(&mut self, query: Query, timeout: Duration);
-    fn poll(&mut self, session: &Session);
+    /// Forwards what arrived (states, outcomes, replies); says whether anything owed to a
+    /// remote client was answered.
+    fn poll(&mut self, session: &Session) -> bool;
     /// The earliest deadline of a relayed request or lease request.
     fn next_deadline(&self) -> Option<Instant>;
     fn listener(&self) -> Rc<Listener<ipc::Service>>;
@@ -237,13 +239,15 @@ trait ExposedDevice {
 }
 
 impl<I: Interface> Exposed<I> {
-    /// Sends the outcomes of the remote clients' commands that arrived back to each one.
-    fn forward_outcomes(&mut self, session: &Session) {
+    /// Sends the outcomes of the remote clients' commands that arrived back to each one;
+    /// returns how many.
+    fn forward_outcomes(&mut self, session: &Session) -> usize {
         self.relayed = 0;
         let mut outcomes = Vec::new();
         if let Err(e) = self.client.relay_own_outcomes(|o| outcomes.push(*o)) {
             tracing::warn!(device = %self.device, error = %e, "cannot take the outcomes");
         }
+        let mut n = 0;
         for mut o in outcomes {
             let Some((origin, remote)) = self.ids.to_remote.get(&o.client_id).cloned() else {
                 continue; // an id forgotten (more than MAX_REMOTE_CLIENTS)
@@ -253,7 +257,9 @@ impl<I: Interface> Exposed<I> {
                 o.other_client = *other;
             }
             put_outcome(session, &self.device, &origin, &o);
+            n += 1;
         }
+        n
     }
 }
 
@@ -295,7 +301,8 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
         // process's outcome stream (TOLD_BUFFER deep) does not overflow behind it.
         self.relayed += 1;
         if self.relayed >= DRAIN_EVERY {
-            self.forward_outcomes(session);
+            // Counted as answers by the loop's next look at the device, not here.
+            let _forwarded = self.forward_outcomes(session);
         }
     }
 
@@ -382,7 +389,8 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
         }
     }
 
-    fn poll(&mut self, session: &Session) {
+    fn poll(&mut self, session: &Session) -> bool {
+        let owed = self.pending.len() + self.leases.len();
         self.poll_leases();
         let (device, state_pub) = (&self.device, &self.state_pub);
         if let Err(e) = self.client.relay_states(|d| {
@@ -392,7 +400,7 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
         }) {
             tracing::warn!(device = %self.device, error = %e, "cannot take the states");
         }
-        self.forward_outcomes(session);
+        let forwarded = self.forward_outcomes(session);
         let now = Instant::now();
         let names = self.names;
         self.pending.retain(|(query, p, deadline, remote)| {
@@ -414,6 +422,7 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
                 }
             }
         });
+        forwarded > 0 || self.pending.len() + self.leases.len() < owed
     }
 
     fn next_deadline(&self) -> Option<Instant> {
@@ -635,6 +644,7 @@ pub fn expose(
         next_discovery: Instant::now(),
         next_liveness: Instant::now(),
         watch: DirWatch::new(domain),
+        owed: Owed::default(),
     };
     let result = exposer.run(&inbox, stop, report);
     malformed::summarise_now();
@@ -682,6 +692,9 @@ struct Exposer<'a> {
     next_liveness: Instant,
     /// Whether the domain may have changed since the last listing.
     watch: DirWatch,
+    /// An answer (an outcome, a reply) owed by a driver to what was relayed to it, looked
+    /// for without sleeping (`waiting::await_linger`).
+    owed: Owed,
 }
 
 impl Exposer<'_> {
@@ -712,22 +725,32 @@ impl Exposer<'_> {
                         .values()
                         .filter_map(|d| d.next_deadline())
                         .fold(self.next_discovery.min(self.next_liveness), Instant::min);
-                    let woken = wait(due.saturating_duration_since(Instant::now()), None)?;
+                    let woken = wait(
+                        due.saturating_duration_since(Instant::now()),
+                        self.owed.until(),
+                    )?;
                     for name in &woken.devices {
-                        if let Some(d) = self.devices.get_mut(name) {
-                            d.poll(self.session);
+                        if let Some(d) = self.devices.get_mut(name)
+                            && d.poll(self.session)
+                        {
+                            self.owed.answered(Instant::now());
                         }
                     }
                     if woken.mail {
+                        let mut asked = false;
                         for ev in inbox.drain() {
-                            self.handle(ev);
+                            asked |= self.handle(ev);
+                        }
+                        if asked {
+                            self.owed
+                                .asked(Instant::now(), crate::waiting::await_linger());
                         }
                     }
                     // Relayed requests whose time is up are answered "timeout".
                     let now = Instant::now();
                     for d in self.devices.values_mut() {
-                        if d.next_deadline().is_some_and(|t| t <= now) {
-                            d.poll(self.session);
+                        if d.next_deadline().is_some_and(|t| t <= now) && d.poll(self.session) {
+                            self.owed.answered(Instant::now());
                         }
                     }
                 }
@@ -863,8 +886,9 @@ impl Exposer<'_> {
         added
     }
 
-    /// Relays one command or query that came from Zenoh.
-    fn handle(&mut self, ev: Event) {
+    /// Relays one command or query that came from Zenoh; says whether it went to a driver
+    /// (an answer is then owed).
+    fn handle(&mut self, ev: Event) -> bool {
         let timeout = self.config.request_timeout;
         match ev {
             Event::Command {
@@ -872,16 +896,34 @@ impl Exposer<'_> {
                 origin,
                 payload,
             } => match self.devices.get_mut(&device) {
-                Some(d) => d.command(self.session, &origin, &payload),
-                None => tracing::debug!(device = %device, "command for a device gone"),
+                Some(d) => {
+                    d.command(self.session, &origin, &payload);
+                    true
+                }
+                None => {
+                    tracing::debug!(device = %device, "command for a device gone");
+                    false
+                }
             },
             Event::Query { device, query } => match self.devices.get_mut(&device) {
-                Some(d) => d.query(query, timeout),
-                None => refuse(&query, Status::LinkDown),
+                Some(d) => {
+                    d.query(query, timeout);
+                    true
+                }
+                None => {
+                    refuse(&query, Status::LinkDown);
+                    false
+                }
             },
             Event::Lease { device, query } => match self.devices.get_mut(&device) {
-                Some(d) => d.lease(query, timeout),
-                None => refuse(&query, Status::LinkDown),
+                Some(d) => {
+                    d.lease(query, timeout);
+                    true
+                }
+                None => {
+                    refuse(&query, Status::LinkDown);
+                    false
+                }
             },
         }
     }

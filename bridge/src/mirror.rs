@@ -43,7 +43,7 @@ use crate::expose::MIRROR_DRIVER;
 use crate::inbox::{Inbox, InboxError, Sender};
 use crate::keys::{self, TypeNames};
 use crate::session::{self, NetConfig, SessionError};
-use crate::waiting::{Attached, with_waitset};
+use crate::waiting::{Attached, Owed, with_waitset};
 
 /// The longest the loop sleeps with nothing to do, between two looks at `stop` (a signal
 /// wakes it at once).
@@ -635,9 +635,7 @@ pub fn mirror(
         devices: HashMap::new(),
         stats: HashMap::new(),
         gone: Vec::new(),
-        owed: None,
-        asked_at: None,
-        last_answer: None,
+        owed: Owed::default(),
     };
     let result = mirrorer.run(&inbox, stop, report);
     drop(mirrorer);
@@ -658,37 +656,12 @@ struct Mirrorer<'a> {
     stats: HashMap<String, StatsPublisher>,
     /// Devices no longer hosted, reported once the loop no longer waits on them.
     gone: Vec<DeviceName>,
-    /// An answer (an outcome, a reply) is owed to what was put on Zenoh: looked for without
-    /// sleeping until then (`waiting::await_linger`).
-    owed: Option<Instant>,
-    /// When the oldest thing still unanswered was put on Zenoh.
-    asked_at: Option<Instant>,
-    /// How long the last answer took: no looking without sleeping for answers that come
-    /// later than `await_linger` (a network slower than the loopback), which would only
-    /// burn the CPU.
-    last_answer: Option<Duration>,
+    /// An answer (an outcome, a reply) owed to what was put on Zenoh, looked for without
+    /// sleeping (`waiting::await_linger`).
+    owed: Owed,
 }
 
 impl Mirrorer<'_> {
-    /// Something that is answered was put on Zenoh: its answer is looked for without
-    /// sleeping for up to `await_linger`, unless answers came later than that last time.
-    fn asked(&mut self) {
-        let now = Instant::now();
-        self.asked_at.get_or_insert(now);
-        let owe = crate::waiting::await_linger();
-        if !owe.is_zero() && self.last_answer.is_none_or(|d| d <= owe) {
-            self.owed = Some(now + owe);
-        }
-    }
-
-    /// An answer came (an outcome, a reply): how long it took, and nothing owed now.
-    fn answered(&mut self) {
-        if let Some(t) = self.asked_at.take() {
-            self.last_answer = Some(t.elapsed());
-        }
-        self.owed = None;
-    }
-
     /// The loop, until `stop`; the WaitSet is built anew whenever devices come or go.
     fn run(
         &mut self,
@@ -707,13 +680,14 @@ impl Mirrorer<'_> {
                     if stop() {
                         return Ok(());
                     }
-                    let woken = wait(IDLE_WAIT, self.owed)?;
+                    let woken = wait(IDLE_WAIT, self.owed.until())?;
                     let timeout = self.config.request_timeout;
                     for remote in &woken.devices {
                         if let Some((_, d)) = self.devices.get_mut(remote)
                             && d.relay(self.session, timeout)
                         {
-                            self.asked();
+                            self.owed
+                                .asked(Instant::now(), crate::waiting::await_linger());
                         }
                     }
                     let mut changed = false;
@@ -857,7 +831,7 @@ impl Mirrorer<'_> {
                 if let Some((_, d)) = self.devices.get_mut(&device) {
                     d.outcome(&payload);
                 }
-                self.answered();
+                self.owed.answered(Instant::now());
                 false
             }
             Event::Reply {
@@ -869,7 +843,7 @@ impl Mirrorer<'_> {
                 if let Some((_, d)) = self.devices.get_mut(&device) {
                     d.reply(exchange, id, &reply);
                 }
-                self.answered();
+                self.owed.answered(Instant::now());
                 false
             }
             Event::Done {

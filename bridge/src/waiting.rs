@@ -11,9 +11,10 @@
 //! without the wake-up of a sleeping thread (10-25 us each on a 2-core VM; a command through
 //! the bridge pair crosses several).
 //!
-//! A loop that is owed an answer lingers until it comes: the mirror, once it has put a
-//! local client's command or request on Zenoh, looks for its outcome or reply without
-//! sleeping for up to [`await_linger`] (1 ms unless `LIMBER_BRIDGE_AWAIT_US` says
+//! A loop that is owed an answer lingers until it comes ([`Owed`]): the mirror, once it has
+//! put a local client's command or request on Zenoh, and the exposing bridge, once it has
+//! relayed a remote client's to the driver, look for its outcome or reply without sleeping
+//! for up to [`await_linger`] (1 ms unless `LIMBER_BRIDGE_AWAIT_US` says
 //! otherwise), unless the last answer took longer: on the loopback or a fast network the
 //! answer comes back through the exposing bridge and the driver after a few hundred
 //! microseconds, and is then taken without a sleeping thread's wake-up. It costs the CPU of
@@ -55,6 +56,42 @@ pub(crate) const AWAIT: Duration = Duration::from_millis(1);
 pub(crate) fn await_linger() -> Duration {
     static AWAIT_SET: std::sync::OnceLock<Duration> = std::sync::OnceLock::new();
     *AWAIT_SET.get_or_init(|| limber_services::qos::micros_from_env(AWAIT_ENV).unwrap_or(AWAIT))
+}
+
+/// Whether a loop is owed an answer, and until when it looks for it without sleeping.
+#[derive(Debug, Default)]
+pub(crate) struct Owed {
+    /// When the oldest thing still unanswered was sent.
+    asked_at: Option<Instant>,
+    /// How long the last answer took.
+    last_answer: Option<Duration>,
+    /// Looked for without sleeping until then.
+    until: Option<Instant>,
+}
+
+impl Owed {
+    /// Something that is answered was sent at `now`: its answer is looked for without
+    /// sleeping for up to `cap`, unless the last answer took longer than that (a network
+    /// slower than the loopback, where looking would only burn the CPU).
+    pub(crate) fn asked(&mut self, now: Instant, cap: Duration) {
+        self.asked_at.get_or_insert(now);
+        if !cap.is_zero() && self.last_answer.is_none_or(|d| d <= cap) {
+            self.until = Some(now + cap);
+        }
+    }
+
+    /// An answer came at `now`: how long it took is kept, and nothing is owed.
+    pub(crate) fn answered(&mut self, now: Instant) {
+        if let Some(t) = self.asked_at.take() {
+            self.last_answer = Some(now.saturating_duration_since(t));
+        }
+        self.until = None;
+    }
+
+    /// Until when to look without sleeping (the second argument of the loop's wait).
+    pub(crate) fn until(&self) -> Option<Instant> {
+        self.until
+    }
 }
 
 /// What woke the loop.
@@ -253,6 +290,39 @@ mod tests {
             assert_eq!(inbox.drain(), vec![2]);
         })
         .unwrap();
+    }
+
+    /// An answer is looked for up to the cap after the first unanswered send; after an
+    /// answer that took longer than the cap, the next one is not (until a quick one came).
+    #[test]
+    fn an_answer_is_owed_up_to_the_cap_unless_the_last_came_later() {
+        let cap = Duration::from_millis(1);
+        let t0 = Instant::now();
+        let mut owed = Owed::default();
+        assert_eq!(owed.until(), None);
+        owed.asked(t0, cap);
+        assert_eq!(owed.until(), Some(t0 + cap));
+        // A second send before the answer keeps the first one's time for the measure.
+        owed.asked(t0 + Duration::from_micros(100), cap);
+        owed.answered(t0 + Duration::from_micros(300));
+        assert_eq!(owed.until(), None);
+        assert_eq!(owed.last_answer, Some(Duration::from_micros(300)));
+        // A slow answer (2 ms): the next send is not looked for...
+        let t1 = t0 + Duration::from_millis(10);
+        owed.asked(t1, cap);
+        owed.answered(t1 + Duration::from_millis(2));
+        let t2 = t1 + Duration::from_millis(10);
+        owed.asked(t2, cap);
+        assert_eq!(owed.until(), None);
+        // ...and its answer, quick again, brings the looking back.
+        owed.answered(t2 + Duration::from_micros(200));
+        let t3 = t2 + Duration::from_millis(10);
+        owed.asked(t3, cap);
+        assert_eq!(owed.until(), Some(t3 + cap));
+        // A cap of zero never looks.
+        let mut off = Owed::default();
+        off.asked(t0, Duration::ZERO);
+        assert_eq!(off.until(), None);
     }
 
     #[test]
