@@ -130,6 +130,11 @@ static CLIENT_SEQ: AtomicU32 = AtomicU32::new(1);
 /// a bridge relays). Never given to a client.
 pub(crate) const EVERY_CLIENT_OF_PROCESS: u32 = u32::MAX;
 
+/// The process a client id was made by: its high 32 bits ([`Context::new_client_id`]).
+pub(crate) fn process_of(client_id: u64) -> u32 {
+    (client_id >> 32) as u32
+}
+
 /// The id of the outcome stream that carries the outcomes of every client of `client_id`'s
 /// process without a stream of its own (see `crate::host` `told.rs`).
 pub(crate) fn process_stream_id(client_id: u64) -> u64 {

@@ -239,28 +239,7 @@ impl<I: Interface> Client<I> {
             return true;
         }
         self.told.process_checked = Some(t);
-        if let Err(e) = self.told.port.update_connections() {
-            tracing::debug!(device = %self.device, error = %e, "cannot connect the outcome stream's port");
-        }
-        if self.told.process.as_ref().is_some_and(|s| s.is_connected()) {
-            return true;
-        }
-        // Dropped first: its slot is free for the new one.
-        self.told.process = None;
-        let id = crate::context::process_stream_id(self.client_id());
-        match crate::client::open_told_stream(&self.told.port, id) {
-            Ok(s) => {
-                if s.is_some() {
-                    // The driver takes it at once (and sends what it kept meanwhile).
-                    self.wake_driver_with(qos::EVENT_REQUEST);
-                }
-                self.told.process = s;
-            }
-            Err(e) => {
-                tracing::warn!(device = %self.device, error = %e, "cannot open this process's outcome stream");
-            }
-        }
-        self.told.process.is_some()
+        self.keep_process_stream()
     }
 
     /// Takes the outcomes of the commands this process relayed that arrived on its outcome
@@ -274,6 +253,7 @@ impl<I: Interface> Client<I> {
             return Ok(0);
         };
         let mine = self.client_id();
+        let pid = crate::context::process_of(mine);
         let mut n = 0;
         loop {
             match stream.receive() {
@@ -281,7 +261,7 @@ impl<I: Interface> Client<I> {
                     let m: &OutcomeMsg = r.payload();
                     // Only this process's come on it; a driver of another kind may say
                     // otherwise.
-                    if m.client_id >> 32 == mine >> 32 && m.client_id != mine {
+                    if crate::context::process_of(m.client_id) == pid && m.client_id != mine {
                         each(m);
                         n += 1;
                     }

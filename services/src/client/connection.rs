@@ -38,7 +38,7 @@ pub(super) const OUTCOME_SLOTS: usize = 16;
 /// A client's own outcomes: its port on the device's `told` channel and the stream it
 /// opened there (see `crate::host` `told.rs`).
 pub(crate) struct ToldSide {
-    pub(crate) port: IoxClient<ipc::Service, u64, (), OutcomeMsg, ()>,
+    pub(super) port: IoxClient<ipc::Service, u64, (), OutcomeMsg, ()>,
     /// Open while the driver that took it keeps it (a restarted driver needs a new one).
     pub(super) stream: Option<ToldStream>,
     /// This process's stream, for a relay (`Client::relay_own_outcomes`), and when it was
@@ -491,12 +491,41 @@ impl<I: Interface> Client<I> {
 
 /// Asks the driver of `port` for the outcomes of client `client_id`: the stream, or `None`
 /// when no driver took the request.
-pub(crate) fn open_told_stream(
+fn open_told_stream(
     port: &IoxClient<ipc::Service, u64, (), OutcomeMsg, ()>,
     client_id: u64,
 ) -> Result<Option<ToldStream>, Iox2Error> {
     let pending = port.loan_uninit()?.write_payload(client_id).send()?;
     Ok((pending.number_of_server_connections() > 0).then_some(pending))
+}
+
+/// Makes sure the stream in `slot`, asked for with `id` on `port`, is open: one the driver no
+/// longer keeps (a driver that started again) is asked for again. Returns whether it was
+/// asked for anew and reached a driver (which the caller then wakes to take it).
+fn keep_stream(
+    port: &IoxClient<ipc::Service, u64, (), OutcomeMsg, ()>,
+    slot: &mut Option<ToldStream>,
+    id: u64,
+    device: &DeviceName,
+) -> bool {
+    if let Err(e) = port.update_connections() {
+        tracing::debug!(device = %device, error = %e, "cannot connect the outcome stream's port");
+    }
+    if slot.as_ref().is_some_and(|s| s.is_connected()) {
+        return false;
+    }
+    // Dropped first: its slot is free for the new one.
+    *slot = None;
+    match open_told_stream(port, id) {
+        Ok(s) => {
+            *slot = s;
+            slot.is_some()
+        }
+        Err(e) => {
+            tracing::warn!(device = %device, error = %e, "cannot open an outcome stream");
+            false
+        }
+    }
 }
 
 impl<I: Interface> Client<I> {
@@ -507,26 +536,26 @@ impl<I: Interface> Client<I> {
     /// clients without a stream, on the new stream). Called on the waits' liveness checks
     /// (not on the command's path: it costs a look at the port's connections).
     pub(super) fn keep_told_stream(&mut self) {
-        if let Err(e) = self.told.port.update_connections() {
-            tracing::debug!(device = %self.device, error = %e, "cannot connect the outcome stream's port");
+        if keep_stream(
+            &self.told.port,
+            &mut self.told.stream,
+            self.client_id,
+            &self.device,
+        ) {
+            tracing::debug!(device = %self.device, "outcome stream opened again");
+            self.wake_driver_with(qos::EVENT_REQUEST);
         }
-        if self.told.stream.as_ref().is_some_and(|s| s.is_connected()) {
-            return;
+    }
+
+    /// [`Client::keep_told_stream`] for this process's stream (`Client::relay_open_stream`);
+    /// returns whether it is open.
+    pub(crate) fn keep_process_stream(&mut self) -> bool {
+        let id = crate::context::process_stream_id(self.client_id);
+        if keep_stream(&self.told.port, &mut self.told.process, id, &self.device) {
+            // The driver takes it at once (and sends what it kept meanwhile).
+            self.wake_driver_with(qos::EVENT_REQUEST);
         }
-        // Dropped first: its slot is free for the new one.
-        self.told.stream = None;
-        match open_told_stream(&self.told.port, self.client_id) {
-            Ok(s) => {
-                if s.is_some() {
-                    tracing::debug!(device = %self.device, "outcome stream opened again");
-                    self.wake_driver_with(qos::EVENT_REQUEST);
-                }
-                self.told.stream = s;
-            }
-            Err(e) => {
-                tracing::warn!(device = %self.device, error = %e, "cannot open the outcome stream");
-            }
-        }
+        self.told.process.is_some()
     }
 
     /// Watches every outcome of the device, of every client, from now on (for a bridge or a

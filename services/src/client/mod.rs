@@ -23,7 +23,6 @@ mod waiting;
 
 pub use commands::Ticket;
 use connection::OUTCOME_SLOTS;
-pub(crate) use connection::open_told_stream;
 pub use connection::{
     ActArrayClient, Client, GripperClient, LaserClient, LimbClient, RangerClient,
 };

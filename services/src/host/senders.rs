@@ -28,7 +28,7 @@ pub(crate) struct Sender {
 /// process id of the process that made it ([`crate::Context::new_client_id`]). An unknown
 /// process (0) is given the benefit of the doubt.
 pub(crate) fn client_of_process(client_id: u64, pid: u32) -> bool {
-    pid == 0 || (client_id >> 32) as u32 == pid
+    pid == 0 || crate::context::process_of(client_id) == pid
 }
 
 /// Port id → sender of one channel.
