@@ -205,8 +205,9 @@ fn an_output_that_cannot_be_written_is_refused_before_the_run() {
 
 /// `--only lang`: the Rust, C and Python clients' state reads and command round trips; a
 /// language that cannot run here is skipped with the reason (in CI, `CI=true`, with the
-/// venv of `.ci/run` in `LIMBER_PYTHON`, all three must run). And without a Python, the
-/// Python client is skipped with the reason while the others run.
+/// venv of `.ci/run` in `LIMBER_PYTHON`, all three must run, Python's package installed by pip
+/// with its compiled state copy). And without a Python, the Python client is skipped with
+/// the reason while the others run.
 #[test]
 fn lang_measures_rust_c_and_python_or_says_why_not() {
     let dir = std::env::temp_dir().join(format!("limber-bench-lang-{}", std::process::id()));
@@ -233,6 +234,14 @@ fn lang_measures_rust_c_and_python_or_says_why_not() {
                 "{ids:?} ({detail})"
             );
         }
+    }
+    // The package as pip installs it: in CI (a C compiler and Python's headers), with the
+    // state copy in C.
+    if ci {
+        assert!(
+            detail.contains("Python: states copied by the package's compiled limber._fast"),
+            "{detail}"
+        );
     }
     // No Python: skipped, with the reason on stderr and in the report.
     let (ids, detail, stderr) = run(&dir.join("nopy.json"), Some("/nonexistent/python3"));

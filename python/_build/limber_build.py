@@ -1,7 +1,10 @@
 """The PEP 517 build backend of the limber Python package (``pyproject.toml``:
 ``build-backend = "limber_build"``, ``backend-path = ["_build"]``), standard library only.
 
-A wheel holds ``limber/*.py``, ``limber/py.typed`` and ``limber/liblimber.so``: the library is
+A wheel holds ``limber/*.py``, ``limber/py.typed``, ``limber/liblimber.so`` and, where a C compiler
+and Python's headers are, ``limber._fast`` (``limber/_fast.c`` compiled: the state copy of a control
+loop without ctypes; without it the package does the same through ctypes, and the wheel is
+tagged ``py3-none-<platform>`` instead of this Python's). The library is
 built with ``cargo build --release --locked -p limber-c`` in the source tree this package
 lies in (``python/..``), with ``CARGO_TARGET_DIR`` in a temporary directory, or taken from
 ``LIMBER_LIB`` (the path of a liblimber.so already built: CI packages its debug build so it
@@ -16,8 +19,10 @@ import base64
 import hashlib
 import os
 import re
+import shlex
 import shutil
 import subprocess
+import sys
 import sysconfig
 import tarfile
 import tempfile
@@ -28,6 +33,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 PKG_ROOT = os.path.dirname(HERE)  # python/
 REPO = os.path.dirname(PKG_ROOT)  # the source tree (Cargo.toml, capi/)
 LIB_ENV = "LIMBER_LIB"
+#: ``1``: build the wheel without ``limber._fast`` (ctypes alone).
+NO_EXT_ENV = "LIMBER_PY_NO_EXT"
 
 
 class BuildError(RuntimeError):
@@ -105,18 +112,68 @@ def _metadata() -> str:
     return "\n".join(lines) + "\n\n" + text
 
 
-def _tag() -> str:
+def _tag(with_ext: bool) -> str:
+    """The wheel's tag: this CPython's with ``limber._fast``, any Python 3's without."""
     plat = sysconfig.get_platform().replace("-", "_").replace(".", "_")
+    if with_ext:
+        py = f"cp{sys.version_info.major}{sys.version_info.minor}"
+        return f"{py}-{py}{getattr(sys, 'abiflags', '')}-{plat}"
     return f"py3-none-{plat}"
 
 
-def _wheel_file() -> str:
+def _wheel_file(with_ext: bool) -> str:
     return (
         "Wheel-Version: 1.0\n"
         "Generator: limber_build\n"
         "Root-Is-Purelib: false\n"
-        f"Tag: {_tag()}\n"
+        f"Tag: {_tag(with_ext)}\n"
     )
+
+
+# ----- the extension ---------------------------------------------------------------------
+
+
+def _compiler() -> Optional[List[str]]:
+    """The C compiler's command (``CC``, else ``cc`` or ``gcc``), or None."""
+    cc = os.environ.get("CC", "").strip()
+    if cc:
+        return shlex.split(cc)
+    found = shutil.which("cc") or shutil.which("gcc")
+    return [found] if found else None
+
+
+def _ext_unbuildable() -> Optional[str]:
+    """Why ``limber._fast`` cannot be built here, or None if it can be tried."""
+    if os.environ.get(NO_EXT_ENV, "") not in ("", "0"):
+        return f"{NO_EXT_ENV} is set"
+    if sys.implementation.name != "cpython":
+        return f"{sys.implementation.name} is not CPython"
+    if _compiler() is None:
+        return "no C compiler (cc, gcc or CC)"
+    if not os.path.isfile(os.path.join(sysconfig.get_paths()["include"], "Python.h")):
+        return "Python's headers are not installed (Debian: apt-get install python3-dev)"
+    return None
+
+
+def _extension(tmp: str) -> Optional[str]:
+    """``limber._fast`` compiled into ``tmp``, or None (the reason on stderr: the package then
+    works through ctypes alone)."""
+    why = _ext_unbuildable()
+    compiler = _compiler()
+    if why is None and compiler is not None:
+        out = os.path.join(tmp, "_fast" + str(sysconfig.get_config_var("EXT_SUFFIX") or ".so"))
+        cmd = compiler + [
+            "-O2", "-shared", "-fPIC", "-Wall", "-Wextra", "-Werror",
+            "-I", sysconfig.get_paths()["include"],
+            os.path.join(PKG_ROOT, "limber", "_fast.c"), "-o", out,
+        ]
+        done = subprocess.run(cmd)
+        if done.returncode == 0:
+            return out
+        why = f"{' '.join(cmd)} failed (exit {done.returncode})"
+    print(f"limber_build: the wheel has no limber._fast ({why}): states are copied through ctypes",
+          file=sys.stderr)
+    return None
 
 
 # ----- the library -----------------------------------------------------------------------
@@ -192,7 +249,7 @@ def prepare_metadata_for_build_wheel(
     with open(os.path.join(d, "METADATA"), "w", encoding="utf-8") as f:
         f.write(_metadata())
     with open(os.path.join(d, "WHEEL"), "w", encoding="utf-8") as f:
-        f.write(_wheel_file())
+        f.write(_wheel_file(_ext_unbuildable() is None))
     return dist_info
 
 
@@ -203,7 +260,6 @@ def build_wheel(
 ) -> str:
     name, version = _names()
     dist_info = f"{name}-{version}.dist-info"
-    wheel_name = f"{name}-{version}-{_tag()}.whl"
     with tempfile.TemporaryDirectory(prefix="limber-build-") as tmp:
         files: List[Tuple[str, bytes]] = []
         for arcname, path in _package_files():
@@ -211,8 +267,13 @@ def build_wheel(
                 files.append((arcname, f.read()))
         with open(_library(tmp), "rb") as f:
             files.append(("limber/liblimber.so", f.read()))
+        ext = _extension(tmp)
+        if ext is not None:
+            with open(ext, "rb") as f:
+                files.append((f"limber/{os.path.basename(ext)}", f.read()))
+        wheel_name = f"{name}-{version}-{_tag(ext is not None)}.whl"
         files.append((f"{dist_info}/METADATA", _metadata().encode("utf-8")))
-        files.append((f"{dist_info}/WHEEL", _wheel_file().encode("utf-8")))
+        files.append((f"{dist_info}/WHEEL", _wheel_file(ext is not None).encode("utf-8")))
         record = [_record_line(a, d) for a, d in files] + [f"{dist_info}/RECORD,,"]
         files.append((f"{dist_info}/RECORD", ("\n".join(record) + "\n").encode("utf-8")))
         out = os.path.join(wheel_directory, wheel_name)
@@ -234,7 +295,7 @@ def build_sdist(
     base = f"{name}-{version}"
     out = os.path.join(sdist_directory, f"{base}.tar.gz")
     with tarfile.open(out, "w:gz") as t:
-        for rel in ["pyproject.toml", "README.md", "_build/limber_build.py"]:
+        for rel in ["pyproject.toml", "README.md", "_build/limber_build.py", "limber/_fast.c"]:
             t.add(os.path.join(PKG_ROOT, rel), arcname=f"{base}/{rel}")
         for arcname, path in _package_files():
             t.add(path, arcname=f"{base}/{arcname}")

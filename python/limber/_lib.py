@@ -320,6 +320,60 @@ def unchecked(name: str) -> Any:
     return f
 
 
+# ----- the state copy of a control loop ----------------------------------------------------
+
+#: ``1``: call liblimber through ctypes alone even where the package carries its compiled
+#: ``limber._fast`` (to compare the two; they return the same).
+CTYPES_ENV = "LIMBER_PY_CTYPES"
+
+
+_NO_WAIT = c_uint64(0)
+
+
+def _ctypes_copy_out(fn: Any, handle: Any, timeout_ms: int, cls: Any) -> Any:
+    """``copy_out`` through ctypes: ``fn`` is liblimber's function without its argument
+    types (``unchecked``: a call costs half), ``handle`` its ``c_void_p`` (or ``None``)."""
+    out = cls()
+    ms = _NO_WAIT if timeout_ms == 0 else c_uint64(timeout_ms)
+    code: int = fn(handle, ms, ctypes.byref(out), c_size_t(ctypes.sizeof(out)))
+    return code or out
+
+
+def _copy_out_impl() -> "Tuple[Any, bool]":
+    """The ``copy_out`` this process uses, and whether it is the compiled one."""
+    if os.environ.get(CTYPES_ENV, "") not in ("", "0"):
+        return _ctypes_copy_out, False
+    try:
+        from . import _fast  # type: ignore[attr-defined]
+    except ImportError:  # a source checkout, or a wheel built without a C compiler
+        return _ctypes_copy_out, False
+    return _fast.copy_out, True
+
+
+#: ``copy_out(fn, handle, timeout_ms, cls)``: calls a liblimber function of the shape of
+#: ``limber_device_state`` (``copier(name)``) with the handle's address (``None`` for none),
+#: ``timeout_ms`` and a new ``cls()``; returns that instance when the call returns 0, else the
+#: code. The compiled ``limber._fast`` when the package carries it (pip builds it), else
+#: ctypes: both call the same function of the same library, with the same arguments.
+copy_out, COMPILED = _copy_out_impl()
+
+
+def copier(name: str) -> Any:
+    """The ``fn`` that ``copy_out`` takes for liblimber's function ``name``: its address for
+    the compiled ``copy_out``, for ctypes' the function (``unchecked``)."""
+    if COMPILED:
+        return ctypes.cast(getattr(lib, name), c_void_p).value
+    return unchecked(name)
+
+
+def handle_arg(h: Optional[c_void_p]) -> Any:
+    """A handle as ``copy_out`` takes it: its address for the compiled one (``None`` for
+    none), the ``c_void_p`` itself for ctypes'."""
+    if h is None:
+        return None
+    return h.value if COMPILED else h
+
+
 def last_error() -> str:
     """``limber_last_error()``: the detail of the last failure on this thread."""
     raw: Optional[bytes] = lib.limber_last_error()

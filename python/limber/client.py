@@ -145,13 +145,15 @@ _C = TypeVar("_C", bound="_Client[Any]")
 
 _connect = _c.limber_device_connect_checked
 _disconnect = _c.limber_device_disconnect
-_wait_state = _c.limber_device_wait_state
+# The state copies: through the compiled `limber._fast` when the package has it, else ctypes
+# (`_lib.copy_out`).
+_copy_out = _lib.copy_out
+_STATE = _lib.copier("limber_device_state")
+_WAIT_STATE = _lib.copier("limber_device_wait_state")
 # The calls of a control loop, unchecked (see `_lib.unchecked`): every argument below is
 # passed as a ctypes value of its C type.
-_state = _lib.unchecked("limber_device_state")
 _last_state = _lib.unchecked("limber_device_last_state")
 _outcome = _lib.unchecked("limber_device_outcome")
-_NO_WAIT = c_uint64(0)
 # Equal to no timeout a caller passes (None included): the first one is converted.
 _NO_TIMEOUT_YET = object()
 
@@ -167,9 +169,12 @@ class _Client(_Owned, Generic[_D]):
     GEOM: ClassVar[Type[ctypes.Structure]]
 
     _h: Optional[c_void_p]
+    #: The handle as `_lib.copy_out` takes it (``None`` once closed).
+    _hv: Any
 
     def __init__(self) -> None:  # use connect()
         self._h = None
+        self._hv = None
         # Reused by every call: no allocation per command or outcome.
         self._ticket = _lib.Ticket()
         self._ticket_ref = byref(self._ticket)
@@ -242,6 +247,7 @@ class _Client(_Owned, Generic[_D]):
             raise _error(rc)
         self = cls()
         self._h = h
+        self._hv = _lib.handle_arg(h)
         self._device = DeviceName.parse(device)
         self._domain = dom
         _open_clients.add(self)
@@ -263,6 +269,7 @@ class _Client(_Owned, Generic[_D]):
         h = self.__dict__.get("_h")
         if h is not None:
             self._h = None
+            self._hv = None
             _open_clients.discard(self)
             _disconnect(h)
 
@@ -319,13 +326,12 @@ class _Client(_Owned, Generic[_D]):
         """The latest state, after taking what arrived: a *copy* of the ``*Data`` ctypes
         struct (``ActArrayData``, ``LimbData``, ``GripperData``; same fields as in Rust), or
         ``None`` if no sample arrived yet."""
-        d = self.DATA()
-        rc = _state(self._h, _NO_WAIT, byref(d), self._size)
-        if rc:
-            if rc == _lib.CODE_TIMEOUT:
+        d = _copy_out(_STATE, self._hv, 0, self.DATA)
+        if d.__class__ is int:
+            if d == _lib.CODE_TIMEOUT:
                 return None
-            raise self._fail(rc)
-        return d  # type: ignore[return-value]
+            raise self._fail(d)
+        return d  # type: ignore[no-any-return]
 
     def last_state(self) -> Optional[_D]:
         """The latest state already taken (a copy), without looking for a newer one."""
@@ -340,11 +346,10 @@ class _Client(_Owned, Generic[_D]):
     def wait_state(self, timeout: float) -> _D:
         """Waits up to ``timeout`` s for a state newer than the latest one taken and returns
         it (a copy). Raises :class:`WaitTimeout` or :class:`DriverGoneError`."""
-        d = self.DATA()
-        rc = _wait_state(self._h, _ms("timeout", timeout), byref(d), self._data_size)
-        if rc:
-            raise self._fail(rc)
-        return d  # type: ignore[return-value]
+        d = _copy_out(_WAIT_STATE, self._hv, _ms("timeout", timeout), self.DATA)
+        if d.__class__ is int:
+            raise self._fail(d)
+        return d  # type: ignore[no-any-return]
 
     def state_age(self) -> Optional[float]:
         """Age of the latest state taken in seconds (now minus its acquisition time), or

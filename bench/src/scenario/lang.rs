@@ -4,7 +4,8 @@
 //!
 //! * **state read**: the latest arm state (1336 B) from shared memory into the program:
 //!   Rust `ActArrayClient::state()` (in place), C `limber_actarray_state` (a copy into the
-//!   caller's struct), Python `ActArrayClient.state()` (a ctypes copy). Each takes whatever
+//!   caller's struct), Python `ActArrayClient.state()` (a copy into a new ctypes struct, by
+//!   the package's compiled `limber._fast` where pip built it, else through ctypes). Each takes whatever
 //!   arrived first, as a control loop's read does.
 //! * **command round trip**: `move_to` then `wait_outcome`, each client with its defaults
 //!   (event-driven, the 30 µs spin budget).
@@ -12,8 +13,11 @@
 //! The C client is `bench/clients/lang_client.c`, compiled here with `cc` against the
 //! source tree's headers and the `liblimber.so` beside this executable (or in
 //! `LIMBER_LIB_DIR`); the Python client is `bench/clients/lang_client.py`, run by
-//! `LIMBER_PYTHON` (default `python3`) with the source tree's `python/` on `PYTHONPATH` and
-//! `LIMBER_LIB` set to that same `liblimber.so` (the package is a ctypes binding over it).
+//! `LIMBER_PYTHON` (default `python3`) with the package as a user installs it: `pip install
+//! --target` of the source tree's `python/` into the run's directory, over that same
+//! `liblimber.so` (`LIMBER_LIB`), with `limber._fast` where a C compiler and Python's
+//! headers are (the report notes which; without pip, the source tree's `python/`;
+//! `LIMBER_PY_CTYPES=1` in the environment has it copy through ctypes, to compare).
 //! Each language that cannot run (no C compiler, no liblimber.so, no Python that imports
 //! limber) is skipped with the reason, printed and noted in the report; Rust always runs.
 
@@ -259,16 +263,30 @@ fn c_client(ctx: &RunCtx) -> Result<PathBuf, String> {
 }
 
 /// The Python client's command; `Err(why)` when there is no liblimber.so or no Python that
-/// imports limber (from the source tree, over that liblimber.so).
-fn python(ctx: &RunCtx) -> Result<Command, String> {
+/// imports limber. The package is the one a user installs: `pip install --target` of the
+/// source tree's `python/` into this run's directory, over that liblimber.so (with
+/// `limber._fast` where a C compiler and Python's headers are); where pip cannot install it,
+/// the source tree's `python/` (ctypes alone). Which one, and why, is noted in the report.
+fn python(ctx: &mut RunCtx) -> Result<Command, String> {
     let py = std::env::var_os("LIMBER_PYTHON").unwrap_or_else(|| "python3".into());
-    let path = Path::new(TREE).join("python");
     // The C client's liblimber.so; without one, the package looks for its own (and says
     // where it looked when it finds none).
     let lib = lib_dir().map(|d| d.join("liblimber.so"));
+    let path = match pip_install(ctx, &py, lib.as_ref().ok()) {
+        Ok(dir) => dir,
+        Err(why) => {
+            ctx.notes.push(format!(
+                "Python: the package from the source tree (pip could not install it: {why})"
+            ));
+            Path::new(TREE).join("python")
+        }
+    };
     let mut probe = Command::new(&py);
     probe
-        .args(["-c", "import limber.client"])
+        .args([
+            "-c",
+            "import limber._lib as l; print('compiled' if l.COMPILED else 'ctypes')",
+        ])
         .env("PYTHONPATH", &path);
     if let Ok(lib) = &lib {
         probe.env("LIMBER_LIB", lib);
@@ -287,6 +305,13 @@ fn python(ctx: &RunCtx) -> Result<Command, String> {
                 .trim()
         ));
     }
+    let how = String::from_utf8_lossy(&o.stdout).trim().to_string();
+    ctx.notes.push(if how == "compiled" {
+        "Python: states copied by the package's compiled limber._fast".to_string()
+    } else {
+        "Python: states copied through ctypes (no limber._fast in the package, or LIMBER_PY_CTYPES=1)"
+            .to_string()
+    });
     let script = ctx.tmp_file("lang_client.py");
     std::fs::write(&script, PY_CLIENT).map_err(|e| format!("{}: {e}", script.display()))?;
     let mut cmd = Command::new(py);
@@ -295,6 +320,42 @@ fn python(ctx: &RunCtx) -> Result<Command, String> {
         cmd.env("LIMBER_LIB", lib);
     }
     Ok(cmd)
+}
+
+/// `pip install --target` of the source tree's package into this run's directory (over
+/// `lib` when given, so nothing is compiled but `limber._fast`); the directory, or why not.
+fn pip_install(
+    ctx: &RunCtx,
+    py: &std::ffi::OsStr,
+    lib: Option<&PathBuf>,
+) -> Result<PathBuf, String> {
+    let dir = ctx.tmp_file("python-package");
+    let mut cmd = Command::new(py);
+    cmd.args([
+        "-m",
+        "pip",
+        "install",
+        "--quiet",
+        "--disable-pip-version-check",
+        "--no-deps",
+        "--no-build-isolation",
+        "--target",
+    ])
+    .arg(&dir)
+    .arg(Path::new(TREE).join("python"));
+    if let Some(lib) = lib {
+        cmd.env("LIMBER_LIB", lib);
+    }
+    let o = run_bounded(cmd, Duration::from_secs(300))?;
+    if !o.status.success() {
+        return Err(String::from_utf8_lossy(&o.stderr)
+            .lines()
+            .last()
+            .unwrap_or("pip failed")
+            .trim()
+            .to_string());
+    }
+    Ok(dir)
 }
 
 /// An external client's samples: state reads, round trips, single calls into liblimber
