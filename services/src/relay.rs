@@ -112,7 +112,7 @@ impl<I: Interface> DeviceHost<I> {
         if let Err(e) = self.data_port().update_connections() {
             tracing::debug!(device = %self.device(), error = %e, "cannot connect new clients");
         }
-        if let Err(e) = self.outcome_port().update_connections() {
+        if let Err(e) = self.update_outcome_connections() {
             tracing::debug!(device = %self.device(), error = %e, "cannot connect new clients");
         }
         self.consume_wakeups();

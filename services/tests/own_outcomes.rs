@@ -283,3 +283,38 @@ fn a_relayed_commands_outcome_outlives_a_local_clients_flood() {
         "{got:?}"
     );
 }
+
+/// The driver looks whether anybody watches the `outcome` channel when it looks at its
+/// connections and with each state it publishes, not before every outcome (iceoryx2's count
+/// writes a cache line every process of the service shares): a watcher that subscribes
+/// between two commands of a spinning driver gets the outcomes from the driver's next
+/// published state on.
+#[test]
+fn a_watcher_gets_the_outcomes_from_the_drivers_next_state_on() {
+    let domain = Domain::unique_for_test();
+    let (_dctx, mut host) = host(&domain);
+    let mut arm = TestArm::new(2);
+    let cctx = Context::new(&domain, Role::Client, "own-watched").unwrap();
+    let mut mine = ActArrayClient::connect_timeout(&cctx, DEVICE, T).unwrap();
+    let wctx = Context::new(&domain, Role::Client, "own-watcher").unwrap();
+    let mut watcher = ActArrayClient::connect_timeout(&wctx, DEVICE, T).unwrap();
+    let first = mine.move_to(0, 0.1).unwrap();
+    host.process_spin(&mut arm).unwrap();
+    assert_eq!(mine.wait_outcome(first, T).unwrap(), Status::Ok);
+
+    watcher.watch_outcomes().unwrap();
+    // The driver's tick: it publishes its state, and looks.
+    host.publish().unwrap();
+    let second = mine.move_to(0, 0.2).unwrap();
+    // One spinning poll (which looks at the connections only every few polls).
+    assert_eq!(host.process_spin(&mut arm).unwrap().commands, 1);
+    assert_eq!(mine.wait_outcome(second, T).unwrap(), Status::Ok);
+    let mut watched = Vec::new();
+    watcher.relay_outcomes(|o| watched.push(*o)).unwrap();
+    assert!(
+        watched
+            .iter()
+            .any(|o| o.client_id == mine.client_id() && o.cmd_seq == second.seq && o.result == 0),
+        "{watched:?}"
+    );
+}

@@ -18,7 +18,7 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::server::Server;
 use iceoryx2::port::subscriber::Subscriber;
-use iceoryx2::port::update_connections::UpdateConnections;
+use iceoryx2::port::update_connections::{ConnectionFailure, UpdateConnections};
 use iceoryx2::prelude::*;
 use iceoryx2::sample_mut_uninit::SampleMutUninit;
 use limber_interfaces::prelude::*;
@@ -237,6 +237,8 @@ impl<I: Interface> DeviceHost<I> {
     pub fn publish(&mut self) -> Result<(), PublishError> {
         self.send_state()?;
         self.state_sent();
+        // A driver's tick: whoever began to watch the outcomes gets those from now on.
+        self.out.look_for_watchers();
         Ok(())
     }
 
@@ -298,8 +300,10 @@ impl<I: Interface> DeviceHost<I> {
         &self.server
     }
 
-    pub(crate) fn outcome_port(&self) -> &Publisher<ipc::Service, OutcomeMsg, ()> {
-        &self.out.all
+    /// Connects the `outcome` publisher to watchers that came, and looks whether anybody
+    /// watches (a relay's housekeeping).
+    pub(crate) fn update_outcome_connections(&mut self) -> Result<(), ConnectionFailure> {
+        self.out.update_connections()
     }
 
     /// Sends an outcome as given to the client it names and to the watchers (a relay's).

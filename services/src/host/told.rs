@@ -60,6 +60,14 @@ pub(crate) struct Outcomes {
     pub(super) all: Publisher<ipc::Service, OutcomeMsg, ()>,
     /// A sample of `all` loaned ahead, for the next outcome.
     pub(super) loan: Option<SampleMutUninit<ipc::Service, MaybeUninit<OutcomeMsg>, ()>>,
+    /// Whether anybody watches `all`, as looked at when its connections were
+    /// ([`Outcomes::update_connections`]), with each state the driver publishes
+    /// ([`DeviceHost::publish`](super::DeviceHost::publish)) and after each send, not before
+    /// every outcome: iceoryx2 counts a service's subscribers by reading every slot of its
+    /// registry and writing the registry's generation counter, a cache line that every
+    /// process of the service shares. A watcher that subscribes gets the outcomes from the
+    /// driver's next look (each `process`, every few polls when it spins, each tick's state).
+    watched: bool,
     pub(super) told_svc: ToldSvc,
     told: Server<ipc::Service, u64, (), OutcomeMsg, ()>,
     senders: PortNodes,
@@ -86,10 +94,12 @@ impl Outcomes {
         told: Server<ipc::Service, u64, (), OutcomeMsg, ()>,
         ports: usize,
     ) -> Self {
+        let watched = all_svc.dynamic_config().number_of_subscribers() != 0;
         Outcomes {
             all_svc,
             all,
             loan: None,
+            watched,
             told_svc,
             told,
             senders: PortNodes::new(ports),
@@ -129,14 +139,17 @@ impl Outcomes {
     ) -> Result<(), PublishError> {
         let told = self.tell(device, msg);
         // A sample only for watchers (usually nobody).
-        if self.all_svc.dynamic_config().number_of_subscribers() != 0 {
+        if self.watched {
             let loan = match self.loan.take() {
                 Some(l) => l,
                 None => self.all.loan_uninit().map_err(PublishError::Loan)?,
             };
-            loan.write_payload(*msg)
+            let reached = loan
+                .write_payload(*msg)
                 .send()
                 .map_err(PublishError::Send)?;
+            // The last watcher left: none is looked for until the next look.
+            self.watched = reached != 0;
         }
         stats.outcomes += 1;
         stats.told += u64::from(told);
@@ -150,9 +163,16 @@ impl Outcomes {
         }
     }
 
-    /// Connects the `outcome` publisher to watchers that came since the last call.
-    pub(super) fn update_connections(&self) -> Result<(), ConnectionFailure> {
+    /// Connects the `outcome` publisher to watchers that came since the last call, and
+    /// looks whether anybody watches.
+    pub(crate) fn update_connections(&mut self) -> Result<(), ConnectionFailure> {
+        self.look_for_watchers();
         self.all.update_connections()
+    }
+
+    /// Looks whether anybody watches the `outcome` channel.
+    pub(super) fn look_for_watchers(&mut self) {
+        self.watched = self.all_svc.dynamic_config().number_of_subscribers() != 0;
     }
 
     /// Sends `msg` on the stream of the client it names. A client whose stream is not
