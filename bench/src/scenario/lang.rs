@@ -272,7 +272,13 @@ fn python(ctx: &mut RunCtx) -> Result<Command, String> {
     // The C client's liblimber.so; without one, the package looks for its own (and says
     // where it looked when it finds none).
     let lib = lib_dir().map(|d| d.join("liblimber.so"));
-    let path = match pip_install(ctx, &py, lib.as_ref().ok()) {
+    // Without a liblimber.so to package, pip would build one with cargo (minutes): the
+    // source tree's package then, which finds its own.
+    let installed = match &lib {
+        Ok(lib) => pip_install(ctx, &py, lib),
+        Err(why) => Err(format!("no liblimber.so to package: {why}")),
+    };
+    let path = match installed {
         Ok(dir) => dir,
         Err(why) => {
             ctx.notes.push(format!(
@@ -298,11 +304,7 @@ fn python(ctx: &mut RunCtx) -> Result<Command, String> {
             path.display(),
             lib.as_ref()
                 .map_or_else(|why| why.clone(), |l| l.display().to_string()),
-            String::from_utf8_lossy(&o.stderr)
-                .lines()
-                .last()
-                .unwrap_or("")
-                .trim()
+            last_line(&o.stderr, "")
         ));
     }
     let how = String::from_utf8_lossy(&o.stdout).trim().to_string();
@@ -322,13 +324,9 @@ fn python(ctx: &mut RunCtx) -> Result<Command, String> {
     Ok(cmd)
 }
 
-/// `pip install --target` of the source tree's package into this run's directory (over
-/// `lib` when given, so nothing is compiled but `limber._fast`); the directory, or why not.
-fn pip_install(
-    ctx: &RunCtx,
-    py: &std::ffi::OsStr,
-    lib: Option<&PathBuf>,
-) -> Result<PathBuf, String> {
+/// `pip install --target` of the source tree's package into this run's directory, over
+/// `lib` (so nothing is compiled but `limber._fast`); the directory, or why not.
+fn pip_install(ctx: &RunCtx, py: &std::ffi::OsStr, lib: &Path) -> Result<PathBuf, String> {
     let dir = ctx.tmp_file("python-package");
     let mut cmd = Command::new(py);
     cmd.args([
@@ -342,20 +340,24 @@ fn pip_install(
         "--target",
     ])
     .arg(&dir)
-    .arg(Path::new(TREE).join("python"));
-    if let Some(lib) = lib {
-        cmd.env("LIMBER_LIB", lib);
-    }
+    .arg(Path::new(TREE).join("python"))
+    .env("LIMBER_LIB", lib);
     let o = run_bounded(cmd, Duration::from_secs(300))?;
     if !o.status.success() {
-        return Err(String::from_utf8_lossy(&o.stderr)
-            .lines()
-            .last()
-            .unwrap_or("pip failed")
-            .trim()
-            .to_string());
+        return Err(last_line(&o.stderr, "pip failed"));
     }
     Ok(dir)
+}
+
+/// The last line of a program's output (what Python and pip say last: the error), or
+/// `none` when it printed nothing.
+fn last_line(out: &[u8], none: &str) -> String {
+    String::from_utf8_lossy(out)
+        .lines()
+        .last()
+        .unwrap_or(none)
+        .trim()
+        .to_string()
 }
 
 /// An external client's samples: state reads, round trips, single calls into liblimber
