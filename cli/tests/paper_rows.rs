@@ -95,12 +95,18 @@ fn brakes_accel_and_current_through_the_cli() {
     state_until(dom, arm, |v| {
         v["actuators"][0]["state_name"] == "idle" && v["actuators"][0]["position"] == 1.0
     });
-    // CURRENT: joint 0 (no gravity about the vertical) turns at k I / damping; the
-    // state's current is the model's.
+    // CURRENT: joint 0 (no gravity about the vertical) turns at k I / damping (the
+    // default motor: 2 N·m/A x 0.5 A / 2 N·m·s/rad = 0.5 rad/s); the state's current is
+    // the model's. A state published in the tick that took the command shows the joint
+    // MOVING at speed 0 (it has not been stepped yet): the test waits for it to turn.
     assert!(ok(dom, &["actarray", arm, "current", "0", "0.5"]).contains("ok"));
-    let s = state_until(dom, arm, |v| v["actuators"][0]["state_name"] == "moving");
+    let s = state_until(dom, arm, |v| {
+        v["actuators"][0]["state_name"] == "moving"
+            && v["actuators"][0]["speed"].as_f64().is_some_and(|s| s > 0.0)
+    });
     assert_eq!(s["actuators"][0]["current"], 0.5);
-    assert!(s["actuators"][0]["speed"].as_f64().unwrap() > 0.0, "{s}");
+    let speed = s["actuators"][0]["speed"].as_f64().unwrap();
+    assert!((speed - 0.5).abs() < 1e-6, "{s}");
     // MULTI_CURRENT opening the open gripper: at its limit, stalled.
     assert!(
         ok(
