@@ -330,9 +330,13 @@ CTYPES_ENV = "LIMBER_PY_CTYPES"
 _NO_WAIT = c_uint64(0)
 
 
-def _ctypes_copy_out(fn: Any, handle: Any, timeout_ms: int, cls: Any) -> Any:
+def _ctypes_copy_out(
+    fn: Any, handle: Any, timeout_ms: int, cls: Any, spare: Optional[List[Any]] = None
+) -> Any:
     """``copy_out`` through ctypes: ``fn`` is liblimber's function without its argument
-    types (``unchecked``: a call costs half), ``handle`` its ``c_void_p`` (or ``None``)."""
+    types (``unchecked``: a call costs half), ``handle`` its ``c_void_p`` (or ``None``).
+    ``spare`` is not used: every instance is new (what the compiled one recycles is an
+    instance nobody can tell from a new one)."""
     out = cls()
     ms = _NO_WAIT if timeout_ms == 0 else c_uint64(timeout_ms)
     code: int = fn(handle, ms, ctypes.byref(out), c_size_t(ctypes.sizeof(out)))
@@ -350,12 +354,19 @@ def _copy_out_impl() -> "Tuple[Any, bool]":
     return _fast.copy_out, True
 
 
-#: ``copy_out(fn, handle, timeout_ms, cls)``: calls a liblimber function of the shape of
-#: ``limber_device_state`` (``copier(name)``) with the handle's address (``None`` for none),
-#: ``timeout_ms`` and a new ``cls()``; returns that instance when the call returns 0, else the
-#: code. The compiled ``limber._fast`` when the package carries it (pip builds it), else
-#: ctypes: both call the same function of the same library, with the same arguments.
+#: ``copy_out(fn, handle, timeout_ms, cls, spare=None)``: calls a liblimber function of the
+#: shape of ``limber_device_state`` (``copier(name)``) with the handle's address (``None`` for
+#: none), ``timeout_ms`` and a new ``cls()``; returns that instance when the call returns 0,
+#: else the code. The compiled ``limber._fast`` when the package carries it (pip builds it),
+#: else ctypes: both call the same function of the same library, with the same arguments.
+#: ``spare`` (``new_spare()``, kept by the caller): the compiled one may hand back an instance
+#: it returned before that nothing else references any more instead of allocating one.
 copy_out, COMPILED = _copy_out_impl()
+
+
+def new_spare() -> List[Any]:
+    """The ``spare`` of ``copy_out``: two entries, empty at first."""
+    return [None, None]
 
 
 def copier(name: str) -> Any:

@@ -175,6 +175,9 @@ class _Client(_Owned, Generic[_D]):
     def __init__(self) -> None:  # use connect()
         self._h = None
         self._hv = None
+        # The states `state()` and `wait_state()` may recycle (`_lib.copy_out`): only an
+        # instance nothing else references any more.
+        self._spare = _lib.new_spare()
         # Reused by every call: no allocation per command or outcome.
         self._ticket = _lib.Ticket()
         self._ticket_ref = byref(self._ticket)
@@ -270,6 +273,7 @@ class _Client(_Owned, Generic[_D]):
         if h is not None:
             self._h = None
             self._hv = None
+            self._spare[:] = _lib.new_spare()
             _open_clients.discard(self)
             _disconnect(h)
 
@@ -326,7 +330,7 @@ class _Client(_Owned, Generic[_D]):
         """The latest state, after taking what arrived: a *copy* of the ``*Data`` ctypes
         struct (``ActArrayData``, ``LimbData``, ``GripperData``; same fields as in Rust), or
         ``None`` if no sample arrived yet."""
-        d = _copy_out(_STATE, self._hv, 0, self.DATA)
+        d = _copy_out(_STATE, self._hv, 0, self.DATA, self._spare)
         if d.__class__ is int:
             if d == _lib.CODE_TIMEOUT:
                 return None
@@ -346,7 +350,7 @@ class _Client(_Owned, Generic[_D]):
     def wait_state(self, timeout: float) -> _D:
         """Waits up to ``timeout`` s for a state newer than the latest one taken and returns
         it (a copy). Raises :class:`WaitTimeout` or :class:`DriverGoneError`."""
-        d = _copy_out(_WAIT_STATE, self._hv, _ms("timeout", timeout), self.DATA)
+        d = _copy_out(_WAIT_STATE, self._hv, _ms("timeout", timeout), self.DATA, self._spare)
         if d.__class__ is int:
             raise self._fail(d)
         return d  # type: ignore[no-any-return]

@@ -80,6 +80,26 @@ now = arm.state()
 assert type(now) is ActArrayData and bytes(now) == bytes(arm.last_state())
 assert now is not arm.state()  # a new copy each time
 print(now.actuators_count, now.header.seq > 0)
+try:
+    now.postion = 1.0  # a misspelt field: the classes take no other attributes
+except AttributeError:
+    print("misspelt: AttributeError")
+# What the compiled copy recycles is a state nothing references: one held, directly or
+# through a part of it, keeps its bytes while newer states are read and dropped.
+held = arm.wait_state(5.0)
+raw = bytes(held)
+header = arm.wait_state(5.0).header  # holds its state through the part
+hseq = header.seq
+for _ in range(4):
+    arm.wait_state(5.0)  # dropped at once: recycled by the compiled copy
+    arm.state()
+assert bytes(held) == raw and header.seq == hseq > held.header.seq
+a, b = arm.wait_state(5.0), arm.wait_state(5.0)
+assert a is not b and a.header.seq < b.header.seq
+x = arm.wait_state(5.0)
+del x
+y = arm.wait_state(5.0)
+print("recycled:", any(y is o for o in arm._spare))
 arm.close()
 for call in (arm.state, lambda: arm.wait_state(1.0)):
     try:
@@ -101,6 +121,8 @@ def test_the_installed_package_copies_states_in_c_or_through_ctypes_alike(driver
     assert out.returncode == 0, out.stderr
     assert out.stdout.splitlines() == [
         "6 True",
+        "misspelt: AttributeError",
+        f"recycled: {how == 'compiled'}",
         "closed: ActArrayClient is closed",
         "closed: ActArrayClient is closed",
     ], out.stdout
@@ -157,7 +179,8 @@ def test_the_compiled_copy_refuses_bad_arguments_with_an_error(installed):
         "fn = ctypes.cast(_lib.lib.limber_device_state, ctypes.c_void_p).value\n"
         "for args in [(), (fn, None, 0), (0, None, 0, int), (fn, None, -1, int),\n"
         "             (fn, 'h', 0, int), (fn, None, 0, int), (fn, None, 0, 3),\n"
-        "             (fn, None, 0, bytes)]:\n"
+        "             (fn, None, 0, bytes), (fn, None, 0, _lib.L.ActArrayData, [None]),\n"
+        "             (fn, None, 0, _lib.L.ActArrayData, (None, None))]:\n"
         "    try:\n"
         "        _fast.copy_out(*args)\n"
         "    except (TypeError, ValueError, OverflowError, BufferError) as e:\n"
@@ -170,7 +193,41 @@ def test_the_compiled_copy_refuses_bad_arguments_with_an_error(installed):
     # Each a Python exception (nothing called), and a NULL handle liblimber's own refusal.
     assert out.stdout.split() == ["TypeError", "TypeError", "ValueError", "OverflowError",
                                   "TypeError", "TypeError", "TypeError", "BufferError",
-                                  "True"], out.stdout
+                                  "TypeError", "TypeError", "True"], out.stdout
+
+
+def test_the_compiled_copy_recycles_only_a_slotted_state_nothing_references(driver, installed):  # noqa: F811
+    # copy_out's spare: an instance it returned comes back only once nothing but the spare
+    # references it, and only of a class without an instance dict or weak references (an
+    # attribute or a weak reference could otherwise outlive the state it was made on).
+    py, env, _, _ = installed
+    script = (
+        "import ctypes, sys, weakref\n"
+        "from limber import ActArrayClient, ActArrayData, _fast, _lib\n"
+        "arm = ActArrayClient.connect(sys.argv[2], sys.argv[1], timeout=10.0)\n"
+        "arm.wait_state(5.0)\n"
+        "fn = _lib.copier('limber_device_state')\n"
+        "hv = arm._hv\n"
+        "class Loose(ctypes.Structure):\n"
+        "    _fields_ = ActArrayData._fields_\n"
+        "for cls in (ActArrayData, Loose):\n"
+        "    spare = _lib.new_spare()\n"
+        "    first = _fast.copy_out(fn, hv, 0, cls, spare)\n"
+        "    assert spare[1] is first and spare[0] is None\n"
+        "    again = _fast.copy_out(fn, hv, 0, cls, spare)  # first is held: a new one\n"
+        "    assert again is not first and spare == [first, again]\n"
+        "    del first, again\n"
+        "    last = id(spare[1])\n"
+        "    w = weakref.ref(spare[1]) if cls is Loose else None\n"
+        "    third = _fast.copy_out(fn, hv, 0, cls, spare)\n"
+        "    print(cls.__name__, 'recycled' if id(third) in (id(spare[0]), last) and\n"
+        "          any(third is o for o in spare) else 'new', w is None or w() is not third)\n"
+    )
+    out = subprocess.run([py, "-c", script, driver.domain, driver.dev("actarray")], env=env,
+                         capture_output=True, text=True, timeout=LIMIT)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.splitlines() == ["ActArrayData recycled True", "Loose new True"], \
+        out.stdout
 
 
 def test_a_wheel_without_a_c_compiler_is_ctypes_alone_for_any_python_3(tmp_path):

@@ -2,7 +2,7 @@
 //! other, against one event-driven driver child (`cmd-driver-event`, the `command`
 //! scenario's driver with its default linger):
 //!
-//! * **state read**: the latest arm state (1336 B) from shared memory into the program:
+//! * **state read**: the latest arm state (1376 B) from shared memory into the program:
 //!   Rust `ActArrayClient::state()` (in place), C `limber_actarray_state` (a copy into the
 //!   caller's struct), Python `ActArrayClient.state()` (a copy into a new ctypes struct, by
 //!   the package's compiled `limber._fast` where pip built it, else through ctypes). Each takes whatever

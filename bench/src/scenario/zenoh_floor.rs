@@ -2,10 +2,10 @@
 //! version and features of `limber-bridge`, peer to peer over the link the bridge pair uses
 //! (a Unix socket, as `bridge expose` listens on by default), no limber in between:
 //!
-//! * `put`: a 296 B put on a declared publisher → the echo's subscriber → a 1336 B put
+//! * `put`: a 296 B put on a declared publisher → the echo's subscriber → a 1376 B put
 //!   back → the pinger's subscriber (the path of a command and its outcome through a
 //!   bridge pair);
-//! * `get`: a `get` with a 296 B payload → the echo's queryable replies 1336 B (the path of
+//! * `get`: a `get` with a 296 B payload → the echo's queryable replies 1376 B (the path of
 //!   a request), consolidation off as a mirror asks.
 //!
 //! Round trips only, measured by the pinging parent (`bridge.raw.put.rtt`,
