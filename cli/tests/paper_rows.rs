@@ -86,12 +86,14 @@ fn brakes_accel_and_current_through_the_cli() {
     state_until(dom, "simarm/limb/0", |v| v["state_name"] == "braked");
     assert!(ok(dom, &["limb", "simarm/limb/0", "brakes", "off"]).contains("ok"));
     state_until(dom, arm, |v| v["actuators"][0]["state_name"] == "idle");
-    // ACCEL: the state reports the acceleration of a limited move.
-    assert!(ok(dom, &["actarray", arm, "accel", "0", "0.5"]).contains("ok"));
+    // ACCEL: the state reports the acceleration of a limited move. 1 rad at 0.05 rad/s²
+    // takes 2 sqrt(1 / 0.05) = 8.9 s, 0.9 s at time scale 10: long enough for a loaded
+    // machine's `limber echo` to see it moving.
+    assert!(ok(dom, &["actarray", arm, "accel", "0", "0.05"]).contains("ok"));
     assert!(ok(dom, &["actarray", arm, "pos", "0", "1.0"]).contains("ok"));
     let s = state_until(dom, arm, |v| v["actuators"][0]["state_name"] == "moving");
     let a = s["actuators"][0]["acceleration"].as_f64().unwrap();
-    assert!((0.0..=0.5 + 1e-9).contains(&a), "{s}");
+    assert!((0.0..=0.05 + 1e-9).contains(&a), "{s}");
     state_until(dom, arm, |v| {
         v["actuators"][0]["state_name"] == "idle" && v["actuators"][0]["position"] == 1.0
     });
