@@ -47,6 +47,12 @@ def installed(tmp_path_factory):
     return py, env, before, porcelain()
 
 
+def run(py, env, script, *args, cwd=None):
+    """`script` run by the installed package's python with `args` (its output, as text)."""
+    return subprocess.run([py, "-c", script, *args], env=env, cwd=cwd, capture_output=True,
+                          text=True, timeout=LIMIT)
+
+
 def test_pip_install_packages_the_library_and_leaves_the_tree_as_it_was(driver, installed, tmp_path):  # noqa: F811
     py, env, before, after = installed
     assert after == before
@@ -59,8 +65,7 @@ def test_pip_install_packages_the_library_and_leaves_the_tree_as_it_was(driver, 
         "assert 'site-packages' in pkg, pkg\n"
         "print(' '.join(str(d.name) for d in limber.list_devices(sys.argv[1])))\n"
     )
-    out = subprocess.run([py, "-c", script, driver.domain], env=env, cwd=str(tmp_path),
-                         capture_output=True, text=True, timeout=LIMIT)
+    out = run(py, env, script, driver.domain, cwd=str(tmp_path))
     assert out.returncode == 0, out.stderr
     assert driver.dev("actarray") in out.stdout.split()
 
@@ -116,8 +121,7 @@ def test_the_installed_package_copies_states_in_c_or_through_ctypes_alike(driver
     py, env, _, _ = installed
     if how == "ctypes":
         env = dict(env, LIMBER_PY_CTYPES="1")
-    out = subprocess.run([py, "-c", STATES, driver.domain, driver.dev("actarray"), how],
-                         env=env, capture_output=True, text=True, timeout=LIMIT)
+    out = run(py, env, STATES, driver.domain, driver.dev("actarray"), how)
     assert out.returncode == 0, out.stderr
     assert out.stdout.splitlines() == [
         "6 True",
@@ -161,8 +165,7 @@ def test_the_compiled_wait_lets_other_threads_run_and_times_out_as_ctypes_does(i
             "t.join()\n"
             "print('other thread ran:', ran > ref / 4, ran, ref)\n"
         )
-        out = subprocess.run([py, "-c", script, d.domain, d.dev("actarray")], env=env,
-                             capture_output=True, text=True, timeout=LIMIT)
+        out = run(py, env, script, d.domain, d.dev("actarray"))
     finally:
         d.stop()
     assert out.returncode == 0, out.stderr
@@ -187,8 +190,7 @@ def test_the_compiled_copy_refuses_bad_arguments_with_an_error(installed):
         "        print(type(e).__name__)\n"
         "print(_fast.copy_out(fn, None, 0, _lib.L.ActArrayData) == _lib.CODE_NULL_ARGUMENT)\n"
     )
-    out = subprocess.run([py, "-c", script], env=env, capture_output=True, text=True,
-                         timeout=LIMIT)
+    out = run(py, env, script)
     assert out.returncode == 0, out.stderr
     # Each a Python exception (nothing called), and a NULL handle liblimber's own refusal.
     assert out.stdout.split() == ["TypeError", "TypeError", "ValueError", "OverflowError",
@@ -223,8 +225,7 @@ def test_the_compiled_copy_recycles_only_a_slotted_state_nothing_references(driv
         "    print(cls.__name__, 'recycled' if id(third) in (id(spare[0]), last) and\n"
         "          any(third is o for o in spare) else 'new', w is None or w() is not third)\n"
     )
-    out = subprocess.run([py, "-c", script, driver.domain, driver.dev("actarray")], env=env,
-                         capture_output=True, text=True, timeout=LIMIT)
+    out = run(py, env, script, driver.domain, driver.dev("actarray"))
     assert out.returncode == 0, out.stderr
     assert out.stdout.splitlines() == ["ActArrayData recycled True", "Loose new True"], \
         out.stdout
