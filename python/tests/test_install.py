@@ -89,6 +89,13 @@ try:
     now.postion = 1.0  # a misspelt field: the classes take no other attributes
 except AttributeError:
     print("misspelt: AttributeError")
+# Copied and pickled as their bytes (ctypes' own pickling needs an instance dict).
+import copy, pickle
+for twin in (copy.copy(now), copy.deepcopy(now), pickle.loads(pickle.dumps(now)),
+             pickle.loads(pickle.dumps(now, protocol=0))):
+    assert type(twin) is ActArrayData and twin is not now and bytes(twin) == bytes(now)
+part = pickle.loads(pickle.dumps(now.actuators[0]))
+assert bytes(part) == bytes(now.actuators[0])
 # What the compiled copy recycles is a state nothing references: one held, directly or
 # through a part of it, keeps its bytes while newer states are read and dropped.
 held = arm.wait_state(5.0)
