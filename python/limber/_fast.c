@@ -47,12 +47,6 @@ PyDoc_STRVAR(copy_out_doc,
  * waits without the GIL.
  */
 static PyObject *take_spare(PyObject *spare, PyObject *cls) {
-#ifdef Py_GIL_DISABLED
-    /* Free-threaded CPython: a reference count read here is not the whole truth. */
-    (void)spare;
-    (void)cls;
-    return NULL;
-#endif
     if (!PyType_Check(cls)) {
         return NULL;
     }
@@ -94,6 +88,11 @@ static PyObject *copy_out(PyObject *module, PyObject *const *args, Py_ssize_t na
         PyErr_SetString(PyExc_TypeError, "copy_out: spare is a list of two entries, or None");
         return NULL;
     }
+#ifdef Py_GIL_DISABLED
+    /* Free-threaded CPython: a reference count read here is not the whole truth, and the
+     * list is not ours alone while we change it. Every instance is new. */
+    spare = NULL;
+#endif
     void *fn_addr = PyLong_AsVoidPtr(args[0]);
     if (fn_addr == NULL) {
         if (!PyErr_Occurred()) {
