@@ -334,6 +334,16 @@ pub const RATIOS: &[RatioDef] = &[
         floor: None,
     },
     RatioDef {
+        // Like for like: C and Python both copy the whole state into the program's memory
+        // (Rust's read above is in place), so this is what Python adds to the same copy.
+        label: "Python state read / C state read, both a copy (lang)",
+        num: "lang.python.state",
+        den: "lang.c.state",
+        pct: Pct::P50,
+        goal: None,
+        floor: None,
+    },
+    RatioDef {
         label: "Python state read / one ctypes call into liblimber (lang)",
         num: "lang.python.state",
         den: "lang.python.ffi",
