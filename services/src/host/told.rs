@@ -94,12 +94,11 @@ impl Outcomes {
         told: Server<ipc::Service, u64, (), OutcomeMsg, ()>,
         ports: usize,
     ) -> Self {
-        let watched = all_svc.dynamic_config().number_of_subscribers() != 0;
-        Outcomes {
+        let mut out = Outcomes {
             all_svc,
             all,
             loan: None,
-            watched,
+            watched: false,
             told_svc,
             told,
             senders: PortNodes::new(ports),
@@ -109,7 +108,9 @@ impl Outcomes {
             forged: 0,
             untold: vec![OutcomeMsg::default(); UNTOLD].into_boxed_slice(),
             untold_at: 0,
-        }
+        };
+        out.look_for_watchers();
+        out
     }
 
     /// Sends `msg`, stamped now, to the client it names and to every watcher
