@@ -3,13 +3,13 @@
 //!
 //! | key | what | payload |
 //! | --- | --- | --- |
-//! | `limber/<robot>/<interface>/<index>/state` | put by `expose` on every state sample | the interface's state struct (e.g. `limber.v5.ActArrayData`) |
-//! | `limber/<robot>/<interface>/<index>/cmd/<principal>/<session>` | put by a remote client | the command envelope (e.g. `limber.v5.ActArrayCmdMsg`) |
-//! | `limber/<robot>/<interface>/<index>/outcome/<principal>/<session>` | put by `expose` for each command of that sender | `limber.v5.OutcomeMsg` |
+//! | `limber/<robot>/<interface>/<index>/state` | put by `expose` on every state sample | the interface's state struct (e.g. `limber.v6.ActArrayData`) |
+//! | `limber/<robot>/<interface>/<index>/cmd/<principal>/<session>` | put by a remote client | the command envelope (e.g. `limber.v6.ActArrayCmdMsg`) |
+//! | `limber/<robot>/<interface>/<index>/outcome/<principal>/<session>` | put by `expose` for each command of that sender | `limber.v6.OutcomeMsg` |
 //! | `limber/<robot>/<interface>/<index>/req/<principal>/<session>` | queryable of `expose` | query: the request envelope; reply: the reply envelope |
-//! | `limber/<robot>/<interface>/<index>/lease/<principal>/<session>` | queryable of `expose` | query: `limber.v5.LeaseReq`; reply: `limber.v5.LeaseReply` |
+//! | `limber/<robot>/<interface>/<index>/lease/<principal>/<session>` | queryable of `expose` | query: `limber.v6.LeaseReq`; reply: `limber.v6.LeaseReply` |
 //! | `limber/<robot>/<interface>/<index>/alive` | liveliness token of `expose` | none |
-//! | `limber/<robot>/driver/0/stats` | put by `expose` about once a second | `limber.v5.DriverStats` |
+//! | `limber/<robot>/driver/0/stats` | put by `expose` about once a second | `limber.v6.DriverStats` |
 //!
 //! `<principal>` is who the sender is as Zenoh's authentication established it (its user
 //! name or certificate common name; `local` on the owner's Unix socket): the exposing
@@ -73,7 +73,7 @@ pub fn outcome_key(device: &DeviceName, origin: &str) -> String {
     format!("{}/{origin}", device_key(device, "outcome"))
 }
 
-/// The key of the driver statistics of `robot` (`limber.v5.DriverStats`, put by `expose`
+/// The key of the driver statistics of `robot` (`limber.v6.DriverStats`, put by `expose`
 /// about once a second).
 pub fn driver_stats_key(robot: &str) -> String {
     format!("{ROOT}/{robot}/driver/0/stats")

@@ -29,7 +29,10 @@ fn start_view(d: &Domain) -> (Bg, String) {
 
 fn connect(addr: &str) -> TcpStream {
     let s = TcpStream::connect(addr).unwrap();
+    // Every read and every write bounded: a server that stops reading fails the test with
+    // the call that waited, never hangs it (a write was the one wait without a bound).
     s.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
+    s.set_write_timeout(Some(Duration::from_secs(10))).unwrap();
     s
 }
 

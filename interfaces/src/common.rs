@@ -11,7 +11,7 @@ pub const MAX_ACTUATORS: usize = 32;
 
 wire_struct! {
     /// A point or vector in 3D (Player's `point_3d`), metres or unitless.
-    pub struct Vec3 : "limber.v5.Vec3", size = 24, align = 8 {
+    pub struct Vec3 : "limber.v6.Vec3", size = 24, align = 8 {
         /// x (forward in the robot frame).
         pub x: f64,
         /// y (left).
@@ -23,7 +23,7 @@ wire_struct! {
 
 wire_struct! {
     /// Roll, pitch and yaw in radians (Player's `orientation_3d`).
-    pub struct Orientation3 : "limber.v5.Orientation3", size = 24, align = 8 {
+    pub struct Orientation3 : "limber.v6.Orientation3", size = 24, align = 8 {
         /// Rotation about x.
         pub roll: f64,
         /// Rotation about y.
@@ -35,7 +35,7 @@ wire_struct! {
 
 wire_struct! {
     /// A 3D pose (Player's `pose3d`): position in metres, orientation in radians.
-    pub struct Pose3 : "limber.v5.Pose3", size = 48, align = 8 {
+    pub struct Pose3 : "limber.v6.Pose3", size = 48, align = 8 {
         /// Position.
         pub position: Vec3,
         /// Orientation.
@@ -45,7 +45,7 @@ wire_struct! {
 
 wire_struct! {
     /// A box size in metres (Player's `bbox3d`).
-    pub struct Bbox3 : "limber.v5.Bbox3", size = 24, align = 8 {
+    pub struct Bbox3 : "limber.v6.Bbox3", size = 24, align = 8 {
         /// Width (along y).
         pub width: f64,
         /// Length (along x).
@@ -58,7 +58,7 @@ wire_struct! {
 wire_struct! {
     /// The outcome of the last command a driver applied, carried in every state sample so
     /// the sender of a command sees whether (and why not) it was carried out.
-    pub struct CmdOutcome : "limber.v5.CmdOutcome", size = 24, align = 8 {
+    pub struct CmdOutcome : "limber.v6.CmdOutcome", size = 24, align = 8 {
         /// The client that sent it (0: no command applied yet).
         pub client_id: u64,
         /// That client's sequence number of the command.
@@ -72,7 +72,7 @@ wire_struct! {
 
 wire_struct! {
     /// The header of every state sample.
-    pub struct StateHeader : "limber.v5.StateHeader", size = 48, align = 8 {
+    pub struct StateHeader : "limber.v6.StateHeader", size = 48, align = 8 {
         /// Sample sequence number, +1 per published sample of this device.
         pub seq: u64,
         /// `CLOCK_MONOTONIC` time in ns at which the state was acquired (e.g. when the
@@ -89,7 +89,7 @@ wire_struct! {
 
 wire_struct! {
     /// Metadata in front of every command and every request.
-    pub struct MsgMeta : "limber.v5.MsgMeta", size = 32, align = 8 {
+    pub struct MsgMeta : "limber.v6.MsgMeta", size = 32, align = 8 {
         /// The sending client (unique per client in a domain; never 0).
         pub client_id: u64,
         /// The client's sequence number, +1 per message it sends on this channel.
@@ -105,7 +105,7 @@ wire_struct! {
 
 wire_struct! {
     /// Metadata in front of every reply.
-    pub struct ReplyMeta : "limber.v5.ReplyMeta", size = 32, align = 8 {
+    pub struct ReplyMeta : "limber.v6.ReplyMeta", size = 32, align = 8 {
         /// The client whose request this answers.
         pub client_id: u64,
         /// The request's sequence number.

@@ -12,8 +12,11 @@ wire_struct! {
     /// The outcome of one command, published on the device's `outcome` channel to every
     /// client (each keeps its own, by `client_id`): one sample when the command is applied
     /// or refused, and one more with `STATUS_PREEMPTED` when another client's command
-    /// cuts short the motion it started.
-    pub struct OutcomeMsg : "limber.v5.OutcomeMsg", size = 608, align = 8 {
+    /// cuts short the motion it started. The motion's result is one more sample
+    /// (`result` set) when it ends; a command whose result is decided when the driver
+    /// carries it out with `STATUS_OK` (it drives nothing that runs on, or it is a stop)
+    /// gets a single sample, its result with `also_outcome` set.
+    pub struct OutcomeMsg : "limber.v6.OutcomeMsg", size = 616, align = 8 {
         /// The client that sent the command.
         pub client_id: u64,
         /// That client's sequence number of the command.
@@ -33,7 +36,8 @@ wire_struct! {
         /// 0: this sample is the command's outcome (applied or refused). Otherwise a
         /// `RESULT` code: the motion the command started has ended, and how (one such
         /// sample per command carried out; `status` then says why, e.g. `LINK_DOWN` for
-        /// an aborted motion, and `other_client` names the command that preempted it).
+        /// an aborted motion, and `other_client` names the command that preempted it; with
+        /// `also_outcome`, the command's outcome too).
         pub result: u32,
         /// The parts (joints) the command drove: the valid entries of `position` and
         /// `error` (at most 32).
@@ -48,6 +52,12 @@ wire_struct! {
         /// Each part's final error against the command's goal (position − goal); NaN if
         /// not known (a motion preempted before its goal was set, a SPEED).
         pub error: [f64; 32],
+        /// 1: this result sample is also the command's outcome, carried out with
+        /// `STATUS_OK` (its result was decided when the driver carried it out, and no
+        /// outcome sample of its own came or comes before it); 0 otherwise.
+        pub also_outcome: u32,
+        /// Zero.
+        pub _pad: u32,
     }
 }
 
@@ -198,7 +208,7 @@ pub(crate) const RESULT_GROUP: ConstantGroup = ConstantGroup {
 
 wire_struct! {
     /// A request on a device's `lease` channel (`op` is a `LEASE_OP` code).
-    pub struct LeaseReq : "limber.v5.LeaseReq", size = 80, align = 8 {
+    pub struct LeaseReq : "limber.v6.LeaseReq", size = 80, align = 8 {
         /// The requesting client's id (the one its commands carry).
         pub client_id: u64,
         /// The client's sequence number of this request.
@@ -222,7 +232,7 @@ wire_struct! {
 
 wire_struct! {
     /// The answer to a [`LeaseReq`]: the status and who holds the device now.
-    pub struct LeaseReply : "limber.v5.LeaseReply", size = 80, align = 8 {
+    pub struct LeaseReply : "limber.v6.LeaseReply", size = 80, align = 8 {
         /// The holder's client id (0: nobody holds the device).
         pub holder_client: u64,
         /// The request's sequence number.
@@ -299,7 +309,7 @@ impl OutcomeMsg {
         Status::try_from(self.status)
     }
 
-    /// The motion's result in one sentence (empty when the sample is the command's
+    /// The motion's result in one sentence (empty when the sample is only the command's
     /// outcome): how it ended, why, and the largest final error against the tolerance.
     pub fn result_sentence(&self) -> String {
         let Ok(Some(r)) = self.motion_result() else {
@@ -324,7 +334,13 @@ impl OutcomeMsg {
         s
     }
 
-    /// The motion's result, decoded: `None` when the sample is the command's outcome.
+    /// Whether this sample is the command's outcome: a sample without a result, or a
+    /// result that is also the outcome ([`OutcomeMsg::also_outcome`]).
+    pub fn is_outcome(&self) -> bool {
+        self.result == 0 || self.also_outcome != 0
+    }
+
+    /// The motion's result, decoded: `None` when the sample is only the command's outcome.
     pub fn motion_result(&self) -> Result<Option<MotionResult>, DecodeError> {
         match self.result {
             0 => Ok(None),

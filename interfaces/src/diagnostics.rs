@@ -13,7 +13,7 @@ pub const TEXT_LEN: usize = 32;
 
 wire_struct! {
     /// Loop, link and robot facts of one driver process.
-    pub struct DriverStats : "limber.v5.DriverStats", size = 352, align = 8 {
+    pub struct DriverStats : "limber.v6.DriverStats", size = 352, align = 8 {
         /// Common header (`flags`: `DEVICE_FLAG_LINK_UP` while the link is up).
         pub header: StateHeader,
         /// The driver's name (NUL-padded ASCII), e.g. "pioneer".

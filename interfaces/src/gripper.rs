@@ -70,7 +70,7 @@ impl TryFrom<u32> for GripperState {
 
 wire_struct! {
     /// The gripper's state (channel `data`).
-    pub struct GripperData : "limber.v5.GripperData", size = 64, align = 8 {
+    pub struct GripperData : "limber.v6.GripperData", size = 64, align = 8 {
         /// Common header.
         pub header: StateHeader,
         /// `GRIPPER_STATE` value.
@@ -86,7 +86,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD GOAL: move the fingers to a gap, with at most an effort and a speed.
-    pub struct GripperGoalCmd : "limber.v5.GripperGoalCmd", size = 24, align = 8 {
+    pub struct GripperGoalCmd : "limber.v6.GripperGoalCmd", size = 24, align = 8 {
         /// The goal gap between the fingers, m (0: closed).
         pub gap: f64,
         /// The largest grip effort, N; 0: the gripper's own.
@@ -99,7 +99,7 @@ wire_struct! {
 wire_struct! {
     /// The command envelope (channel `cmd`). GOAL's body is a [`GripperGoalCmd`]; every
     /// other gripper command has an empty body.
-    pub struct GripperCmdMsg : "limber.v5.GripperCmdMsg", size = 56, align = 8 {
+    pub struct GripperCmdMsg : "limber.v6.GripperCmdMsg", size = 56, align = 8 {
         /// Sender, sequence, time, kind, body length.
         pub meta: MsgMeta,
         /// The body (GOAL's `GripperGoalCmd`), zero-padded.
@@ -109,7 +109,7 @@ wire_struct! {
 
 wire_struct! {
     /// The request envelope (channel `req`). GET_GEOM has an empty body.
-    pub struct GripperReqMsg : "limber.v5.GripperReqMsg", size = 40, align = 8 {
+    pub struct GripperReqMsg : "limber.v6.GripperReqMsg", size = 40, align = 8 {
         /// Sender, sequence, time, kind, body length (0).
         pub meta: MsgMeta,
         /// Reserved, zero.
@@ -119,7 +119,7 @@ wire_struct! {
 
 wire_struct! {
     /// The gripper geometry (the GET_GEOM reply).
-    pub struct GripperGeom : "limber.v5.GripperGeom", size = 104, align = 8 {
+    pub struct GripperGeom : "limber.v6.GripperGeom", size = 104, align = 8 {
         /// Pose of the gripper in the robot frame.
         pub pose: Pose3,
         /// Outer size, m.
@@ -135,7 +135,7 @@ wire_struct! {
 
 wire_struct! {
     /// The reply envelope (channel `req`).
-    pub struct GripperReplyMsg : "limber.v5.GripperReplyMsg", size = 136, align = 8 {
+    pub struct GripperReplyMsg : "limber.v6.GripperReplyMsg", size = 136, align = 8 {
         /// Client, sequence, time, kind, status.
         pub meta: ReplyMeta,
         /// `GripperGeom` for GET_GEOM.

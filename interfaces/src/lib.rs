@@ -53,7 +53,9 @@ pub use wire::{WireField, WireStruct};
 /// the statuses `PATH_COLLIDES` and `PATH_JUMPS`.
 /// Version 5 added the `told` channel: each client's own outcomes, on a stream of its own
 /// ([`protocol::TOLD_BUFFER`]); the `outcome` channel is for those who watch every outcome.
-pub const LAYOUT_VERSION: u32 = 5;
+/// Version 6 added [`control::OutcomeMsg::also_outcome`]: a command whose result is decided
+/// when the driver carries it out gets one sample, its result and its outcome at once.
+pub const LAYOUT_VERSION: u32 = 6;
 
 /// Everything a driver or client author needs, in one `use`.
 pub mod prelude {

@@ -96,7 +96,7 @@ impl TryFrom<u32> for LimbState {
 
 wire_struct! {
     /// The limb's state (channel `data`).
-    pub struct LimbData : "limber.v5.LimbData", size = 184, align = 8 {
+    pub struct LimbData : "limber.v6.LimbData", size = 184, align = 8 {
         /// Common header.
         pub header: StateHeader,
         /// End-effector position, robot coordinates, m.
@@ -132,7 +132,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD SETPOSE: move the end effector to a pose.
-    pub struct LimbSetPoseCmd : "limber.v5.LimbSetPoseCmd", size = 72, align = 8 {
+    pub struct LimbSetPoseCmd : "limber.v6.LimbSetPoseCmd", size = 72, align = 8 {
         /// Target position, robot coordinates, m.
         pub position: Vec3,
         /// Target approach vector (need not be unit length, must not be zero).
@@ -144,7 +144,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD SETPOSITION: move the end effector to a position, orientation left to the driver.
-    pub struct LimbSetPositionCmd : "limber.v5.LimbSetPositionCmd", size = 24, align = 8 {
+    pub struct LimbSetPositionCmd : "limber.v6.LimbSetPositionCmd", size = 24, align = 8 {
         /// Target position, robot coordinates, m.
         pub position: Vec3,
     }
@@ -152,7 +152,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD VECMOVE: move the end effector `length` m along `direction` in a straight line.
-    pub struct LimbVecMoveCmd : "limber.v5.LimbVecMoveCmd", size = 32, align = 8 {
+    pub struct LimbVecMoveCmd : "limber.v6.LimbVecMoveCmd", size = 32, align = 8 {
         /// Direction (need not be unit length, must not be zero).
         pub direction: Vec3,
         /// Distance, m.
@@ -162,7 +162,7 @@ wire_struct! {
 
 wire_struct! {
     /// The command envelope (channel `cmd`). HOME and STOP have an empty body.
-    pub struct LimbCmdMsg : "limber.v5.LimbCmdMsg", size = 120, align = 8 {
+    pub struct LimbCmdMsg : "limber.v6.LimbCmdMsg", size = 120, align = 8 {
         /// Sender, sequence, time, kind, body length.
         pub meta: MsgMeta,
         /// One of the `Limb*Cmd` structs.
@@ -172,7 +172,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ POWER: power on (1) or off (0).
-    pub struct LimbPowerReq : "limber.v5.LimbPowerReq", size = 4, align = 4 {
+    pub struct LimbPowerReq : "limber.v6.LimbPowerReq", size = 4, align = 4 {
         /// 0 off, 1 on.
         pub value: u32,
     }
@@ -180,7 +180,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ BRAKES: brakes on (1) or off (0).
-    pub struct LimbBrakesReq : "limber.v5.LimbBrakesReq", size = 4, align = 4 {
+    pub struct LimbBrakesReq : "limber.v6.LimbBrakesReq", size = 4, align = 4 {
         /// 0 off, 1 on.
         pub value: u32,
     }
@@ -188,7 +188,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ SPEED: the end-effector speed for later moves, m/s.
-    pub struct LimbSpeedReq : "limber.v5.LimbSpeedReq", size = 8, align = 8 {
+    pub struct LimbSpeedReq : "limber.v6.LimbSpeedReq", size = 8, align = 8 {
         /// Speed, m/s.
         pub speed: f64,
     }
@@ -196,7 +196,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ REACH: the pose a SETPOSE would ask for (same fields as [`LimbSetPoseCmd`]).
-    pub struct LimbReachReq : "limber.v5.LimbReachReq", size = 72, align = 8 {
+    pub struct LimbReachReq : "limber.v6.LimbReachReq", size = 72, align = 8 {
         /// Target position, robot coordinates, m.
         pub position: Vec3,
         /// Target approach vector (non-zero).
@@ -208,7 +208,7 @@ wire_struct! {
 
 wire_struct! {
     /// The request envelope (channel `req`). GEOM has an empty body.
-    pub struct LimbReqMsg : "limber.v5.LimbReqMsg", size = 104, align = 8 {
+    pub struct LimbReqMsg : "limber.v6.LimbReqMsg", size = 104, align = 8 {
         /// Sender, sequence, time, kind, body length.
         pub meta: MsgMeta,
         /// One of the `Limb*Req` structs.
@@ -218,7 +218,7 @@ wire_struct! {
 
 wire_struct! {
     /// The limb geometry (the GEOM reply).
-    pub struct LimbGeom : "limber.v5.LimbGeom", size = 24, align = 8 {
+    pub struct LimbGeom : "limber.v6.LimbGeom", size = 24, align = 8 {
         /// The limb base in robot coordinates, m.
         pub base_pos: Vec3,
     }
@@ -227,7 +227,7 @@ wire_struct! {
 wire_struct! {
     /// The REACH reply: where a SETPOSE to the requested pose would end (before the
     /// joints are rounded to the hardware's resolution) and what it would change.
-    pub struct LimbReach : "limber.v5.LimbReach", size = 104, align = 8 {
+    pub struct LimbReach : "limber.v6.LimbReach", size = 104, align = 8 {
         /// End-effector position it would end at, robot coordinates, m.
         pub position: Vec3,
         /// Approach vector it would end with.
@@ -249,7 +249,7 @@ wire_struct! {
 
 wire_struct! {
     /// The reply envelope (channel `req`).
-    pub struct LimbReplyMsg : "limber.v5.LimbReplyMsg", size = 136, align = 8 {
+    pub struct LimbReplyMsg : "limber.v6.LimbReplyMsg", size = 136, align = 8 {
         /// Client, sequence, time, kind, status.
         pub meta: ReplyMeta,
         /// `LimbGeom` for GEOM, `LimbReach` for REACH, empty otherwise.

@@ -27,7 +27,7 @@ pub mod req {
 wire_struct! {
     /// One scan (channel `data`). Range `i` was measured along the bearing
     /// `min_angle + i * angular_res` (rad, counter-clockwise from the sensor's x axis).
-    pub struct RangerData : "limber.v5.RangerData", size = 5888, align = 8 {
+    pub struct RangerData : "limber.v6.RangerData", size = 5888, align = 8 {
         /// Common header.
         pub header: StateHeader,
         /// Bearing of the first range, rad.
@@ -58,7 +58,7 @@ wire_struct! {
 wire_struct! {
     /// The command envelope (channel `cmd`). A ranger has no command: every kind is
     /// refused as unknown.
-    pub struct RangerCmdMsg : "limber.v5.RangerCmdMsg", size = 40, align = 8 {
+    pub struct RangerCmdMsg : "limber.v6.RangerCmdMsg", size = 40, align = 8 {
         /// Sender, sequence, time, kind, body length.
         pub meta: MsgMeta,
         /// Reserved, zero.
@@ -68,7 +68,7 @@ wire_struct! {
 
 wire_struct! {
     /// The request envelope (channel `req`). GET_GEOM has an empty body.
-    pub struct RangerReqMsg : "limber.v5.RangerReqMsg", size = 40, align = 8 {
+    pub struct RangerReqMsg : "limber.v6.RangerReqMsg", size = 40, align = 8 {
         /// Sender, sequence, time, kind, body length (0).
         pub meta: MsgMeta,
         /// Reserved, zero.
@@ -78,7 +78,7 @@ wire_struct! {
 
 wire_struct! {
     /// The ranger's geometry and configuration (the GET_GEOM reply).
-    pub struct RangerGeom : "limber.v5.RangerGeom", size = 136, align = 8 {
+    pub struct RangerGeom : "limber.v6.RangerGeom", size = 136, align = 8 {
         /// Pose of the sensor in the robot frame (its x axis is bearing 0).
         pub pose: Pose3,
         /// The sensor's size, m.
@@ -106,7 +106,7 @@ wire_struct! {
 
 wire_struct! {
     /// The reply envelope (channel `req`).
-    pub struct RangerReplyMsg : "limber.v5.RangerReplyMsg", size = 168, align = 8 {
+    pub struct RangerReplyMsg : "limber.v6.RangerReplyMsg", size = 168, align = 8 {
         /// Client, sequence, time, kind, status.
         pub meta: ReplyMeta,
         /// `RangerGeom` for GET_GEOM.

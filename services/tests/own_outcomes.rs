@@ -274,7 +274,7 @@ fn a_relayed_commands_outcome_outlives_a_local_clients_flood() {
     // (told to that remote client as it would be to a local one).
     assert!(
         got.iter()
-            .any(|o| o.client_id == remote2 && o.result == 0 && o.status == Status::Ok.code()),
+            .any(|o| o.client_id == remote2 && o.is_outcome() && o.status == Status::Ok.code()),
         "{got:?}"
     );
     assert!(
@@ -314,7 +314,94 @@ fn a_watcher_gets_the_outcomes_from_the_drivers_next_state_on() {
     assert!(
         watched
             .iter()
-            .any(|o| o.client_id == mine.client_id() && o.cmd_seq == second.seq && o.result == 0),
+            .any(|o| o.client_id == mine.client_id() && o.cmd_seq == second.seq && o.is_outcome()),
         "{watched:?}"
+    );
+}
+
+/// An arm whose commands drive nothing that runs on (the default [`DeviceHandler::motion`]):
+/// each command's result is decided when the driver carries it out.
+struct Instant;
+
+impl DeviceHandler<ActArray> for Instant {
+    fn command(&mut self, cmd: &ActArrayCommand, _: &Origin, state: &mut ActArrayData) -> Status {
+        match *cmd {
+            ActArrayCommand::Position { joint: 0, position } => {
+                state.actuators[0].position = position;
+                Status::Ok
+            }
+            _ => Status::UnknownJoint,
+        }
+    }
+    fn request(
+        &mut self,
+        _: &ActArrayRequest,
+        _: &Origin,
+        _: &mut ActArrayData,
+    ) -> Result<ActArrayReply, Status> {
+        Err(Status::Unsupported)
+    }
+}
+
+/// A command whose result is decided when it is carried out gets one sample, its outcome
+/// and its result at once (`also_outcome`), to its client and to the watchers: one send and
+/// one wake-up less on its path. A refused one gets its outcome alone; a command whose
+/// motion runs on, its outcome and later its result.
+#[test]
+fn a_command_decided_at_once_gets_one_sample_its_outcome_and_its_result() {
+    let domain = Domain::unique_for_test();
+    let (_dctx, mut host) = host(&domain);
+    let cctx = Context::new(&domain, Role::Client, "own-instant").unwrap();
+    let mut mine = ActArrayClient::connect_timeout(&cctx, DEVICE, T).unwrap();
+    let wctx = Context::new(&domain, Role::Client, "own-instant-watcher").unwrap();
+    let mut watcher = ActArrayClient::connect_timeout(&wctx, DEVICE, T).unwrap();
+    watcher.watch_outcomes().unwrap();
+    host.publish().unwrap();
+
+    let ok = mine.move_to(0, 0.2).unwrap();
+    let refused = mine.move_to(1, 0.2).unwrap();
+    assert_eq!(host.process(&mut Instant).unwrap().commands, 2);
+    assert_eq!(mine.wait_outcome(ok, T).unwrap(), Status::Ok);
+    let done = mine.wait_done(ok, T).unwrap();
+    assert_eq!(done.result(), MotionResult::Reached, "{done}");
+    assert_eq!(mine.wait_outcome(refused, T).unwrap(), Status::UnknownJoint);
+
+    let mut watched = Vec::new();
+    watcher.relay_outcomes(|o| watched.push(*o)).unwrap();
+    let of = |seq: u64| -> Vec<OutcomeMsg> {
+        watched
+            .iter()
+            .filter(|o| o.client_id == mine.client_id() && o.cmd_seq == seq)
+            .copied()
+            .collect()
+    };
+    // Old code: two samples for `ok` (its outcome, then its result).
+    let samples = of(ok.seq);
+    assert_eq!(samples.len(), 1, "{samples:?}");
+    let s = samples[0];
+    assert!(s.is_outcome(), "{s:?}");
+    assert_eq!(s.also_outcome, 1);
+    assert_eq!(s.status, Status::Ok.code());
+    assert_eq!(s.motion_result().unwrap(), Some(MotionResult::Reached));
+    let samples = of(refused.seq);
+    assert_eq!(samples.len(), 1, "{samples:?}");
+    assert_eq!(samples[0].status, Status::UnknownJoint.code());
+    assert_eq!(samples[0].motion_result().unwrap(), None);
+
+    // A motion that runs on: its outcome now (no result in it), its result when it ends.
+    let mut arm = TestArm::new(2);
+    let moving = mine.move_at_speed(0, 0.5).unwrap();
+    host.process(&mut arm).unwrap();
+    assert_eq!(mine.wait_outcome(moving, T).unwrap(), Status::Ok);
+    let mut watched = Vec::new();
+    watcher.relay_outcomes(|o| watched.push(*o)).unwrap();
+    let s = watched
+        .iter()
+        .find(|o| o.client_id == mine.client_id() && o.cmd_seq == moving.seq)
+        .copied()
+        .unwrap();
+    assert!(
+        s.is_outcome() && s.also_outcome == 0 && s.result == 0,
+        "{s:?}"
     );
 }

@@ -7,7 +7,7 @@ use crate::wire::{ZeroCopySend, wire_struct};
 
 wire_struct! {
     /// The state of one actuator.
-    pub struct ActuatorState : "limber.v5.ActuatorState", size = 40, align = 8 {
+    pub struct ActuatorState : "limber.v6.ActuatorState", size = 40, align = 8 {
         /// Position, rad or m.
         pub position: f64,
         /// Current speed, rad/s or m/s (NaN-free; 0 when unknown).
@@ -27,7 +27,7 @@ wire_struct! {
 wire_struct! {
     /// The feedback of the device's joint trajectory (control_msgs': the current point,
     /// the error), in its state.
-    pub struct TrajFeedback : "limber.v5.TrajFeedback", size = 40, align = 8 {
+    pub struct TrajFeedback : "limber.v6.TrajFeedback", size = 40, align = 8 {
         /// 0: no trajectory has run; 1: one runs (or waits for its start time); 2: the last
         /// one ended (`result` says how).
         pub active: u32,
@@ -48,7 +48,7 @@ wire_struct! {
 
 wire_struct! {
     /// The state of an actuator array (channel `data`).
-    pub struct ActArrayData : "limber.v5.ActArrayData", size = 1376, align = 8 {
+    pub struct ActArrayData : "limber.v6.ActArrayData", size = 1376, align = 8 {
         /// Common header.
         pub header: StateHeader,
         /// Number of valid entries in `actuators`.
@@ -64,7 +64,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD POS: move one joint to a position.
-    pub struct ActArrayPositionCmd : "limber.v5.ActArrayPositionCmd", size = 16, align = 8 {
+    pub struct ActArrayPositionCmd : "limber.v6.ActArrayPositionCmd", size = 16, align = 8 {
         /// Joint index (0-based).
         pub joint: i32,
         /// Reserved, zero.
@@ -76,7 +76,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD MULTI_POS: move every joint to a position.
-    pub struct ActArrayMultiPositionCmd : "limber.v5.ActArrayMultiPositionCmd", size = 264, align = 8 {
+    pub struct ActArrayMultiPositionCmd : "limber.v6.ActArrayMultiPositionCmd", size = 264, align = 8 {
         /// Number of valid entries.
         pub count: u32,
         /// Reserved, zero.
@@ -88,7 +88,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD SPEED: move one joint at a speed.
-    pub struct ActArraySpeedCmd : "limber.v5.ActArraySpeedCmd", size = 16, align = 8 {
+    pub struct ActArraySpeedCmd : "limber.v6.ActArraySpeedCmd", size = 16, align = 8 {
         /// Joint index.
         pub joint: i32,
         /// Reserved, zero.
@@ -100,7 +100,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD MULTI_SPEED: move every joint at a speed.
-    pub struct ActArrayMultiSpeedCmd : "limber.v5.ActArrayMultiSpeedCmd", size = 264, align = 8 {
+    pub struct ActArrayMultiSpeedCmd : "limber.v6.ActArrayMultiSpeedCmd", size = 264, align = 8 {
         /// Number of valid entries.
         pub count: u32,
         /// Reserved, zero.
@@ -112,7 +112,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD HOME: home one joint, or all (`joint = -1`).
-    pub struct ActArrayHomeCmd : "limber.v5.ActArrayHomeCmd", size = 8, align = 4 {
+    pub struct ActArrayHomeCmd : "limber.v6.ActArrayHomeCmd", size = 8, align = 4 {
         /// Joint index, or -1 for all.
         pub joint: i32,
         /// Reserved, zero.
@@ -122,7 +122,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD CURRENT: drive one joint, or all (`joint = -1`), with a current.
-    pub struct ActArrayCurrentCmd : "limber.v5.ActArrayCurrentCmd", size = 16, align = 8 {
+    pub struct ActArrayCurrentCmd : "limber.v6.ActArrayCurrentCmd", size = 16, align = 8 {
         /// Joint index, or -1 for all.
         pub joint: i32,
         /// Reserved, zero.
@@ -134,7 +134,7 @@ wire_struct! {
 
 wire_struct! {
     /// CMD MULTI_CURRENT: drive every joint with a current.
-    pub struct ActArrayMultiCurrentCmd : "limber.v5.ActArrayMultiCurrentCmd", size = 264, align = 8 {
+    pub struct ActArrayMultiCurrentCmd : "limber.v6.ActArrayMultiCurrentCmd", size = 264, align = 8 {
         /// Number of valid entries.
         pub count: u32,
         /// Reserved, zero.
@@ -150,7 +150,7 @@ wire_struct! {
     /// `ACCELERATION` carry the values of points `first .. first + count` (of joint column
     /// `column` for the last three); `PATH_TOLERANCE` and `GOAL_TOLERANCE` one value per
     /// joint column (`first` and `column` zero).
-    pub struct ActArrayTrajChunkCmd : "limber.v5.ActArrayTrajChunkCmd", size = 264, align = 8 {
+    pub struct ActArrayTrajChunkCmd : "limber.v6.ActArrayTrajChunkCmd", size = 264, align = 8 {
         /// A `TRAJ_FIELD` code.
         pub field: u16,
         /// The trajectory's joint column (0-based) for per-point joint values.
@@ -168,7 +168,7 @@ wire_struct! {
     /// CMD TRAJ: run the joint trajectory uploaded by this client's `TRAJ_CHUNK`s since its
     /// last TRAJ (control_msgs' FollowJointTrajectory goal). It replaces the trajectory
     /// running from its start time.
-    pub struct ActArrayTrajCmd : "limber.v5.ActArrayTrajCmd", size = 64, align = 8 {
+    pub struct ActArrayTrajCmd : "limber.v6.ActArrayTrajCmd", size = 64, align = 8 {
         /// `CLOCK_MONOTONIC` ns at which point times count from; 0 = when it arrives.
         pub start_ns: u64,
         /// How long after the last point's time the joints may take to come within the goal
@@ -190,7 +190,7 @@ wire_struct! {
 wire_struct! {
     /// CMD TRAJ_SCALE: the speed scaling of the running (and later) trajectories: 0
     /// pauses, 1 is nominal.
-    pub struct ActArrayTrajScaleCmd : "limber.v5.ActArrayTrajScaleCmd", size = 8, align = 8 {
+    pub struct ActArrayTrajScaleCmd : "limber.v6.ActArrayTrajScaleCmd", size = 8, align = 8 {
         /// The factor, 0 to 1.
         pub scale: f64,
     }
@@ -198,7 +198,7 @@ wire_struct! {
 
 wire_struct! {
     /// The command envelope (channel `cmd`): `body` holds the struct `meta.kind` names.
-    pub struct ActArrayCmdMsg : "limber.v5.ActArrayCmdMsg", size = 296, align = 8 {
+    pub struct ActArrayCmdMsg : "limber.v6.ActArrayCmdMsg", size = 296, align = 8 {
         /// Sender, sequence, time, kind, body length.
         pub meta: MsgMeta,
         /// One of the `ActArray*Cmd` structs.
@@ -208,7 +208,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ POWER: power on (1) or off (0).
-    pub struct ActArrayPowerReq : "limber.v5.ActArrayPowerReq", size = 4, align = 4 {
+    pub struct ActArrayPowerReq : "limber.v6.ActArrayPowerReq", size = 4, align = 4 {
         /// 0 off, 1 on.
         pub value: u32,
     }
@@ -216,7 +216,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ BRAKES: brakes on (1) or off (0).
-    pub struct ActArrayBrakesReq : "limber.v5.ActArrayBrakesReq", size = 4, align = 4 {
+    pub struct ActArrayBrakesReq : "limber.v6.ActArrayBrakesReq", size = 4, align = 4 {
         /// 0 off, 1 on.
         pub value: u32,
     }
@@ -224,7 +224,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ SPEED: the speed of one joint for later moves.
-    pub struct ActArraySpeedReq : "limber.v5.ActArraySpeedReq", size = 16, align = 8 {
+    pub struct ActArraySpeedReq : "limber.v6.ActArraySpeedReq", size = 16, align = 8 {
         /// Joint index.
         pub joint: i32,
         /// Reserved, zero.
@@ -236,7 +236,7 @@ wire_struct! {
 
 wire_struct! {
     /// REQ ACCEL: the acceleration of one joint for later moves.
-    pub struct ActArrayAccelReq : "limber.v5.ActArrayAccelReq", size = 16, align = 8 {
+    pub struct ActArrayAccelReq : "limber.v6.ActArrayAccelReq", size = 16, align = 8 {
         /// Joint index.
         pub joint: i32,
         /// Reserved, zero.
@@ -248,7 +248,7 @@ wire_struct! {
 
 wire_struct! {
     /// The request envelope (channel `req`). GET_GEOM has an empty body.
-    pub struct ActArrayReqMsg : "limber.v5.ActArrayReqMsg", size = 48, align = 8 {
+    pub struct ActArrayReqMsg : "limber.v6.ActArrayReqMsg", size = 48, align = 8 {
         /// Sender, sequence, time, kind, body length.
         pub meta: MsgMeta,
         /// One of the `ActArray*Req` structs.
@@ -258,7 +258,7 @@ wire_struct! {
 
 wire_struct! {
     /// The geometry of one actuator.
-    pub struct ActuatorGeom : "limber.v5.ActuatorGeom", size = 104, align = 8 {
+    pub struct ActuatorGeom : "limber.v6.ActuatorGeom", size = 104, align = 8 {
         /// `ACTUATOR_KIND`: 1 linear, 2 rotary.
         pub kind: u32,
         /// 1 when the actuator has brakes.
@@ -284,7 +284,7 @@ wire_struct! {
 
 wire_struct! {
     /// The geometry of the array (the GET_GEOM reply).
-    pub struct ActArrayGeom : "limber.v5.ActArrayGeom", size = 3384, align = 8 {
+    pub struct ActArrayGeom : "limber.v6.ActArrayGeom", size = 3384, align = 8 {
         /// Number of valid entries.
         pub actuators_count: u32,
         /// Reserved, zero.
@@ -300,7 +300,7 @@ wire_struct! {
 
 wire_struct! {
     /// The reply envelope (channel `req`): an ACK carries the body of the request's reply.
-    pub struct ActArrayReplyMsg : "limber.v5.ActArrayReplyMsg", size = 3416, align = 8 {
+    pub struct ActArrayReplyMsg : "limber.v6.ActArrayReplyMsg", size = 3416, align = 8 {
         /// Client, sequence, time, kind, status.
         pub meta: ReplyMeta,
         /// `ActArrayGeom` for GET_GEOM, empty otherwise.

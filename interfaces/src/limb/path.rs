@@ -13,7 +13,7 @@ use crate::wire::{ZeroCopySend, wire_struct};
 
 wire_struct! {
     /// CMD LINE and CMD PTP: the goal and how to get there.
-    pub struct LimbPathCmd : "limber.v5.LimbPathCmd", size = 88, align = 8 {
+    pub struct LimbPathCmd : "limber.v6.LimbPathCmd", size = 88, align = 8 {
         /// Goal position of the tool, robot coordinates, m.
         pub position: Vec3,
         /// Goal approach vector (`LIMB_PATH_ORIENT_GIVEN`; ignored with `KEEP`).

@@ -122,7 +122,9 @@ impl<I: Interface> Client<I> {
             }
             if m.result != 0 {
                 self.result_arrived(&m);
-                continue;
+                if !m.is_outcome() {
+                    continue;
+                }
             }
             let o = Outcome::from_msg(&m);
             let slot = (m.cmd_seq as usize) % OUTCOME_SLOTS;

@@ -100,6 +100,8 @@ pub fn remove(domain: &Domain) -> Result<Removed, RemoveError> {
         domain: domain.name().to_string(),
         source,
     })?;
+    // Before iceoryx2 opens anything of the dead: the segments they left half made.
+    let half_made = remove_half_made(&files.prefix, processes.is_empty());
     let mut dead_processes = 0;
     for v in dead {
         match v.blocking_remove_stale_resources(Duration::ZERO) {
@@ -117,7 +119,7 @@ pub fn remove(domain: &Domain) -> Result<Removed, RemoveError> {
         });
     }
     let me = dir::euid();
-    let mut removed = 0;
+    let mut removed = half_made;
     for path in dir::files_of(domain.name(), &files) {
         let Ok(md) = fs::symlink_metadata(&path) else {
             continue;
@@ -142,6 +144,54 @@ pub fn remove(domain: &Domain) -> Result<Removed, RemoveError> {
         dead_processes,
         files: removed,
     })
+}
+
+/// A segment found empty and unreadable this long after it was made is not being made any
+/// more: iceoryx2 sizes and opens a segment within microseconds of creating it.
+const HALF_MADE_AGE: Duration = Duration::from_secs(10);
+
+/// Removes the domain's segments in `/dev/shm` (names starting with `prefix`) that a killed
+/// process left half made, and returns how many. iceoryx2 creates a segment write-only and
+/// empty, sizes it, then makes it readable; a process killed in between leaves an empty,
+/// unreadable file, and iceoryx2's `open` of it (the cleanup after that dead process opens
+/// its connections) tries again every millisecond for ever when it runs as root: root may
+/// open the unreadable file, finds its size zero, and that case never reaches the timeout
+/// (iceoryx2-cal 0.10 `posix_shared_memory::open_impl`; another user is refused the open
+/// and gives up). `all`: no process of the domain is alive, so every such file is left
+/// over; else only those older than [`HALF_MADE_AGE`] (one being made now is not touched).
+fn remove_half_made(prefix: &str, all: bool) -> usize {
+    let me = dir::euid();
+    let mut n = 0;
+    for e in dir::entries(std::path::Path::new(dir::SHM_DIR)) {
+        if !e.file_name().to_string_lossy().starts_with(prefix) {
+            continue;
+        }
+        let Ok(md) = fs::symlink_metadata(e.path()) else {
+            continue;
+        };
+        let old = md
+            .modified()
+            .ok()
+            .and_then(|t| t.elapsed().ok())
+            .is_some_and(|age| age >= HALF_MADE_AGE);
+        if !md.is_file() || md.uid() != me || md.len() != 0 || md.mode() & 0o444 != 0 {
+            continue;
+        }
+        if !all && !old {
+            continue;
+        }
+        match fs::remove_file(e.path()) {
+            Ok(()) => {
+                n += 1;
+                tracing::info!(path = %e.path().display(), "removed a segment a killed process left half made");
+            }
+            Err(err) if err.kind() == io::ErrorKind::NotFound => {}
+            Err(err) => {
+                tracing::warn!(path = %e.path().display(), error = %err, "cannot remove a half-made segment");
+            }
+        }
+    }
+    n
 }
 
 /// `NODE (pid N)` for a live node (`a process` when its details cannot be read).

@@ -596,7 +596,7 @@ pub fn files_of(domain: &str, files: &DomainFiles) -> Vec<PathBuf> {
 
 /// The entries of `dir`: none when it does not exist; one that cannot be read is logged
 /// and left out (its files stay behind rather than the cleanup failing).
-fn entries(dir: &Path) -> Vec<fs::DirEntry> {
+pub(crate) fn entries(dir: &Path) -> Vec<fs::DirEntry> {
     let rd = match fs::read_dir(dir) {
         Ok(rd) => rd,
         Err(e) if e.kind() == io::ErrorKind::NotFound => return Vec::new(),

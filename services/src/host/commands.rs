@@ -136,7 +136,15 @@ impl<I: Interface> DeviceHost<I> {
         // (Clients are notified after both.)
         let state_sent = self.publish_each_outcome.then(|| self.send_state());
         let told = self.arbiter.outcome(cmd, node, status);
-        publish_outcome(&mut self.out, &mut self.stats, &self.device, told);
+        // A command carried out whose result is decided now: one sample, result and
+        // outcome (`publish_decided`); else the outcome, and the result when it comes.
+        let decided = told.status == Status::Ok
+            && told.other_client == 0
+            && told.other_name.is_none()
+            && self.publish_decided(cmd);
+        if !decided {
+            publish_outcome(&mut self.out, &mut self.stats, &self.device, told);
+        }
         self.stats.commands += 1;
         if !status.is_carried_out() {
             self.stats.refused += 1;
@@ -145,8 +153,8 @@ impl<I: Interface> DeviceHost<I> {
             sent?;
             self.state_sent();
         }
-        // A command that drives nothing that runs on has its result now, after its
-        // outcome (so do the motions it preempted or stopped).
+        // The motions it preempted or stopped have their results now, after its outcome
+        // (and so has the command itself if it was not sent with its outcome).
         self.publish_results();
         // The next command's outcome sample, loaned now rather than on its path.
         self.out.loan_ahead(&self.device);

@@ -212,6 +212,16 @@ impl Motions {
         given_up
     }
 
+    /// Takes the motion of `cmd` if it has ended already (a command that drives nothing
+    /// that runs on, or a stop, ends when it is carried out).
+    pub(crate) fn take_ended_of(&mut self, cmd: CmdRef) -> Option<Tracked> {
+        let i = self
+            .slots
+            .iter()
+            .position(|t| t.is_some_and(|t| t.cmd == cmd && t.left == 0))?;
+        self.slots[i].take()
+    }
+
     /// Takes the motions that ended (every part), oldest first, one at a time.
     pub(crate) fn take_ended(&mut self) -> Option<Tracked> {
         let i = (0..MAX_TRACKED)
@@ -293,6 +303,22 @@ impl<I: Interface> DeviceHost<I> {
         self.out.publish(&mut self.stats, &self.device, t.message());
         self.stats.results += 1;
     }
+
+    /// The command `cmd` carried out with `STATUS_OK` just now: if its result is decided
+    /// already (it drives nothing that runs on, or it is a stop), publishes one sample, its
+    /// result and its outcome at once ([`OutcomeMsg::also_outcome`]), and returns true;
+    /// else false (its outcome is to be published on its own). One sample where there were
+    /// two: a send and a wake-up less on the command's path.
+    pub(super) fn publish_decided(&mut self, cmd: CmdRef) -> bool {
+        let Some(t) = self.motions.take_ended_of(cmd) else {
+            return false;
+        };
+        let mut msg = t.message();
+        msg.also_outcome = 1;
+        self.out.publish(&mut self.stats, &self.device, msg);
+        self.stats.results += 1;
+        true
+    }
 }
 
 #[cfg(test)]
@@ -349,7 +375,9 @@ mod tests {
             (MotionResult::Aborted, Status::LinkDown)
         );
         m.start(cmd(1, 2), Motion::NONE);
-        let t = m.take_ended().unwrap();
+        assert!(m.take_ended_of(cmd(1, 3)).is_none());
+        let t = m.take_ended_of(cmd(1, 2)).unwrap();
+        assert!(m.take_ended().is_none());
         assert_eq!(
             (t.result, t.message().max_error),
             (MotionResult::Reached, 0.0)

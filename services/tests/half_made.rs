@@ -1,0 +1,102 @@
+//! A process killed while iceoryx2 was making one of its segments leaves it half made: an
+//! empty file nobody may read. iceoryx2 0.10's cleanup after that dead process opens the
+//! segment and, run as root, tries again every millisecond for ever (root may open it; its
+//! size is zero, and that case never reaches the timeout). That hung a test's teardown
+//! (`limber-cli::view`, its driver and viewer SIGKILLed at the end) for its whole 180 s
+//! and then `limber clean`, until the file was removed by hand. The domain's cleanup now
+//! removes such files before iceoryx2 looks.
+
+use std::os::unix::fs::PermissionsExt;
+use std::sync::mpsc;
+use std::time::Duration;
+
+use limber_interfaces::prelude::*;
+use limber_services::prelude::*;
+
+const CHILD_ENV: &str = "LIMBER_TEST_HALF_MADE_DOMAIN";
+const DEVICE: &str = "half/actarray/0";
+
+/// Run by `a_segment_left_half_made_does_not_hang_the_cleanup` as a process of its own (a
+/// no-op otherwise): a driver and a client of its device, connected, then waits to be killed.
+#[test]
+fn half_made_child() {
+    let Ok(name) = std::env::var(CHILD_ENV) else {
+        return;
+    };
+    let domain = Domain::new(&name).unwrap();
+    let dctx = Context::new(&domain, Role::Driver, "half-driver").unwrap();
+    let mut host = DeviceHost::<ActArray>::new(&dctx, &DEVICE.parse().unwrap(), "t").unwrap();
+    host.publish().unwrap();
+    let cctx = Context::new(&domain, Role::Client, "half-client").unwrap();
+    let mut client =
+        ActArrayClient::connect_timeout(&cctx, DEVICE, Duration::from_secs(10)).unwrap();
+    host.publish().unwrap();
+    client.wait_state(Duration::from_secs(10)).unwrap();
+    println!("READY");
+    let mut line = String::new();
+    let _ = std::io::stdin().read_line(&mut line);
+}
+
+#[test]
+fn a_segment_left_half_made_does_not_hang_the_cleanup() {
+    use std::io::{BufRead, BufReader};
+    let domain = Domain::unique_for_test();
+    let prefix = domain.prefix().unwrap().to_string();
+    let mut child = std::process::Command::new(std::env::current_exe().unwrap())
+        .args(["--exact", "half_made_child", "--nocapture"])
+        .env(CHILD_ENV, domain.name())
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut line = String::new();
+    loop {
+        line.clear();
+        assert!(
+            out.read_line(&mut line).unwrap() > 0,
+            "the child ended early"
+        );
+        if line.starts_with("READY") {
+            break;
+        }
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    // What a kill between iceoryx2's create and its sizing leaves: each connection of the
+    // dead process empty and write-only.
+    let mut half_made = 0;
+    for e in std::fs::read_dir("/dev/shm").unwrap().flatten() {
+        let name = e.file_name().to_string_lossy().to_string();
+        if name.starts_with(&prefix) && name.ends_with(".connection") {
+            let f = std::fs::OpenOptions::new()
+                .write(true)
+                .open(e.path())
+                .unwrap();
+            f.set_len(0).unwrap();
+            f.set_permissions(std::fs::Permissions::from_mode(0o200))
+                .unwrap();
+            half_made += 1;
+        }
+    }
+    assert!(half_made > 0, "the child left no connection to spoil");
+
+    // Old code, as root: the cleanup never returns.
+    let (tx, rx) = mpsc::channel();
+    let cleaner = domain.clone();
+    std::thread::spawn(move || {
+        let _ = tx.send(cleaner.remove_files().map_err(|e| e.to_string()));
+    });
+    let removed = rx
+        .recv_timeout(Duration::from_secs(60))
+        .expect("the domain's cleanup hung on a half-made segment")
+        .unwrap();
+    assert!(removed.files >= half_made, "{removed:?}");
+    let left: Vec<String> = std::fs::read_dir("/dev/shm")
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().to_string())
+        .filter(|n| n.starts_with(&prefix))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+}
