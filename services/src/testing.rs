@@ -496,3 +496,44 @@ impl TestDriver {
         })
     }
 }
+
+/// A test of this test binary run as a process of its own (a test that does nothing unless
+/// its variable is set), waited for until it said it is ready.
+#[derive(Debug)]
+pub struct TestProcess {
+    /// The process (its stdin piped: closing it, or a line, tells it to go on).
+    pub child: std::process::Child,
+    /// Its stdout, after the ready line.
+    pub out: std::io::BufReader<std::process::ChildStdout>,
+}
+
+impl TestProcess {
+    /// Runs the test `name` of this binary with `var` = `value` in its environment, and
+    /// reads its stdout until a line starting with `ready`. Panics if it cannot start or
+    /// ends before that line.
+    pub fn start(name: &str, var: &str, value: &str, ready: &str) -> TestProcess {
+        use std::io::BufRead;
+        let mut child = std::process::Command::new(std::env::current_exe().expect("this test"))
+            .args(["--exact", name, "--nocapture"])
+            .env(var, value)
+            .stdin(std::process::Stdio::piped())
+            .stdout(std::process::Stdio::piped())
+            .spawn()
+            .expect("the test process starts");
+        let mut out = std::io::BufReader::new(child.stdout.take().expect("its stdout"));
+        let mut line = String::new();
+        loop {
+            line.clear();
+            match out.read_line(&mut line) {
+                Ok(n) if n > 0 && line.starts_with(ready) => return TestProcess { child, out },
+                Ok(n) if n > 0 => {}
+                ended => {
+                    if let Err(e) = child.kill().and_then(|()| child.wait().map(drop)) {
+                        tracing::warn!(error = %e, "cannot end test process {name}");
+                    }
+                    panic!("test process {name} ended before saying {ready:?}: {ended:?}");
+                }
+            }
+        }
+    }
+}

@@ -39,28 +39,15 @@ fn half_made_child() {
 
 #[test]
 fn a_segment_left_half_made_does_not_hang_the_cleanup() {
-    use std::io::{BufRead, BufReader};
     let domain = Domain::unique_for_test();
     let prefix = domain.prefix().unwrap().to_string();
-    let mut child = std::process::Command::new(std::env::current_exe().unwrap())
-        .args(["--exact", "half_made_child", "--nocapture"])
-        .env(CHILD_ENV, domain.name())
-        .stdin(std::process::Stdio::piped())
-        .stdout(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut out = BufReader::new(child.stdout.take().unwrap());
-    let mut line = String::new();
-    loop {
-        line.clear();
-        assert!(
-            out.read_line(&mut line).unwrap() > 0,
-            "the child ended early"
-        );
-        if line.starts_with("READY") {
-            break;
-        }
-    }
+    let mut child = limber_services::testing::TestProcess::start(
+        "half_made_child",
+        CHILD_ENV,
+        domain.name(),
+        "READY",
+    )
+    .child;
     child.kill().unwrap();
     child.wait().unwrap();
     // What a kill between iceoryx2's create and its sizing leaves: each connection of the
@@ -99,4 +86,81 @@ fn a_segment_left_half_made_does_not_hang_the_cleanup() {
         .filter(|n| n.starts_with(&prefix))
         .collect();
     assert!(left.is_empty(), "{left:?}");
+}
+
+/// Run by `a_driver_does_not_hang_on_what_a_killed_client_left_half_made` as a process of
+/// its own (a no-op otherwise): a client of the parent's device, then waits to be killed.
+#[test]
+fn half_made_client() {
+    let Ok(name) = std::env::var(CLIENT_ENV) else {
+        return;
+    };
+    let domain = Domain::new(&name).unwrap();
+    let cctx = Context::new(&domain, Role::Client, "half-client").unwrap();
+    let mut client =
+        ActArrayClient::connect_timeout(&cctx, DEVICE, Duration::from_secs(10)).unwrap();
+    println!("CONNECTED");
+    client.wait_state(Duration::from_secs(10)).unwrap();
+    println!("READY");
+    let mut line = String::new();
+    let _ = std::io::stdin().read_line(&mut line);
+}
+
+const CLIENT_ENV: &str = "LIMBER_TEST_HALF_MADE_CLIENT";
+
+/// A live driver cleans up after its dead clients (its 1 Hz housekeeping): a client killed
+/// while iceoryx2 made one of its connections does not hang the driver's loop. While such a
+/// file is young (its maker may be making it still) the driver leaves the cleanup for a
+/// later tick; once it is old, the driver removes it and cleans up.
+#[test]
+fn a_driver_does_not_hang_on_what_a_killed_client_left_half_made() {
+    let domain = Domain::unique_for_test();
+    let prefix = domain.prefix().unwrap().to_string();
+    let ctx = Context::new(&domain, Role::Driver, "half-driver").unwrap();
+    let mut host = DeviceHost::<ActArray>::new(&ctx, &DEVICE.parse().unwrap(), "t").unwrap();
+    host.publish().unwrap();
+    let limber_services::testing::TestProcess {
+        child: mut client,
+        mut out,
+    } = limber_services::testing::TestProcess::start(
+        "half_made_client",
+        CLIENT_ENV,
+        domain.name(),
+        "CONNECTED",
+    );
+    // A state for the client: the driver connects to it as it publishes.
+    host.publish().unwrap();
+    let mut line = String::new();
+    std::io::BufRead::read_line(&mut out, &mut line).unwrap();
+    assert!(line.starts_with("READY"), "the client said {line:?}");
+    client.kill().unwrap();
+    client.wait().unwrap();
+    // Each connection file made anew, empty and write-only (the driver keeps its mapping
+    // of the old one): what a kill between iceoryx2's create and its sizing leaves.
+    let mut spoiled = Vec::new();
+    for e in std::fs::read_dir("/dev/shm").unwrap().flatten() {
+        let name = e.file_name().to_string_lossy().to_string();
+        if name.starts_with(&prefix) && name.ends_with(".connection") {
+            std::fs::remove_file(e.path()).unwrap();
+            let f = std::fs::File::create(e.path()).unwrap();
+            f.set_permissions(std::fs::Permissions::from_mode(0o200))
+                .unwrap();
+            spoiled.push((e.path(), f));
+        }
+    }
+    assert!(
+        !spoiled.is_empty(),
+        "the client left no connection to spoil"
+    );
+    // Young: left alone, the cleanup put off (old code, as root: never returns).
+    host.cleanup_dead();
+    assert!(spoiled.iter().all(|(p, _)| p.exists()));
+    // Old: removed, and the cleanup goes on.
+    for (_, f) in &spoiled {
+        f.set_modified(std::time::SystemTime::now() - Duration::from_secs(60))
+            .unwrap();
+    }
+    host.cleanup_dead();
+    assert!(spoiled.iter().all(|(p, _)| !p.exists()));
+    host.publish().unwrap();
 }

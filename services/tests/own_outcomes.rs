@@ -172,34 +172,21 @@ fn stream_forger_process() {
 /// not take the victim's stream from it.
 #[test]
 fn a_stream_asked_for_with_another_processs_client_id_gets_nothing() {
-    use std::io::{BufRead, BufReader, Write};
+    use std::io::{BufRead, Write};
     let domain = Domain::unique_for_test();
     let (_dctx, mut host) = host(&domain);
     let mut arm = TestArm::new(2);
     let vctx = Context::new(&domain, Role::Client, "victim").unwrap();
     let mut victim = ActArrayClient::connect_timeout(&vctx, DEVICE, T).unwrap();
-    let mut child = std::process::Command::new(std::env::current_exe().unwrap())
-        .args(["--exact", "stream_forger_process", "--nocapture"])
-        .env(
-            FORGE_ENV,
-            format!("{} {}", domain.name(), victim.client_id()),
-        )
-        .stdin(std::process::Stdio::piped())
-        .stdout(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let limber_services::testing::TestProcess {
+        mut child, mut out, ..
+    } = limber_services::testing::TestProcess::start(
+        "stream_forger_process",
+        FORGE_ENV,
+        &format!("{} {}", domain.name(), victim.client_id()),
+        "ASKED",
+    );
     let mut line = String::new();
-    loop {
-        line.clear();
-        assert!(
-            out.read_line(&mut line).unwrap() > 0,
-            "the forger ended early"
-        );
-        if line.starts_with("ASKED") {
-            break;
-        }
-    }
     // The driver meets the forged request (after the victim's own) when it sends the
     // victim's outcome.
     let ticket = victim.move_to(0, 0.4).unwrap();

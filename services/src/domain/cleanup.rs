@@ -101,7 +101,7 @@ pub fn remove(domain: &Domain) -> Result<Removed, RemoveError> {
         source,
     })?;
     // Before iceoryx2 opens anything of the dead: the segments they left half made.
-    let half_made = remove_half_made(&files.prefix, processes.is_empty());
+    let (half_made, _) = remove_half_made(&files.prefix, processes.is_empty());
     let mut dead_processes = 0;
     for v in dead {
         match v.blocking_remove_stale_resources(Duration::ZERO) {
@@ -159,9 +159,10 @@ const HALF_MADE_AGE: Duration = Duration::from_secs(10);
 /// (iceoryx2-cal 0.10 `posix_shared_memory::open_impl`; another user is refused the open
 /// and gives up). `all`: no process of the domain is alive, so every such file is left
 /// over; else only those older than [`HALF_MADE_AGE`] (one being made now is not touched).
-fn remove_half_made(prefix: &str, all: bool) -> usize {
+/// Returns how many it removed and how many younger ones it left.
+fn remove_half_made(prefix: &str, all: bool) -> (usize, usize) {
     let me = dir::euid();
-    let mut n = 0;
+    let (mut n, mut young) = (0, 0);
     for e in dir::entries(std::path::Path::new(dir::SHM_DIR)) {
         if !e.file_name().to_string_lossy().starts_with(prefix) {
             continue;
@@ -178,6 +179,7 @@ fn remove_half_made(prefix: &str, all: bool) -> usize {
             continue;
         }
         if !all && !old {
+            young += 1;
             continue;
         }
         match fs::remove_file(e.path()) {
@@ -191,7 +193,19 @@ fn remove_half_made(prefix: &str, all: bool) -> usize {
             }
         }
     }
-    n
+    (n, young)
+}
+
+/// Before a live process cleans up after the dead of `domain` through iceoryx2: removes the
+/// segments a killed process left half made ([`remove_half_made`], those older than
+/// [`HALF_MADE_AGE`]) and says whether the cleanup may go on, false while a younger one is
+/// there (iceoryx2 would wait on it for ever, as root, if its maker is dead: the cleanup
+/// waits for a later call instead, by when it is made or old enough to remove).
+pub(crate) fn half_made_cleared(domain: &Domain) -> bool {
+    let Ok(prefix) = domain.prefix() else {
+        return true;
+    };
+    remove_half_made(prefix, false).1 == 0
 }
 
 /// `NODE (pid N)` for a live node (`a process` when its details cannot be read).

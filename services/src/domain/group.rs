@@ -390,21 +390,26 @@ where
     P: iceoryx2::service::port_factory::PortFactory<Service = iceoryx2::prelude::ipc::Service>,
 {
     use iceoryx2::prelude::{CallbackProgression, NodeState};
-    if !matches!(domain.group(), Ok(Some(_))) {
-        svc.try_cleanup_dead_nodes();
-        return;
-    }
-    let Ok(root) = domain.root() else { return };
+    let group = matches!(domain.group(), Ok(Some(_)));
+    let root = domain.root().ok();
     let mut dead = Vec::new();
     if let Err(e) = svc.nodes(|n| {
         if let NodeState::Dead(v) = n
-            && node_is_mine(root, v.id().value())
+            && (!group || root.is_some_and(|r| node_is_mine(r, v.id().value())))
         {
             dead.push(v);
         }
         CallbackProgression::Continue
     }) {
         tracing::warn!(error = %e, "cannot list the nodes of a service");
+    }
+    // Nobody dead, nothing to do; else not before iceoryx2 can open what they left.
+    if dead.is_empty() || !super::cleanup::half_made_cleared(domain) {
+        return;
+    }
+    if !group {
+        svc.try_cleanup_dead_nodes();
+        return;
     }
     for v in dead {
         if let Err(e) = v.blocking_remove_stale_resources(std::time::Duration::ZERO) {
