@@ -164,3 +164,58 @@ fn a_driver_does_not_hang_on_what_a_killed_client_left_half_made() {
     assert!(spoiled.iter().all(|(p, _)| !p.exists()));
     host.publish().unwrap();
 }
+
+/// A process joining the domain cleans up after its dead processes (iceoryx2 did that on
+/// every node's creation, and, as root, never returned on a segment a killed process left
+/// half made: a client or driver started after such a kill hung in `Context::new`). The
+/// join now puts the cleanup off while such a file is young, and removes it once old.
+#[test]
+fn a_process_joining_does_not_hang_on_what_a_killed_one_left_half_made() {
+    let domain = Domain::unique_for_test();
+    let prefix = domain.prefix().unwrap().to_string();
+    let mut child = limber_services::testing::TestProcess::start(
+        "half_made_child",
+        CHILD_ENV,
+        domain.name(),
+        "READY",
+    )
+    .child;
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let mut spoiled = Vec::new();
+    for e in std::fs::read_dir("/dev/shm").unwrap().flatten() {
+        let name = e.file_name().to_string_lossy().to_string();
+        if name.starts_with(&prefix) && name.ends_with(".connection") {
+            let f = std::fs::OpenOptions::new()
+                .write(true)
+                .open(e.path())
+                .unwrap();
+            f.set_len(0).unwrap();
+            f.set_permissions(std::fs::Permissions::from_mode(0o200))
+                .unwrap();
+            spoiled.push((e.path(), f));
+        }
+    }
+    assert!(!spoiled.is_empty(), "the child left no connection to spoil");
+    let join = |name: &'static str| {
+        let (tx, rx) = mpsc::channel();
+        let d = domain.clone();
+        std::thread::spawn(move || {
+            let r = Context::new(&d, Role::Client, name).map(|_| ());
+            let _ = tx.send(r.map_err(|e| e.to_string()));
+        });
+        rx.recv_timeout(Duration::from_secs(60))
+            .unwrap_or_else(|_| panic!("{name} hung joining the domain"))
+            .unwrap();
+    };
+    // Young: left alone, the cleanup put off (old code, as root: never returns).
+    join("late-client");
+    assert!(spoiled.iter().all(|(p, _)| p.exists()));
+    // Old: removed, and the cleanup goes on.
+    for (_, f) in &spoiled {
+        f.set_modified(std::time::SystemTime::now() - Duration::from_secs(60))
+            .unwrap();
+    }
+    join("later-client");
+    assert!(spoiled.iter().all(|(p, _)| !p.exists()));
+}

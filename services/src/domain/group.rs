@@ -383,8 +383,9 @@ pub(crate) fn node_is_mine(root: &Path, id: u128) -> bool {
 /// of this user's processes: `/dev/shm` is sticky, so a member cleaning up another member's
 /// dead process removes its registrations but not its files, and leaves its services marked
 /// for destruction with files nobody but their owner (or root) can remove, which no driver
-/// can offer again. So iceoryx2's own cleanup of dead nodes is off in group mode
-/// ([`super::Domain::config`]) and each member's processes clean up after its own.
+/// can offer again. So each member's processes clean up after their own (iceoryx2's own
+/// cleanup of dead nodes is off in every domain: [`super::Domain::config`]). Put off while
+/// a segment a dead process left half made is young ([`super::cleanup::half_made_cleared`]).
 pub(crate) fn cleanup_dead_nodes<P>(svc: &P, domain: &super::Domain)
 where
     P: iceoryx2::service::port_factory::PortFactory<Service = iceoryx2::prelude::ipc::Service>,
@@ -418,14 +419,19 @@ where
     }
 }
 
-/// Removes the resources of this user's dead processes in the domain (group mode: what
-/// iceoryx2 does for every dead process when a node is created, see [`cleanup_dead_nodes`]).
-pub(crate) fn cleanup_own_dead_nodes(config: &iceoryx2::config::Config, root: &Path) {
+/// Removes the resources of the dead processes in the domain, only this user's if
+/// `only_mine` (group mode, see [`cleanup_dead_nodes`]): what iceoryx2 would do when a node
+/// is created, with its own cleanup off ([`super::Domain::after_join`] says when).
+pub(crate) fn cleanup_domain_dead_nodes(
+    config: &iceoryx2::config::Config,
+    root: &Path,
+    only_mine: bool,
+) {
     use iceoryx2::prelude::{CallbackProgression, Node, NodeState, ipc};
     let mut dead = Vec::new();
     if let Err(e) = Node::<ipc::Service>::list(config, |n| {
         if let NodeState::Dead(v) = n
-            && node_is_mine(root, v.id().value())
+            && (!only_mine || node_is_mine(root, v.id().value()))
         {
             dead.push(v);
         }
@@ -435,7 +441,7 @@ pub(crate) fn cleanup_own_dead_nodes(config: &iceoryx2::config::Config, root: &P
     }
     for v in dead {
         if let Err(e) = v.blocking_remove_stale_resources(std::time::Duration::ZERO) {
-            tracing::debug!(error = ?e, "cannot clean up after a dead process of ours");
+            tracing::debug!(error = ?e, "cannot clean up after a dead process");
         }
     }
 }

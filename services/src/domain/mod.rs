@@ -178,12 +178,16 @@ impl Domain {
         config.global.set_root_path(
             &IoxPath::new(root.as_bytes()).map_err(|_| bad("an invalid iceoryx2 root path"))?,
         );
-        if files.group.is_some() {
-            // Each member cleans up after its own dead processes only (group::cleanup_dead_nodes).
-            config.global.node.cleanup_dead_nodes_on_creation = false;
-            config.global.node.cleanup_dead_nodes_on_destruction = false;
-            config.global.service.cleanup_dead_nodes_on_open = false;
-        }
+        // iceoryx2's own cleanup after dead processes is off: it runs where limber does
+        // not look first (a node's creation and drop, a service's opening) and, as root,
+        // never returns on a segment a killed process left half made
+        // ([`cleanup::half_made_cleared`]); in group mode each member may clean up after
+        // its own dead processes only. limber cleans up itself, with both guards:
+        // [`Self::after_join`] after the domain's dead processes, [`group::cleanup_dead_nodes`]
+        // after those of a service it opens, and the driver's housekeeping.
+        config.global.node.cleanup_dead_nodes_on_creation = false;
+        config.global.node.cleanup_dead_nodes_on_destruction = false;
+        config.global.service.cleanup_dead_nodes_on_open = false;
         Ok(self.config.get_or_init(|| Resolved {
             config,
             prefix: files.prefix,
@@ -207,13 +211,18 @@ impl Domain {
     }
 
     /// Secures the domain after this process's node was made: the node counter iceoryx2
-    /// makes world-writable is narrowed ([`dir::secure_shm`]); in group mode this user's dead
-    /// processes are cleaned up after, and the files of their ports that are gone removed.
+    /// makes world-writable is narrowed ([`dir::secure_shm`]); the domain's dead processes
+    /// (in group mode, this user's) are cleaned up after, unless a segment one of them left
+    /// half made is too young to remove ([`cleanup::half_made_cleared`]: the next process
+    /// to join, or a driver's housekeeping, does it then); in group mode the files of this
+    /// user's ports that are gone are removed.
     pub(crate) fn after_join(&self) -> Result<(), DomainError> {
         let r = self.resolved()?;
         dir::secure_shm(&r.prefix, r.group.as_ref())?;
+        if cleanup::half_made_cleared(self) {
+            group::cleanup_domain_dead_nodes(&r.config, &r.root, r.group.is_some());
+        }
         if r.group.is_some() {
-            group::cleanup_own_dead_nodes(&r.config, &r.root);
             group::remove_orphans(&r.prefix, &r.root);
         }
         Ok(())
