@@ -448,16 +448,10 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
     }
 }
 
-/// Puts outcome `o` for the commands of `origin`. Not `express`: with Zenoh's default
-/// congestion control for puts (drop after 1 ms without a free batch), express puts, each a
-/// batch of its own, lost outcomes under load (`limber bench --only bridge`, 2-core VM,
-/// back-to-back commands: 3 runs of 7 lost one, none of 9 without express).
+/// Puts outcome `o` for the commands of `origin` ([`session::put_control`]).
 fn put_outcome(session: &Session, device: &DeviceName, origin: &str, o: &OutcomeMsg) {
     let key = keys::outcome_key(device, origin);
-    if let Err(e) = session
-        .put(&key, o.as_bytes().to_vec())
-        .encoding(keys::encoding(keys::outcome_type()))
-        .wait()
+    if let Err(e) = session::put_control(session, &key, o.as_bytes().to_vec(), keys::outcome_type())
     {
         tracing::warn!(device = %device, error = %e, "cannot publish an outcome");
     }

@@ -328,11 +328,7 @@ impl<I: Interface> MirroredDevice for Mirrored<I> {
         }
         let mut asked = !commands.is_empty();
         for c in commands {
-            if let Err(e) = session
-                .put(&self.cmd_key, c)
-                .encoding(keys::encoding(self.names.cmd))
-                .wait()
-            {
+            if let Err(e) = session::put_control(session, &self.cmd_key, c, self.names.cmd) {
                 tracing::warn!(device = %self.local, error = %e, "cannot relay a command");
             }
         }
