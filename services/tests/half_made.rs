@@ -37,9 +37,10 @@ fn half_made_child() {
     let _ = std::io::stdin().read_line(&mut line);
 }
 
-#[test]
-fn a_segment_left_half_made_does_not_hang_the_cleanup() {
-    let domain = Domain::unique_for_test();
+/// Starts `half_made_child` in `domain`, kills it once ready, and spoils each of its
+/// connections as a kill between iceoryx2's create and its sizing leaves them: empty and
+/// write-only. Returns each spoiled file with its path (at least one).
+fn killed_leaving_half_made(domain: &Domain) -> Vec<(std::path::PathBuf, std::fs::File)> {
     let prefix = domain.prefix().unwrap().to_string();
     let mut child = limber_services::testing::TestProcess::start(
         "half_made_child",
@@ -50,9 +51,7 @@ fn a_segment_left_half_made_does_not_hang_the_cleanup() {
     .child;
     child.kill().unwrap();
     child.wait().unwrap();
-    // What a kill between iceoryx2's create and its sizing leaves: each connection of the
-    // dead process empty and write-only.
-    let mut half_made = 0;
+    let mut spoiled = Vec::new();
     for e in std::fs::read_dir("/dev/shm").unwrap().flatten() {
         let name = e.file_name().to_string_lossy().to_string();
         if name.starts_with(&prefix) && name.ends_with(".connection") {
@@ -63,10 +62,18 @@ fn a_segment_left_half_made_does_not_hang_the_cleanup() {
             f.set_len(0).unwrap();
             f.set_permissions(std::fs::Permissions::from_mode(0o200))
                 .unwrap();
-            half_made += 1;
+            spoiled.push((e.path(), f));
         }
     }
-    assert!(half_made > 0, "the child left no connection to spoil");
+    assert!(!spoiled.is_empty(), "the child left no connection to spoil");
+    spoiled
+}
+
+#[test]
+fn a_segment_left_half_made_does_not_hang_the_cleanup() {
+    let domain = Domain::unique_for_test();
+    let prefix = domain.prefix().unwrap().to_string();
+    let half_made = killed_leaving_half_made(&domain).len();
 
     // Old code, as root: the cleanup never returns.
     let (tx, rx) = mpsc::channel();
@@ -172,31 +179,7 @@ fn a_driver_does_not_hang_on_what_a_killed_client_left_half_made() {
 #[test]
 fn a_process_joining_does_not_hang_on_what_a_killed_one_left_half_made() {
     let domain = Domain::unique_for_test();
-    let prefix = domain.prefix().unwrap().to_string();
-    let mut child = limber_services::testing::TestProcess::start(
-        "half_made_child",
-        CHILD_ENV,
-        domain.name(),
-        "READY",
-    )
-    .child;
-    child.kill().unwrap();
-    child.wait().unwrap();
-    let mut spoiled = Vec::new();
-    for e in std::fs::read_dir("/dev/shm").unwrap().flatten() {
-        let name = e.file_name().to_string_lossy().to_string();
-        if name.starts_with(&prefix) && name.ends_with(".connection") {
-            let f = std::fs::OpenOptions::new()
-                .write(true)
-                .open(e.path())
-                .unwrap();
-            f.set_len(0).unwrap();
-            f.set_permissions(std::fs::Permissions::from_mode(0o200))
-                .unwrap();
-            spoiled.push((e.path(), f));
-        }
-    }
-    assert!(!spoiled.is_empty(), "the child left no connection to spoil");
+    let spoiled = killed_leaving_half_made(&domain);
     let join = |name: &'static str| {
         let (tx, rx) = mpsc::channel();
         let d = domain.clone();

@@ -31,9 +31,8 @@ fn session(endpoint: &str) -> zenoh::Session {
     zenoh::open(config).wait().unwrap()
 }
 
-#[test]
-fn a_flood_of_malformed_messages_is_counted_not_logged_one_by_one() {
-    let a = Domain::unique_for_test();
+/// The private socket of `bridge expose` in `a`, and `limber pioneer --emulated` there, ready.
+fn driver_in(a: &Domain) -> (String, Proc) {
     let endpoint = format!(
         "unixsock-stream/{}/bridge/{}.sock",
         a.runtime_dir().expect("the runtime directory").display(),
@@ -41,6 +40,13 @@ fn a_flood_of_malformed_messages_is_counted_not_logged_one_by_one() {
     );
     let mut driver = Proc::spawn(CLI, a.name(), &["pioneer", "--emulated"]);
     assert!(driver.read_until(|l| l.ends_with("ready")).is_some());
+    (endpoint, driver)
+}
+
+#[test]
+fn a_flood_of_malformed_messages_is_counted_not_logged_one_by_one() {
+    let a = Domain::unique_for_test();
+    let (endpoint, mut driver) = driver_in(&a);
     let log = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
         .join(format!("bridge-malformed-{}.log", std::process::id()));
     let mut c = Command::new("sh");
@@ -85,10 +91,10 @@ fn a_flood_of_malformed_messages_is_counted_not_logged_one_by_one() {
         "a malformed request was answered ok"
     );
     s.close().wait().unwrap();
-    expose.signal(libc::SIGTERM);
-    assert_eq!(expose.wait_timeout(Duration::from_secs(10)), Some(0));
-    driver.signal(libc::SIGTERM);
-    assert_eq!(driver.wait_timeout(Duration::from_secs(10)), Some(0));
+    for p in [&mut expose, &mut driver] {
+        p.signal(libc::SIGTERM);
+        assert_eq!(p.wait_timeout(Duration::from_secs(10)), Some(0));
+    }
     let text = std::fs::read_to_string(&log).unwrap();
     std::fs::remove_file(&log).unwrap();
     let lines: Vec<&str> = text
@@ -117,13 +123,7 @@ fn a_flood_of_malformed_messages_is_counted_not_logged_one_by_one() {
 #[test]
 fn an_outcome_comes_back_express_ahead_of_the_states() {
     let a = Domain::unique_for_test();
-    let endpoint = format!(
-        "unixsock-stream/{}/bridge/{}.sock",
-        a.runtime_dir().expect("the runtime directory").display(),
-        a.name()
-    );
-    let mut driver = Proc::spawn(CLI, a.name(), &["pioneer", "--emulated"]);
-    assert!(driver.read_until(|l| l.ends_with("ready")).is_some());
+    let (endpoint, mut driver) = driver_in(&a);
     let mut expose = Proc::spawn(CLI, a.name(), &["bridge", "expose"]);
     assert!(
         expose
@@ -160,8 +160,8 @@ fn an_outcome_comes_back_express_ahead_of_the_states() {
     assert!(sample.express(), "the outcome was batched");
     assert_eq!(sample.priority(), Priority::InteractiveHigh);
     s.close().wait().unwrap();
-    expose.signal(libc::SIGTERM);
-    assert_eq!(expose.wait_timeout(Duration::from_secs(10)), Some(0));
-    driver.signal(libc::SIGTERM);
-    assert_eq!(driver.wait_timeout(Duration::from_secs(10)), Some(0));
+    for p in [&mut expose, &mut driver] {
+        p.signal(libc::SIGTERM);
+        assert_eq!(p.wait_timeout(Duration::from_secs(10)), Some(0));
+    }
 }
