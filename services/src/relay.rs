@@ -69,7 +69,7 @@ impl<I: Interface> DeviceHost<I> {
         &mut self,
         mut each: impl FnMut(&I::CmdMsg),
     ) -> Result<usize, ProcessError> {
-        self.take_commands_fairly(|_, sample| {
+        self.take_commands_fairly(|_, sample, _| {
             each(&sample);
             Ok(true)
         })

@@ -24,11 +24,14 @@ impl<I: Interface> DeviceHost<I> {
         &mut self,
         handler: &mut H,
     ) -> Result<usize, ProcessError> {
-        self.take_commands_fairly(|host, sample| host.process_command(handler, sample))
+        self.take_commands_fairly(|host, sample, received_ns| {
+            host.process_command(handler, sample, received_ns)
+        })
     }
 
     /// The rounds of [`DeviceHost::process_commands`] (and of the relay's): `each` handles
-    /// one command and says whether it counts; returns how many counted.
+    /// one command, given when `receive` returned it, and says whether it counts; returns
+    /// how many counted.
     ///
     /// Why rounds: the transport hands out the samples of its first connection that has
     /// data, so draining sample by sample served a flooding client before every client
@@ -37,7 +40,7 @@ impl<I: Interface> DeviceHost<I> {
     /// a round holds its samples until it has taken one of every client.
     pub(crate) fn take_commands_fairly(
         &mut self,
-        mut each: impl FnMut(&mut Self, CmdSample<I>) -> Result<bool, ProcessError>,
+        mut each: impl FnMut(&mut Self, CmdSample<I>, u64) -> Result<bool, ProcessError>,
     ) -> Result<usize, ProcessError> {
         // The round's storage, allocated once for every client's CMD_BORROWED.
         let mut round = core::mem::take(&mut self.cmd_round);
@@ -48,7 +51,7 @@ impl<I: Interface> DeviceHost<I> {
             }
             while round.len() < round.capacity() && taken + round.len() < qos::CMD_BUFFER {
                 match self.commands.receive() {
-                    Ok(Some(s)) => round.push(s),
+                    Ok(Some(s)) => round.push((s, monotonic_ns())),
                     Ok(None) | Err(ReceiveError::ExceedsMaxBorrows) => break,
                     Err(e) => {
                         round.clear();
@@ -62,8 +65,8 @@ impl<I: Interface> DeviceHost<I> {
             }
             taken += round.len();
             let mut failed = None;
-            for sample in round.drain(..) {
-                match each(self, sample) {
+            for (sample, received_ns) in round.drain(..) {
+                match each(self, sample, received_ns) {
                     Ok(true) => n += 1,
                     Ok(false) => {}
                     Err(e) => {
@@ -81,11 +84,13 @@ impl<I: Interface> DeviceHost<I> {
         result
     }
 
-    /// Handles one command sample; `false` if it was dropped uncounted (a forged client id).
+    /// Handles one command sample, taken from the channel at `received_ns`; `false` if it
+    /// was dropped uncounted (a forged client id).
     fn process_command<H: DeviceHandler<I>>(
         &mut self,
         handler: &mut H,
         sample: CmdSample<I>,
+        received_ns: u64,
     ) -> Result<bool, ProcessError> {
         let raw: &I::CmdMsg = &sample;
         let meta = *raw.meta();
@@ -105,7 +110,7 @@ impl<I: Interface> DeviceHost<I> {
             client_id: meta.client_id,
             seq: meta.seq,
             sent_ns: meta.stamp_ns,
-            received_ns: monotonic_ns(),
+            received_ns,
         };
         let cmd = CmdRef {
             client_id: meta.client_id,

@@ -89,9 +89,10 @@ pub struct DeviceHost<I: Interface> {
     /// ([`crate::wake`]); None if it could not be made.
     state_wake: Option<crate::wake::WakeWord>,
     commands: Subscriber<ipc::Service, I::CmdMsg, ()>,
-    /// One round of commands taken fairly (see `commands.rs`): allocated once, for every
+    /// One round of commands taken fairly (see `commands.rs`), each with when it was taken
+    /// (`CLOCK_MONOTONIC` ns, its [`Origin::received_ns`]): allocated once, for every
     /// client's [`qos::CMD_BORROWED`].
-    cmd_round: Vec<CmdSample<I>>,
+    cmd_round: Vec<(CmdSample<I>, u64)>,
     /// The `cmd` service, whose registry says which node each command's publisher is.
     cmd_svc: iceoryx2::service::port_factory::publish_subscribe::PortFactory<
         ipc::Service,
