@@ -102,8 +102,11 @@ def main():
         msg.meta.stamp_ns = time.monotonic_ns()
         msg.meta.kind = L.ACTARRAY_CMD_POS
         msg.meta.body_len = ctypes.sizeof(body)
+        # As the bridges put commands and outcomes: express (never batched behind another
+        # message) at the priority of their own queue, ahead of the states.
         session.put(key(a.device, f"cmd/{origin}"), bytes(msg),
-                    encoding=zenoh.Encoding("application/octet-stream;" + msg.type_name()))
+                    encoding=zenoh.Encoding("application/octet-stream;" + msg.type_name()),
+                    express=True, priority=zenoh.Priority.INTERACTIVE_HIGH)
 
         deadline = time.monotonic() + a.timeout
         while True:
