@@ -161,25 +161,50 @@ const HALF_MADE_AGE: Duration = Duration::from_secs(10);
 /// over; else only those older than [`HALF_MADE_AGE`] (one being made now is not touched).
 /// Returns how many it removed and how many younger ones it left.
 fn remove_half_made(prefix: &str, all: bool) -> (usize, usize) {
-    let me = dir::euid();
-    let (mut n, mut young) = (0, 0);
-    for e in dir::entries(std::path::Path::new(dir::SHM_DIR)) {
-        if !e.file_name().to_string_lossy().starts_with(prefix) {
-            continue;
-        }
-        let Ok(md) = fs::symlink_metadata(e.path()) else {
-            continue;
-        };
+    let mut young = 0;
+    let n = sweep_half_made(prefix, |_, md| {
         let old = md
             .modified()
             .ok()
             .and_then(|t| t.elapsed().ok())
             .is_some_and(|age| age >= HALF_MADE_AGE);
+        if !all && !old {
+            young += 1;
+        }
+        all || old
+    });
+    (n, young)
+}
+
+/// Removes the domain's segments (names starting with `prefix`) that are half made
+/// (as [`remove_half_made`] sees them, whatever their age) and name a port for which
+/// `gone` says its process is gone: nobody will finish them, and iceoryx2, as root, would
+/// wait on one for ever when a live port connects to that port. Returns how many.
+pub(crate) fn remove_half_made_of(prefix: &str, gone: impl Fn(u128) -> bool) -> usize {
+    sweep_half_made(prefix, |name, _| {
+        super::group::port_ids(prefix, name)
+            .is_some_and(|ids| ids.iter().any(|i| i.parse::<u128>().is_ok_and(&gone)))
+    })
+}
+
+/// The one test of a half-made segment of the domain (names starting with `prefix`): a
+/// file of this user in `/dev/shm`, empty, that nobody may read (see [`remove_half_made`]).
+/// Removes each one for which `remove(name, metadata)` says so; returns how many it removed.
+fn sweep_half_made(prefix: &str, mut remove: impl FnMut(&str, &fs::Metadata) -> bool) -> usize {
+    let me = dir::euid();
+    let mut n = 0;
+    for e in dir::entries(std::path::Path::new(dir::SHM_DIR)) {
+        let name = e.file_name().to_string_lossy().to_string();
+        if !name.starts_with(prefix) {
+            continue;
+        }
+        let Ok(md) = fs::symlink_metadata(e.path()) else {
+            continue;
+        };
         if !md.is_file() || md.uid() != me || md.len() != 0 || md.mode() & 0o444 != 0 {
             continue;
         }
-        if !all && !old {
-            young += 1;
+        if !remove(&name, &md) {
             continue;
         }
         match fs::remove_file(e.path()) {
@@ -193,7 +218,7 @@ fn remove_half_made(prefix: &str, all: bool) -> (usize, usize) {
             }
         }
     }
-    (n, young)
+    n
 }
 
 /// Before a live process cleans up after the dead of `domain` through iceoryx2: removes the

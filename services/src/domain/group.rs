@@ -310,7 +310,7 @@ fn tagged_ports(prefix: &str, root: &Path) -> Option<HashSet<String>> {
 
 /// The port ids in the name of a segment, connection or event of the domain
 /// (`<prefix><hash>_<id>[_<id>].<data|connection|event_mgmt>`), or None for other files.
-fn port_ids<'a>(prefix: &str, name: &'a str) -> Option<Vec<&'a str>> {
+pub(crate) fn port_ids<'a>(prefix: &str, name: &'a str) -> Option<Vec<&'a str>> {
     let rest = name.strip_prefix(prefix)?;
     let (stem, suffix) = rest.rsplit_once('.')?;
     if !matches!(suffix, "data" | "connection" | "event_mgmt") {

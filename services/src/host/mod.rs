@@ -36,6 +36,7 @@ pub mod handler;
 mod lease;
 mod motions;
 mod open;
+mod peers;
 mod requests;
 mod senders;
 pub mod stats;
@@ -111,6 +112,9 @@ pub struct DeviceHost<I: Interface> {
     cmd_senders: senders::PortNodes,
     /// Commands dropped because their client id named another process than their sender.
     forged: u64,
+    /// How many peer ports the device's services had when last looked at
+    /// ([`DeviceHost::guard_new_peers`]).
+    peers_seen: usize,
     req_senders: senders::PortNodes,
     lease_senders: senders::PortNodes,
     server: Server<ipc::Service, I::ReqMsg, (), I::ReplyMsg, ()>,
@@ -273,6 +277,8 @@ impl<I: Interface> DeviceHost<I> {
 
     /// Sends the state as it is.
     fn send_verbatim(&mut self) -> Result<(), PublishError> {
+        // The send connects to new clients first.
+        self.guard_new_peers();
         let sample = match self.state_loan.take() {
             Some(s) => s,
             None => self.publisher.loan_uninit().map_err(PublishError::Loan)?,
@@ -335,6 +341,7 @@ impl<I: Interface> DeviceHost<I> {
     /// Connects the state publisher to clients that came since the last call, so they
     /// get the latest state (history 1) now; a failure is counted and logged.
     fn update_connections(&mut self) {
+        self.guard_new_peers();
         // New streams too: a client that found its stream closed (a restarted driver) asks
         // again, without a command to bring the driver to it.
         self.out.accept(&self.device);

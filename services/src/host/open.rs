@@ -249,6 +249,7 @@ impl<I: Interface> DeviceHost<I> {
             req_svc,
             cmd_senders: super::senders::PortNodes::new(ports),
             forged: 0,
+            peers_seen: 0,
             req_senders: super::senders::PortNodes::new(ports),
             lease_senders: super::senders::PortNodes::new(ports),
             server,

@@ -120,7 +120,7 @@ impl PortNodes {
 }
 
 /// The sender of a node of the registry.
-fn sender(node: &iceoryx2::identifiers::UniqueNodeId) -> Sender {
+pub(crate) fn sender(node: &iceoryx2::identifiers::UniqueNodeId) -> Sender {
     Sender {
         node: node.value(),
         pid: node
