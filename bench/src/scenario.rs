@@ -254,6 +254,8 @@ pub struct RunCtx {
     /// When pinned: the client's core and the driver/echo child's, probed before this
     /// process pinned itself (afterwards its affinity names one core only).
     pinned: Option<[usize; 2]>,
+    /// Whether `pinned` is one scenario's ([`RunCtx::pin_scenario`]), not the run's.
+    scenario_pin: bool,
     /// Progress output on stderr.
     pub progress: bool,
     /// Scratch directory (histograms of children, socket files), removed at the end.
@@ -308,6 +310,7 @@ impl RunCtx {
             strategy: args.strategy(),
             pin,
             pinned,
+            scenario_pin: false,
             progress: !args.no_progress,
             tmp,
             notes: Vec::new(),
@@ -342,6 +345,40 @@ impl RunCtx {
     /// The core this process (the client side) is pinned to (when pinning).
     pub fn client_cpu(&self) -> Option<usize> {
         self.pinned.map(|[client, _]| client)
+    }
+
+    /// Pins for one scenario whose series compare clients run one after the other against
+    /// one driver (`lang`): this process's thread (and so the client processes it starts,
+    /// which inherit its affinity) on one core, the driver child on another, as `--pin`
+    /// does for the whole run. Unpinned, each client lands on the driver's core or not as
+    /// the scheduler has it, and a read of what the driver just wrote costs some 3x more
+    /// from the other core (on the project's VM, 0.25 against 0.76 us for a Rust state
+    /// read): the ratio between languages then measures the placement. Returns the note
+    /// for the report; `None` when the run is pinned already or cannot be (fewer than two
+    /// cores, refused). [`RunCtx::end_scenario_pin`] undoes it.
+    pub fn pin_scenario(&mut self, scenario: &str) -> Option<String> {
+        if self.pinned.is_some() {
+            return None;
+        }
+        let ids = core_affinity::get_core_ids()?;
+        if ids.len() < 2 || !core_affinity::set_for_current(ids[0]) {
+            return None;
+        }
+        self.pinned = Some([ids[0].id, ids[1].id]);
+        self.scenario_pin = true;
+        Some(format!(
+            "{scenario} pinned whatever --pin says (one placement for every client): the \
+             clients on core {}, the driver child on core {}",
+            ids[0].id, ids[1].id
+        ))
+    }
+
+    /// Undoes [`RunCtx::pin_scenario`] (nothing when it did not pin).
+    pub fn end_scenario_pin(&mut self) {
+        if std::mem::take(&mut self.scenario_pin) {
+            self.pinned = None;
+            crate::roles::unpin();
+        }
     }
 
     /// Whether spinning variants run: asked for, and at least 2 cores (never more

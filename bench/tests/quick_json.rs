@@ -235,6 +235,14 @@ fn lang_measures_rust_c_and_python_or_says_why_not() {
             );
         }
     }
+    // One placement for every language (the driver on a core of its own) where there are
+    // two cores: unpinned, the ratios between languages measured where each process landed.
+    if std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2) {
+        assert!(
+            detail.contains("lang pinned whatever --pin says (one placement for every client)"),
+            "{detail}"
+        );
+    }
     // The package as pip installs it: in CI (a C compiler and Python's headers), with the
     // state copy in C.
     if ci {

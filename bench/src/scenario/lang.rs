@@ -18,6 +18,9 @@
 //! `liblimber.so` (`LIMBER_LIB`), with `limber._fast` where a C compiler and Python's
 //! headers are (the report notes which; without pip, the source tree's `python/`;
 //! `LIMBER_PY_CTYPES=1` in the environment has it copy through ctypes, to compare).
+//! The scenario is pinned whatever `--pin` says (`RunCtx::pin_scenario`): every client on
+//! one core, the driver on another, so that the languages compare on one placement, not on
+//! where the scheduler put each process.
 //! Each language that cannot run (no C compiler, no liblimber.so, no Python that imports
 //! limber) is skipped with the reason, printed and noted in the report; Rust always runs.
 
@@ -81,6 +84,15 @@ fn skip(ctx: &mut RunCtx, lang: &str, why: String) {
 }
 
 fn run(ctx: &mut RunCtx) -> Result<(), BenchError> {
+    if let Some(note) = ctx.pin_scenario("lang") {
+        ctx.notes.push(note);
+    }
+    let r = run_pinned(ctx);
+    ctx.end_scenario_pin();
+    r
+}
+
+fn run_pinned(ctx: &mut RunCtx) -> Result<(), BenchError> {
     let domain = ctx.domain();
     let (warm, n) = (ctx.count(500, 50), ctx.count(5_000, 300));
     // Three clients, one after the other; Python's exchanges are the slowest.
