@@ -1,6 +1,6 @@
 """limber for Python: clients of limber devices, a thin ctypes binding over liblimber.
 
-* :mod:`limber.client`: :class:`ActArrayClient`, :class:`LimbClient`; :mod:`limber.gripper`: :class:`GripperClient`
+* :mod:`limber.client`: :class:`ActArrayClient`; :mod:`limber.limb`: :class:`LimbClient`; :mod:`limber.gripper`: :class:`GripperClient`
   (connect, state, commands with outcomes, requests, leases), :class:`Domain`,
   :class:`Status`, :func:`list_devices`, :class:`DriverStatsReader` and the errors. See
   ``python/README.md``.
@@ -47,7 +47,6 @@ from .client import (
     LeaseHolder as LeaseHolder,
     LeaseLostError as LeaseLostError,
     LimberError as LimberError,
-    LimbClient as LimbClient,
     NackError as NackError,
     NoDriverError as NoDriverError,
     Outcome as Outcome,
@@ -70,6 +69,7 @@ from .done import (
     MotionResult as MotionResult,
 )
 from .gripper import GripperClient as GripperClient
+from .limb import LimbClient as LimbClient
 from .ranger import (
     LaserClient as LaserClient,
     RangerClient as RangerClient,
