@@ -1,7 +1,8 @@
 /* lang_client.c: the C client of `limber bench`'s `lang` scenario (compiled by the bench
- * against liblimber). Usage: lang_client WARMUP COUNT OUT. Connects to bench/actarray/0 in
- * $LIMBER_DOMAIN and, WARMUP + COUNT times each, times (CLOCK_MONOTONIC, ns) reading the
- * latest state (limber_actarray_state, a copy) and a command's round trip
+ * against liblimber). Usage: lang_client WARMUP COUNT OUT SETTLE_NS. Connects to
+ * bench/actarray/0 in $LIMBER_DOMAIN and, WARMUP + COUNT times each, times (CLOCK_MONOTONIC,
+ * ns) reading the latest state (limber_actarray_state, a copy), SETTLE_NS after the previous
+ * round trip ended (spinning on the clock; the bench's SETTLE_NS says why), and a command's round trip
  * (limber_actarray_move_to, then limber_actarray_wait_outcome); writes the samples after the
  * warm-up to OUT, one a line: "state NS" or "rtt NS". Exits 1 with the reason on stderr. */
 #define _POSIX_C_SOURCE 200809L /* clock_gettime */
@@ -23,11 +24,12 @@ static int fail(const char *what, limber_code c) {
 }
 
 int main(int argc, char **argv) {
-    if (argc != 4) {
-        fprintf(stderr, "usage: lang_client WARMUP COUNT OUT\n");
+    if (argc != 5) {
+        fprintf(stderr, "usage: lang_client WARMUP COUNT OUT SETTLE_NS\n");
         return 2;
     }
     long warm = atol(argv[1]), count = atol(argv[2]);
+    uint64_t settle = strtoull(argv[4], NULL, 10), settled = 0;
     FILE *out = fopen(argv[3], "w");
     if (!out) {
         perror(argv[3]);
@@ -39,6 +41,8 @@ int main(int argc, char **argv) {
     limber_actarray_data d;
     if ((c = limber_actarray_state(arm, 5000, &d)) != LIMBER_CODE_OK) return fail("first state", c);
     for (long i = 1; i <= warm + count; i++) {
+        while (now_ns() < settled) {
+        }
         uint64_t t0 = now_ns();
         c = limber_actarray_state(arm, 0, &d);
         uint64_t t1 = now_ns();
@@ -51,6 +55,7 @@ int main(int argc, char **argv) {
         if ((c = limber_actarray_wait_outcome(arm, ticket, 2000, &status)) != LIMBER_CODE_OK)
             return fail("wait_outcome", c);
         uint64_t t3 = now_ns();
+        settled = t3 + settle;
         if (status != LIMBER_STATUS_OK) {
             fprintf(stderr, "lang_client: refused: %s\n", limber_status_text(status));
             return 1;

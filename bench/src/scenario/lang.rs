@@ -20,7 +20,8 @@
 //! `LIMBER_PY_CTYPES=1` in the environment has it copy through ctypes, to compare).
 //! The scenario is pinned whatever `--pin` says (`RunCtx::pin_scenario`): every client on
 //! one core, the driver on another, so that the languages compare on one placement, not on
-//! where the scheduler put each process.
+//! where the scheduler put each process; and each client reads [`SETTLE_NS`] after its
+//! round trip, so that every read takes the same messages.
 //! Each language that cannot run (no C compiler, no liblimber.so, no Python that imports
 //! limber) is skipped with the reason, printed and noted in the report; Rust always runs.
 
@@ -140,6 +141,22 @@ fn run_pinned(ctx: &mut RunCtx) -> Result<(), BenchError> {
     r
 }
 
+/// How long every client waits, spinning on the clock, between a command's round trip and
+/// the next timed state read (passed to the C and Python clients as their 4th argument).
+/// `wait_outcome` returns on the state that shows the command; the driver sends the
+/// command's `told` message after it, and the next read takes that message. Read at once,
+/// it has come or not as the moment has it (Rust's read 0.18 us without it, 0.35-0.76 us
+/// with it, within one run); after the wait it is there for every language, and each read
+/// takes the same: the message, and nothing newer.
+const SETTLE_NS: u64 = 20_000;
+
+/// Spins until the monotonic clock reads `until` (ns): [`SETTLE_NS`], Rust's side.
+fn settle(until: u64) {
+    while monotonic_ns() < until {
+        std::hint::spin_loop();
+    }
+}
+
 /// The Rust client's samples (this process): state reads and command round trips.
 fn rust_client(
     ctx: &RunCtx,
@@ -152,7 +169,9 @@ fn rust_client(
         .map_err(|e| err("first state", e))?;
     let (mut state, mut rtt) = (new_histogram()?, new_histogram()?);
     let progress = Progress::new(ctx.progress, "lang Rust", warm + n);
+    let mut settled = 0;
     for i in 1..=warm + n {
+        settle(settled);
         let t0 = monotonic_ns();
         let p = client.state().map(|d| d.actuators[0].position);
         let t1 = monotonic_ns();
@@ -164,6 +183,7 @@ fn rust_client(
             .wait_outcome(ticket, SAMPLE_TIMEOUT)
             .map_err(|e| err("wait_outcome", e))?;
         let t3 = monotonic_ns();
+        settled = t3 + SETTLE_NS;
         if status != Status::Ok {
             return Err(err("command", format!("refused: {status}")));
         }
@@ -376,7 +396,7 @@ fn last_line(out: &[u8], none: &str) -> String {
 /// (Python's; empty from C).
 type Samples = (Histogram<u64>, Histogram<u64>, Histogram<u64>);
 
-/// Runs an external client (`cmd WARMUP COUNT OUT`) in the scenario's domain and reads its
+/// Runs an external client (`cmd WARMUP COUNT OUT SETTLE_NS`) in the scenario's domain and reads its
 /// samples: state reads, round trips, and (Python) single calls into liblimber.
 fn external(
     ctx: &RunCtx,
@@ -393,6 +413,7 @@ fn external(
     cmd.arg(warm.to_string())
         .arg(n.to_string())
         .arg(&out)
+        .arg(SETTLE_NS.to_string())
         .env("LIMBER_DOMAIN", domain.name());
     let o = run_bounded(cmd, limit).map_err(|why| BenchError::ChildFailed {
         role: format!("{lang} client"),
