@@ -56,7 +56,9 @@ pub struct ChildProc {
     kill_at: Instant,
 }
 
-fn command() -> Result<Command, BenchError> {
+/// A command that runs this executable's bench (`limber bench` or `limber-bench`), for a
+/// child role.
+pub(crate) fn command() -> Result<Command, BenchError> {
     if let Some(p) = std::env::var_os("LIMBER_BENCH_EXE") {
         return Ok(Command::new(p));
     }

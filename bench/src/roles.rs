@@ -15,6 +15,7 @@
 //! | `pioneer-driver-spin` | loop | the same, the driver busy-polling |
 //! | `{uds,tcp}-echo-{spin,blocking}` | peers | a socket echo with the same bytes |
 //! | `zenoh-echo` | bridge | raw Zenoh: a pong for each ping, a reply for each query |
+//! | `lang-rust` | lang | the Rust client: state reads and command round trips, its samples to `--out` as the C and Python clients write theirs |
 
 use std::io::Write;
 use std::time::{Duration, Instant};
@@ -52,6 +53,7 @@ pub fn run_role(role: &str, args: &BenchArgs) -> Result<(), BenchError> {
         "tcp-echo-spin" => peers::echo_role(args, peers::Transport::Tcp, true),
         "tcp-echo-blocking" => peers::echo_role(args, peers::Transport::Tcp, false),
         "zenoh-echo" => crate::scenario::zenoh_floor::echo_role(args),
+        crate::scenario::lang::RUST_ROLE => crate::scenario::lang::rust_role(args),
         other => Err(BenchError::Args(format!("unknown role {other:?}"))),
     };
     if let Err(e) = &r {
