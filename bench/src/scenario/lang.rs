@@ -21,7 +21,7 @@
 //! `LIMBER_PY_CTYPES=1` in the environment has it copy through ctypes, to compare).
 //! The scenario is pinned whatever `--pin` says (`RunCtx::pin_scenario`): every client on
 //! one core, the driver on another, so that the languages compare on one placement, not on
-//! where the scheduler put each process; and each client reads [`SETTLE_NS`] after its
+//! where the scheduler put each process; and each client reads `SETTLE_NS` (20 µs) after its
 //! round trip, so that every read takes the same messages.
 //! Each language that cannot run (no C compiler, no liblimber.so, no Python that imports
 //! limber) is skipped with the reason, printed and noted in the report; Rust always runs.
