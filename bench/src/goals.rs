@@ -4,6 +4,16 @@
 
 use crate::report::{Goal, Pct, RatioDef, RatioFloor, TimeGoalDef};
 
+/// A command's round trip with 16 drivers against 1: its floor is the same growth of a raw
+/// iceoryx2 event round trip at the same rate beside the same drivers (what 16 robots on
+/// the machine's cores add to any exchange).
+const MANY_RTT_FLOOR: RatioFloor = RatioFloor {
+    num: "many.16.paced.event.rtt",
+    plus: &[],
+    den: "many.1.paced.event.rtt",
+    what: "a raw iceoryx2 event round trip at 1 kHz beside 16 drivers / beside 1",
+};
+
 /// The ratios reported, like with like (spin with spin, blocking with blocking).
 pub const RATIOS: &[RatioDef] = &[
     RatioDef {
@@ -12,7 +22,7 @@ pub const RATIOS: &[RatioDef] = &[
         den: "many.1.rtt",
         pct: Pct::P50,
         goal: Some(Goal::AtMost(1.2)),
-        floor: None,
+        floor: Some(MANY_RTT_FLOOR),
     },
     RatioDef {
         label: "command round trip with 16 drivers / with 1 driver (many, 64 clients)",
@@ -20,7 +30,41 @@ pub const RATIOS: &[RatioDef] = &[
         den: "many.1.rtt",
         pct: Pct::P99,
         goal: Some(Goal::AtMost(1.2)),
+        floor: Some(MANY_RTT_FLOOR),
+    },
+    RatioDef {
+        label: "raw iceoryx2 event round trip at 1 kHz beside 16 drivers / beside 1 (many)",
+        num: "many.16.paced.event.rtt",
+        den: "many.1.paced.event.rtt",
+        pct: Pct::P99,
+        goal: None,
         floor: None,
+    },
+    RatioDef {
+        label: "simarm's loop period with 16 drivers / alone (many, 64 clients)",
+        num: "many.16.simarm.period",
+        den: "many.1.simarm.period",
+        pct: Pct::P99,
+        goal: Some(Goal::AtMost(1.2)),
+        floor: Some(RatioFloor {
+            num: "many.16.ticker.period",
+            plus: &[],
+            den: "many.1.ticker.period",
+            what: "a bare event loop's 10 ms period beside 16 drivers / beside 1",
+        }),
+    },
+    RatioDef {
+        label: "an emulated Pioneer's loop period with 16 drivers / alone (many, 64 clients)",
+        num: "many.16.pioneer.period",
+        den: "many.1p.pioneer.period",
+        pct: Pct::P99,
+        goal: Some(Goal::AtMost(1.2)),
+        floor: Some(RatioFloor {
+            num: "many.16.ticker.period",
+            plus: &[],
+            den: "many.1p.ticker.period",
+            what: "a bare event loop's 10 ms period beside 16 drivers / beside 1",
+        }),
     },
     RatioDef {
         label: "command through the bridge pair / raw Zenoh put ping-pong (bridge)",

@@ -15,6 +15,9 @@
 //! | `pioneer-driver-spin` | loop | the same, the driver busy-polling |
 //! | `{uds,tcp}-echo-{spin,blocking}` | peers | a socket echo with the same bytes |
 //! | `zenoh-echo` | bridge | raw Zenoh: a pong for each ping, a reply for each query |
+//! | `many-simarm` | many | simarm serving `--device`'s robot, its loop periods to `--out` at `quit` |
+//! | `many-pioneer` | many | the emulator on a pty at its 100 ms cycle and the Pioneer driver on it, the same |
+//! | `many-ticker` | many | limber's event loop on a 10 ms timer, no device: the floor of the drivers' loops |
 //! | `lang-rust` | lang | the Rust client: state reads and command round trips, its samples to `--out` as the C and Python clients write theirs |
 
 use std::io::Write;
@@ -24,7 +27,7 @@ use iceoryx2::prelude::*;
 use limber_pioneer::LoopMode;
 use limber_services::Domain;
 
-use crate::scenario::{command, floor, peers, physical, state};
+use crate::scenario::{command, floor, many_drivers, peers, physical, state};
 use crate::{BenchArgs, BenchError};
 
 /// Runs `role`; on failure prints `error: <why>` on stdout for the parent, and returns it.
@@ -54,6 +57,9 @@ pub fn run_role(role: &str, args: &BenchArgs) -> Result<(), BenchError> {
         "tcp-echo-blocking" => peers::echo_role(args, peers::Transport::Tcp, false),
         "zenoh-echo" => crate::scenario::zenoh_floor::echo_role(args),
         crate::scenario::lang::RUST_ROLE => crate::scenario::lang::rust_role(args),
+        many_drivers::SIMARM_ROLE => many_drivers::simarm_role(args),
+        many_drivers::PIONEER_ROLE => many_drivers::pioneer_role(args),
+        many_drivers::TICKER_ROLE => many_drivers::ticker_role(args),
         other => Err(BenchError::Args(format!("unknown role {other:?}"))),
     };
     if let Err(e) = &r {

@@ -16,6 +16,7 @@ pub mod gateway;
 pub mod ik;
 pub mod lang;
 pub mod many;
+pub mod many_drivers;
 pub mod peers;
 pub mod physical;
 pub mod pty_loop;
@@ -83,6 +84,10 @@ pub enum Pace {
         period: Duration,
         /// The scenario the floor belongs to (and the ids' first part).
         scenario: &'static str,
+        /// What runs beside the exchanges, for a floor measured under a scenario's load:
+        /// the ids' second part and the label's words (`("16", "16 drivers")`:
+        /// `many.16.paced.*`, "..., beside 16 drivers").
+        beside: Option<(&'static str, &'static str)>,
     },
 }
 
@@ -98,6 +103,11 @@ impl Pace {
     pub fn id(self, key: &str, suffix: &str) -> String {
         match self {
             Pace::BackToBack => format!("floor.{key}.{suffix}"),
+            Pace::Paced {
+                scenario,
+                beside: Some((tag, _)),
+                ..
+            } => format!("{scenario}.{tag}.paced.{key}.{suffix}"),
             Pace::Paced { scenario, .. } => format!("{scenario}.paced.{key}.{suffix}"),
         }
     }
@@ -105,12 +115,16 @@ impl Pace {
     pub fn label(self) -> String {
         match self {
             Pace::BackToBack => String::new(),
-            Pace::Paced { period, .. } => {
+            Pace::Paced { period, beside, .. } => {
                 let hz = 1_000_000_000 / period.as_nanos().max(1);
-                if hz >= 1_000 && hz % 1_000 == 0 {
+                let rate = if hz >= 1_000 && hz % 1_000 == 0 {
                     format!(", {} kHz", hz / 1_000)
                 } else {
                     format!(", {hz} Hz")
+                };
+                match beside {
+                    Some((_, what)) => format!("{rate}, beside {what}"),
+                    None => rate,
                 }
             }
         }

@@ -473,26 +473,46 @@ fn results_writes_the_run_with_its_machine_and_command() {
     std::fs::remove_dir_all(&dir).expect("remove the test's directory");
 }
 
-/// `--only many` (quick: 1 and 4 drivers, 16 clients): listing the domain and a command's
-/// round trip for each number of drivers, and the memory per driver and per client in the
-/// notes.
+/// `--only many` (quick: 1 simarm, 1 emulated Pioneer, then 4 drivers of both kinds; 16
+/// clients): listing the domain, a command's round trip to simarm and its floor beside the
+/// same drivers, each kind's loop period and the floor's, for each pass; the goals at 16
+/// drivers are not in a quick run; the memory per driver of each kind and per client in
+/// the notes.
 #[test]
-fn many_measures_listing_round_trips_and_memory_per_number_of_drivers() {
+fn many_measures_listing_round_trips_loop_periods_and_memory_per_number_of_drivers() {
     let dir = std::env::temp_dir().join(format!("limber-bench-many-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let (s, ids, _, _) = run_only("many", &dir.join("many.json"), None);
-    for n in [1, 4] {
-        for what in ["list", "rtt"] {
-            let id = format!("many.{n}.{what}");
-            assert!(ids.contains(&id), "{id} missing from {ids:?}");
+    let mut want = Vec::new();
+    for tag in ["1", "1p", "4"] {
+        want.push(format!("many.{tag}.list"));
+        want.push(format!("many.{tag}.ticker.period"));
+        for what in ["rtt", "oneway", "back"] {
+            want.push(format!("many.{tag}.paced.event.{what}"));
         }
-        let detail = s["detail"].as_str().unwrap();
-        assert!(
-            detail.contains(&format!("{n} driver(s), 16 clients: per driver RSS ")),
-            "{detail}"
-        );
-        assert!(detail.contains("per client "), "{detail}");
     }
+    for tag in ["1", "4"] {
+        want.push(format!("many.{tag}.rtt"));
+        want.push(format!("many.{tag}.simarm.period"));
+    }
+    for tag in ["1p", "4"] {
+        want.push(format!("many.{tag}.pioneer.period"));
+    }
+    for id in &want {
+        assert!(ids.contains(id), "{id} missing from {ids:?}");
+    }
+    // Nothing else: no round trip through the Pioneer alone, no simarm there.
+    assert_eq!(ids.len(), want.len(), "{ids:?}");
+    let detail = s["detail"].as_str().unwrap();
+    for pass in [
+        "1 driver (simarm), 16 clients: per simarm RSS ",
+        "1 driver (an emulated Pioneer), 16 clients: per emulated Pioneer RSS ",
+        "4 drivers, 16 clients: per simarm RSS ",
+    ] {
+        assert!(detail.contains(pass), "{pass} missing: {detail}");
+    }
+    assert!(detail.contains("per emulated Pioneer RSS "), "{detail}");
+    assert!(detail.contains("per client "), "{detail}");
     std::fs::remove_dir_all(&dir).expect("remove the test's directory");
 }
 

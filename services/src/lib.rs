@@ -10,6 +10,7 @@ pub mod domain;
 pub mod error;
 pub mod event_loop;
 pub mod host;
+pub mod loop_stats;
 pub mod naming;
 pub mod qos;
 pub mod relay;

@@ -147,6 +147,7 @@ fn measure(
     let pace = Pace::Paced {
         period: PERIOD,
         scenario: "cpu",
+        beside: None,
     };
     let mut rtt = new_histogram()?;
     let w = Window::start(&procs).map_err(cpu_err)?;

@@ -70,6 +70,7 @@ pub fn fanout(ctx: &mut RunCtx, fan: usize) -> Result<(), BenchError> {
     let pace = Pace::Paced {
         period: PERIOD,
         scenario: "state",
+        beside: None,
     };
     let (warm, n) = pace.counts(ctx, ((0, 0), (0, 0)));
     let deadline = pace.deadline(ctx, warm + n, PERIOD);

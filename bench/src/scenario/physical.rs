@@ -355,6 +355,7 @@ fn run_fanout(
     let pace = Pace::Paced {
         period: PERIOD,
         scenario: "state",
+        beside: None,
     };
     let (warm, n) = pace.counts(ctx, ((0, 0), (0, 0)));
     let deadline = pace.deadline(ctx, warm + n, PERIOD);

@@ -6,9 +6,9 @@
 
 use std::time::{Duration, Instant};
 
-use limber_emulator::{Emulator, EmulatorConfig};
+use limber_emulator::EmulatorConfig;
 use limber_interfaces::prelude::*;
-use limber_pioneer::{LoopMode, PioneerConfig, PioneerDriver, RunOptions};
+use limber_pioneer::{LoopMode, PioneerConfig, RunOptions};
 use limber_services::prelude::*;
 use limber_services::{Role, monotonic_ns};
 
@@ -122,26 +122,12 @@ pub fn driver_role(args: &BenchArgs, mode: LoopMode) -> Result<(), BenchError> {
         .map_err(|e| err("driver context", e.to_string()))?;
     // Fast mode: the emulator answers at once instead of at its 100 ms cycle boundary,
     // so the scenarios measure limber, not the controller's cycle (the labels say so).
-    // A thread starts with its creator's affinity: pinned, the emulator's thread is
-    // created on its own core, then this thread goes back to the driver's.
-    if let Some(cpu) = args.emulator_cpu {
-        roles::pin_to(cpu);
-    }
-    let emu = Emulator::start_pty(EmulatorConfig::fast());
-    match (args.emulator_cpu, args.cpu) {
-        (None, _) => {}
-        (Some(_), Some(cpu)) => roles::pin_to(cpu),
-        (Some(_), None) => roles::unpin(),
-    }
-    let emu = emu.map_err(|e| err("emulator", e.to_string()))?;
-    let mut driver = PioneerDriver::start(&ctx, PioneerConfig::default(), emu.link_target())
-        .map_err(|e| err("pioneer driver", e.to_string()))?;
-    if !driver.hardware().arm {
-        return Err(err(
-            "pioneer driver",
-            "the emulated robot has no arm".into(),
-        ));
-    }
+    let (emu, mut driver) = super::many_drivers::start_emulated_pioneer(
+        args,
+        &ctx,
+        EmulatorConfig::fast(),
+        PioneerConfig::default(),
+    )?;
     let lines = roles::stdin_lines();
     roles::announce("ready");
     let r = driver.run_until(RunOptions { mode }, move || {

@@ -59,6 +59,7 @@ impl Scenario for StateFanout {
         let pace = Pace::Paced {
             period: PERIOD,
             scenario: "state",
+            beside: None,
         };
         physical::ping_pong(ctx, physical::Wait::Futex, pace)?;
         floor::ping_pong(ctx, Echo::Listener, pace)?;

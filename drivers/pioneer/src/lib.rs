@@ -13,4 +13,4 @@ pub use driver::{
 };
 pub use realtime::{CpuError, RealtimeWarning, apply_realtime, check_cpu};
 pub use robot::{INTERNAL, Outbox, PacketEffect, Queued, RobotModel};
-pub use stats::{LoopStats, Ring};
+pub use stats::{LoopStats, Ring, TickStats};

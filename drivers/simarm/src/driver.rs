@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use limber_interfaces::common::device_flag;
 use limber_services::event_loop::{self, LoopError, LoopExit, Wake};
+use limber_services::loop_stats::TickStats;
 use limber_services::prelude::*;
 use limber_services::{DeviceError, HostError, ProcessError, PublishError, ShareLeaseError, qos};
 
@@ -174,6 +175,7 @@ pub struct SimArm {
     hosts: DeviceSet,
     last: Instant,
     failures: SimArmFailures,
+    ticks: TickStats,
 }
 
 impl core::fmt::Debug for SimArm {
@@ -205,6 +207,7 @@ impl SimArm {
             hosts,
             last: Instant::now(),
             failures: SimArmFailures::default(),
+            ticks: TickStats::default(),
         };
         s.publish_all()?;
         Ok(s)
@@ -213,6 +216,12 @@ impl SimArm {
     /// The simulation (read-only: joint values, gripper, object).
     pub fn model(&self) -> &ArmModel {
         &self.model
+    }
+
+    /// The timer cycles of [`run`](Self::run): periods between ticks, their jitter, overruns
+    /// (the latest 512, as every driver keeps them).
+    pub fn tick_stats(&self) -> &TickStats {
+        &self.ticks
     }
 
     /// The failures [`run`](Self::run) survived so far.
@@ -264,10 +273,14 @@ impl SimArm {
     pub fn run(&mut self, mut stop: impl FnMut() -> bool) -> Result<LoopExit, SimArmError> {
         let listeners = self.hosts.take_wake_listeners();
         let tick = self.model.options().tick;
+        let nominal = u64::try_from(tick.as_nanos()).unwrap_or(u64::MAX);
         let mut housekeeping = 0u32;
         let (mut process_failing, mut publish_failing) = (false, false);
         self.last = Instant::now();
         let exit = event_loop::run(&listeners, tick, None, |wake| {
+            if let Wake::Tick(expirations) = wake {
+                self.ticks.tick(Instant::now(), nominal, expirations);
+            }
             match self.process() {
                 Ok(n) => {
                     process_failing = false;

@@ -250,6 +250,7 @@ impl<I: Interface> DeviceHost<I> {
             cmd_senders: super::senders::PortNodes::new(ports),
             forged: 0,
             peers_seen: 0,
+            full_cleanup_at: std::cell::Cell::new(None),
             req_senders: super::senders::PortNodes::new(ports),
             lease_senders: super::senders::PortNodes::new(ports),
             server,

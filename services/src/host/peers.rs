@@ -48,28 +48,11 @@ impl<I: Interface> DeviceHost<I> {
             return;
         };
         let mut gone: Vec<u128> = Vec::new();
-        let mut note = |port: u128, node: &iceoryx2::identifiers::UniqueNodeId| {
+        self.for_each_peer_port(|port, node| {
             if !process_exists(super::senders::sender(node).pid) {
                 gone.push(port);
             }
-            CallbackProgression::Continue
-        };
-        self.data_svc
-            .dynamic_config()
-            .list_subscribers(|d| note(d.subscriber_id.value(), &d.node_id));
-        self.cmd_svc
-            .dynamic_config()
-            .list_publishers(|d| note(d.publisher_id.value(), &d.node_id));
-        self.req_svc
-            .dynamic_config()
-            .list_clients(|d| note(d.client_id.value(), &d.node_id));
-        self.lease_svc
-            .dynamic_config()
-            .list_clients(|d| note(d.client_id.value(), &d.node_id));
-        self.out
-            .told_svc
-            .dynamic_config()
-            .list_clients(|d| note(d.client_id.value(), &d.node_id));
+        });
         if gone.is_empty() {
             return;
         }
@@ -78,5 +61,62 @@ impl<I: Interface> DeviceHost<I> {
             tracing::warn!(device = %self.device, removed,
                 "a client that is gone left segments half made: removed before connecting");
         }
+    }
+
+    /// Calls `f` with every port of the device's five services that a client owns (the
+    /// state's subscribers, the publishers of commands, the clients of requests, leases
+    /// and outcomes), and its node: from iceoryx2's registries in shared memory, no file
+    /// read.
+    fn for_each_peer_port(&self, mut f: impl FnMut(u128, &iceoryx2::identifiers::UniqueNodeId)) {
+        self.data_svc.dynamic_config().list_subscribers(|d| {
+            f(d.subscriber_id.value(), &d.node_id);
+            CallbackProgression::Continue
+        });
+        self.cmd_svc.dynamic_config().list_publishers(|d| {
+            f(d.publisher_id.value(), &d.node_id);
+            CallbackProgression::Continue
+        });
+        self.req_svc.dynamic_config().list_clients(|d| {
+            f(d.client_id.value(), &d.node_id);
+            CallbackProgression::Continue
+        });
+        self.lease_svc.dynamic_config().list_clients(|d| {
+            f(d.client_id.value(), &d.node_id);
+            CallbackProgression::Continue
+        });
+        self.out.told_svc.dynamic_config().list_clients(|d| {
+            f(d.client_id.value(), &d.node_id);
+            CallbackProgression::Continue
+        });
+    }
+
+    /// Whether a port of the device's services belongs to a process that is gone (a client
+    /// that crashed or was killed, its ports left behind): iceoryx2 records each node's
+    /// process id in its node id, so this is a look at the registries and one `kill(pid, 0)`
+    /// per process, where iceoryx2's own look at a service's nodes reads every node's files
+    /// (1 ms with 64 clients, up to 15 ms, measured on the project's 2-core VM). A process id
+    /// iceoryx2 did not record is taken as alive.
+    pub(crate) fn a_peer_is_gone(&self) -> bool {
+        const SEEN: usize = 128;
+        let own = std::process::id();
+        // The processes seen alive in this look: each is asked once, not once per port.
+        let mut alive = [0u32; SEEN];
+        let mut n = 0;
+        let mut gone = false;
+        self.for_each_peer_port(|_, node| {
+            let pid = super::senders::sender(node).pid;
+            if gone || pid == own || alive[..n].contains(&pid) {
+                return;
+            }
+            if process_exists(pid) {
+                if n < SEEN {
+                    alive[n] = pid;
+                    n += 1;
+                }
+            } else {
+                gone = true;
+            }
+        });
+        gone
     }
 }

@@ -554,10 +554,10 @@ impl PioneerDriver {
             LoopMode::Event => loop_mode::EVENT,
             LoopMode::Spin => loop_mode::SPIN,
         };
-        s.cycles = ls.cycles;
-        s.overruns = ls.overruns;
-        (s.period_p50_ns, s.period_p99_ns, s.period_max_ns) = ls.period.summary();
-        s.jitter_p99_ns = ls.jitter.summary().1;
+        s.cycles = ls.ticks.cycles;
+        s.overruns = ls.ticks.overruns;
+        (s.period_p50_ns, s.period_p99_ns, s.period_max_ns) = ls.ticks.period.summary();
+        s.jitter_p99_ns = ls.ticks.jitter.summary().1;
         (
             s.cmd_to_wire_p50_ns,
             s.cmd_to_wire_p99_ns,
