@@ -41,7 +41,7 @@ use crate::dirwatch::DirWatch;
 use crate::inbox::{Inbox, InboxError, Sender};
 use crate::keys::{self, TypeNames};
 use crate::malformed;
-use crate::session::{self, NetConfig, SessionError};
+use crate::session::{self, ControlPublishers, NetConfig, SessionError};
 use crate::waiting::{Attached, Owed, with_waitset};
 
 /// How often each exposed device's driver is checked for life (a dead driver's token is
@@ -209,6 +209,8 @@ struct Exposed<I: Interface> {
     names: TypeNames,
     allow: Allow,
     ids: Ids,
+    /// The outcomes' publishers, one per origin.
+    outcomes: ControlPublishers,
     /// Commands relayed since the outcomes were last taken.
     relayed: usize,
     pending: Vec<(Query, PendingRelay<I>, Instant, u64)>,
@@ -256,7 +258,7 @@ impl<I: Interface> Exposed<I> {
             if let Some((_, other)) = self.ids.to_remote.get(&o.other_client) {
                 o.other_client = *other;
             }
-            put_outcome(session, &self.device, &origin, &o);
+            put_outcome(&mut self.outcomes, session, &self.device, &origin, &o);
             n += 1;
         }
         n
@@ -289,7 +291,7 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
                 status: Status::Unsupported.code(),
                 ..OutcomeMsg::default()
             };
-            put_outcome(session, &self.device, origin, &o);
+            put_outcome(&mut self.outcomes, session, &self.device, origin, &o);
             return;
         }
         let meta = cmd.meta_mut();
@@ -448,11 +450,16 @@ impl<I: Interface> ExposedDevice for Exposed<I> {
     }
 }
 
-/// Puts outcome `o` for the commands of `origin` ([`session::put_control`]).
-fn put_outcome(session: &Session, device: &DeviceName, origin: &str, o: &OutcomeMsg) {
+/// Puts outcome `o` for the commands of `origin` through `publishers`.
+fn put_outcome(
+    publishers: &mut ControlPublishers,
+    session: &Session,
+    device: &DeviceName,
+    origin: &str,
+    o: &OutcomeMsg,
+) {
     let key = keys::outcome_key(device, origin);
-    if let Err(e) = session::put_control(session, &key, o.as_bytes().to_vec(), keys::outcome_type())
-    {
+    if let Err(e) = publishers.put(session, &key, o.as_bytes().to_vec()) {
         tracing::warn!(device = %device, error = %e, "cannot publish an outcome");
     }
 }
@@ -590,6 +597,7 @@ fn expose_device<I: Interface>(
             to_local: HashMap::new(),
             to_remote: HashMap::new(),
         },
+        outcomes: ControlPublishers::new(keys::outcome_type()),
         relayed: 0,
         pending: Vec::new(),
         doubted: false,

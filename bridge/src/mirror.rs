@@ -42,7 +42,7 @@ use crate::access;
 use crate::expose::MIRROR_DRIVER;
 use crate::inbox::{Inbox, InboxError, Sender};
 use crate::keys::{self, TypeNames};
-use crate::session::{self, NetConfig, SessionError};
+use crate::session::{self, ControlPublishers, NetConfig, SessionError};
 use crate::waiting::{Attached, Owed, with_waitset};
 
 /// The longest the loop sleeps with nothing to do, between two looks at `stop` (a signal
@@ -196,6 +196,8 @@ struct Mirrored<I: Interface> {
     remote: DeviceName,
     host: DeviceHost<I>,
     cmd_key: String,
+    /// The commands' publisher.
+    commands: ControlPublishers,
     req_key: String,
     lease_key: String,
     names: TypeNames,
@@ -328,7 +330,7 @@ impl<I: Interface> MirroredDevice for Mirrored<I> {
         }
         let mut asked = !commands.is_empty();
         for c in commands {
-            if let Err(e) = session::put_control(session, &self.cmd_key, c, self.names.cmd) {
+            if let Err(e) = self.commands.put(session, &self.cmd_key, c) {
                 tracing::warn!(device = %self.local, error = %e, "cannot relay a command");
             }
         }
@@ -505,6 +507,7 @@ fn host_device<I: Interface>(
         remote: remote.clone(),
         host,
         cmd_key: keys::sender_key(remote, "cmd", origin),
+        commands: ControlPublishers::new(keys::type_names::<I>().cmd),
         req_key: keys::sender_key(remote, "req", origin),
         lease_key: keys::sender_key(remote, "lease", origin),
         names: keys::type_names::<I>(),
