@@ -3,7 +3,9 @@
 //! loop sleeps until something arrives instead of polling.
 //!
 //! The wake-up is one end of a socket pair: a sender writes a byte when no wake-up is
-//! pending already, the loop reads the socket empty before it empties the channel.
+//! pending already and the loop is asleep (or about to be), the loop reads the socket empty
+//! before it empties the channel. A loop awake (working, or looking without sleeping after
+//! activity) finds the item by the `pending` flag alone: no system call on either side.
 
 use std::io::{self, Read, Write};
 use std::os::unix::net::UnixStream;
@@ -14,8 +16,11 @@ use limber_services::event_loop::FdSource;
 
 struct Wake {
     writer: UnixStream,
-    /// A byte is (or is about to be) in the socket: no other is needed.
+    /// Something was sent since the loop's last drain (and, while the loop sleeps, a byte
+    /// is or is about to be in the socket: no other is needed).
     pending: AtomicBool,
+    /// The loop is asleep in its WaitSet, or about to be: a sender must write a byte.
+    sleeping: AtomicBool,
 }
 
 /// The sending side, cloned into each callback.
@@ -37,7 +42,12 @@ impl<T> Sender<T> {
     /// Hands `item` to the loop and wakes it; `Err(item)` once the loop has ended.
     pub(crate) fn send(&self, item: T) -> Result<(), T> {
         self.tx.send(item).map_err(|e| e.0)?;
-        if !self.wake.pending.swap(true, Ordering::SeqCst) {
+        // In this order against the loop's (`Inbox::about_to_sleep`): `pending` set, then
+        // `sleeping` read. Either this read sees the loop asleep and writes, or the loop's
+        // look at `pending` after it said it sleeps sees this item, and it does not sleep.
+        if !self.wake.pending.swap(true, Ordering::SeqCst)
+            && self.wake.sleeping.load(Ordering::SeqCst)
+        {
             match (&self.wake.writer).write(&[1]) {
                 Ok(_) => {}
                 // The socket is full of wake-ups the loop has not read yet.
@@ -78,6 +88,7 @@ impl<T> Inbox<T> {
         let wake = Arc::new(Wake {
             writer,
             pending: AtomicBool::new(false),
+            sleeping: AtomicBool::new(false),
         });
         let sender = Sender {
             tx,
@@ -103,6 +114,22 @@ impl<T> Inbox<T> {
     /// system call, for a loop that lingers).
     pub(crate) fn has_mail(&self) -> bool {
         self.wake.pending.load(Ordering::SeqCst)
+    }
+
+    /// The loop is about to sleep in its WaitSet: senders write their wake-up from now on.
+    /// False (and the loop must not sleep) when something was sent since the last drain.
+    pub(crate) fn about_to_sleep(&self) -> bool {
+        self.wake.sleeping.store(true, Ordering::SeqCst);
+        if self.wake.pending.load(Ordering::SeqCst) {
+            self.wake.sleeping.store(false, Ordering::SeqCst);
+            return false;
+        }
+        true
+    }
+
+    /// The loop is awake again: senders leave their wake-up out.
+    pub(crate) fn awake(&self) {
+        self.wake.sleeping.store(false, Ordering::SeqCst);
     }
 
     /// Takes everything that arrived, oldest first, and consumes the wake-ups.
@@ -139,10 +166,15 @@ mod tests {
     fn items_arrive_in_order_and_the_wakeup_is_consumed() {
         let (inbox, tx) = Inbox::<u32>::new().expect("an inbox");
         let tx2 = tx.clone();
+        assert!(inbox.about_to_sleep(), "nothing sent yet");
         for i in 0..3 {
             assert!(tx.send(i).is_ok());
         }
         assert!(tx2.send(3).is_ok());
+        // One wake-up for the four.
+        let mut one = [0u8; 8];
+        assert_eq!((&inbox.reader).read(&mut one).ok(), Some(1));
+        inbox.awake();
         assert_eq!(inbox.drain(), vec![0, 1, 2, 3]);
         // Nothing left: the socket is empty again.
         let mut b = [0u8; 1];
@@ -151,10 +183,22 @@ mod tests {
             Err(io::ErrorKind::WouldBlock)
         );
         assert!(inbox.drain().is_empty());
-        // A later send wakes again.
+        // A later send to a sleeping loop wakes it again.
+        assert!(inbox.about_to_sleep());
         assert!(tx.send(7).is_ok());
         assert_eq!((&inbox.reader).read(&mut b).ok(), Some(1));
+        inbox.awake();
         assert_eq!(inbox.drain(), vec![7]);
+        // A send to a loop awake writes nothing: the flag says it.
+        assert!(tx.send(8).is_ok());
+        assert!(inbox.has_mail());
+        assert_eq!(
+            (&inbox.reader).read(&mut b).map_err(|e| e.kind()),
+            Err(io::ErrorKind::WouldBlock)
+        );
+        // ...and a loop about to sleep then does not.
+        assert!(!inbox.about_to_sleep());
+        assert_eq!(inbox.drain(), vec![8]);
     }
 
     /// A sender on another thread, as Zenoh's callbacks are, against a loop that sleeps
@@ -184,6 +228,46 @@ mod tests {
         .expect("a WaitSet");
         sender.join().expect("the sender");
         assert!(got.iter().copied().eq(0..N), "items lost or out of order");
+    }
+
+    /// The same with pauses longer than the loop's linger between bursts, so that the loop
+    /// goes to sleep between them and the senders race its falling asleep: a wake-up lost
+    /// there would leave it asleep for the wait's 10 s.
+    #[test]
+    fn a_loop_falling_asleep_between_bursts_misses_no_wakeup() {
+        const N: u32 = 3_000;
+        let (inbox, tx) = Inbox::<u32>::new().expect("an inbox");
+        let sender = std::thread::spawn(move || {
+            for i in 0..N {
+                assert!(tx.send(i).is_ok());
+                if i % 3 == 0 {
+                    // Past the 50 µs linger, by a varying amount.
+                    std::thread::sleep(std::time::Duration::from_micros(
+                        60 + u64::from(i % 7) * 30,
+                    ));
+                }
+            }
+        });
+        let mut got = Vec::with_capacity(N as usize);
+        let mut slept = 0;
+        crate::waiting::with_waitset(&inbox, &Vec::new(), |wait| {
+            while got.len() < N as usize {
+                let woken = wait(std::time::Duration::from_secs(10), None).expect("a wait");
+                assert!(
+                    woken.mail,
+                    "no wake-up within 10 s with {} of {N} items received",
+                    got.len()
+                );
+                if !woken.looked {
+                    slept += 1;
+                }
+                got.extend(inbox.drain());
+            }
+        })
+        .expect("a WaitSet");
+        sender.join().expect("the sender");
+        assert!(got.iter().copied().eq(0..N), "items lost or out of order");
+        assert!(slept > 0, "the loop never slept: the test raced nothing");
     }
 
     #[test]

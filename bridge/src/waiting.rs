@@ -162,9 +162,14 @@ pub(crate) fn with_waitset<T, R>(
         let lingered = until.and_then(|u| linger_look(inbox, listeners, u.min(now + timeout)));
         let woken = match lingered {
             Some(w) => w,
+            // Something came since the last look: no sleep.
+            None if !inbox.about_to_sleep() => Woken {
+                mail: true,
+                ..Woken::default()
+            },
             None => {
                 let mut woken = Woken::default();
-                ws.wait_and_process_once_with_timeout(
+                let waited = ws.wait_and_process_once_with_timeout(
                     |id| {
                         if id.has_event_from(&inbox_guard) {
                             woken.mail = true;
@@ -181,8 +186,9 @@ pub(crate) fn with_waitset<T, R>(
                         CallbackProgression::Continue
                     },
                     whole_ms(timeout),
-                )
-                .map_err(LoopError::Wait)?;
+                );
+                inbox.awake();
+                waited.map_err(LoopError::Wait)?;
                 woken
             }
         };
