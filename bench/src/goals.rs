@@ -452,7 +452,10 @@ pub const TIME_GOALS: &[TimeGoalDef] = &[
         id: "many.16.list",
         pct: Pct::P50,
         at_most_ns: 100_000_000,
-        floor: None,
+        floor: Some((
+            "many.16.list.raw",
+            "iceoryx2's own listing of the domain's services",
+        )),
     },
     TimeGoalDef {
         label: "Pioneer GET_GEOM request round trip",

@@ -486,6 +486,7 @@ fn many_measures_listing_round_trips_loop_periods_and_memory_per_number_of_drive
     let mut want = Vec::new();
     for tag in ["1", "1p", "4"] {
         want.push(format!("many.{tag}.list"));
+        want.push(format!("many.{tag}.list.raw"));
         want.push(format!("many.{tag}.ticker.period"));
         for what in ["rtt", "oneway", "back"] {
             want.push(format!("many.{tag}.paced.event.{what}"));

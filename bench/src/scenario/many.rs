@@ -7,7 +7,9 @@
 //! measures, with the others running:
 //!
 //! * listing the domain as `limber list` does (`limber_services::list_devices`):
-//!   `many.<n>.list`; goal in time: at most 100 ms with 16 drivers;
+//!   `many.<n>.list`; goal in time: at most 100 ms with 16 drivers; its floor, in turn with
+//!   it: iceoryx2's own listing of the domain's services (`ipc::Service::list`, which reads
+//!   every service's nodes; nothing done with them), `many.<n>.list.raw`;
 //! * a command's round trip (`move_to` then `wait_outcome`, one a millisecond) from one
 //!   client to the first simarm: `many.<n>.rtt`; goal: at most 1.2x from 1 to 16 drivers,
 //!   at p50 and p99;
@@ -184,6 +186,7 @@ fn kib(path: &str, key: &str) -> Option<u64> {
 /// What a pass measured through its clients (the periods come from the children).
 struct Measured {
     list: Histogram<u64>,
+    list_raw: Histogram<u64>,
     rtt: Option<Histogram<u64>>,
     rss_after: Option<u64>,
 }
@@ -227,7 +230,7 @@ fn run(ctx: &mut RunCtx, pass: &Pass, clients: usize) -> Result<(), BenchError> 
             connected.push((client, cctx));
         }
         let rss_after = kib(&me, "VmRSS:");
-        let list = list_times(ctx, &domain, pass.n)?;
+        let (list, list_raw) = list_times(ctx, &domain, pass.n)?;
         // Client 0 is on driver 0: the round trips when it is a simarm. Without one, the
         // same time with nothing sent, so that the loops' latest 512 periods (5.1 s) are
         // those of the measurements in every pass, not of the clients' connecting.
@@ -250,6 +253,7 @@ fn run(ctx: &mut RunCtx, pass: &Pass, clients: usize) -> Result<(), BenchError> 
         )?;
         Ok::<_, BenchError>(Measured {
             list,
+            list_raw,
             rtt,
             rss_after,
         })
@@ -302,6 +306,12 @@ fn run(ctx: &mut RunCtx, pass: &Pass, clients: usize) -> Result<(), BenchError> 
         format!("list the domain, {label}, {clients} clients"),
         Metric::Read,
         measured.list,
+    ));
+    ctx.push(blocking(
+        format!("many.{tag}.list.raw"),
+        format!("iceoryx2's own listing of the domain's services (the floor), {label}"),
+        Metric::Read,
+        measured.list_raw,
     ));
     if let Some(rtt) = measured.rtt {
         ctx.push(blocking(
@@ -368,10 +378,31 @@ fn note_memory(
     ));
 }
 
-/// Lists the domain 20 times (5 in quick mode), checking that every driver is there.
-fn list_times(ctx: &RunCtx, domain: &Domain, n: usize) -> Result<Histogram<u64>, BenchError> {
-    let mut h = new_histogram()?;
+/// Lists the domain 20 times (5 in quick mode), checking that every driver is there, and
+/// as many times, in turn, as iceoryx2 itself lists the domain's services (the same call,
+/// which reads every service's nodes, with nothing done with what it finds): the floor.
+fn list_times(
+    ctx: &RunCtx,
+    domain: &Domain,
+    n: usize,
+) -> Result<(Histogram<u64>, Histogram<u64>), BenchError> {
+    use iceoryx2::prelude::*;
+    let config = domain
+        .config()
+        .map_err(|e| err("the domain's configuration", e))?;
+    let (mut h, mut raw) = (new_histogram()?, new_histogram()?);
     for _ in 0..ctx.count(20, 5) {
+        let t0 = monotonic_ns();
+        let mut services = 0usize;
+        ipc::Service::list(config, |_| {
+            services += 1;
+            CallbackProgression::Continue
+        })
+        .map_err(|e| err("iceoryx2's listing of the domain", format!("{e:?}")))?;
+        raw.saturating_record(monotonic_ns().saturating_sub(t0));
+        if services == 0 {
+            return Err(err("iceoryx2's listing of the domain", "no service"));
+        }
         let t0 = monotonic_ns();
         let list = list_devices(domain).map_err(|e| err("list the domain", e))?;
         let t1 = monotonic_ns();
@@ -391,7 +422,7 @@ fn list_times(ctx: &RunCtx, domain: &Domain, n: usize) -> Result<Histogram<u64>,
         }
         h.saturating_record(t1.saturating_sub(t0));
     }
-    Ok(h)
+    Ok((h, raw))
 }
 
 /// `warm` + `count` command round trips, one a millisecond; the last `count` recorded.
