@@ -201,61 +201,32 @@ mod tests {
         assert_eq!(inbox.drain(), vec![8]);
     }
 
-    /// A sender on another thread, as Zenoh's callbacks are, against a loop that sleeps
-    /// in a WaitSet between drains: every item arrives, and no wait ends without a wake-up
-    /// while items are on their way (a lost wake-up would leave the loop asleep).
-    #[test]
-    fn a_loop_that_sleeps_between_drains_gets_every_item_of_another_thread() {
-        const N: u32 = 200_000;
+    /// `n` items from a sender on another thread, as Zenoh's callbacks are, pausing
+    /// `pause(i)` after item `i`, against a loop that sleeps in a WaitSet between drains:
+    /// every item arrives in order, and no wait ends without a wake-up while items are on
+    /// their way (a lost wake-up would leave the loop asleep for the wait's 10 s). Returns
+    /// how many waits ended asleep (by the WaitSet, not by looking).
+    fn every_item_arrives(
+        n: u32,
+        pause: impl Fn(u32) -> Option<std::time::Duration> + Send + 'static,
+    ) -> usize {
         let (inbox, tx) = Inbox::<u32>::new().expect("an inbox");
         let sender = std::thread::spawn(move || {
-            for i in 0..N {
+            for i in 0..n {
                 assert!(tx.send(i).is_ok());
-            }
-        });
-        let mut got = Vec::with_capacity(N as usize);
-        crate::waiting::with_waitset(&inbox, &Vec::new(), |wait| {
-            while got.len() < N as usize {
-                let woken = wait(std::time::Duration::from_secs(10), None).expect("a wait");
-                assert!(
-                    woken.mail,
-                    "no wake-up within 10 s with {} of {N} items received",
-                    got.len()
-                );
-                got.extend(inbox.drain());
-            }
-        })
-        .expect("a WaitSet");
-        sender.join().expect("the sender");
-        assert!(got.iter().copied().eq(0..N), "items lost or out of order");
-    }
-
-    /// The same with pauses longer than the loop's linger between bursts, so that the loop
-    /// goes to sleep between them and the senders race its falling asleep: a wake-up lost
-    /// there would leave it asleep for the wait's 10 s.
-    #[test]
-    fn a_loop_falling_asleep_between_bursts_misses_no_wakeup() {
-        const N: u32 = 3_000;
-        let (inbox, tx) = Inbox::<u32>::new().expect("an inbox");
-        let sender = std::thread::spawn(move || {
-            for i in 0..N {
-                assert!(tx.send(i).is_ok());
-                if i % 3 == 0 {
-                    // Past the 50 µs linger, by a varying amount.
-                    std::thread::sleep(std::time::Duration::from_micros(
-                        60 + u64::from(i % 7) * 30,
-                    ));
+                if let Some(d) = pause(i) {
+                    std::thread::sleep(d);
                 }
             }
         });
-        let mut got = Vec::with_capacity(N as usize);
+        let mut got = Vec::with_capacity(n as usize);
         let mut slept = 0;
         crate::waiting::with_waitset(&inbox, &Vec::new(), |wait| {
-            while got.len() < N as usize {
+            while got.len() < n as usize {
                 let woken = wait(std::time::Duration::from_secs(10), None).expect("a wait");
                 assert!(
                     woken.mail,
-                    "no wake-up within 10 s with {} of {N} items received",
+                    "no wake-up within 10 s with {} of {n} items received",
                     got.len()
                 );
                 if !woken.looked {
@@ -266,7 +237,23 @@ mod tests {
         })
         .expect("a WaitSet");
         sender.join().expect("the sender");
-        assert!(got.iter().copied().eq(0..N), "items lost or out of order");
+        assert!(got.iter().copied().eq(0..n), "items lost or out of order");
+        slept
+    }
+
+    #[test]
+    fn a_loop_that_sleeps_between_drains_gets_every_item_of_another_thread() {
+        every_item_arrives(200_000, |_| None);
+    }
+
+    /// With pauses longer than the loop's linger between bursts, the loop goes to sleep
+    /// between them and the sender races its falling asleep.
+    #[test]
+    fn a_loop_falling_asleep_between_bursts_misses_no_wakeup() {
+        // Past the 50 µs linger, by a varying amount, every third item.
+        let slept = every_item_arrives(3_000, |i| {
+            (i % 3 == 0).then(|| std::time::Duration::from_micros(60 + u64::from(i % 7) * 30))
+        });
         assert!(slept > 0, "the loop never slept: the test raced nothing");
     }
 
