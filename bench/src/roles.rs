@@ -175,3 +175,45 @@ pub fn stdin_lines() -> std::sync::mpsc::Receiver<String> {
     });
     rx
 }
+
+/// Starts the emulator on a pty with `emulator` and the Pioneer driver on it with `config`,
+/// the emulator's thread on `--emulator-cpu` and the driver's on `--cpu` when given (a
+/// thread starts with its creator's affinity: the emulator's is created on its own core,
+/// then this thread goes back to the driver's).
+pub fn start_emulated_pioneer(
+    args: &BenchArgs,
+    ctx: &limber_services::Context,
+    emulator: limber_emulator::EmulatorConfig,
+    config: limber_pioneer::PioneerConfig,
+) -> Result<(limber_emulator::Emulator, limber_pioneer::PioneerDriver), BenchError> {
+    if let Some(cpu) = args.emulator_cpu {
+        pin_to(cpu);
+    }
+    let emu = limber_emulator::Emulator::start_pty(emulator);
+    match (args.emulator_cpu, args.cpu) {
+        (None, _) => {}
+        (Some(_), Some(cpu)) => pin_to(cpu),
+        (Some(_), None) => unpin(),
+    }
+    let emu = emu.map_err(|e| BenchError::Transport {
+        context: "emulator".into(),
+        reason: e.to_string(),
+    })?;
+    let driver = limber_pioneer::PioneerDriver::start_with(
+        ctx,
+        config,
+        emu.link_target(),
+        limber_pioneer::StartOptions { simulated: true },
+    )
+    .map_err(|e| BenchError::Transport {
+        context: "pioneer driver".into(),
+        reason: e.to_string(),
+    })?;
+    if !driver.hardware().arm {
+        return Err(BenchError::Transport {
+            context: "pioneer driver".into(),
+            reason: "the emulated robot has no arm".into(),
+        });
+    }
+    Ok((emu, driver))
+}

@@ -21,8 +21,9 @@
 //!   periods between the timer cycles of its 10 ms tick, the latest 512 (5.1 s: the round
 //!   trips and the floor; in the Pioneer's own pass, which has no simarm, the round trips'
 //!   time with nothing sent) as the driver keeps them, written when the pass ends, before
-//!   its clients leave; goal: p99 at most 1.2x from 1 to 16 drivers. Their floor, beside the same drivers: limber's event loop on a 10 ms timer
-//!   with no device (`many.<n>.ticker.period`);
+//!   its clients leave; goal: p99 at most 1.2x from 1 to 16 drivers. Their floor, beside
+//!   the same drivers: limber's event loop on a 10 ms timer with no device
+//!   (`many.<n>.ticker.period`);
 //! * memory: each driver's resident set (`VmRSS`) and its proportional share of shared
 //!   memory (`Pss_Shmem` of `/proc/<pid>/smaps_rollup`), by kind, and what one more client
 //!   adds to this process's (the growth over the clients, divided by their number); in the

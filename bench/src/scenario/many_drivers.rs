@@ -19,8 +19,8 @@ use std::ops::ControlFlow;
 use std::sync::mpsc::{Receiver, TryRecvError};
 use std::time::{Duration, Instant};
 
-use limber_emulator::{Emulator, EmulatorConfig};
-use limber_pioneer::{LoopMode, PioneerConfig, PioneerDriver, RunOptions, StartOptions};
+use limber_emulator::EmulatorConfig;
+use limber_pioneer::{LoopMode, PioneerConfig, RunOptions};
 use limber_services::loop_stats::{Ring, TickStats};
 use limber_services::{Context, Role, event_loop};
 
@@ -94,39 +94,6 @@ pub fn simarm_role(args: &BenchArgs) -> Result<(), BenchError> {
     write_periods(args, &arm.tick_stats().period)
 }
 
-/// Starts the emulator on a pty with `emulator` and the Pioneer driver on it with `config`,
-/// the emulator's thread on `--emulator-cpu` and the driver's on `--cpu` when given (a
-/// thread starts with its creator's affinity: the emulator's is created on its own core,
-/// then this thread goes back to the driver's).
-pub fn start_emulated_pioneer(
-    args: &BenchArgs,
-    ctx: &Context,
-    emulator: EmulatorConfig,
-    config: PioneerConfig,
-) -> Result<(Emulator, PioneerDriver), BenchError> {
-    if let Some(cpu) = args.emulator_cpu {
-        roles::pin_to(cpu);
-    }
-    let emu = Emulator::start_pty(emulator);
-    match (args.emulator_cpu, args.cpu) {
-        (None, _) => {}
-        (Some(_), Some(cpu)) => roles::pin_to(cpu),
-        (Some(_), None) => roles::unpin(),
-    }
-    let emu = emu.map_err(|e| err("emulator", e))?;
-    let driver = PioneerDriver::start_with(
-        ctx,
-        config,
-        emu.link_target(),
-        StartOptions { simulated: true },
-    )
-    .map_err(|e| err("pioneer driver", e))?;
-    if !driver.hardware().arm {
-        return Err(err("pioneer driver", "the emulated robot has no arm"));
-    }
-    Ok((emu, driver))
-}
-
 /// `many-pioneer`.
 pub fn pioneer_role(args: &BenchArgs) -> Result<(), BenchError> {
     let domain = roles::child_domain(args)?;
@@ -138,7 +105,8 @@ pub fn pioneer_role(args: &BenchArgs) -> Result<(), BenchError> {
     };
     let ctx = Context::new(&domain, Role::Driver, "bench-pioneer")
         .map_err(|e| err("driver context", e))?;
-    let (emu, mut driver) = start_emulated_pioneer(args, &ctx, EmulatorConfig::default(), config)?;
+    let (emu, mut driver) =
+        roles::start_emulated_pioneer(args, &ctx, EmulatorConfig::default(), config)?;
     let lines = roles::stdin_lines();
     roles::announce("ready");
     let ran = driver.run_until(

@@ -122,7 +122,7 @@ pub fn driver_role(args: &BenchArgs, mode: LoopMode) -> Result<(), BenchError> {
         .map_err(|e| err("driver context", e.to_string()))?;
     // Fast mode: the emulator answers at once instead of at its 100 ms cycle boundary,
     // so the scenarios measure limber, not the controller's cycle (the labels say so).
-    let (emu, mut driver) = super::many_drivers::start_emulated_pioneer(
+    let (emu, mut driver) = roles::start_emulated_pioneer(
         args,
         &ctx,
         EmulatorConfig::fast(),
