@@ -199,7 +199,12 @@ pub const RATIOS: &[RatioDef] = &[
         den: "floor.spin.oneway",
         pct: Pct::P50,
         goal: Some(Goal::AtMost(1.5)),
-        floor: None,
+        floor: Some(RatioFloor {
+            num: "floor.spin2.oneway",
+            plus: &[],
+            den: "floor.spin.oneway",
+            what: "raw iceoryx2 in the command path's shape (a state sample before each reply, topics sized as a device's) / raw iceoryx2",
+        }),
     },
     RatioDef {
         label: "command spin one-way / floor spin one-way",
@@ -207,7 +212,12 @@ pub const RATIOS: &[RatioDef] = &[
         den: "floor.spin.oneway",
         pct: Pct::P99,
         goal: Some(Goal::AtMost(2.0)),
-        floor: None,
+        floor: Some(RatioFloor {
+            num: "floor.spin2.oneway",
+            plus: &[],
+            den: "floor.spin.oneway",
+            what: "raw iceoryx2 in the command path's shape (a state sample before each reply, topics sized as a device's) / raw iceoryx2",
+        }),
     },
     RatioDef {
         label: "command spin round trip / floor spin round trip",
@@ -215,7 +225,12 @@ pub const RATIOS: &[RatioDef] = &[
         den: "floor.spin.rtt",
         pct: Pct::P50,
         goal: Some(Goal::AtMost(1.2)),
-        floor: None,
+        floor: Some(RatioFloor {
+            num: "floor.spin2.rtt",
+            plus: &[],
+            den: "floor.spin.rtt",
+            what: "raw iceoryx2 in the command path's shape (a state sample before each reply, topics sized as a device's) / raw iceoryx2",
+        }),
     },
     RatioDef {
         label: "command spin round trip / cache-line ping-pong round trip",
@@ -311,7 +326,12 @@ pub const RATIOS: &[RatioDef] = &[
         den: "command.spin.rtt",
         pct: Pct::P50,
         goal: Some(Goal::AtLeast(10.0)),
-        floor: None,
+        floor: Some(RatioFloor {
+            num: "peers.tcp.spin.rtt",
+            plus: &[],
+            den: "floor.spin2.rtt",
+            what: "TCP spin round trip / raw iceoryx2's in the command path's shape",
+        }),
     },
     RatioDef {
         label: "UDS spin round trip / command spin round trip",
@@ -319,7 +339,12 @@ pub const RATIOS: &[RatioDef] = &[
         den: "command.spin.rtt",
         pct: Pct::P50,
         goal: Some(Goal::AtLeast(5.0)),
-        floor: None,
+        floor: Some(RatioFloor {
+            num: "peers.uds.spin.rtt",
+            plus: &[],
+            den: "floor.spin2.rtt",
+            what: "UDS spin round trip / raw iceoryx2's in the command path's shape",
+        }),
     },
     RatioDef {
         label: "TCP blocking round trip / command event round trip",

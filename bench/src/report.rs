@@ -209,12 +209,17 @@ impl Ratio {
     }
 
     /// What the report adds after the goal: the floors' ratio, and whether the goal is
-    /// below it (empty without a floor).
+    /// out of its reach (empty without a floor).
     pub fn floor_note(&self) -> String {
         match self.floor {
-            Some((f, what)) if self.below_floor() => {
-                format!(" (the goal is below its floor: {what} = {f:.2})")
-            }
+            // A ratio that must stay under its goal cannot go below the floors' ratio; one
+            // that must reach its goal cannot go above it.
+            Some((f, what)) if self.below_floor() => match self.goal {
+                Some(Goal::AtLeast(_)) => {
+                    format!(" (the goal is above its floor: {what} = {f:.2})")
+                }
+                _ => format!(" (the goal is below its floor: {what} = {f:.2})"),
+            },
             Some((f, what)) => format!(" ({what} = {f:.2})"),
             None => String::new(),
         }
@@ -634,5 +639,45 @@ mod tests {
             constant("bridge.raw.put.rtt", 100_000),
         ]);
         assert!(r.floor.is_none());
+    }
+
+    /// A goal that a ratio must reach (TCP spin over limber's spin) is out of reach when
+    /// the floors' own ratio (TCP spin over raw iceoryx2's) stays under it, and the report
+    /// says so; one within reach only shows the floor.
+    #[test]
+    fn an_at_least_goal_over_its_floor_says_the_goal_is_above_it() {
+        let ratio = |tcp: u64| {
+            Report::new(
+                Machine::probe("off".into(), "test".into()),
+                &BenchArgs::default(),
+                Vec::new(),
+                vec![
+                    constant("peers.tcp.spin.rtt", tcp),
+                    constant("command.spin.rtt", 1_000),
+                    constant("floor.spin2.rtt", 800),
+                ],
+            )
+            .ratios
+            .into_iter()
+            .find(|r| r.num == "peers.tcp.spin.rtt" && r.den == "command.spin.rtt")
+            .expect("the TCP spin goal")
+        };
+        let r = ratio(6_000);
+        assert_eq!(r.met, Some(false));
+        assert!(r.below_floor());
+        assert!(
+            r.floor_note().contains("the goal is above its floor")
+                && r.floor_note().contains("7.50"),
+            "{}",
+            r.floor_note()
+        );
+        let r = ratio(12_000);
+        assert_eq!(r.met, Some(true));
+        assert!(!r.below_floor());
+        assert!(
+            !r.floor_note().contains("the goal is"),
+            "{}",
+            r.floor_note()
+        );
     }
 }

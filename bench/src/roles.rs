@@ -4,6 +4,7 @@
 //! |---|---|---|
 //! | `futex-echo` / `cacheline-echo` | floor | no middleware: a shared page, `FUTEX_WAIT`/`FUTEX_WAKE` or spinning |
 //! | `pubsub-echo` | floor | raw iceoryx2: spins on the ping topic, answers on the pong topic |
+//! | `pubsub-state-echo` | floor | the same, publishing a state sample on a third topic before each answer |
 //! | `event-echo` | floor | the same, blocking on an event listener, notifying back |
 //! | `waitset-echo` | floor | the same, blocking in a WaitSet with the listener attached |
 //! | `state-pub` | state | a `DeviceHost` publishing the arm state at 1 kHz after `go` |
@@ -42,6 +43,7 @@ pub fn run_role(role: &str, args: &BenchArgs) -> Result<(), BenchError> {
         physical::FANOUT_ROLE => physical::fanout_role(args),
         "cacheline-echo" => physical::echo_role(args, physical::Wait::Spin),
         "pubsub-echo" => floor::echo_role(args, floor::Echo::Spin),
+        "pubsub-state-echo" => floor::echo_role(args, floor::Echo::SpinState),
         "event-echo" => floor::echo_role(args, floor::Echo::Listener),
         "waitset-echo" => floor::echo_role(args, floor::Echo::WaitSet),
         "state-pub" => state::publisher_role(args),

@@ -60,6 +60,9 @@ fn quick_run_writes_a_well_formed_report() {
     for id in [
         "floor.spin.rtt",
         "floor.spin.oneway",
+        "floor.spin2.rtt",
+        "floor.spin2.oneway",
+        "floor.spin2.back",
         "floor.event.rtt",
         "floor.event.oneway",
         "floor.futex.rtt",

@@ -2,6 +2,17 @@
 //! (a 296 B `ActArrayCmdMsg` out, a 1376 B `ActArrayData` back), no limber-services.
 //!
 //! * spin: both sides busy-poll `receive()`; the floor of the driver's `--spin` mode.
+//! * spin, limber's shape (`spin2`): the same, but the echo publishes a state sample on a
+//!   third topic before each reply, and the pinger takes it, as a driver publishes the
+//!   state that shows a command before its outcome; and the topics are sized as a
+//!   device's (`limber_services::qos`: a client slot for each of the default capacity's
+//!   ports, the command and state buffers): the floor of the spinning command path's
+//!   design, where the plain `spin` floor is iceoryx2 at its smallest (1 port a side).
+//!   Like the driver, it loans each next sample once one is sent, off the path to the
+//!   reply: back to back, that work delays the next ping instead (the one-way ping→echo
+//!   pays for it, the round trip does not change).
+//!   Measured on this VM: the second send adds some 25 % to the round trip, the sizes
+//!   some 15 % (iceoryx2's receive looks at every publisher slot).
 //! * blocking (`event`): each message is followed by a `notify()` on an event service and
 //!   the other side blocks in `Listener::timed_wait`; the floor of the event-driven mode.
 //! * blocking (`waitset`): the same, but the echo blocks in a WaitSet with its listener
@@ -54,6 +65,7 @@ impl Scenario for Floor {
         if ctx.spin_enabled() {
             physical::ping_pong(ctx, physical::Wait::Spin, Pace::BackToBack)?;
             ping_pong(ctx, Echo::Spin, Pace::BackToBack)?;
+            ping_pong(ctx, Echo::SpinState, Pace::BackToBack)?;
         }
         if ctx.blocking_enabled() {
             physical::ping_pong(ctx, physical::Wait::Futex, Pace::BackToBack)?;
@@ -69,6 +81,8 @@ impl Scenario for Floor {
 pub enum Echo {
     /// Busy-polls `receive()` (the pinger spins too).
     Spin,
+    /// Busy-polls, and publishes a state sample before each reply (the pinger takes it).
+    SpinState,
     /// Blocks in `Listener::timed_wait` (the pinger too).
     Listener,
     /// Blocks in a WaitSet with the listener attached, like a driver's event loop (the
@@ -80,6 +94,7 @@ impl Echo {
     fn key(self) -> &'static str {
         match self {
             Echo::Spin => "spin",
+            Echo::SpinState => "spin2",
             Echo::Listener => "event",
             Echo::WaitSet => "waitset",
         }
@@ -88,9 +103,14 @@ impl Echo {
     pub fn role(self) -> &'static str {
         match self {
             Echo::Spin => "pubsub-echo",
+            Echo::SpinState => "pubsub-state-echo",
             Echo::Listener => "event-echo",
             Echo::WaitSet => "waitset-echo",
         }
+    }
+
+    fn spins(self) -> bool {
+        matches!(self, Echo::Spin | Echo::SpinState)
     }
 }
 
@@ -100,11 +120,56 @@ type Pong = Subscriber<ipc::Service, ActArrayData, ()>;
 struct Services {
     a2b: PsFactory<ipc::Service, ActArrayCmdMsg, ()>,
     b2a: PsFactory<ipc::Service, ActArrayData, ()>,
+    /// The echo's state samples (`Echo::SpinState`).
+    state: PsFactory<ipc::Service, ActArrayData, ()>,
     ev_a2b: iceoryx2::service::port_factory::event::PortFactory<ipc::Service>,
     ev_b2a: iceoryx2::service::port_factory::event::PortFactory<ipc::Service>,
 }
 
-fn services(node: &Node<ipc::Service>, tag: &str) -> Result<Services, BenchError> {
+/// The sizes of the floor's topics: iceoryx2's smallest, or a device's (`Echo::SpinState`).
+struct Sizes {
+    /// Publishers of commands, subscribers of replies and states.
+    clients: usize,
+    cmd_buffer: usize,
+    cmd_borrowed: usize,
+    cmd_subscribers: usize,
+    reply_buffer: usize,
+    state_publishers: usize,
+    state_buffer: usize,
+    state_history: usize,
+}
+
+impl Sizes {
+    fn of(echo: Echo) -> Self {
+        use limber_services::qos;
+        match echo {
+            Echo::SpinState => Sizes {
+                clients: qos::Capacity::default().ports(),
+                cmd_buffer: qos::CMD_BUFFER,
+                cmd_borrowed: qos::CMD_BORROWED,
+                cmd_subscribers: qos::CMD_SUBSCRIBERS,
+                reply_buffer: qos::TOLD_BUFFER,
+                state_publishers: qos::DATA_PUBLISHERS,
+                state_buffer: qos::DATA_BUFFER,
+                state_history: 1,
+            },
+            _ => Sizes {
+                clients: 1,
+                cmd_buffer: 4,
+                cmd_borrowed: 2,
+                cmd_subscribers: 1,
+                reply_buffer: 4,
+                state_publishers: 1,
+                state_buffer: 4,
+                state_history: 0,
+            },
+        }
+    }
+}
+
+fn services(node: &Node<ipc::Service>, echo: Echo) -> Result<Services, BenchError> {
+    let tag = format!("floor-{}", echo.key());
+    let z = Sizes::of(echo);
     let name = |ch: &str| -> Result<ServiceName, BenchError> {
         ServiceName::new(&format!("limber-bench/{tag}/{ch}"))
             .map_err(|e| BenchError::transport("service name", e))
@@ -112,21 +177,31 @@ fn services(node: &Node<ipc::Service>, tag: &str) -> Result<Services, BenchError
     let a2b = node
         .service_builder(&name("a2b")?)
         .publish_subscribe::<ActArrayCmdMsg>()
-        .max_publishers(1)
-        .max_subscribers(1)
+        .max_publishers(z.clients)
+        .max_subscribers(z.cmd_subscribers)
         .history_size(0)
-        .subscriber_max_buffer_size(4)
+        .subscriber_max_buffer_size(z.cmd_buffer)
+        .subscriber_max_borrowed_samples(z.cmd_borrowed)
         .open_or_create()
         .map_err(|e| BenchError::transport("floor a2b service", e))?;
     let b2a = node
         .service_builder(&name("b2a")?)
         .publish_subscribe::<ActArrayData>()
         .max_publishers(1)
-        .max_subscribers(1)
+        .max_subscribers(z.clients)
         .history_size(0)
-        .subscriber_max_buffer_size(4)
+        .subscriber_max_buffer_size(z.reply_buffer)
         .open_or_create()
         .map_err(|e| BenchError::transport("floor b2a service", e))?;
+    let state = node
+        .service_builder(&name("state")?)
+        .publish_subscribe::<ActArrayData>()
+        .max_publishers(z.state_publishers)
+        .max_subscribers(z.clients)
+        .history_size(z.state_history)
+        .subscriber_max_buffer_size(z.state_buffer)
+        .open_or_create()
+        .map_err(|e| BenchError::transport("floor state service", e))?;
     let ev_a2b = node
         .service_builder(&name("ev_a2b")?)
         .event()
@@ -140,6 +215,7 @@ fn services(node: &Node<ipc::Service>, tag: &str) -> Result<Services, BenchError
     Ok(Services {
         a2b,
         b2a,
+        state,
         ev_a2b,
         ev_b2a,
     })
@@ -162,6 +238,7 @@ fn send_ping(p: &Ping, seq: u64, kind: u32) -> Result<(), BenchError> {
 /// Waits for the pong of `seq`: returns (receipt time, the echo's stamp).
 fn recv_pong(
     sub: &Pong,
+    states: Option<&Pong>,
     listener: Option<&Listener<ipc::Service>>,
     seq: u64,
     timeout: Duration,
@@ -169,6 +246,13 @@ fn recv_pong(
     let mut spins = 0u32;
     let mut deadline: Option<Instant> = None;
     loop {
+        if let Some(states) = states {
+            while states
+                .receive()
+                .map_err(|e| BenchError::transport("receive state", e))?
+                .is_some()
+            {}
+        }
         while let Some(s) = sub
             .receive()
             .map_err(|e| BenchError::transport("receive pong", e))?
@@ -226,7 +310,7 @@ fn sync(
     loop {
         send_ping(p, 0, 0)?;
         notify(notifier)?;
-        match recv_pong(sub, listener, 0, Duration::from_millis(10)) {
+        match recv_pong(sub, None, listener, 0, Duration::from_millis(10)) {
             Ok(_) => return Ok(()),
             Err(BenchError::Timeout { .. }) if Instant::now() < deadline => {}
             Err(e) => return Err(e),
@@ -237,12 +321,12 @@ fn sync(
 /// Runs the raw iceoryx2 floor with `echo`, spaced as `pace` says, and adds its three
 /// measurements.
 pub fn ping_pong(ctx: &mut RunCtx, echo: Echo, pace: Pace) -> Result<(), BenchError> {
-    let event = echo != Echo::Spin;
+    let event = !echo.spins();
     let domain = ctx.domain();
     let node = roles::raw_node(&domain)?;
     let tag = format!("floor-{}", echo.key());
     let tag = tag.as_str();
-    let svc = services(&node, tag)?;
+    let svc = services(&node, echo)?;
     let publisher = svc
         .a2b
         .publisher_builder()
@@ -253,6 +337,15 @@ pub fn ping_pong(ctx: &mut RunCtx, echo: Echo, pace: Pace) -> Result<(), BenchEr
         .subscriber_builder()
         .create()
         .map_err(|e| BenchError::transport("floor subscriber", e))?;
+    let states = match echo {
+        Echo::SpinState => Some(
+            svc.state
+                .subscriber_builder()
+                .create()
+                .map_err(|e| BenchError::transport("floor state subscriber", e))?,
+        ),
+        _ => None,
+    };
     let (notifier, listener) = if event {
         (
             Some(
@@ -304,7 +397,13 @@ pub fn ping_pong(ctx: &mut RunCtx, echo: Echo, pace: Pace) -> Result<(), BenchEr
         let t0 = monotonic_ns();
         send_ping(&publisher, seq, 0)?;
         notify(notifier.as_ref())?;
-        let (t1, stamp) = recv_pong(&subscriber, listener.as_ref(), seq, SAMPLE_TIMEOUT)?;
+        let (t1, stamp) = recv_pong(
+            &subscriber,
+            states.as_ref(),
+            listener.as_ref(),
+            seq,
+            SAMPLE_TIMEOUT,
+        )?;
         if seq > warm {
             rtt.saturating_record(t1.saturating_sub(t0));
             back.saturating_record(t1.saturating_sub(stamp));
@@ -323,10 +422,10 @@ pub fn ping_pong(ctx: &mut RunCtx, echo: Echo, pace: Pace) -> Result<(), BenchEr
         Strategy::Spin
     };
     let key = echo.key();
-    let via = if echo == Echo::WaitSet {
-        ", echo in WaitSet"
-    } else {
-        ""
+    let via = match echo {
+        Echo::WaitSet => ", echo in WaitSet",
+        Echo::SpinState => ", limber's shape (a state sample before each reply, a device's sizes)",
+        _ => "",
     };
     let via = format!("{via}{}", pace.label());
     ctx.push(Measurement {
@@ -359,13 +458,13 @@ pub fn ping_pong(ctx: &mut RunCtx, echo: Echo, pace: Pace) -> Result<(), BenchEr
     Ok(())
 }
 
-/// The echo child (`pubsub-echo`, `event-echo`, `waitset-echo`).
+/// The echo child (`pubsub-echo`, `pubsub-state-echo`, `event-echo`, `waitset-echo`).
 pub fn echo_role(args: &BenchArgs, echo: Echo) -> Result<(), BenchError> {
-    let event = echo != Echo::Spin;
+    let event = !echo.spins();
     let domain = roles::child_domain(args)?;
     let deadline = roles::child_deadline(args);
     let node = roles::raw_node(&domain)?;
-    let svc = services(&node, &format!("floor-{}", echo.key()))?;
+    let svc = services(&node, echo)?;
     let sub = svc
         .a2b
         .subscriber_builder()
@@ -376,6 +475,15 @@ pub fn echo_role(args: &BenchArgs, echo: Echo) -> Result<(), BenchError> {
         .publisher_builder()
         .create()
         .map_err(|e| BenchError::transport("echo publisher", e))?;
+    let state_pub = match echo {
+        Echo::SpinState => Some(
+            svc.state
+                .publisher_builder()
+                .create()
+                .map_err(|e| BenchError::transport("echo state publisher", e))?,
+        ),
+        _ => None,
+    };
     let (listener, notifier) = if event {
         (
             Some(
@@ -411,6 +519,7 @@ pub fn echo_role(args: &BenchArgs, echo: Echo) -> Result<(), BenchError> {
         ),
         _ => None,
     };
+    let (mut state_loan, mut reply_loan) = (None, None);
     roles::announce("ready");
     let mut spins = 0u32;
     loop {
@@ -427,15 +536,43 @@ pub fn echo_role(args: &BenchArgs, echo: Echo) -> Result<(), BenchError> {
             if meta.seq > args.warmup {
                 oneway.saturating_record(now.saturating_sub(meta.stamp_ns));
             }
-            let loan = publisher
-                .loan_uninit()
-                .map_err(|e| BenchError::transport("echo loan", e))?;
+            // Limber's shape loans each next sample as soon as one is sent, off the path
+            // to the reply (as the driver does); the plain floor loans on the path.
+            if let Some(p) = &state_pub {
+                let loan = match state_loan.take() {
+                    Some(l) => l,
+                    None => p
+                        .loan_uninit()
+                        .map_err(|e| BenchError::transport("echo state loan", e))?,
+                };
+                let mut st = loan.write_payload(ActArrayData::default());
+                st.payload_mut().header.seq = meta.seq;
+                st.send()
+                    .map_err(|e| BenchError::transport("echo state send", e))?;
+            }
+            let loan = match reply_loan.take() {
+                Some(l) => l,
+                None => publisher
+                    .loan_uninit()
+                    .map_err(|e| BenchError::transport("echo loan", e))?,
+            };
             let mut r = loan.write_payload(ActArrayData::default());
             let h = &mut r.payload_mut().header;
             h.seq = meta.seq;
             h.stamp_ns = monotonic_ns();
             r.send()
                 .map_err(|e| BenchError::transport("echo send", e))?;
+            if let Some(p) = &state_pub {
+                state_loan = Some(
+                    p.loan_uninit()
+                        .map_err(|e| BenchError::transport("echo state loan", e))?,
+                );
+                reply_loan = Some(
+                    publisher
+                        .loan_uninit()
+                        .map_err(|e| BenchError::transport("echo loan", e))?,
+                );
+            }
             notify(notifier.as_ref())?;
         }
         match &listener {
