@@ -1,5 +1,10 @@
 //! The `driver` channel: a driver's loop, link and robot facts ([`DriverStats`]), published
 //! on `limber/<robot>/driver/0/data` (history 1) and read by `limber echo <robot>/driver`.
+//!
+//! Every driver (the Pioneer driver, simarm) publishes the same way: a [`StatsPublisher`]
+//! made at start, a first publication then (a reader finds it at once, from the history)
+//! and one every [`PUBLISH_PERIOD`] while it runs ([`StatsPublisher::due`]), the fields
+//! they share filled by [`put_loop`] and [`put_clients`].
 
 use core::time::Duration;
 use std::time::Instant;
@@ -15,7 +20,38 @@ use thiserror::Error;
 
 use crate::context::{Context, monotonic_ns};
 use crate::error::Iox2Error;
+use crate::host::HostStats;
+use crate::loop_stats::TickStats;
 use crate::qos;
+
+/// How often a running driver publishes its statistics: about once a second.
+pub const PUBLISH_PERIOD: Duration = Duration::from_secs(1);
+
+/// Fills the loop's fields of `stats`: `loop_mode` (a
+/// [`loop_mode`](limber_interfaces::diagnostics::loop_mode) value) and, from the loop's
+/// timer cycles `ticks`, the cycles, the overruns, the period's p50, p99 and maximum and
+/// the jitter's p99 (the latest [`RING`](crate::loop_stats::RING) periods; zeros before
+/// the second tick).
+pub fn put_loop(stats: &mut DriverStats, mode: u32, ticks: &TickStats) {
+    stats.loop_mode = mode;
+    stats.cycles = ticks.cycles;
+    stats.overruns = ticks.overruns;
+    (
+        stats.period_p50_ns,
+        stats.period_p99_ns,
+        stats.period_max_ns,
+    ) = ticks.period.summary();
+    stats.jitter_p99_ns = ticks.jitter.summary().1;
+}
+
+/// Fills the client counters of `stats` (commands, refused, requests, overflows) from the
+/// counters of the driver's devices added up ([`DeviceSet::stats`](crate::DeviceSet::stats)).
+pub fn put_clients(stats: &mut DriverStats, hosts: &HostStats) {
+    stats.commands = hosts.commands;
+    stats.refused = hosts.refused;
+    stats.requests = hosts.requests;
+    stats.cmd_overflows = hosts.overflows;
+}
 
 /// The service name of a robot's driver statistics.
 pub fn service_name(robot: &str) -> Result<ServiceName, DiagnosticsError> {
@@ -101,6 +137,8 @@ pub enum DiagnosticsError {
 pub struct StatsPublisher {
     publisher: Publisher<ipc::Service, DriverStats, ()>,
     seq: u64,
+    /// When the last sample was published (`None` before the first).
+    last: Option<Instant>,
 }
 
 impl core::fmt::Debug for StatsPublisher {
@@ -133,11 +171,25 @@ impl StatsPublisher {
             .publisher_builder()
             .create()
             .map_err(|e| offer(e.into()))?;
-        Ok(StatsPublisher { publisher, seq: 0 })
+        Ok(StatsPublisher {
+            publisher,
+            seq: 0,
+            last: None,
+        })
     }
 
-    /// Publishes `stats` (stamping its header's sequence number and time).
+    /// True when statistics are due at `now`: none was published yet, or the last
+    /// publication is [`PUBLISH_PERIOD`] old or more (a failed publication counts: it is
+    /// retried a period later, not at every cycle).
+    pub fn due(&self, now: Instant) -> bool {
+        self.last
+            .is_none_or(|last| now.saturating_duration_since(last) >= PUBLISH_PERIOD)
+    }
+
+    /// Publishes `stats` (stamping its header's sequence number and time) and notes the
+    /// time for [`due`](Self::due).
     pub fn publish(&mut self, stats: &mut DriverStats) -> Result<(), DiagnosticsError> {
+        self.last = Some(Instant::now());
         self.seq += 1;
         stats.header.seq = self.seq;
         stats.header.stamp_ns = monotonic_ns();

@@ -2,8 +2,8 @@
 //! latest [`RING`]), their percentiles computed on a copy that lives on the stack, and the
 //! timer cycles of a periodic loop ([`TickStats`]: cycles, overruns, periods, jitter).
 //!
-//! Every driver's loop keeps its tick timing here (the Pioneer driver publishes it on its
-//! `driver` channel, simarm keeps it for whoever runs it), so that the period of one
+//! Every driver's loop keeps its tick timing here (the Pioneer driver and simarm publish it
+//! on their `driver` channel, [`crate::diagnostics::put_loop`]), so that the period of one
 //! driver's loop means what it means for every other.
 
 use std::time::Instant;

@@ -1,10 +1,14 @@
 //! The simulated arm on the services layer: a [`DeviceSet`] of three devices around one
-//! [`ArmModel`], advanced and published on a timer tick.
+//! [`ArmModel`], advanced and published on a timer tick, and the driver's statistics
+//! ([`DriverStats`]) on `<robot>/driver/0` as every driver publishes them
+//! ([`limber_services::diagnostics`]).
 
 use core::ops::ControlFlow;
 use std::time::Instant;
 
 use limber_interfaces::common::device_flag;
+use limber_interfaces::diagnostics::{self, DriverStats, loop_mode};
+use limber_services::diagnostics::{DiagnosticsError, StatsPublisher, put_clients, put_loop};
 use limber_services::event_loop::{self, LoopError, LoopExit, Wake};
 use limber_services::loop_stats::TickStats;
 use limber_services::prelude::*;
@@ -38,6 +42,9 @@ pub enum SimArmError {
     /// Commands or requests could not be received.
     #[error(transparent)]
     Process(#[from] DeviceError<ProcessError>),
+    /// The driver statistics could not be offered or first published.
+    #[error("cannot publish the simarm driver statistics: {0}")]
+    Stats(#[source] DiagnosticsError),
     /// The event loop failed.
     #[error(transparent)]
     Loop(#[from] LoopError),
@@ -165,17 +172,27 @@ pub struct SimArmFailures {
     pub process: u64,
     /// Ticks whose states could not all be published ([`SimArm::publish_all`] failed).
     pub publish: u64,
+    /// Driver statistics that could not be published (retried a second later).
+    pub stats: u64,
 }
+
+/// The flags of every state simarm publishes: a simulation whose "link" is always up and
+/// whose joints are calibrated.
+const FLAGS: u32 = device_flag::SIMULATED | device_flag::LINK_UP | device_flag::CALIBRATED;
 
 /// The simulated arm: serves `<robot>/actarray/0` (the chain's joints, then the gripper
 /// opening as the last actuator), `<robot>/limb/0` and `<robot>/gripper/0`, every
-/// state flagged [`device_flag::SIMULATED`].
+/// state flagged [`device_flag::SIMULATED`], and publishes its [`DriverStats`] on
+/// `<robot>/driver/0` (`limber echo <robot>/driver`): at start, then about once a second
+/// while it [runs](Self::run).
 pub struct SimArm {
     model: ArmModel,
     hosts: DeviceSet,
     last: Instant,
     failures: SimArmFailures,
     ticks: TickStats,
+    stats_pub: StatsPublisher,
+    stats: DriverStats,
 }
 
 impl core::fmt::Debug for SimArm {
@@ -201,15 +218,27 @@ impl SimArm {
         let mut hosts = DeviceSet::new(ctx, &robot, DRIVER_NAME, &devices)?;
         // The joints, the end effector and the gripper are one arm: one lease holds them.
         hosts.share_lease(&devices)?;
-        hosts.set_flags(device_flag::SIMULATED | device_flag::LINK_UP | device_flag::CALIBRATED);
+        hosts.set_flags(FLAGS);
+        // After the devices: a robot name another driver serves is refused before this.
+        let stats_pub = StatsPublisher::new(ctx, &robot).map_err(SimArmError::Stats)?;
+        let mut stats = DriverStats::default();
+        diagnostics::put_text(&mut stats.driver, DRIVER_NAME);
+        diagnostics::put_text(&mut stats.robot_name, &robot);
+        // A simulation has no link: its header says LINK_UP (as its devices' states do) and
+        // SIMULATED; the robot's class, subclass and hardware bits, the link's and the
+        // command-to-wire fields stay empty and zero.
+        stats.header.flags = device_flag::SIMULATED | device_flag::LINK_UP;
         let mut s = SimArm {
             model,
             hosts,
             last: Instant::now(),
             failures: SimArmFailures::default(),
             ticks: TickStats::default(),
+            stats_pub,
+            stats,
         };
         s.publish_all()?;
+        s.publish_stats().map_err(SimArmError::Stats)?;
         Ok(s)
     }
 
@@ -222,6 +251,20 @@ impl SimArm {
     /// (the latest 512, as every driver keeps them).
     pub fn tick_stats(&self) -> &TickStats {
         &self.ticks
+    }
+
+    /// The driver statistics as last published (the sequence number of the header counts
+    /// the publications).
+    pub fn driver_stats(&self) -> &DriverStats {
+        &self.stats
+    }
+
+    /// Fills the driver statistics from the loop's timer cycles and the devices' counters
+    /// and publishes them.
+    fn publish_stats(&mut self) -> Result<(), DiagnosticsError> {
+        put_loop(&mut self.stats, loop_mode::EVENT, &self.ticks);
+        put_clients(&mut self.stats, &self.hosts.stats());
+        self.stats_pub.publish(&mut self.stats)
     }
 
     /// The failures [`run`](Self::run) survived so far.
@@ -266,7 +309,8 @@ impl SimArm {
 
     /// Serves until SIGINT/SIGTERM ([`LoopExit::Signal`]) or until `stop` returns true
     /// (checked at every wake-up, [`LoopExit::Stopped`]): advances the simulation and
-    /// publishes every device each tick, handles clients as they wake it. Transient
+    /// publishes every device each tick, handles clients as they wake it, and publishes the
+    /// driver statistics about once a second. Transient
     /// publish or receive failures are skipped (the next tick retries), counted in
     /// [`failures`](Self::failures) and logged. The wake
     /// listeners move into the loop: a second `run` reacts to clients only on ticks.
@@ -275,7 +319,7 @@ impl SimArm {
         let tick = self.model.options().tick;
         let nominal = u64::try_from(tick.as_nanos()).unwrap_or(u64::MAX);
         let mut housekeeping = 0u32;
-        let (mut process_failing, mut publish_failing) = (false, false);
+        let (mut process_failing, mut publish_failing, mut stats_failing) = (false, false, false);
         self.last = Instant::now();
         let exit = event_loop::run(&listeners, tick, None, |wake| {
             if let Wake::Tick(expirations) = wake {
@@ -319,6 +363,21 @@ impl SimArm {
                         survived(&mut publish_failing, "publishing the states", &e, n);
                     }
                 }
+                if self.stats_pub.due(Instant::now()) {
+                    match self.publish_stats() {
+                        Ok(()) => stats_failing = false,
+                        Err(e) => {
+                            self.failures.stats += 1;
+                            let n = self.failures.stats;
+                            survived(
+                                &mut stats_failing,
+                                "publishing the driver statistics",
+                                &e,
+                                n,
+                            );
+                        }
+                    }
+                }
                 housekeeping += 1;
                 if u128::from(housekeeping) * tick.as_millis().max(1) >= 1000 {
                     housekeeping = 0;
@@ -345,7 +404,8 @@ fn survived(failing: &mut bool, what: &str, error: &dyn std::error::Error, count
         tracing::warn!(
             error = %error,
             count,
-            "simarm: {what} failed; skipped, retried at the next tick"
+            "simarm: {what} failed; skipped, retried at the next tick (the statistics a \
+             second later)"
         );
     }
     *failing = true;

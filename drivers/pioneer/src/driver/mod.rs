@@ -13,11 +13,11 @@ mod run;
 mod serve;
 
 use std::sync::mpsc::Receiver;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use limber_interfaces::diagnostics::{self, DriverStats, loop_mode};
 use limber_interfaces::prelude::*;
-use limber_services::diagnostics::StatsPublisher;
+use limber_services::diagnostics::{StatsPublisher, put_clients, put_loop};
 use limber_services::{Context, DeviceSet, Drain, HostError, monotonic_ns};
 use thiserror::Error;
 
@@ -187,7 +187,6 @@ pub struct PioneerDriver {
     reconnects: u64,
     link_faults: u64,
     next_reconnect: Instant,
-    last_stats: Instant,
     last_cleanup: Instant,
     mode: LoopMode,
     wakeups: u64,
@@ -348,7 +347,6 @@ impl PioneerDriver {
             reconnects: 0,
             link_faults: 0,
             next_reconnect: Instant::now(),
-            last_stats: Instant::now() - Duration::from_secs(10),
             last_cleanup: Instant::now(),
             mode: LoopMode::Event,
             wakeups: 0,
@@ -535,8 +533,7 @@ impl PioneerDriver {
             stats: &mut self.timing,
         };
         self.hosts.check_motions(&mut handler);
-        if now.duration_since(self.last_stats) >= Duration::from_secs(1) {
-            self.last_stats = now;
+        if self.stats_pub.due(now) {
             self.publish_stats();
         }
     }
@@ -550,14 +547,11 @@ impl PioneerDriver {
         } else {
             0
         } | simulated;
-        s.loop_mode = match self.mode {
+        let mode = match self.mode {
             LoopMode::Event => loop_mode::EVENT,
             LoopMode::Spin => loop_mode::SPIN,
         };
-        s.cycles = ls.ticks.cycles;
-        s.overruns = ls.ticks.overruns;
-        (s.period_p50_ns, s.period_p99_ns, s.period_max_ns) = ls.ticks.period.summary();
-        s.jitter_p99_ns = ls.ticks.jitter.summary().1;
+        put_loop(s, mode, &ls.ticks);
         (
             s.cmd_to_wire_p50_ns,
             s.cmd_to_wire_p99_ns,
@@ -574,11 +568,7 @@ impl PioneerDriver {
         }
         s.reconnects = self.reconnects;
         s.link_faults = self.link_faults;
-        let st = self.hosts.stats();
-        s.commands = st.commands;
-        s.refused = st.refused;
-        s.requests = st.requests;
-        s.cmd_overflows = st.overflows;
+        put_clients(s, &self.hosts.stats());
         if let Err(e) = self.stats_pub.publish(s) {
             self.failures.note(Failure::Publish, &e);
         }
