@@ -33,7 +33,7 @@ use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PsFactory;
 use limber_interfaces::prelude::*;
-use limber_services::monotonic_ns;
+use limber_services::{monotonic_ns, qos};
 
 use super::{Pace, READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario, physical};
 use crate::child::{ChildProc, ChildSpec, read_histogram};
@@ -120,48 +120,40 @@ type Pong = Subscriber<ipc::Service, ActArrayData, ()>;
 struct Services {
     a2b: PsFactory<ipc::Service, ActArrayCmdMsg, ()>,
     b2a: PsFactory<ipc::Service, ActArrayData, ()>,
-    /// The echo's state samples (`Echo::SpinState`).
-    state: PsFactory<ipc::Service, ActArrayData, ()>,
+    /// The echo's state samples (`Echo::SpinState` only).
+    state: Option<PsFactory<ipc::Service, ActArrayData, ()>>,
     ev_a2b: iceoryx2::service::port_factory::event::PortFactory<ipc::Service>,
     ev_b2a: iceoryx2::service::port_factory::event::PortFactory<ipc::Service>,
 }
 
-/// The sizes of the floor's topics: iceoryx2's smallest, or a device's (`Echo::SpinState`).
+/// The sizes of the command and reply topics: iceoryx2's smallest, or a device's
+/// (`Echo::SpinState`).
 struct Sizes {
-    /// Publishers of commands, subscribers of replies and states.
+    /// Publishers of commands, subscribers of replies (and of states).
     clients: usize,
     cmd_buffer: usize,
-    cmd_borrowed: usize,
+    /// The subscriber's borrow limit (`None`: iceoryx2's default, as the plain floors).
+    cmd_borrowed: Option<usize>,
     cmd_subscribers: usize,
     reply_buffer: usize,
-    state_publishers: usize,
-    state_buffer: usize,
-    state_history: usize,
 }
 
 impl Sizes {
     fn of(echo: Echo) -> Self {
-        use limber_services::qos;
         match echo {
             Echo::SpinState => Sizes {
                 clients: qos::Capacity::default().ports(),
                 cmd_buffer: qos::CMD_BUFFER,
-                cmd_borrowed: qos::CMD_BORROWED,
+                cmd_borrowed: Some(qos::CMD_BORROWED),
                 cmd_subscribers: qos::CMD_SUBSCRIBERS,
                 reply_buffer: qos::TOLD_BUFFER,
-                state_publishers: qos::DATA_PUBLISHERS,
-                state_buffer: qos::DATA_BUFFER,
-                state_history: 1,
             },
             _ => Sizes {
                 clients: 1,
                 cmd_buffer: 4,
-                cmd_borrowed: 2,
+                cmd_borrowed: None,
                 cmd_subscribers: 1,
                 reply_buffer: 4,
-                state_publishers: 1,
-                state_buffer: 4,
-                state_history: 0,
             },
         }
     }
@@ -174,14 +166,17 @@ fn services(node: &Node<ipc::Service>, echo: Echo) -> Result<Services, BenchErro
         ServiceName::new(&format!("limber-bench/{tag}/{ch}"))
             .map_err(|e| BenchError::transport("service name", e))
     };
-    let a2b = node
+    let mut a2b = node
         .service_builder(&name("a2b")?)
         .publish_subscribe::<ActArrayCmdMsg>()
         .max_publishers(z.clients)
         .max_subscribers(z.cmd_subscribers)
         .history_size(0)
-        .subscriber_max_buffer_size(z.cmd_buffer)
-        .subscriber_max_borrowed_samples(z.cmd_borrowed)
+        .subscriber_max_buffer_size(z.cmd_buffer);
+    if let Some(n) = z.cmd_borrowed {
+        a2b = a2b.subscriber_max_borrowed_samples(n);
+    }
+    let a2b = a2b
         .open_or_create()
         .map_err(|e| BenchError::transport("floor a2b service", e))?;
     let b2a = node
@@ -193,15 +188,20 @@ fn services(node: &Node<ipc::Service>, echo: Echo) -> Result<Services, BenchErro
         .subscriber_max_buffer_size(z.reply_buffer)
         .open_or_create()
         .map_err(|e| BenchError::transport("floor b2a service", e))?;
-    let state = node
-        .service_builder(&name("state")?)
-        .publish_subscribe::<ActArrayData>()
-        .max_publishers(z.state_publishers)
-        .max_subscribers(z.clients)
-        .history_size(z.state_history)
-        .subscriber_max_buffer_size(z.state_buffer)
-        .open_or_create()
-        .map_err(|e| BenchError::transport("floor state service", e))?;
+    // The state topic as a device's `data` channel.
+    let state = match echo {
+        Echo::SpinState => Some(
+            node.service_builder(&name("state")?)
+                .publish_subscribe::<ActArrayData>()
+                .max_publishers(qos::DATA_PUBLISHERS)
+                .max_subscribers(z.clients)
+                .history_size(1)
+                .subscriber_max_buffer_size(qos::DATA_BUFFER)
+                .open_or_create()
+                .map_err(|e| BenchError::transport("floor state service", e))?,
+        ),
+        _ => None,
+    };
     let ev_a2b = node
         .service_builder(&name("ev_a2b")?)
         .event()
@@ -337,15 +337,12 @@ pub fn ping_pong(ctx: &mut RunCtx, echo: Echo, pace: Pace) -> Result<(), BenchEr
         .subscriber_builder()
         .create()
         .map_err(|e| BenchError::transport("floor subscriber", e))?;
-    let states = match echo {
-        Echo::SpinState => Some(
-            svc.state
-                .subscriber_builder()
-                .create()
-                .map_err(|e| BenchError::transport("floor state subscriber", e))?,
-        ),
-        _ => None,
-    };
+    let states = svc
+        .state
+        .as_ref()
+        .map(|f| f.subscriber_builder().create())
+        .transpose()
+        .map_err(|e| BenchError::transport("floor state subscriber", e))?;
     let (notifier, listener) = if event {
         (
             Some(
@@ -475,15 +472,12 @@ pub fn echo_role(args: &BenchArgs, echo: Echo) -> Result<(), BenchError> {
         .publisher_builder()
         .create()
         .map_err(|e| BenchError::transport("echo publisher", e))?;
-    let state_pub = match echo {
-        Echo::SpinState => Some(
-            svc.state
-                .publisher_builder()
-                .create()
-                .map_err(|e| BenchError::transport("echo state publisher", e))?,
-        ),
-        _ => None,
-    };
+    let state_pub = svc
+        .state
+        .as_ref()
+        .map(|f| f.publisher_builder().create())
+        .transpose()
+        .map_err(|e| BenchError::transport("echo state publisher", e))?;
     let (listener, notifier) = if event {
         (
             Some(
