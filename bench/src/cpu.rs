@@ -114,6 +114,61 @@ impl Window {
     }
 }
 
+/// CPU readings of several processes over several stretches of time, summed: what they
+/// cost while one path ran, when its exchanges alternate with another path's (the
+/// bridge's blocks between its floor's).
+#[derive(Debug)]
+pub struct Stretches {
+    processes: Vec<(String, u32)>,
+    used: Vec<Duration>,
+    wall: Duration,
+}
+
+impl Stretches {
+    /// Nothing measured yet, over `processes` (what each is, its pid).
+    pub fn new(processes: &[(&str, u32)]) -> Self {
+        Stretches {
+            processes: processes
+                .iter()
+                .map(|(who, pid)| ((*who).to_string(), *pid))
+                .collect(),
+            used: vec![Duration::ZERO; processes.len()],
+            wall: Duration::ZERO,
+        }
+    }
+
+    /// Runs `stretch` and adds what each process used meanwhile.
+    pub fn measure<T>(&mut self, stretch: impl FnOnce() -> T) -> Result<T, CpuError> {
+        let before = self
+            .processes
+            .iter()
+            .map(|(_, pid)| cpu_time(*pid))
+            .collect::<Result<Vec<_>, CpuError>>()?;
+        let started = Instant::now();
+        let out = stretch();
+        self.wall += started.elapsed();
+        for ((used, (_, pid)), b) in self.used.iter_mut().zip(&self.processes).zip(before) {
+            *used += cpu_time(*pid)?.saturating_sub(b);
+        }
+        Ok(out)
+    }
+
+    /// The stretches' wall time, summed.
+    pub fn wall(&self) -> Duration {
+        self.wall
+    }
+
+    /// Each process's share of one core over the stretches, percent, in the order given.
+    pub fn shares(&self) -> Vec<(String, f64)> {
+        let wall = self.wall.as_secs_f64().max(1e-9);
+        self.processes
+            .iter()
+            .zip(&self.used)
+            .map(|((who, _), used)| (who.clone(), used.as_secs_f64() / wall * 100.0))
+            .collect()
+    }
+}
+
 /// What a process cost in one state of a scenario, as reported.
 #[derive(Debug, Clone, Serialize)]
 pub struct CpuCost {
@@ -193,6 +248,43 @@ mod tests {
         assert_eq!(parse_stat(line), Some(Duration::from_secs(3)));
         assert_eq!(parse_stat("4242 (x) S 1"), None);
         assert_eq!(parse_stat("no name here"), None);
+    }
+
+    /// Only the stretches count: time between them (burning or not) is neither wall time
+    /// nor use.
+    #[test]
+    fn stretches_count_only_what_ran_inside_them() {
+        let me = std::process::id();
+        let mut s = Stretches::new(&[("me", me)]);
+        assert_eq!(s.shares(), vec![("me".to_string(), 0.0)]);
+        let deadline = Instant::now() + Duration::from_secs(20);
+        let mut x = 0u64;
+        // Burning, in several stretches, until the kernel has charged a tick in one.
+        while s.used[0].is_zero() && Instant::now() < deadline {
+            s.measure(|| {
+                let before = cpu_time(me).expect("cpu time");
+                while cpu_time(me).expect("cpu time") == before && Instant::now() < deadline {
+                    for _ in 0..100_000 {
+                        x = x.wrapping_mul(6364136223846793005).wrapping_add(1);
+                    }
+                    std::hint::black_box(x);
+                }
+            })
+            .expect("a stretch");
+        }
+        let wall = s.wall();
+        assert!(!wall.is_zero());
+        // Between stretches: not counted.
+        let between = Instant::now();
+        while between.elapsed() < Duration::from_millis(30) {
+            std::hint::black_box(x.wrapping_add(1));
+        }
+        assert_eq!(s.wall(), wall, "time between stretches was counted");
+        let got = s.shares();
+        assert_eq!(got[0].0, "me");
+        assert!(got[0].1 > 0.0, "{got:?}");
+        let mut gone = Stretches::new(&[("none", u32::MAX)]);
+        assert!(matches!(gone.measure(|| ()), Err(CpuError::Read { .. })));
     }
 
     #[test]

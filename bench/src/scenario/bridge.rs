@@ -8,8 +8,12 @@
 //! direct row), then the one in B (the bridge row); the report sets the bridge row beside
 //! the TCP loopback peer row of the same run (`peers`).
 //!
-//! Its floor runs first, in the same run: raw Zenoh between two processes over a Unix
-//! socket, a put/subscribe ping-pong and a get/queryable exchange ([`zenoh_floor`]).
+//! Its floor, in the same run: raw Zenoh between two processes over a Unix socket, a
+//! get/queryable exchange first and a put/subscribe ping-pong ([`zenoh_floor`]) whose
+//! blocks alternate with the bridge row's (`interleaved`), so that the goal's ratio is of
+//! the same moments of the machine (on this VM the pace of wake-ups changes by up to 2x for
+//! seconds at a time: a floor measured first and the bridge after could fall in
+//! different ones).
 //!
 //! The bridges are the `limber` executable: `$LIMBER_BIN` if set, else this executable if
 //! it is `limber`, else `limber` beside it. If none can run `limber bridge` (e.g.
@@ -117,13 +121,54 @@ fn start_bridge(
     Ok(child)
 }
 
+/// The round trips of one run: the floor's put and get, the client direct and through the
+/// bridge pair.
+struct RoundTrips {
+    put: Histogram<u64>,
+    get: Histogram<u64>,
+    direct: Histogram<u64>,
+    bridge: Histogram<u64>,
+}
+
 fn run(ctx: &mut RunCtx, exe: &Path) -> Result<(), BenchError> {
-    let (a, b) = (ctx.domain(), ctx.domain());
     let (warm, n) = (ctx.count(300, 50), ctx.count(3_000, 300));
-    // The floor first: raw Zenoh over the same kind of link, same payloads.
-    zenoh_floor::run(ctx, warm, n)?;
-    // Two clients, one after the other; through the bridge an exchange takes ~1 ms or less.
-    let deadline = ctx.deadline_for(2 * (warm + n), Duration::from_millis(1));
+    // The floor: raw Zenoh over the same kind of link, same payloads; its echo lives through
+    // the run (its ping-pong alternates with the bridge's commands). Through the bridge an
+    // exchange takes ~1 ms or less; four series of `warm + n`.
+    let deadline = ctx.deadline_for(4 * (warm + n), Duration::from_millis(1));
+    let floor = zenoh_floor::Floor::start(ctx, deadline)?;
+    let r = with_floor(ctx, exe, &floor, (warm, n), deadline);
+    let finished = floor.finish();
+    let rt = r?;
+    finished?;
+    zenoh_floor::push(ctx, rt.put, rt.get);
+    push(
+        ctx,
+        "bridge.direct.rtt",
+        "command→outcome, client in the driver's domain",
+        rt.direct,
+    );
+    push(
+        ctx,
+        "bridge.zenoh.rtt",
+        "command→outcome through bridge expose+mirror (Zenoh, Unix socket)",
+        rt.bridge,
+    );
+    Ok(())
+}
+
+/// The scenario with its floor's echo up: the floor's get exchanges, the driver and the
+/// direct client, the bridge pair idle, then the floor's ping-pong and the command through
+/// the pair in alternating blocks ([`interleaved`]).
+fn with_floor(
+    ctx: &mut RunCtx,
+    exe: &Path,
+    floor: &zenoh_floor::Floor,
+    (warm, n): (u64, u64),
+    deadline: Duration,
+) -> Result<RoundTrips, BenchError> {
+    let (a, b) = (ctx.domain(), ctx.domain());
+    let get = floor.get_round_trips(ctx, warm, n)?;
     let driver = start_event_driver(ctx, &a, "bridge-driver.hdr", deadline)?;
     let cctx_a = Context::new(&a, Role::Client, "bench-bridge")
         .map_err(|e| err("client context in A", e))?;
@@ -153,16 +198,19 @@ fn run(ctx: &mut RunCtx, exe: &Path) -> Result<(), BenchError> {
             .map_err(|e| err("client context in B", e))?;
         let mut remote = ActArrayClient::connect_timeout(&cctx_b, DEVICE, READY_TIMEOUT)
             .map_err(|e| err("connect in B", e))?;
-        // What the pair costs while it carries them, beside the latency.
-        let busy = cpu::Window::start(&[
+        remote
+            .current(READY_TIMEOUT)
+            .map_err(|e| err("first state", e))?;
+        let mut pinger = floor.pinger()?;
+        // What the pair costs while it carries them, beside the latency: over the bridge's
+        // blocks only.
+        let mut busy = cpu::Stretches::new(&[
             ("bridge expose", expose.pid()),
             ("bridge mirror", mirror.pid()),
             ("driver", driver.pid()),
-        ])
-        .map_err(|e| err("cpu time", e))?;
-        let rtt_bridge = round_trips(ctx, &mut remote, "bridge zenoh", warm, n)?;
-        let window = busy.elapsed();
-        for (process, percent) in busy.end().map_err(|e| err("cpu time", e))? {
+        ]);
+        let (put, bridge) = interleaved(ctx, &mut pinger, &mut remote, (warm, n), &mut busy)?;
+        for (process, percent) in busy.shares() {
             ctx.push_cpu(CpuCost {
                 id: format!("bridge.busy.{}", process.replace(' ', "_")),
                 scenario: "bridge",
@@ -170,7 +218,7 @@ fn run(ctx: &mut RunCtx, exe: &Path) -> Result<(), BenchError> {
                 load: "commands back to back".into(),
                 process,
                 percent,
-                window_s: window.as_secs_f64(),
+                window_s: busy.wall().as_secs_f64(),
                 latency_id: Some("bridge.zenoh.rtt".into()),
                 at_most_percent: None,
             });
@@ -178,27 +226,77 @@ fn run(ctx: &mut RunCtx, exe: &Path) -> Result<(), BenchError> {
         drop(remote);
         mirror.terminate(Duration::from_secs(10))?;
         expose.terminate(Duration::from_secs(10))?;
-        Ok((rtt_direct, rtt_bridge))
+        Ok((rtt_direct, put, bridge))
     })();
     // HOME all joints stops the driver child (if it cannot be sent, its deadline does).
     if let Err(e) = direct.home(None) {
         tracing::warn!("cannot tell the driver child to stop: {e}");
     }
     driver.finish(Duration::from_secs(10))?;
-    let (rtt_direct, rtt_bridge) = r?;
-    push(
-        ctx,
-        "bridge.direct.rtt",
-        "command→outcome, client in the driver's domain",
-        rtt_direct,
-    );
-    push(
-        ctx,
-        "bridge.zenoh.rtt",
-        "command→outcome through bridge expose+mirror (Zenoh, Unix socket)",
-        rtt_bridge,
-    );
-    Ok(())
+    let (direct, put, bridge) = r?;
+    Ok(RoundTrips {
+        put,
+        get,
+        direct,
+        bridge,
+    })
+}
+
+/// How many blocks of each path a run of `n` exchanges makes (fewer when blocks would be
+/// shorter than [`MIN_BLOCK`]).
+const BLOCKS: u64 = 15;
+
+/// The fewest exchanges in a block.
+const MIN_BLOCK: u64 = 20;
+
+/// The floor's put ping-pong (`pinger`) and the command through the bridge pair
+/// (`remote`), `warm` + `n` of each, alternating: `warm` pairs first, unrecorded, then
+/// blocks of about `n / 15` of one path and then of the other, so that a change of the
+/// machine's pace (a VM's vCPU placement changes its wake-ups by 2x for seconds) falls on
+/// both and their ratio is of the same moments. Each block begins with one exchange not
+/// recorded (the first after the other path's block finds its threads asleep). `busy`
+/// measures the bridge's blocks. Returns (floor, bridge).
+fn interleaved(
+    ctx: &RunCtx,
+    pinger: &mut zenoh_floor::Pinger,
+    remote: &mut ActArrayClient,
+    (warm, n): (u64, u64),
+    busy: &mut cpu::Stretches,
+) -> Result<(Histogram<u64>, Histogram<u64>), BenchError> {
+    const WHAT: &str = "bridge zenoh";
+    let mut i = 0u64;
+    let mut command = |remote: &mut ActArrayClient| {
+        i += 1;
+        timed_command(remote, i, WHAT)
+    };
+    let progress = Progress::new(ctx.progress, "bridge + zenoh floor", warm + n);
+    for k in 1..=warm {
+        pinger.round_trip()?;
+        command(remote)?;
+        progress.tick(k);
+    }
+    let (mut floor, mut bridge) = (new_histogram()?, new_histogram()?);
+    let block = (n / BLOCKS).max(MIN_BLOCK);
+    let mut done = 0;
+    while done < n {
+        let len = block.min(n - done);
+        pinger.round_trip()?;
+        for _ in 0..len {
+            floor.saturating_record(pinger.round_trip()?);
+        }
+        busy.measure(|| -> Result<(), BenchError> {
+            command(remote)?;
+            for _ in 0..len {
+                bridge.saturating_record(command(remote)?);
+            }
+            Ok(())
+        })
+        .map_err(|e| err("cpu time", e))??;
+        done += len;
+        progress.tick(warm + done);
+    }
+    progress.finish();
+    Ok((floor, bridge))
 }
 
 /// The most an idle bridge of the pair may cost, percent of a core.

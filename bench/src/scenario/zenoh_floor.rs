@@ -9,13 +9,18 @@
 //!   a request), consolidation off as a mirror asks.
 //!
 //! Round trips only, measured by the pinging parent (`bridge.raw.put.rtt`,
-//! `bridge.raw.get.rtt`). The echo answers from Zenoh's callbacks.
+//! `bridge.raw.get.rtt`). The echo answers from Zenoh's callbacks. The get exchanges run
+//! back to back; the put ping-pong is the bridge's floor and runs in blocks that alternate
+//! with the bridge's own (`bridge`), so that both see the same moments of the machine.
 
 use std::time::{Duration, Instant};
 
 use hdrhistogram::Histogram;
 use limber_services::monotonic_ns;
+use zenoh::handlers::FifoChannelHandler;
+use zenoh::pubsub::{Publisher, Subscriber};
 use zenoh::query::ConsolidationMode;
+use zenoh::sample::Sample;
 use zenoh::{Config, Session, Wait};
 
 use super::floor::BYTES;
@@ -66,34 +71,69 @@ fn seq_of(bytes: &[u8]) -> Option<u64> {
     Some(u64::from_le_bytes(bytes.get(..8)?.try_into().ok()?))
 }
 
-/// Runs the raw Zenoh floor against an echo child on a Unix socket in the scratch
-/// directory, and adds its two measurements.
-pub fn run(ctx: &mut RunCtx, warm: u64, n: u64) -> Result<(), BenchError> {
-    let sock = ctx.tmp_file("zenoh-floor.sock");
-    let endpoint = format!("unixsock-stream/{}", sock.display());
-    let deadline = ctx.deadline_for(2 * (warm + n), Duration::from_millis(1));
-    let mut child = ChildProc::spawn(&ChildSpec {
-        role: "zenoh-echo".into(),
-        addr: Some(endpoint.clone()),
-        cpu: ctx.child_cpu(),
-        deadline,
-        ..Default::default()
-    })?;
-    child.expect("ready", READY_TIMEOUT)?;
-    let session = open(&[], &[&endpoint])?;
-    let r = (|| {
-        let put = put_round_trips(ctx, &session, warm, n)?;
-        let get = get_round_trips(ctx, &session, warm, n)?;
-        Ok::<_, BenchError>((put, get))
-    })();
-    if let Err(e) = session.close().wait() {
-        tracing::warn!("cannot close the zenoh floor's session: {e}");
+/// The raw Zenoh floor: an echo child on a Unix socket in the scratch directory and this
+/// process's session connected to it, open while the bridge's own exchanges run, so that
+/// the floor's ping-pong can alternate with them ([`Pinger`]).
+pub struct Floor {
+    child: ChildProc,
+    session: Session,
+}
+
+impl Floor {
+    /// Starts the echo child (alive for `deadline` at most) and connects to it.
+    pub fn start(ctx: &mut RunCtx, deadline: Duration) -> Result<Floor, BenchError> {
+        let sock = ctx.tmp_file("zenoh-floor.sock");
+        let endpoint = format!("unixsock-stream/{}", sock.display());
+        let mut child = ChildProc::spawn(&ChildSpec {
+            role: "zenoh-echo".into(),
+            addr: Some(endpoint.clone()),
+            cpu: ctx.child_cpu(),
+            deadline,
+            ..Default::default()
+        })?;
+        child.expect("ready", READY_TIMEOUT)?;
+        match open(&[], &[&endpoint]) {
+            Ok(session) => Ok(Floor { child, session }),
+            Err(e) => {
+                if let Err(k) = child.terminate(Duration::from_secs(10)) {
+                    tracing::warn!("cannot stop the zenoh echo: {k}");
+                }
+                Err(e)
+            }
+        }
     }
-    if let Err(e) = child.send_line("quit") {
-        tracing::warn!("cannot tell the zenoh echo to quit: {e}");
+
+    /// The put/subscribe ping-pong, once both sides see each other.
+    pub fn pinger(&self) -> Result<Pinger, BenchError> {
+        Pinger::new(&self.session)
     }
-    child.finish(Duration::from_secs(10))?;
-    let (put, get) = r?;
+
+    /// `warm` + `n` get/queryable exchanges back to back; the last `n` recorded.
+    pub fn get_round_trips(
+        &self,
+        ctx: &RunCtx,
+        warm: u64,
+        n: u64,
+    ) -> Result<Histogram<u64>, BenchError> {
+        get_round_trips(ctx, &self.session, warm, n)
+    }
+
+    /// Closes the session and tells the echo to end.
+    pub fn finish(self) -> Result<(), BenchError> {
+        let Floor { mut child, session } = self;
+        if let Err(e) = session.close().wait() {
+            tracing::warn!("cannot close the zenoh floor's session: {e}");
+        }
+        if let Err(e) = child.send_line("quit") {
+            tracing::warn!("cannot tell the zenoh echo to quit: {e}");
+        }
+        child.finish(Duration::from_secs(10))
+    }
+}
+
+/// Adds the floor's two measurements: the put ping-pong's round trips and the get
+/// exchange's.
+pub fn push(ctx: &mut RunCtx, put: Histogram<u64>, get: Histogram<u64>) {
     for (id, label, hist) in [
         (
             "bridge.raw.put.rtt",
@@ -116,50 +156,61 @@ pub fn run(ctx: &mut RunCtx, warm: u64, n: u64) -> Result<(), BenchError> {
             hist,
         });
     }
-    Ok(())
 }
 
-fn put_round_trips(
-    ctx: &RunCtx,
-    session: &Session,
-    warm: u64,
-    n: u64,
-) -> Result<Histogram<u64>, BenchError> {
-    let ping = session
-        .declare_publisher(PING)
-        .wait()
-        .map_err(zerr("ping publisher"))?;
-    let pongs = session
-        .declare_subscriber(PONG)
-        .wait()
-        .map_err(zerr("pong subscriber"))?;
-    // Until both sides see each other, a put goes nowhere: ping 0 until its pong comes.
-    let until = Instant::now() + READY_TIMEOUT;
-    'sync: loop {
-        ping.put(payload(0, BYTES.0)).wait().map_err(zerr("ping"))?;
-        let tick = Instant::now() + Duration::from_millis(100);
-        while let Some(s) = pongs.recv_deadline(tick).map_err(zerr("pong"))? {
-            if seq_of(&s.payload().to_bytes()) == Some(0) {
-                break 'sync;
+/// The pinging side of the put/subscribe ping-pong.
+pub struct Pinger {
+    ping: Publisher<'static>,
+    pongs: Subscriber<FifoChannelHandler<Sample>>,
+    seq: u64,
+}
+
+impl Pinger {
+    fn new(session: &Session) -> Result<Pinger, BenchError> {
+        let ping = session
+            .declare_publisher(PING)
+            .wait()
+            .map_err(zerr("ping publisher"))?;
+        let pongs = session
+            .declare_subscriber(PONG)
+            .wait()
+            .map_err(zerr("pong subscriber"))?;
+        // Until both sides see each other, a put goes nowhere: ping 0 until its pong comes.
+        let until = Instant::now() + READY_TIMEOUT;
+        'sync: loop {
+            ping.put(payload(0, BYTES.0)).wait().map_err(zerr("ping"))?;
+            let tick = Instant::now() + Duration::from_millis(100);
+            while let Some(s) = pongs.recv_deadline(tick).map_err(zerr("pong"))? {
+                if seq_of(&s.payload().to_bytes()) == Some(0) {
+                    break 'sync;
+                }
+            }
+            if Instant::now() > until {
+                return Err(BenchError::Timeout {
+                    what: "the zenoh echo's first pong".into(),
+                    timeout: READY_TIMEOUT,
+                });
             }
         }
-        if Instant::now() > until {
-            return Err(BenchError::Timeout {
-                what: "the zenoh echo's first pong".into(),
-                timeout: READY_TIMEOUT,
-            });
-        }
+        Ok(Pinger {
+            ping,
+            pongs,
+            seq: 0,
+        })
     }
-    let mut rtt = new_histogram()?;
-    let progress = Progress::new(ctx.progress, "zenoh put", warm + n);
-    for seq in 1..=warm + n {
+
+    /// One ping and its pong: the round trip, ns.
+    pub fn round_trip(&mut self) -> Result<u64, BenchError> {
+        self.seq += 1;
+        let seq = self.seq;
         let t0 = monotonic_ns();
-        ping.put(payload(seq, BYTES.0))
+        self.ping
+            .put(payload(seq, BYTES.0))
             .wait()
             .map_err(zerr("ping"))?;
         let until = Instant::now() + SAMPLE_TIMEOUT;
         loop {
-            let Some(s) = pongs.recv_deadline(until).map_err(zerr("pong"))? else {
+            let Some(s) = self.pongs.recv_deadline(until).map_err(zerr("pong"))? else {
                 return Err(BenchError::Timeout {
                     what: format!("zenoh pong {seq}"),
                     timeout: SAMPLE_TIMEOUT,
@@ -169,14 +220,8 @@ fn put_round_trips(
                 break;
             }
         }
-        let t1 = monotonic_ns();
-        if seq > warm {
-            rtt.saturating_record(t1.saturating_sub(t0));
-        }
-        progress.tick(seq);
+        Ok(monotonic_ns().saturating_sub(t0))
     }
-    progress.finish();
-    Ok(rtt)
 }
 
 fn get_round_trips(
