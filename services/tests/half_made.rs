@@ -116,9 +116,9 @@ fn half_made_client() {
 const CLIENT_ENV: &str = "LIMBER_TEST_HALF_MADE_CLIENT";
 
 /// A live driver cleans up after its dead clients (its 1 Hz housekeeping): a client killed
-/// while iceoryx2 made one of its connections does not hang the driver's loop. While such a
-/// file is young (its maker may be making it still) the driver leaves the cleanup for a
-/// later tick; once it is old, the driver removes it and cleans up.
+/// while iceoryx2 made one of its connections does not hang the driver's loop. Such a file
+/// names a port of the dead client: the driver removes it at once, young as it is, and
+/// cleans up.
 #[test]
 fn a_driver_does_not_hang_on_what_a_killed_client_left_half_made() {
     let domain = Domain::unique_for_test();
@@ -159,27 +159,64 @@ fn a_driver_does_not_hang_on_what_a_killed_client_left_half_made() {
         !spoiled.is_empty(),
         "the client left no connection to spoil"
     );
-    // Young: left alone, the cleanup put off (old code, as root: never returns).
-    host.cleanup_dead();
-    assert!(spoiled.iter().all(|(p, _)| p.exists()));
-    // Old: removed, and the cleanup goes on.
-    for (_, f) in &spoiled {
-        f.set_modified(std::time::SystemTime::now() - Duration::from_secs(60))
-            .unwrap();
-    }
+    // Young, and of the dead client's ports: removed, and the cleanup goes on (old code,
+    // as root: never returns).
     host.cleanup_dead();
     assert!(spoiled.iter().all(|(p, _)| !p.exists()));
+    assert_eq!(
+        dead_nodes(&domain),
+        0,
+        "the dead client is cleaned up after"
+    );
     host.publish().unwrap();
+}
+
+/// The processes of `domain` that iceoryx2 lists dead (not cleaned up after yet).
+fn dead_nodes(domain: &Domain) -> usize {
+    use iceoryx2::prelude::{CallbackProgression, Node, NodeState, ipc};
+    let mut n = 0;
+    Node::<ipc::Service>::list(domain.config().unwrap(), |s| {
+        if matches!(s, NodeState::Dead(_)) {
+            n += 1;
+        }
+        CallbackProgression::Continue
+    })
+    .unwrap();
+    n
+}
+
+/// Plants in `/dev/shm`, next to the connection `like` of the domain with `prefix`, a
+/// connection between two ports that no process has, empty and write-only: what a live
+/// process's connection looks like in the instant iceoryx2 makes it. Returns its path and
+/// the open file.
+fn plant_stray(prefix: &str, like: &std::path::Path) -> (std::path::PathBuf, std::fs::File) {
+    let name = like.file_name().unwrap().to_string_lossy().to_string();
+    let hash = name
+        .strip_prefix(prefix)
+        .and_then(|r| r.split('_').next())
+        .expect("a connection of the domain");
+    let path = like.with_file_name(format!("{prefix}{hash}_11_22.connection"));
+    let f = std::fs::File::create(&path).unwrap();
+    f.set_permissions(std::fs::Permissions::from_mode(0o200))
+        .unwrap();
+    (path, f)
 }
 
 /// A process joining the domain cleans up after its dead processes (iceoryx2 did that on
 /// every node's creation, and, as root, never returned on a segment a killed process left
 /// half made: a client or driver started after such a kill hung in `Context::new`). The
-/// join now puts the cleanup off while such a file is young, and removes it once old.
+/// join removes the segments the dead left half made, whatever their age, and cleans up
+/// after them at once (it used to put the whole cleanup off while they were young: a
+/// member's crashed driver stayed dead after its user's next `limber list`,
+/// tests/tests/group.rs). A young half-made segment of ports that are not the dead's (its
+/// maker may be making it still) puts the cleanup off; once old, it is removed and the
+/// cleanup goes on.
 #[test]
 fn a_process_joining_does_not_hang_on_what_a_killed_one_left_half_made() {
     let domain = Domain::unique_for_test();
+    let prefix = domain.prefix().unwrap().to_string();
     let spoiled = killed_leaving_half_made(&domain);
+    assert!(dead_nodes(&domain) > 0, "the killed child is listed dead");
     let join = |name: &'static str| {
         let (tx, rx) = mpsc::channel();
         let d = domain.clone();
@@ -191,16 +228,42 @@ fn a_process_joining_does_not_hang_on_what_a_killed_one_left_half_made() {
             .unwrap_or_else(|_| panic!("{name} hung joining the domain"))
             .unwrap();
     };
-    // Young: left alone, the cleanup put off (old code, as root: never returns).
+    // Young, of the dead's ports: removed, and the cleanup goes on at once (old code: put
+    // off; as root before that: never returned).
     join("late-client");
-    assert!(spoiled.iter().all(|(p, _)| p.exists()));
+    let left: Vec<_> = spoiled.iter().filter(|(p, _)| p.exists()).collect();
+    assert!(left.is_empty(), "left half made: {left:?}");
+    assert_eq!(
+        dead_nodes(&domain),
+        0,
+        "the killed child is cleaned up after"
+    );
+
+    // A young one of ports nobody has, and a dead process again: the cleanup is put off.
+    let again = killed_leaving_half_made(&domain);
+    let stray = plant_stray(&prefix, &again[0].0);
+    join("next-client");
+    assert!(
+        stray.0.exists(),
+        "a young segment of unknown ports is left alone"
+    );
+    assert!(
+        again.iter().all(|(p, _)| !p.exists()),
+        "the dead's are removed"
+    );
+    assert!(dead_nodes(&domain) > 0, "the cleanup is put off");
     // Old: removed, and the cleanup goes on.
-    for (_, f) in &spoiled {
-        f.set_modified(std::time::SystemTime::now() - Duration::from_secs(60))
-            .unwrap();
-    }
+    stray
+        .1
+        .set_modified(std::time::SystemTime::now() - Duration::from_secs(60))
+        .unwrap();
     join("later-client");
-    assert!(spoiled.iter().all(|(p, _)| !p.exists()));
+    assert!(!stray.0.exists());
+    assert_eq!(
+        dead_nodes(&domain),
+        0,
+        "the killed child is cleaned up after"
+    );
 }
 
 /// A client killed while iceoryx2 made one of its connections, before the driver

@@ -574,3 +574,60 @@ fn a_members_crashed_driver_is_cleaned_up_by_its_user_then_another_member_restar
     assert_eq!(driver.wait_timeout(LIMIT), Some(0), "B's driver's exit");
     remove_leftovers(&prefix);
 }
+
+/// A member's driver SIGKILLed while iceoryx2 made one of its connections (a port of its
+/// own connecting, as the world's watch of the arm does when the arm answers late) leaves
+/// that file empty and write-only. Its user's next command removes it with the rest of the
+/// dead driver's files and cleans up at once: it used to put the whole cleanup off while
+/// the file was young (under 10 s), so another member's driver was still refused after it
+/// (the flaky end of the test above, on a loaded machine).
+#[test]
+fn a_members_driver_killed_mid_connection_is_cleaned_up_by_its_users_next_command() {
+    let Some(_) = users() else { return };
+    let s = Scratch::new("midconn");
+    let domain = Domain::unique_for_test();
+    let mut driver = start_driver(&s, &domain);
+    let prefix = prefix(&s, &domain);
+    // The driver's own ports connect (the world watches the arm) a moment after "ready".
+    let a_uid = std::fs::metadata(s.runtime()).unwrap().uid();
+    let deadline = std::time::Instant::now() + LIMIT;
+    let conn = loop {
+        let found = shm_files(&prefix).into_iter().find(|p| {
+            p.to_string_lossy().ends_with(".connection")
+                && std::fs::metadata(p).is_ok_and(|md| md.uid() == a_uid && md.len() > 0)
+        });
+        if let Some(p) = found {
+            break p;
+        }
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the driver made no connection"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    driver.signal(libc::SIGKILL);
+    assert_eq!(driver.wait_timeout(LIMIT), None, "killed");
+
+    // That connection, as the kill between iceoryx2's creating it and sizing it leaves it:
+    // empty, write-only, of its user.
+    let md = std::fs::metadata(&conn).unwrap();
+    std::fs::remove_file(&conn).unwrap();
+    let f = std::fs::File::create(&conn).unwrap();
+    f.set_permissions(std::fs::Permissions::from_mode(0o200))
+        .unwrap();
+    std::os::unix::fs::fchown(&f, Some(md.uid()), Some(md.gid())).unwrap();
+    drop(f);
+
+    // A's next limber command cleans up, that file included; then B's driver serves.
+    let out = run(&mut s.limber(A, &domain, true, &["list"]));
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(!conn.exists(), "{} is left", conn.display());
+    let mut driver = spawn(s.limber(B, &domain, true, &["pioneer", "--emulated"]));
+    assert!(
+        driver.read_until(|l| l.ends_with("ready")).is_some(),
+        "B's driver did not start"
+    );
+    driver.signal(libc::SIGTERM);
+    assert_eq!(driver.wait_timeout(LIMIT), Some(0), "B's driver's exit");
+    remove_leftovers(&prefix);
+}

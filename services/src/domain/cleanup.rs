@@ -7,9 +7,11 @@
 //! the test killed, the node counter iceoryx2 leaves in `/dev/shm`, and the domain's token.
 //! A test run thus leaves nothing in the runtime directory or in `/dev/shm`.
 
+use std::collections::HashSet;
 use std::fs;
 use std::io;
 use std::os::unix::fs::MetadataExt;
+use std::path::Path;
 use std::time::{Duration, Instant};
 
 use iceoryx2::node::{NodeListFailure, NodeView};
@@ -101,7 +103,9 @@ pub fn remove(domain: &Domain) -> Result<Removed, RemoveError> {
         source,
     })?;
     // Before iceoryx2 opens anything of the dead: the segments they left half made.
-    let (half_made, _) = remove_half_made(&files.prefix, processes.is_empty());
+    let dead_ids: Vec<u128> = dead.iter().map(|v| v.id().value()).collect();
+    let half_made = remove_half_made_of_nodes(&files.prefix, &files.root, &dead_ids)
+        + remove_half_made(&files.prefix, processes.is_empty()).0;
     let mut dead_processes = 0;
     for v in dead {
         match v.blocking_remove_stale_resources(Duration::ZERO) {
@@ -193,7 +197,7 @@ pub(crate) fn remove_half_made_of(prefix: &str, gone: impl Fn(u128) -> bool) -> 
 fn sweep_half_made(prefix: &str, mut remove: impl FnMut(&str, &fs::Metadata) -> bool) -> usize {
     let me = dir::euid();
     let mut n = 0;
-    for e in dir::entries(std::path::Path::new(dir::SHM_DIR)) {
+    for e in dir::entries(Path::new(dir::SHM_DIR)) {
         let name = e.file_name().to_string_lossy().to_string();
         if !name.starts_with(prefix) {
             continue;
@@ -221,16 +225,77 @@ fn sweep_half_made(prefix: &str, mut remove: impl FnMut(&str, &fs::Metadata) -> 
     n
 }
 
-/// Before a live process cleans up after the dead of `domain` through iceoryx2: removes the
-/// segments a killed process left half made ([`remove_half_made`], those older than
-/// [`HALF_MADE_AGE`]) and says whether the cleanup may go on, false while a younger one is
-/// there (iceoryx2 would wait on it for ever, as root, if its maker is dead: the cleanup
-/// waits for a later call instead, by when it is made or old enough to remove).
-pub(crate) fn half_made_cleared(domain: &Domain) -> bool {
-    let Ok(prefix) = domain.prefix() else {
+/// The port ids of the nodes `nodes` of the domain with `prefix` (iceoryx2 root `root`): the
+/// port tags in each one's node directory (`<root>/nodes/<node>/<prefix><port>.port_tag`),
+/// which iceoryx2 writes when it makes a port, before any of the port's segments or
+/// connections exists, and removes last when it cleans up after the port. A node directory
+/// that cannot be read adds none (logged).
+fn ports_of_nodes(prefix: &str, root: &Path, nodes: &[u128]) -> HashSet<u128> {
+    let mut ports = HashSet::new();
+    for node in nodes {
+        let dir = root.join("nodes").join(node.to_string());
+        let rd = match fs::read_dir(&dir) {
+            Ok(rd) => rd,
+            Err(e) if e.kind() == io::ErrorKind::NotFound => continue,
+            Err(e) => {
+                tracing::warn!(dir = %dir.display(), error = %e, "cannot read the ports of a dead process");
+                continue;
+            }
+        };
+        for e in rd.filter_map(Result::ok) {
+            let name = e.file_name();
+            if let Some(port) = name
+                .to_string_lossy()
+                .strip_prefix(prefix)
+                .and_then(|n| n.strip_suffix(".port_tag"))
+                .and_then(|n| n.parse::<u128>().ok())
+            {
+                ports.insert(port);
+            }
+        }
+    }
+    ports
+}
+
+/// Removes the domain's segments (names starting with `prefix`, iceoryx2 root `root`) left
+/// half made that name a port of one of the dead nodes `dead`, whatever their age, and
+/// returns how many: a process killed while iceoryx2 made one of its connections leaves
+/// one (a driver SIGKILLed while it connected a port of its own), and nobody finishes it.
+/// A live process of this user connecting to a dead port at that instant keeps the file it
+/// has open (only its name goes), and the connection is to a dead peer anyway.
+fn remove_half_made_of_nodes(prefix: &str, root: &Path, dead: &[u128]) -> usize {
+    if dead.is_empty() {
+        return 0;
+    }
+    let ports = ports_of_nodes(prefix, root, dead);
+    if ports.is_empty() {
+        return 0;
+    }
+    remove_half_made_of(prefix, |p| ports.contains(&p))
+}
+
+/// Before a live process cleans up through iceoryx2 after the dead nodes `dead` of
+/// `domain`: removes the segments they left half made ([`remove_half_made_of_nodes`], at
+/// any age), then the other half-made ones older than [`HALF_MADE_AGE`]
+/// ([`remove_half_made`]), and says whether the cleanup may go on: false while a younger
+/// one of other ports is there (its maker may be making it still; if it is dead, iceoryx2
+/// would wait on it for ever, as root: the cleanup waits for a later call instead, by when
+/// it is made or old enough to remove).
+pub(crate) fn half_made_cleared(domain: &Domain, dead: &[u128]) -> bool {
+    let (Ok(prefix), Ok(root)) = (domain.prefix(), domain.root()) else {
         return true;
     };
-    remove_half_made(prefix, false).1 == 0
+    remove_half_made_of_nodes(prefix, root, dead);
+    let young = remove_half_made(prefix, false).1;
+    if young > 0 {
+        tracing::info!(
+            domain = domain.name(),
+            young,
+            age_limit_s = HALF_MADE_AGE.as_secs(),
+            "the cleanup after dead processes is put off: a segment of a port not theirs is being made, or was left half made less than age_limit_s ago"
+        );
+    }
+    young == 0
 }
 
 /// `NODE (pid N)` for a live node (`a process` when its details cannot be read).

@@ -384,8 +384,9 @@ pub(crate) fn node_is_mine(root: &Path, id: u128) -> bool {
 /// dead process removes its registrations but not its files, and leaves its services marked
 /// for destruction with files nobody but their owner (or root) can remove, which no driver
 /// can offer again. So each member's processes clean up after their own (iceoryx2's own
-/// cleanup of dead nodes is off in every domain: [`super::Domain::config`]). Put off while
-/// a segment a dead process left half made is young ([`super::cleanup::half_made_cleared`]).
+/// cleanup of dead nodes is off in every domain: [`super::Domain::config`]). The segments
+/// the dead left half made are removed first, whatever their age; the cleanup is put off
+/// while a half-made segment of another port is young ([`super::cleanup::half_made_cleared`]).
 pub(crate) fn cleanup_dead_nodes<P>(svc: &P, domain: &super::Domain)
 where
     P: iceoryx2::service::port_factory::PortFactory<Service = iceoryx2::prelude::ipc::Service>,
@@ -405,7 +406,11 @@ where
         tracing::warn!(error = %e, "cannot list the nodes of a service");
     }
     // Nobody dead, nothing to do; else not before iceoryx2 can open what they left.
-    if dead.is_empty() || !super::cleanup::half_made_cleared(domain) {
+    if dead.is_empty() {
+        return;
+    }
+    let ids: Vec<u128> = dead.iter().map(|v| v.id().value()).collect();
+    if !super::cleanup::half_made_cleared(domain, &ids) {
         return;
     }
     if !group {
@@ -419,15 +424,21 @@ where
     }
 }
 
-/// Removes the resources of the dead processes in the domain, only this user's if
-/// `only_mine` (group mode, see [`cleanup_dead_nodes`]): what iceoryx2 would do when a node
-/// is created, with its own cleanup off ([`super::Domain::after_join`] says when).
-pub(crate) fn cleanup_domain_dead_nodes(
-    config: &iceoryx2::config::Config,
-    root: &Path,
-    only_mine: bool,
-) {
+/// Removes the resources of the dead processes in `domain`, only this user's in group mode
+/// (see [`cleanup_dead_nodes`]): what iceoryx2 would do when a node is created, with its own
+/// cleanup off ([`super::Domain::after_join`] says when). Put off, as
+/// [`cleanup_dead_nodes`], while a segment of another port is young and half made.
+pub(crate) fn cleanup_domain_dead_nodes(domain: &super::Domain) {
     use iceoryx2::prelude::{CallbackProgression, Node, NodeState, ipc};
+    // Resolved by the joining process before its node was made: these cannot fail here.
+    let (Ok(config), Ok(root), Ok(group)) = (domain.config(), domain.root(), domain.group()) else {
+        tracing::warn!(
+            domain = domain.name(),
+            "cannot clean up after the dead: the domain's files are not known"
+        );
+        return;
+    };
+    let only_mine = group.is_some();
     let mut dead = Vec::new();
     if let Err(e) = Node::<ipc::Service>::list(config, |n| {
         if let NodeState::Dead(v) = n
@@ -438,6 +449,11 @@ pub(crate) fn cleanup_domain_dead_nodes(
         CallbackProgression::Continue
     }) {
         tracing::warn!(error = ?e, "cannot list the nodes of the domain");
+    }
+    // On every join, the dead or not: the old half-made segments go (as they always did).
+    let ids: Vec<u128> = dead.iter().map(|v| v.id().value()).collect();
+    if !super::cleanup::half_made_cleared(domain, &ids) || dead.is_empty() {
+        return;
     }
     for v in dead {
         if let Err(e) = v.blocking_remove_stale_resources(std::time::Duration::ZERO) {

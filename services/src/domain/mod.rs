@@ -212,16 +212,16 @@ impl Domain {
 
     /// Secures the domain after this process's node was made: the node counter iceoryx2
     /// makes world-writable is narrowed ([`dir::secure_shm`]); the domain's dead processes
-    /// (in group mode, this user's) are cleaned up after, unless a segment one of them left
-    /// half made is too young to remove ([`cleanup::half_made_cleared`]: the next process
-    /// to join, or a driver's housekeeping, does it then); in group mode the files of this
-    /// user's ports that are gone are removed.
+    /// (in group mode, this user's) are cleaned up after ([`group::cleanup_domain_dead_nodes`]:
+    /// the segments they left half made are removed first, whatever their age; the cleanup
+    /// is put off while a half-made segment of another port is too young to remove,
+    /// [`cleanup::half_made_cleared`], and the next process to join, or a driver's
+    /// housekeeping, does it then); in group mode the files of this user's ports that are
+    /// gone are removed.
     pub(crate) fn after_join(&self) -> Result<(), DomainError> {
         let r = self.resolved()?;
         dir::secure_shm(&r.prefix, r.group.as_ref())?;
-        if cleanup::half_made_cleared(self) {
-            group::cleanup_domain_dead_nodes(&r.config, &r.root, r.group.is_some());
-        }
+        group::cleanup_domain_dead_nodes(self);
         if r.group.is_some() {
             group::remove_orphans(&r.prefix, &r.root);
         }
