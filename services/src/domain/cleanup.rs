@@ -104,8 +104,8 @@ pub fn remove(domain: &Domain) -> Result<Removed, RemoveError> {
     })?;
     // Before iceoryx2 opens anything of the dead: the segments they left half made.
     let dead_ids: Vec<u128> = dead.iter().map(|v| v.id().value()).collect();
-    let half_made = remove_half_made_of_nodes(&files.prefix, &files.root, &dead_ids)
-        + remove_half_made(&files.prefix, processes.is_empty()).0;
+    let (half_made, _) =
+        sweep_for_dead(&files.prefix, &files.root, &dead_ids, processes.is_empty());
     let mut dead_processes = 0;
     for v in dead {
         match v.blocking_remove_stale_resources(Duration::ZERO) {
@@ -274,6 +274,16 @@ fn remove_half_made_of_nodes(prefix: &str, root: &Path, dead: &[u128]) -> usize 
     remove_half_made_of(prefix, |p| ports.contains(&p))
 }
 
+/// The sweep before a cleanup after the dead nodes `dead`: the half-made segments of their
+/// ports at any age ([`remove_half_made_of_nodes`]), then the other half-made ones, old ones
+/// or, with `all`, every one ([`remove_half_made`]). Returns how many went and how many
+/// young ones of other ports stayed.
+fn sweep_for_dead(prefix: &str, root: &Path, dead: &[u128], all: bool) -> (usize, usize) {
+    let theirs = remove_half_made_of_nodes(prefix, root, dead);
+    let (others, young) = remove_half_made(prefix, all);
+    (theirs + others, young)
+}
+
 /// Before a live process cleans up through iceoryx2 after the dead nodes `dead` of
 /// `domain`: removes the segments they left half made ([`remove_half_made_of_nodes`], at
 /// any age), then the other half-made ones older than [`HALF_MADE_AGE`]
@@ -285,8 +295,7 @@ pub(crate) fn half_made_cleared(domain: &Domain, dead: &[u128]) -> bool {
     let (Ok(prefix), Ok(root)) = (domain.prefix(), domain.root()) else {
         return true;
     };
-    remove_half_made_of_nodes(prefix, root, dead);
-    let young = remove_half_made(prefix, false).1;
+    let (_, young) = sweep_for_dead(prefix, root, dead, false);
     if young > 0 {
         tracing::info!(
             domain = domain.name(),
