@@ -164,8 +164,9 @@ impl core::fmt::Debug for DeviceSet {
 pub enum Drain {
     /// Everything pending ([`DeviceHost::process`]): after a wake-up.
     All,
-    /// Commands on every call, requests on every 16th ([`DeviceHost::process_spin`]): a
-    /// busy-polling loop, where commands are the hot path.
+    /// Commands on every call, each other look (requests, lease operations, new clients,
+    /// the lease's check) on one call in 16, one look a call
+    /// ([`DeviceHost::process_spin`]): a busy-polling loop, where commands are the hot path.
     Spin,
     /// Commands and requests on every call ([`DeviceHost::process_linger`]): the linger
     /// of an event-driven loop after activity, where a client's next request must not
