@@ -74,10 +74,10 @@ pub struct RatioDef {
 pub struct RatioFloor {
     /// Numerator measurement id.
     pub num: &'static str,
-    /// Further series added to the numerator at the same percentile, each so many times:
-    /// a floor made of several hops, each measured alone (a sum of medians is at most the
-    /// median of the sum for these right-skewed latencies, so the floor is not overstated;
-    /// used at p50 only).
+    /// Further series added to the numerator, each so many times, each at its median: a
+    /// floor made of several hops, each measured alone. At p50, a sum of medians is at most
+    /// the median of the sum for these right-skewed latencies; at p99, one hop's p99 plus
+    /// the others' medians is at most the sum's p99. Either way the floor is not overstated.
     pub plus: &'static [(&'static str, u32)],
     /// Denominator measurement id.
     pub den: &'static str,
@@ -366,7 +366,8 @@ impl Report {
                     let d = r.pct.of(&Summary::of(&b.hist)) as f64;
                     let mut extra = 0.0;
                     for (id, times) in f.plus {
-                        extra += f64::from(*times) * r.pct.of(&Summary::of(&find(id)?.hist)) as f64;
+                        extra +=
+                            f64::from(*times) * Pct::P50.of(&Summary::of(&find(id)?.hist)) as f64;
                     }
                     Some((v + extra / d, f.what))
                 });
@@ -600,6 +601,11 @@ mod tests {
 
     /// The report of a run of `measurements`, and its bridge p50 goal.
     fn bridge_goal(measurements: Vec<Measurement>) -> Ratio {
+        bridge_goal_at(measurements, Pct::P50)
+    }
+
+    /// The bridge's goal at `pct` in a run of `measurements`.
+    fn bridge_goal_at(measurements: Vec<Measurement>, pct: Pct) -> Ratio {
         let report = Report::new(
             Machine::probe("off".into(), "test".into()),
             &BenchArgs::default(),
@@ -609,10 +615,8 @@ mod tests {
         report
             .ratios
             .into_iter()
-            .find(|r| {
-                r.num == "bridge.zenoh.rtt" && r.den == "bridge.raw.put.rtt" && r.pct == Pct::P50
-            })
-            .expect("the bridge's p50 goal")
+            .find(|r| r.num == "bridge.zenoh.rtt" && r.den == "bridge.raw.put.rtt" && r.pct == pct)
+            .expect("the bridge's goal")
     }
 
     /// The bridge's goal carries a floor made of its hops: raw Zenoh's round trip plus two
@@ -639,6 +643,43 @@ mod tests {
             constant("bridge.raw.put.rtt", 100_000),
         ]);
         assert!(r.floor.is_none());
+    }
+
+    /// A series of 100 samples: 98 of `p50`, 2 of `p99` (its 99th percentile).
+    fn two_valued(id: &str, p50: u64, p99: u64) -> Measurement {
+        let mut m = constant(id, p50);
+        m.hist.reset();
+        for i in 0..100 {
+            m.hist
+                .record(if i < 98 { p50 } else { p99 })
+                .expect("in range");
+        }
+        m
+    }
+
+    /// At p99 the bridge's floor is raw Zenoh's p99 plus the two iceoryx2 round trips'
+    /// medians (not their p99s, which would overstate it).
+    #[test]
+    fn the_bridges_p99_floor_adds_the_hops_at_their_median() {
+        let r = bridge_goal_at(
+            vec![
+                two_valued("bridge.zenoh.rtt", 150_000, 280_000),
+                two_valued("bridge.raw.put.rtt", 100_000, 200_000),
+                two_valued("state.paced.event.rtt", 25_000, 100_000),
+            ],
+            Pct::P99,
+        );
+        assert!((r.value - 1.4).abs() < 0.01, "{}", r.value);
+        let (floor, _) = r.floor.expect("its floor");
+        assert!((floor - 1.25).abs() < 0.01, "{floor}");
+        assert_eq!(r.met, Some(false));
+        // Its floor is under the goal: not met, and not excused.
+        assert!(!r.below_floor());
+        assert!(
+            !r.floor_note().contains("the goal is"),
+            "{}",
+            r.floor_note()
+        );
     }
 
     /// A goal that a ratio must reach (TCP spin over limber's spin) is out of reach when
