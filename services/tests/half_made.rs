@@ -328,3 +328,61 @@ fn a_driver_does_not_hang_connecting_to_a_client_killed_mid_connection() {
         }
     }
 }
+
+/// A process killed while iceoryx2 wrote one of its port or service tags leaves the tag
+/// unfinished (mode 0600, iceoryx2's mode while it writes a static storage): iceoryx2 does
+/// not list it, and with an unfinished service tag its cleanup after that process failed:
+/// the process stayed listed dead for good (seen after a driver SIGKILLed mid-connection,
+/// tests/tests/group.rs; an unfinished port tag did no harm, checked too). Nobody will
+/// finish a tag: the cleanup after the dead removes the tags they left unfinished, and the
+/// dead process is gone from the list.
+#[test]
+fn a_tag_a_killed_process_left_unfinished_does_not_keep_it_listed_dead() {
+    for kind in [".port_tag", ".service_tag"] {
+        let domain = Domain::unique_for_test();
+        let prefix = domain.prefix().unwrap().to_string();
+        let mut child = limber_services::testing::TestProcess::start(
+            "half_made_child",
+            CHILD_ENV,
+            domain.name(),
+            "READY",
+        )
+        .child;
+        child.kill().unwrap();
+        child.wait().unwrap();
+        let nodes = domain.root().unwrap().join("nodes");
+        let mut files = Vec::new();
+        for node in std::fs::read_dir(&nodes).unwrap().flatten() {
+            if !node.path().is_dir() {
+                continue;
+            }
+            for e in std::fs::read_dir(node.path()).unwrap().flatten() {
+                let name = e.file_name().to_string_lossy().to_string();
+                if name.starts_with(&prefix) && name.ends_with(kind) {
+                    files.push(e.path());
+                }
+            }
+        }
+        let file = files
+            .first()
+            .unwrap_or_else(|| panic!("no {kind} of the killed child"));
+        std::fs::set_permissions(file, std::fs::Permissions::from_mode(0o600)).unwrap();
+        assert!(dead_nodes(&domain) > 0, "the killed child is listed dead");
+        // A process joining the domain cleans up after the dead.
+        let (tx, rx) = mpsc::channel();
+        let d = domain.clone();
+        std::thread::spawn(move || {
+            let r = Context::new(&d, Role::Client, "after-unfinished").map(|_| ());
+            let _ = tx.send(r.map_err(|e| e.to_string()));
+        });
+        rx.recv_timeout(Duration::from_secs(60))
+            .expect("joining the domain hung")
+            .unwrap();
+        assert_eq!(
+            dead_nodes(&domain),
+            0,
+            "{kind} left unfinished: the killed child stays listed dead"
+        );
+        assert!(!file.exists(), "the unfinished {} stayed", file.display());
+    }
+}

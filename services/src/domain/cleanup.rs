@@ -274,14 +274,63 @@ fn remove_half_made_of_nodes(prefix: &str, root: &Path, dead: &[u128]) -> usize 
     remove_half_made_of(prefix, |p| ports.contains(&p))
 }
 
-/// The sweep before a cleanup after the dead nodes `dead`: the half-made segments of their
+/// iceoryx2's mode of a static storage (a node's details, its port and service tags) while
+/// it writes it; it makes it read-only when done, and does not list one still at this mode
+/// (iceoryx2-cal 0.10 `static_storage::file`, `INIT_PERMISSIONS`).
+const UNFINISHED_MODE: u32 = 0o600;
+
+/// Removes from the directories of the dead nodes `dead` (iceoryx2 root `root`, file names
+/// starting with `prefix`) the port and service tags they left unfinished, and returns how
+/// many: a process killed while iceoryx2 wrote one leaves it at [`UNFINISHED_MODE`].
+/// iceoryx2 does not list such a file; with an unfinished service tag its cleanup after
+/// that process failed, and the process stayed listed dead for good. Nobody finishes a
+/// tag, and nothing was made after it (iceoryx2 writes a tag before what it tags).
+/// Only this user's files go. (A node's details left unfinished, a process killed as its
+/// node was made, are not touched: iceoryx2 needs them to clean up after the node with the
+/// domain's configuration; `limber clean` removes that node's files once nothing runs.)
+fn remove_unfinished_of_nodes(prefix: &str, root: &Path, dead: &[u128]) -> usize {
+    let me = dir::euid();
+    let mut n = 0;
+    for node in dead {
+        let node_dir = root.join("nodes").join(node.to_string());
+        for e in dir::entries(&node_dir) {
+            let name = e.file_name().to_string_lossy().to_string();
+            let tag = name.ends_with(".port_tag") || name.ends_with(".service_tag");
+            if !name.starts_with(prefix) || !tag {
+                continue;
+            }
+            let Ok(md) = fs::symlink_metadata(e.path()) else {
+                continue;
+            };
+            if !md.is_file() || md.uid() != me || md.mode() & 0o7777 != UNFINISHED_MODE {
+                continue;
+            }
+            match fs::remove_file(e.path()) {
+                Ok(()) => {
+                    n += 1;
+                    tracing::info!(path = %e.path().display(), "removed what a killed process left unfinished in its node's directory");
+                }
+                Err(err) if err.kind() == io::ErrorKind::NotFound => {}
+                Err(err) => {
+                    tracing::warn!(path = %e.path().display(), error = %err, "cannot remove an unfinished file of a dead process");
+                }
+            }
+        }
+    }
+    n
+}
+
+/// The sweep before a cleanup after the dead nodes `dead`: what they left unfinished in
+/// their node directories ([`remove_unfinished_of_nodes`]), the half-made segments of their
 /// ports at any age ([`remove_half_made_of_nodes`]), then the other half-made ones, old ones
 /// or, with `all`, every one ([`remove_half_made`]). Returns how many went and how many
 /// young ones of other ports stayed.
 fn sweep_for_dead(prefix: &str, root: &Path, dead: &[u128], all: bool) -> (usize, usize) {
+    // The port tags first: the half-made segments of their ports are found by them.
     let theirs = remove_half_made_of_nodes(prefix, root, dead);
+    let unfinished = remove_unfinished_of_nodes(prefix, root, dead);
     let (others, young) = remove_half_made(prefix, all);
-    (theirs + others, young)
+    (theirs + unfinished + others, young)
 }
 
 /// Before a live process cleans up through iceoryx2 after the dead nodes `dead` of
