@@ -14,7 +14,7 @@ use std::os::unix::fs::MetadataExt;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use iceoryx2::node::{NodeListFailure, NodeView};
+use iceoryx2::node::{DeadNodeView, NodeListFailure, NodeView};
 use iceoryx2::prelude::{CallbackProgression, Node, NodeState, ipc};
 use thiserror::Error;
 
@@ -103,18 +103,13 @@ pub fn remove(domain: &Domain) -> Result<Removed, RemoveError> {
         source,
     })?;
     // Before iceoryx2 opens anything of the dead: the segments they left half made.
-    let dead_ids: Vec<u128> = dead.iter().map(|v| v.id().value()).collect();
-    let (half_made, _) =
-        sweep_for_dead(&files.prefix, &files.root, &dead_ids, processes.is_empty());
-    let mut dead_processes = 0;
-    for v in dead {
-        match v.blocking_remove_stale_resources(Duration::ZERO) {
-            Ok(_) => dead_processes += 1,
-            Err(e) => {
-                tracing::debug!(error = ?e, "cannot clean up after a dead process of the domain");
-            }
-        }
-    }
+    let (half_made, _) = sweep_for_dead(
+        &files.prefix,
+        &files.root,
+        &ids_of(&dead),
+        processes.is_empty(),
+    );
+    let dead_processes = remove_stale(dead);
     if !processes.is_empty() {
         return Err(RemoveError::Alive {
             domain: domain.name().to_string(),
@@ -354,6 +349,29 @@ pub(crate) fn half_made_cleared(domain: &Domain, dead: &[u128]) -> bool {
         );
     }
     young == 0
+}
+
+/// The ids of the dead nodes `dead` (for [`half_made_cleared`]).
+pub(crate) fn ids_of(dead: &[DeadNodeView<ipc::Service>]) -> Vec<u128> {
+    dead.iter().map(|v| v.id().value()).collect()
+}
+
+/// Has iceoryx2 remove the resources of each of the dead nodes `dead` (their segments,
+/// ports, registrations and node directories); returns how many it cleaned up. A failure
+/// is logged (another process may be cleaning up after the same node) and the next one
+/// tried.
+pub(crate) fn remove_stale(dead: Vec<DeadNodeView<ipc::Service>>) -> usize {
+    let mut n = 0;
+    for v in dead {
+        let node = v.id().value();
+        match v.blocking_remove_stale_resources(Duration::ZERO) {
+            Ok(_) => n += 1,
+            Err(e) => {
+                tracing::debug!(node, error = ?e, "cannot clean up after a dead process");
+            }
+        }
+    }
+    n
 }
 
 /// `NODE (pid N)` for a live node (`a process` when its details cannot be read).

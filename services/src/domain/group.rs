@@ -409,19 +409,14 @@ where
     if dead.is_empty() {
         return;
     }
-    let ids: Vec<u128> = dead.iter().map(|v| v.id().value()).collect();
-    if !super::cleanup::half_made_cleared(domain, &ids) {
+    if !super::cleanup::half_made_cleared(domain, &super::cleanup::ids_of(&dead)) {
         return;
     }
     if !group {
         svc.try_cleanup_dead_nodes();
         return;
     }
-    for v in dead {
-        if let Err(e) = v.blocking_remove_stale_resources(std::time::Duration::ZERO) {
-            tracing::debug!(error = ?e, "cannot clean up after a dead process of ours");
-        }
-    }
+    super::cleanup::remove_stale(dead);
 }
 
 /// Removes the resources of the dead processes in `domain`, only this user's in group mode
@@ -451,15 +446,11 @@ pub(crate) fn cleanup_domain_dead_nodes(domain: &super::Domain) {
         tracing::warn!(error = ?e, "cannot list the nodes of the domain");
     }
     // On every join, the dead or not: the old half-made segments go (as they always did).
-    let ids: Vec<u128> = dead.iter().map(|v| v.id().value()).collect();
-    if !super::cleanup::half_made_cleared(domain, &ids) || dead.is_empty() {
+    if !super::cleanup::half_made_cleared(domain, &super::cleanup::ids_of(&dead)) || dead.is_empty()
+    {
         return;
     }
-    for v in dead {
-        if let Err(e) = v.blocking_remove_stale_resources(std::time::Duration::ZERO) {
-            tracing::debug!(error = ?e, "cannot clean up after a dead process");
-        }
-    }
+    super::cleanup::remove_stale(dead);
 }
 
 #[cfg(test)]
