@@ -384,36 +384,3 @@ fn a_test_domain_removes_the_files_of_the_processes_its_test_killed() {
     let dirs_left: Vec<_> = node_dirs.iter().filter(|d| d.exists()).collect();
     assert!(dirs_left.is_empty(), "node directories left: {dirs_left:?}");
 }
-
-/// A driver held up longer than its command silence (250 ms) while the robot went on
-/// talking (a busy machine, a stop and continue) reads the robot's packets that wait in the
-/// link before it judges the commands that woke it: a command sent meanwhile is carried out,
-/// not refused LINK_DOWN as if the robot had gone silent.
-#[test]
-fn a_driver_held_up_past_its_command_silence_reads_the_robot_first_and_carries_out_the_command() {
-    use limber_emulator::{Emulator, EmulatorConfig};
-    let domain = Domain::unique_for_test();
-    let emu = Emulator::start_pty(EmulatorConfig::default()).unwrap();
-    let port = emu.pty_path().unwrap().display().to_string();
-    // The link's own timeout well past the hold-up: only the command silence is at stake.
-    let cfg = limber_tests::pioneer_test_config(
-        std::path::Path::new(env!("CARGO_TARGET_TMPDIR")),
-        "heldup",
-        "link_timeout_ms = 5000",
-    );
-    let mut driver = limber_tests::start_pioneer(PIONEER, domain.name(), &port, &cfg);
-    let c = ctx(&domain);
-    let mut arm = ActArrayClient::connect_timeout(&c, "pioneer/actarray/0", T).unwrap();
-    let t = arm.move_to(3, 0.2).unwrap();
-    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
-    driver.signal(libc::SIGSTOP);
-    // The robot talks on: five SIPs (one every 100 ms) while the driver is stopped.
-    let sips = emu.state().stats.sips_out;
-    let (talked, _) = emu.wait_for(T, |s| s.stats.sips_out >= sips + 5);
-    assert!(talked, "the emulator sent no SIPs");
-    let t = arm.move_to(3, -0.2).unwrap();
-    driver.signal(libc::SIGCONT);
-    assert_eq!(arm.wait_outcome(t, T).unwrap(), Status::Ok);
-    driver.signal(libc::SIGTERM);
-    assert_eq!(driver.wait_timeout(T), Some(0));
-}

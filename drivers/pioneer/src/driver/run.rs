@@ -144,16 +144,6 @@ impl PioneerDriver {
                     }
                     Wake::Clients => {
                         self.woken_since_tick = true;
-                        // Held up (a busy machine, a stop and continue), the loop may take
-                        // the clients' wake-up before the link's: the robot's packets that
-                        // wait in the link are read first, or it would seem silent and the
-                        // commands be refused LINK_DOWN.
-                        if self.conn.is_some()
-                            && self.robot.silent_too_long(now)
-                            && !self.read_link(now)
-                        {
-                            self.link_failed("read failed");
-                        }
                         if self.process_clients(Drain::All) {
                             // A client in a tight loop sends its next command within the
                             // linger: picked up without a wake-up.

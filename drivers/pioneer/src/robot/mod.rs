@@ -472,9 +472,12 @@ impl RobotModel {
         }
         // A robot silent for a while may be gone: a client's command written now could be
         // carried out much later (from the link's buffers, after a reconnect), or never.
-        if from.sent_ns != 0 && self.silent_too_long(Instant::now()) {
-            tracing::debug!("{cmd:?} refused: the robot is silent");
-            return Err(Status::LinkDown);
+        if from.sent_ns != 0 {
+            let silent = Instant::now().saturating_duration_since(self.link.last_rx);
+            if silent > self.cfg.command_silence() {
+                tracing::debug!(?silent, "{cmd:?} refused: the robot is silent");
+                return Err(Status::LinkDown);
+            }
         }
         if let Err(e) = self.outbox.push(Queued {
             cmd: *cmd,
@@ -494,15 +497,6 @@ impl RobotModel {
             *ms = ms_per_step;
         }
         Ok(())
-    }
-
-    /// Whether nothing came from the robot for longer than
-    /// [`PioneerConfig::command_silence`] by `now`: a client's command is then refused. A
-    /// loop that was held up (a busy machine, a stop and continue) reads the link before it
-    /// takes the clients' commands when this is true, so that the packets waiting in it
-    /// count.
-    pub fn silent_too_long(&self, now: Instant) -> bool {
-        now.saturating_duration_since(self.link.last_rx) > self.cfg.command_silence()
     }
 
     /// Queues one of the driver's own commands (power, autopark, the ARMpac stream).
