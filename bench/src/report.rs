@@ -214,6 +214,13 @@ impl Ratio {
         match self.floor {
             // A ratio that must stay under its goal cannot go below the floors' ratio; one
             // that must reach its goal cannot go above it.
+            // Met although the floors' ratio says it could not be: the floor, composed of
+            // series measured at other moments, overstated this run's.
+            Some((f, what)) if self.below_floor() && self.met == Some(true) => {
+                format!(
+                    " ({what} = {f:.2}: met past that floor, whose series ran at other moments)"
+                )
+            }
             Some((f, what)) if self.below_floor() => match self.goal {
                 Some(Goal::AtLeast(_)) => {
                     format!(" (the goal is above its floor: {what} = {f:.2})")
@@ -655,6 +662,25 @@ mod tests {
                 .expect("in range");
         }
         m
+    }
+
+    /// A goal met past its floor (the floor composed of series measured at other moments,
+    /// the bridge's) says so, not that the goal is below its floor.
+    #[test]
+    fn a_goal_met_past_its_floor_does_not_say_it_is_below_it() {
+        let r = bridge_goal(vec![
+            constant("bridge.zenoh.rtt", 125_000),
+            constant("bridge.raw.put.rtt", 100_000),
+            constant("state.paced.event.rtt", 25_000),
+        ]);
+        assert_eq!(r.met, Some(true));
+        assert!(r.below_floor());
+        let note = r.floor_note();
+        assert!(!note.contains("the goal is below its floor"), "{note}");
+        assert!(
+            note.contains("met past that floor") && note.contains("1.50"),
+            "{note}"
+        );
     }
 
     /// At p99 the bridge's floor is raw Zenoh's p99 plus the two iceoryx2 round trips'
