@@ -37,11 +37,22 @@ fn half_made_child() {
     let _ = std::io::stdin().read_line(&mut line);
 }
 
-/// Starts `half_made_child` in `domain`, kills it once ready, and spoils each of its
-/// connections as a kill between iceoryx2's create and its sizing leaves them: empty and
-/// write-only. Returns each spoiled file with its path (at least one).
-fn killed_leaving_half_made(domain: &Domain) -> Vec<(std::path::PathBuf, std::fs::File)> {
-    let prefix = domain.prefix().unwrap().to_string();
+/// Joins `domain` as a client named `name` (which cleans up after its dead processes), in a
+/// thread of its own: a join that hangs fails the test after a minute instead of hanging it.
+fn join_within_a_minute(domain: &Domain, name: &'static str) {
+    let (tx, rx) = mpsc::channel();
+    let d = domain.clone();
+    std::thread::spawn(move || {
+        let r = Context::new(&d, Role::Client, name).map(|_| ());
+        let _ = tx.send(r.map_err(|e| e.to_string()));
+    });
+    rx.recv_timeout(Duration::from_secs(60))
+        .unwrap_or_else(|_| panic!("{name} hung joining the domain"))
+        .unwrap();
+}
+
+/// Starts `half_made_child` in `domain` and kills it once ready (SIGKILL).
+fn killed_child(domain: &Domain) {
     let mut child = limber_services::testing::TestProcess::start(
         "half_made_child",
         CHILD_ENV,
@@ -51,6 +62,14 @@ fn killed_leaving_half_made(domain: &Domain) -> Vec<(std::path::PathBuf, std::fs
     .child;
     child.kill().unwrap();
     child.wait().unwrap();
+}
+
+/// Starts `half_made_child` in `domain`, kills it once ready, and spoils each of its
+/// connections as a kill between iceoryx2's create and its sizing leaves them: empty and
+/// write-only. Returns each spoiled file with its path (at least one).
+fn killed_leaving_half_made(domain: &Domain) -> Vec<(std::path::PathBuf, std::fs::File)> {
+    let prefix = domain.prefix().unwrap().to_string();
+    killed_child(domain);
     let mut spoiled = Vec::new();
     for e in std::fs::read_dir("/dev/shm").unwrap().flatten() {
         let name = e.file_name().to_string_lossy().to_string();
@@ -217,17 +236,7 @@ fn a_process_joining_does_not_hang_on_what_a_killed_one_left_half_made() {
     let prefix = domain.prefix().unwrap().to_string();
     let spoiled = killed_leaving_half_made(&domain);
     assert!(dead_nodes(&domain) > 0, "the killed child is listed dead");
-    let join = |name: &'static str| {
-        let (tx, rx) = mpsc::channel();
-        let d = domain.clone();
-        std::thread::spawn(move || {
-            let r = Context::new(&d, Role::Client, name).map(|_| ());
-            let _ = tx.send(r.map_err(|e| e.to_string()));
-        });
-        rx.recv_timeout(Duration::from_secs(60))
-            .unwrap_or_else(|_| panic!("{name} hung joining the domain"))
-            .unwrap();
-    };
+    let join = |name: &'static str| join_within_a_minute(&domain, name);
     // Young, of the dead's ports: removed, and the cleanup goes on at once (old code: put
     // off; as root before that: never returned).
     join("late-client");
@@ -341,15 +350,7 @@ fn a_tag_a_killed_process_left_unfinished_does_not_keep_it_listed_dead() {
     for kind in [".port_tag", ".service_tag"] {
         let domain = Domain::unique_for_test();
         let prefix = domain.prefix().unwrap().to_string();
-        let mut child = limber_services::testing::TestProcess::start(
-            "half_made_child",
-            CHILD_ENV,
-            domain.name(),
-            "READY",
-        )
-        .child;
-        child.kill().unwrap();
-        child.wait().unwrap();
+        killed_child(&domain);
         let nodes = domain.root().unwrap().join("nodes");
         let mut files = Vec::new();
         for node in std::fs::read_dir(&nodes).unwrap().flatten() {
@@ -369,15 +370,7 @@ fn a_tag_a_killed_process_left_unfinished_does_not_keep_it_listed_dead() {
         std::fs::set_permissions(file, std::fs::Permissions::from_mode(0o600)).unwrap();
         assert!(dead_nodes(&domain) > 0, "the killed child is listed dead");
         // A process joining the domain cleans up after the dead.
-        let (tx, rx) = mpsc::channel();
-        let d = domain.clone();
-        std::thread::spawn(move || {
-            let r = Context::new(&d, Role::Client, "after-unfinished").map(|_| ());
-            let _ = tx.send(r.map_err(|e| e.to_string()));
-        });
-        rx.recv_timeout(Duration::from_secs(60))
-            .expect("joining the domain hung")
-            .unwrap();
+        join_within_a_minute(&domain, "after-unfinished");
         assert_eq!(
             dead_nodes(&domain),
             0,

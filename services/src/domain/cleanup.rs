@@ -11,7 +11,7 @@ use std::collections::HashSet;
 use std::fs;
 use std::io;
 use std::os::unix::fs::MetadataExt;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use iceoryx2::node::{DeadNodeView, NodeListFailure, NodeView};
@@ -190,34 +190,42 @@ pub(crate) fn remove_half_made_of(prefix: &str, gone: impl Fn(u128) -> bool) -> 
 /// file of this user in `/dev/shm`, empty, that nobody may read (see [`remove_half_made`]).
 /// Removes each one for which `remove(name, metadata)` says so; returns how many it removed.
 fn sweep_half_made(prefix: &str, mut remove: impl FnMut(&str, &fs::Metadata) -> bool) -> usize {
+    my_files_in(Path::new(dir::SHM_DIR), prefix)
+        .filter(|(_, name, md)| md.len() == 0 && md.mode() & 0o444 == 0 && remove(name, md))
+        .map(|(path, _, _)| remove_left_over(&path, "a segment it left half made"))
+        .filter(|removed| *removed)
+        .count()
+}
+
+/// The files of this user in `dir` whose names start with `prefix`: each one's path, name
+/// and metadata (a symbolic link is not followed, nor listed).
+fn my_files_in(dir: &Path, prefix: &str) -> impl Iterator<Item = (PathBuf, String, fs::Metadata)> {
     let me = dir::euid();
-    let mut n = 0;
-    for e in dir::entries(Path::new(dir::SHM_DIR)) {
+    let prefix = prefix.to_string();
+    dir::entries(dir).into_iter().filter_map(move |e| {
         let name = e.file_name().to_string_lossy().to_string();
-        if !name.starts_with(prefix) {
-            continue;
+        if !name.starts_with(&prefix) {
+            return None;
         }
-        let Ok(md) = fs::symlink_metadata(e.path()) else {
-            continue;
-        };
-        if !md.is_file() || md.uid() != me || md.len() != 0 || md.mode() & 0o444 != 0 {
-            continue;
+        let md = fs::symlink_metadata(e.path()).ok()?;
+        (md.is_file() && md.uid() == me).then(|| (e.path(), name, md))
+    })
+}
+
+/// Removes `path`, `what` a killed process left (said in the log, as is a failure);
+/// whether it removed it.
+fn remove_left_over(path: &Path, what: &str) -> bool {
+    match fs::remove_file(path) {
+        Ok(()) => {
+            tracing::info!(path = %path.display(), "removed {what}, after a killed process");
+            true
         }
-        if !remove(&name, &md) {
-            continue;
-        }
-        match fs::remove_file(e.path()) {
-            Ok(()) => {
-                n += 1;
-                tracing::info!(path = %e.path().display(), "removed a segment a killed process left half made");
-            }
-            Err(err) if err.kind() == io::ErrorKind::NotFound => {}
-            Err(err) => {
-                tracing::warn!(path = %e.path().display(), error = %err, "cannot remove a half-made segment");
-            }
+        Err(err) if err.kind() == io::ErrorKind::NotFound => false,
+        Err(err) => {
+            tracing::warn!(path = %path.display(), error = %err, "cannot remove {what}, after a killed process");
+            false
         }
     }
-    n
 }
 
 /// The port ids of the nodes `nodes` of the domain with `prefix` (iceoryx2 root `root`): the
@@ -284,33 +292,17 @@ const UNFINISHED_MODE: u32 = 0o600;
 /// node was made, are not touched: iceoryx2 needs them to clean up after the node with the
 /// domain's configuration; `limber clean` removes that node's files once nothing runs.)
 fn remove_unfinished_of_nodes(prefix: &str, root: &Path, dead: &[u128]) -> usize {
-    let me = dir::euid();
     let mut n = 0;
     for node in dead {
         let node_dir = root.join("nodes").join(node.to_string());
-        for e in dir::entries(&node_dir) {
-            let name = e.file_name().to_string_lossy().to_string();
-            let tag = name.ends_with(".port_tag") || name.ends_with(".service_tag");
-            if !name.starts_with(prefix) || !tag {
-                continue;
-            }
-            let Ok(md) = fs::symlink_metadata(e.path()) else {
-                continue;
-            };
-            if !md.is_file() || md.uid() != me || md.mode() & 0o7777 != UNFINISHED_MODE {
-                continue;
-            }
-            match fs::remove_file(e.path()) {
-                Ok(()) => {
-                    n += 1;
-                    tracing::info!(path = %e.path().display(), "removed what a killed process left unfinished in its node's directory");
-                }
-                Err(err) if err.kind() == io::ErrorKind::NotFound => {}
-                Err(err) => {
-                    tracing::warn!(path = %e.path().display(), error = %err, "cannot remove an unfinished file of a dead process");
-                }
-            }
-        }
+        n += my_files_in(&node_dir, prefix)
+            .filter(|(_, name, md)| {
+                let tag = name.ends_with(".port_tag") || name.ends_with(".service_tag");
+                tag && md.mode() & 0o7777 == UNFINISHED_MODE
+            })
+            .map(|(path, _, _)| remove_left_over(&path, "a tag it left unfinished"))
+            .filter(|removed| *removed)
+            .count();
     }
     n
 }
