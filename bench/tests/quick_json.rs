@@ -333,6 +333,45 @@ fn bridge_measures_through_a_bridge_pair_or_says_why_not() {
     std::fs::remove_dir_all(&dir).expect("remove the test's directory");
 }
 
+/// `--only bridge` with `LIMBER_BENCH_ZENOH_CONFIG` naming the project's LowLatency
+/// configuration (`bridge/zenoh-lowlatency.json5`): both bridges start with it
+/// (`--zenoh-config`), as docs/guide/bridge.md has them, and relay the commands; the raw
+/// Zenoh floor starts from it too; the report says so. In CI the rows must be there.
+#[test]
+fn bridge_runs_the_pair_and_its_floor_on_a_given_zenoh_configuration() {
+    let dir = std::env::temp_dir().join(format!("limber-bench-zcfg-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../bridge/zenoh-lowlatency.json5")
+        .canonicalize()
+        .expect("bridge/zenoh-lowlatency.json5");
+    let (s, ids, _, _) = run_only(
+        "bridge",
+        &dir.join("bridge.json"),
+        Some(("LIMBER_BENCH_ZENOH_CONFIG", file.to_str().unwrap())),
+    );
+    let detail = s["detail"].as_str().unwrap().to_string();
+    let measured = [
+        "bridge.zenoh.rtt",
+        "bridge.raw.put.rtt",
+        "bridge.raw.get.rtt",
+    ]
+    .iter()
+    .all(|id| ids.contains(&id.to_string()));
+    if std::env::var("CI").as_deref() == Ok("true") || measured {
+        assert!(measured, "the bridge rows are missing: {ids:?} ({detail})");
+        assert!(
+            detail.contains(
+                "the bridges and the raw Zenoh floor started from the Zenoh configuration"
+            ) && detail.contains("zenoh-lowlatency.json5"),
+            "{detail}"
+        );
+    } else {
+        assert!(detail.contains("bridge skipped: "), "{ids:?} ({detail})");
+    }
+    std::fs::remove_dir_all(&dir).expect("remove the test's directory");
+}
+
 /// `--only gateway`: a GET_GEOM's round trip through the Player gateway, with its ratio to
 /// the direct request and Player's own figure in the notes.
 #[test]

@@ -116,6 +116,9 @@ fn start_bridge(
         .arg("bridge")
         .args(args)
         .env_remove("LIMBER_DOMAIN");
+    if let Some(path) = zenoh_floor::zenoh_config() {
+        cmd.arg("--zenoh-config").arg(path);
+    }
     let mut child = ChildProc::spawn_program(role, cmd, deadline)?;
     child.expect(line, READY_TIMEOUT)?;
     Ok(child)
@@ -136,6 +139,13 @@ fn run(ctx: &mut RunCtx, exe: &Path) -> Result<(), BenchError> {
     // the run (its ping-pong alternates with the bridge's commands). Through the bridge an
     // exchange takes ~1 ms or less; four series of `warm + n`.
     let deadline = ctx.deadline_for(4 * (warm + n), Duration::from_millis(1));
+    if let Some(path) = zenoh_floor::zenoh_config() {
+        ctx.notes.push(format!(
+            "the bridges and the raw Zenoh floor started from the Zenoh configuration {} ({})",
+            path.display(),
+            zenoh_floor::ZENOH_CONFIG_ENV
+        ));
+    }
     let floor = zenoh_floor::Floor::start(ctx, deadline)?;
     let r = with_floor(ctx, exe, &floor, (warm, n), deadline);
     let finished = floor.finish();

@@ -34,6 +34,19 @@ const PING: &str = "limber-bench/ping";
 const PONG: &str = "limber-bench/pong";
 const QUERY: &str = "limber-bench/query";
 
+/// The environment variable naming a Zenoh configuration file (JSON5) for the `bridge`
+/// scenario: both bridges get it (`--zenoh-config`) and the floor's two sessions start from
+/// it, so that the floor stays the same transport as the pair (e.g. Zenoh's LowLatency
+/// transport, docs/guide/bridge.md).
+pub const ZENOH_CONFIG_ENV: &str = "LIMBER_BENCH_ZENOH_CONFIG";
+
+/// The file [`ZENOH_CONFIG_ENV`] names, if set and not empty.
+pub fn zenoh_config() -> Option<std::path::PathBuf> {
+    std::env::var_os(ZENOH_CONFIG_ENV)
+        .filter(|v| !v.is_empty())
+        .map(std::path::PathBuf::from)
+}
+
 fn zerr(what: &str) -> impl Fn(zenoh::Error) -> BenchError + '_ {
     move |e| BenchError::transport(what, e)
 }
@@ -45,7 +58,12 @@ fn open(listen: &[&str], connect: &[&str]) -> Result<Session, BenchError> {
         let q: Vec<String> = v.iter().map(|e| format!("\"{e}\"")).collect();
         format!("[{}]", q.join(","))
     };
-    let mut config = Config::default();
+    let mut config = match zenoh_config() {
+        Some(path) => Config::from_file(&path).map_err(|e| {
+            BenchError::transport(format!("the Zenoh configuration {}", path.display()), e)
+        })?,
+        None => Config::default(),
+    };
     for (key, value) in [
         ("mode", "\"peer\"".to_string()),
         ("listen/endpoints", list(listen)),
