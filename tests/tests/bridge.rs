@@ -684,3 +684,52 @@ fn a_bridge_pair_between_two_network_namespaces_moves_the_arm() {
     drop((driver, mirror));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `bridge/zenoh-lowlatency.json5` (Zenoh's LowLatency transport, docs/guide/bridge.md
+/// "How fast") given to both bridges, or to one of them only: the pair connects and
+/// carries a request and a command, and each bridge ends cleanly on SIGTERM.
+#[test]
+fn the_lowlatency_file_on_both_ends_or_on_one_carries_requests_and_commands() {
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../bridge/zenoh-lowlatency.json5"
+    );
+    let a = Domain::unique_for_test();
+    let _driver = start_driver(&a);
+    for (on_expose, on_mirror) in [(true, true), (true, false), (false, true)] {
+        let what = format!("LowLatency on expose: {on_expose}, on mirror: {on_mirror}");
+        let b = Domain::unique_for_test();
+        let cfg = |on: bool| {
+            if on {
+                vec!["--zenoh-config", file]
+            } else {
+                Vec::new()
+            }
+        };
+        let mut expose = expose_with(&a, &cfg(on_expose));
+        let args = [
+            &["bridge", "mirror", "--from", a.name()][..],
+            &cfg(on_mirror),
+        ]
+        .concat();
+        let mut mirror = Proc::spawn(CLI, b.name(), &args);
+        wait_mirrored(&mut mirror);
+        let mut arm = arm_in(&b);
+        let geom = arm
+            .geometry()
+            .unwrap_or_else(|e| panic!("{what}: geometry: {e}"));
+        assert_eq!(geom.actuators_count, 6, "{what}");
+        let t = arm.move_to(1, 0.2).expect("send");
+        assert_eq!(
+            arm.wait_outcome(t, Duration::from_secs(10))
+                .unwrap_or_else(|e| panic!("{what}: outcome: {e}")),
+            Status::Ok,
+            "{what}"
+        );
+        drop(arm);
+        for p in [&mut mirror, &mut expose] {
+            p.signal(libc::SIGTERM);
+            assert_eq!(p.wait_timeout(Duration::from_secs(30)), Some(0), "{what}");
+        }
+    }
+}
