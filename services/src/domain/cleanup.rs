@@ -232,32 +232,19 @@ fn remove_left_over(path: &Path, what: &str) -> bool {
 /// port tags in each one's node directory (`<root>/nodes/<node>/<prefix><port>.port_tag`),
 /// which iceoryx2 writes when it makes a port, before any of the port's segments or
 /// connections exists, and removes last when it cleans up after the port. A node directory
-/// that cannot be read adds none (logged).
+/// that cannot be read adds none (logged by [`dir::entries`]).
 fn ports_of_nodes(prefix: &str, root: &Path, nodes: &[u128]) -> HashSet<u128> {
-    let mut ports = HashSet::new();
-    for node in nodes {
-        let dir = root.join("nodes").join(node.to_string());
-        let rd = match fs::read_dir(&dir) {
-            Ok(rd) => rd,
-            Err(e) if e.kind() == io::ErrorKind::NotFound => continue,
-            Err(e) => {
-                tracing::warn!(dir = %dir.display(), error = %e, "cannot read the ports of a dead process");
-                continue;
-            }
-        };
-        for e in rd.filter_map(Result::ok) {
-            let name = e.file_name();
-            if let Some(port) = name
+    nodes
+        .iter()
+        .flat_map(|node| dir::entries(&root.join("nodes").join(node.to_string())))
+        .filter_map(|e| {
+            e.file_name()
                 .to_string_lossy()
                 .strip_prefix(prefix)
                 .and_then(|n| n.strip_suffix(".port_tag"))
                 .and_then(|n| n.parse::<u128>().ok())
-            {
-                ports.insert(port);
-            }
-        }
-    }
-    ports
+        })
+        .collect()
 }
 
 /// Removes the domain's segments (names starting with `prefix`, iceoryx2 root `root`) left
