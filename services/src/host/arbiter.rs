@@ -13,7 +13,7 @@ use limber_interfaces::control::{get_name, put_name};
 use limber_interfaces::prelude::*;
 
 use super::gaps::ClientTable;
-use super::handler::Motion;
+use super::handler::{Motion, set_bits};
 
 /// The shortest heartbeat timeout a lease may ask for.
 pub const MIN_LEASE_TIMEOUT_NS: u64 = 10_000_000;
@@ -354,18 +354,6 @@ impl Arbiter {
     }
 }
 
-/// The indices of the bits set in `mask`, lowest first.
-fn set_bits(mut mask: u64) -> impl Iterator<Item = usize> {
-    core::iter::from_fn(move || {
-        if mask == 0 {
-            return None;
-        }
-        let bit = mask.trailing_zeros() as usize;
-        mask &= mask - 1;
-        Some(bit)
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -373,14 +361,6 @@ mod tests {
     const MS: u64 = 1_000_000;
     const HOLDER: u64 = 0xA;
     const OTHER: u64 = 0xB;
-
-    #[test]
-    fn set_bits_walks_every_set_bit_lowest_first() {
-        assert_eq!(set_bits(0).count(), 0);
-        assert_eq!(set_bits(0b1011).collect::<Vec<_>>(), [0, 1, 3]);
-        assert_eq!(set_bits(1 << 63 | 1).collect::<Vec<_>>(), [0, 63]);
-        assert_eq!(set_bits(u64::MAX).count(), 64);
-    }
 
     fn lease(op: u32, client_id: u64, timeout_ns: u64, name: &str) -> LeaseReq {
         let mut req = LeaseReq {

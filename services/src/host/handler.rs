@@ -152,3 +152,28 @@ impl Progress {
         }
     }
 }
+
+/// The indices of the bits set in `mask`, lowest first.
+pub(crate) fn set_bits(mut mask: u64) -> impl Iterator<Item = usize> {
+    core::iter::from_fn(move || {
+        if mask == 0 {
+            return None;
+        }
+        let bit = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        Some(bit)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn set_bits_walks_every_set_bit_lowest_first() {
+        assert_eq!(set_bits(0).count(), 0);
+        assert_eq!(set_bits(0b1011).collect::<Vec<_>>(), [0, 1, 3]);
+        assert_eq!(set_bits(1 << 63 | 1).collect::<Vec<_>>(), [0, 63]);
+        assert_eq!(set_bits(u64::MAX).count(), 64);
+    }
+}

@@ -11,7 +11,7 @@
 use limber_interfaces::prelude::*;
 
 use super::arbiter::CmdRef;
-use super::handler::{Motion, Progress};
+use super::handler::{Motion, Progress, set_bits};
 use super::{DeviceHandler, DeviceHost};
 
 /// Motions followed at once per device.
@@ -148,11 +148,9 @@ impl Motions {
     /// Records, for each running part of `parts`, where the driver says it is.
     fn record_parts(&mut self, parts: u64, mut at: impl FnMut(usize) -> Progress) {
         for t in self.slots.iter_mut().flatten() {
-            for part in 0..64 {
-                if t.left & parts & (1 << part) != 0 {
-                    let p = at(part);
-                    t.record(part, &p);
-                }
+            for part in set_bits(t.left & parts) {
+                let p = at(part);
+                t.record(part, &p);
             }
         }
     }
@@ -166,10 +164,8 @@ impl Motions {
         other: u64,
     ) {
         for t in self.slots.iter_mut().flatten() {
-            for part in 0..64 {
-                if t.left & parts & (1 << part) != 0 {
-                    t.end(part, result, cause, other);
-                }
+            for part in set_bits(t.left & parts) {
+                t.end(part, result, cause, other);
             }
         }
     }
@@ -192,7 +188,7 @@ impl Motions {
                 let oldest = (0..MAX_TRACKED).min_by_key(|&i| self.age[i]).unwrap_or(0);
                 let mut old = self.slots[oldest].take();
                 if let Some(t) = old.as_mut() {
-                    for part in 0..64 {
+                    for part in set_bits(t.left) {
                         t.end(
                             part,
                             MotionResult::Preempted,
@@ -259,10 +255,7 @@ impl<I: Interface> DeviceHost<I> {
         if running != 0 {
             let state = &self.state;
             for t in self.motions.slots.iter_mut().flatten() {
-                for part in 0..64 {
-                    if t.left & (1 << part) == 0 {
-                        continue;
-                    }
+                for part in set_bits(t.left) {
                     let p = handler.progress(part as u32, state);
                     t.record(part, &p);
                     if let Some((result, cause)) = p.end {
