@@ -237,6 +237,33 @@ pub const RATIOS: &[RatioDef] = &[
             what: "raw iceoryx2 in the command path's shape (a state sample before each reply, topics sized as a device's) / raw iceoryx2",
         }),
     },
+    // The spinning pair at a control loop's rate (1 kHz), against raw iceoryx2 in the
+    // command path's shape at the same rate: back to back, the one-way above measures the
+    // driver's work after the state that shows an outcome (the next command waits for it).
+    RatioDef {
+        label: "command spin one-way, 1 kHz / raw iceoryx2 in its shape, 1 kHz",
+        num: "command.paced.spin.oneway",
+        den: "command.paced.spin2.oneway",
+        pct: Pct::P50,
+        goal: Some(Goal::AtMost(1.5)),
+        floor: None,
+    },
+    RatioDef {
+        label: "command spin one-way, 1 kHz / raw iceoryx2 in its shape, 1 kHz",
+        num: "command.paced.spin.oneway",
+        den: "command.paced.spin2.oneway",
+        pct: Pct::P99,
+        goal: Some(Goal::AtMost(2.0)),
+        floor: None,
+    },
+    RatioDef {
+        label: "command spin round trip, 1 kHz / raw iceoryx2 in its shape, 1 kHz",
+        num: "command.paced.spin.rtt",
+        den: "command.paced.spin2.rtt",
+        pct: Pct::P50,
+        goal: Some(Goal::AtMost(1.2)),
+        floor: None,
+    },
     RatioDef {
         label: "command spin round trip / cache-line ping-pong round trip",
         num: "command.spin.rtt",

@@ -88,6 +88,11 @@ pub enum Pace {
         /// the ids' second part and the label's words (`("16", "16 drivers")`:
         /// `many.16.paced.*`, "..., beside 16 drivers").
         beside: Option<(&'static str, &'static str)>,
+        /// In how many turns the series is measured, each with its own warm-up and a
+        /// share of the samples, merged into one series (the same id pushed again adds
+        /// to it: [`RunCtx::push`]): a path and its floor measured in alternate turns
+        /// meet the same phases of a VM whose speed changes over seconds. 1: one turn.
+        turns: u32,
     },
 }
 
@@ -134,7 +139,10 @@ impl Pace {
     pub fn counts(self, ctx: &RunCtx, back_to_back: ((u64, u64), (u64, u64))) -> (u64, u64) {
         let ((warm, warm_quick), (n, n_quick)) = match self {
             Pace::BackToBack => back_to_back,
-            Pace::Paced { .. } => ((200, 50), (3_000, 300)),
+            Pace::Paced { turns, .. } => {
+                let t = u64::from(turns.max(1));
+                ((200, 50), (3_000 / t, 300 / t))
+            }
         };
         (ctx.count(warm, warm_quick), ctx.count(n, n_quick))
     }
@@ -425,8 +433,17 @@ impl RunCtx {
     }
 
     /// Adds a measurement.
+    /// A series measured in several turns ([`Pace::Paced::turns`]) is one: a measurement
+    /// whose id is there already adds its samples to it.
     pub fn push(&mut self, m: Measurement) {
-        self.measurements.push(m);
+        match self.measurements.iter_mut().find(|o| o.id == m.id) {
+            Some(o) => {
+                if let Err(e) = o.hist.add(&m.hist) {
+                    tracing::warn!(id = %m.id, error = %e, "cannot merge a turn's samples: the turn is left out");
+                }
+            }
+            None => self.measurements.push(m),
+        }
     }
 
     /// The measurements so far.

@@ -461,6 +461,68 @@ fn state_measures_the_fanouts_beside_floors_paced_at_their_rate() {
     std::fs::remove_dir_all(&dir).expect("remove the test's directory");
 }
 
+/// `--only command`: the spinning pair back to back and at a control loop's rate (1 kHz)
+/// beside raw iceoryx2 in the command path's shape at that rate, both measured in alternate
+/// turns and each merged into one series; the paced goals are stated against that floor.
+#[test]
+fn command_measures_the_spinning_pair_at_1_khz_beside_its_floor_in_turns() {
+    let dir = std::env::temp_dir().join(format!("limber-bench-command-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (_, ids, v, _) = run_only("command", &dir.join("command.json"), None);
+    let ms = v["measurements"].as_array().unwrap();
+    for id in [
+        "command.spin.oneway",
+        "command.paced.spin.rtt",
+        "command.paced.spin.oneway",
+        "command.paced.spin.back",
+        "command.paced.spin2.rtt",
+        "command.paced.spin2.oneway",
+        "command.paced.spin2.back",
+    ] {
+        // One series of every turn's samples (a turn has at least 10; there are 3).
+        assert_eq!(
+            ids.iter().filter(|i| *i == id).count(),
+            1,
+            "{id} in {ids:?}"
+        );
+        let m = ms.iter().find(|m| m["id"] == id).unwrap();
+        if id.contains("paced") {
+            assert!(m["summary"]["count"].as_u64().unwrap() >= 30, "{m}");
+            assert!(m["label"].as_str().unwrap().ends_with(", 1 kHz"), "{m}");
+        }
+    }
+    let ratios = v["ratios"].as_array().unwrap();
+    for (num, den, pct, at_most) in [
+        (
+            "command.paced.spin.oneway",
+            "command.paced.spin2.oneway",
+            "p50",
+            1.5,
+        ),
+        (
+            "command.paced.spin.oneway",
+            "command.paced.spin2.oneway",
+            "p99",
+            2.0,
+        ),
+        (
+            "command.paced.spin.rtt",
+            "command.paced.spin2.rtt",
+            "p50",
+            1.2,
+        ),
+    ] {
+        let r = ratios
+            .iter()
+            .find(|r| r["num"] == num && r["den"] == den && r["pct"] == pct)
+            .unwrap_or_else(|| panic!("no ratio {num} / {den} ({pct}) in {ratios:?}"));
+        assert_eq!(r["goal"]["at_most"].as_f64(), Some(at_most), "{r}");
+        let value = r["value"].as_f64().unwrap();
+        assert_eq!(r["met"].as_bool().unwrap(), value <= at_most, "{r}");
+    }
+    std::fs::remove_dir_all(&dir).expect("remove the test's directory");
+}
+
 /// `--results DIR`: the run as `DIR/latest.md` (the machine, the exact command, the table,
 /// the goals missed) and `DIR/latest.json`.
 #[test]

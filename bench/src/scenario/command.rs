@@ -13,6 +13,14 @@
 //!     `qos::DRIVER_LINGER` after activity (`event_loop::linger`);
 //!   * `event-block`: both zero: pure blocking, one wake-up per direction;
 //!   * `event-cspin`: only the client's spin; `event-linger`: only the driver's linger.
+//! * spin at 1 kHz (`command.paced.spin.*`): the spinning pair again, one command per
+//!   millisecond from a client that sleeps between commands (a control loop's rate), beside
+//!   raw iceoryx2 in the command path's shape at the same rate (`command.paced.spin2.*`).
+//!   Back to back, the client's next command reaches a driver that is still finishing the
+//!   previous one (the outcome on the client's stream and the next state sample's loan come
+//!   after the state that shows the outcome): the back-to-back one-way measures that work
+//!   as much as the path; at a control loop's rate the driver waits, polling, for each
+//!   command, as it does in use.
 //!
 //! Round trip: client clock before `move_to` to after `wait_outcome`. One-way
 //! client→driver: `MsgMeta.stamp_ns` (set in `Client::send`) against the driver's clock
@@ -32,7 +40,8 @@ use limber_services::prelude::*;
 use limber_services::{Role, WaitMode, monotonic_ns};
 
 use super::floor::BYTES;
-use super::{READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario};
+use super::floor::Echo;
+use super::{Pace, READY_TIMEOUT, RunCtx, SAMPLE_TIMEOUT, Scenario};
 use crate::child::{ChildProc, ChildSpec, read_histogram};
 use crate::progress::Progress;
 use crate::roles;
@@ -57,6 +66,11 @@ impl Scenario for Command {
         let can_spin = ctx.spin_enabled();
         if can_spin {
             run_mode(ctx, true)?;
+            // At a control loop's rate, beside its floor at that rate, in alternate turns.
+            for _ in 0..PACED_TURNS {
+                super::floor::ping_pong(ctx, Echo::SpinState, PACED)?;
+                run_variant(ctx, Some(true), None, PACED)?;
+            }
         }
         if ctx.blocking_enabled() {
             for v in EventVariant::ALL {
@@ -131,37 +145,58 @@ impl EventVariant {
     }
 }
 
+/// The spinning pair at a control loop's rate: `command.paced.spin.*`, and its floor
+/// `command.paced.spin2.*`, in alternate turns.
+const PACED: Pace = Pace::Paced {
+    period: Duration::from_millis(1),
+    scenario: "command",
+    beside: None,
+    turns: PACED_TURNS,
+};
+/// The turns of [`PACED`].
+const PACED_TURNS: u32 = 3;
+
 fn run_event(ctx: &mut RunCtx, v: EventVariant) -> Result<(), BenchError> {
-    run_variant(ctx, None, Some(v))
+    run_variant(ctx, None, Some(v), Pace::BackToBack)
 }
 
 fn run_mode(ctx: &mut RunCtx, spin: bool) -> Result<(), BenchError> {
-    run_variant(ctx, Some(spin), None)
+    run_variant(ctx, Some(spin), None, Pace::BackToBack)
 }
 
 fn run_variant(
     ctx: &mut RunCtx,
     spin: Option<bool>,
     variant: Option<EventVariant>,
+    pace: Pace,
 ) -> Result<(), BenchError> {
     let spin = spin.unwrap_or(false);
     let variant = variant.unwrap_or(EventVariant::Default);
     let domain = ctx.domain();
     let (warm, n) = if spin {
-        (ctx.count(5_000, 1_000), ctx.count(100_000, 10_000))
+        pace.counts(ctx, ((5_000, 1_000), (100_000, 10_000)))
     } else {
-        (ctx.count(500, 100), ctx.count(5_000, 1_000))
+        pace.counts(ctx, ((500, 100), (5_000, 1_000)))
     };
     let key = if spin { "spin" } else { variant.key() };
-    let label = if spin { "" } else { variant.label() };
-    let out = ctx.tmp_file(&format!("command-{key}.hdr"));
+    let label = if spin {
+        pace.label()
+    } else {
+        format!("{}{}", variant.label(), pace.label())
+    };
+    // `command.<key>.*` back to back, `command.paced.<key>.*` paced.
+    let id = |suffix: &str| match pace {
+        Pace::BackToBack => format!("command.{key}.{suffix}"),
+        Pace::Paced { .. } => pace.id(key, suffix),
+    };
+    let out = ctx.tmp_file(&format!("{}.hdr", id("oneway")));
     let mut child = ChildProc::spawn(&ChildSpec {
         role: format!("cmd-driver-{}", if spin { "spin" } else { "event" }),
         domain: Some(domain.name().to_string()),
         out: Some(out.clone()),
         cpu: ctx.child_cpu(),
         warmup: warm,
-        deadline: ctx.deadline_for(warm + n, Duration::from_micros(100)),
+        deadline: pace.deadline(ctx, warm + n, Duration::from_micros(100)),
         linger: (!spin).then(|| variant.driver_linger()),
         ..Default::default()
     })?;
@@ -180,8 +215,10 @@ fn run_variant(
 
     let mut rtt = new_histogram()?;
     let mut back = new_histogram()?;
-    let progress = Progress::new(ctx.progress, &format!("command {key}"), warm + n);
+    let progress = Progress::new(ctx.progress, &format!("command {key}{label}"), warm + n);
+    let start = Instant::now();
     for i in 1..=warm + n {
+        pace.wait_turn(start, i);
         let target = if i % 2 == 0 { 0.25 } else { -0.25 };
         let t0 = monotonic_ns();
         let ticket = client
@@ -222,7 +259,7 @@ fn run_variant(
     };
     ctx.push(Measurement {
         scenario: "command",
-        id: format!("command.{key}.rtt"),
+        id: id("rtt"),
         label: format!("command→outcome{label}"),
         strategy,
         metric: Metric::RoundTrip,
@@ -231,7 +268,7 @@ fn run_variant(
     });
     ctx.push(Measurement {
         scenario: "command",
-        id: format!("command.{key}.oneway"),
+        id: id("oneway"),
         label: format!("command client→driver{label}"),
         strategy,
         metric: Metric::OneWay,
@@ -240,7 +277,7 @@ fn run_variant(
     });
     ctx.push(Measurement {
         scenario: "command",
-        id: format!("command.{key}.back"),
+        id: id("back"),
         label: format!("outcome driver→client{label}"),
         strategy,
         metric: Metric::OneWay,

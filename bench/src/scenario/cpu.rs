@@ -148,6 +148,7 @@ fn measure(
         period: PERIOD,
         scenario: "cpu",
         beside: None,
+        turns: 1,
     };
     let mut rtt = new_histogram()?;
     let w = Window::start(&procs).map_err(cpu_err)?;

@@ -71,6 +71,7 @@ pub fn fanout(ctx: &mut RunCtx, fan: usize) -> Result<(), BenchError> {
         period: PERIOD,
         scenario: "state",
         beside: None,
+        turns: 1,
     };
     let (warm, n) = pace.counts(ctx, ((0, 0), (0, 0)));
     let deadline = pace.deadline(ctx, warm + n, PERIOD);

@@ -250,6 +250,7 @@ fn run(ctx: &mut RunCtx, pass: &Pass, clients: usize) -> Result<(), BenchError> 
                 period: PERIOD,
                 scenario: "many",
                 beside: Some((pass.tag, pass.label)),
+                turns: 1,
             },
         )?;
         Ok::<_, BenchError>(Measured {
@@ -441,6 +442,7 @@ fn round_trips(
         period: PERIOD,
         scenario: "many",
         beside: None,
+        turns: 1,
     };
     let mut rtt = new_histogram()?;
     let progress = Progress::new(ctx.progress, &format!("many {}", pass.tag), warm + count);

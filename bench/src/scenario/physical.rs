@@ -356,6 +356,7 @@ fn run_fanout(
         period: PERIOD,
         scenario: "state",
         beside: None,
+        turns: 1,
     };
     let (warm, n) = pace.counts(ctx, ((0, 0), (0, 0)));
     let deadline = pace.deadline(ctx, warm + n, PERIOD);

@@ -60,6 +60,7 @@ impl Scenario for StateFanout {
             period: PERIOD,
             scenario: "state",
             beside: None,
+            turns: 1,
         };
         physical::ping_pong(ctx, physical::Wait::Futex, pace)?;
         floor::ping_pong(ctx, Echo::Listener, pace)?;
