@@ -8,9 +8,12 @@
 //!   device's (`limber_services::qos`: a client slot for each of the default capacity's
 //!   ports, the command and state buffers): the floor of the spinning command path's
 //!   design, where the plain `spin` floor is iceoryx2 at its smallest (1 port a side).
-//!   Like the driver, it loans each next sample once one is sent, off the path to the
-//!   reply: back to back, that work delays the next ping instead (the one-way ping→echo
-//!   pays for it, the round trip does not change).
+//!   Like the driver, the echo loans each next sample once one is sent, off the path to
+//!   the reply: back to back, that work delays the next ping instead (the one-way
+//!   ping→echo pays for it, the round trip does not change); and like a spinning client,
+//!   the pinger loans its next ping's sample once one is sent, so that its clock is read
+//!   where a client's is, before the send alone (paced, the first touches of the
+//!   publisher's memory after an idle millisecond fall after the stamp, as a client's do).
 //!   Measured on this VM: the second send adds some 25 % to the round trip, the sizes
 //!   some 15 % (iceoryx2's receive looks at every publisher slot).
 //! * blocking (`event`): each message is followed by a `notify()` on an event service and
@@ -115,6 +118,12 @@ impl Echo {
 }
 
 type Ping = Publisher<ipc::Service, ActArrayCmdMsg, ()>;
+/// A ping's sample, loaned ahead.
+type PingLoan = iceoryx2::sample_mut_uninit::SampleMutUninit<
+    ipc::Service,
+    core::mem::MaybeUninit<ActArrayCmdMsg>,
+    (),
+>;
 type Pong = Subscriber<ipc::Service, ActArrayData, ()>;
 
 struct Services {
@@ -221,10 +230,14 @@ fn services(node: &Node<ipc::Service>, echo: Echo) -> Result<Services, BenchErro
     })
 }
 
-fn send_ping(p: &Ping, seq: u64, kind: u32) -> Result<(), BenchError> {
-    let loan = p
-        .loan_uninit()
-        .map_err(|e| BenchError::transport("loan ping", e))?;
+/// Sends ping `seq` in `loan`, or in a sample loaned now.
+fn send_ping(p: &Ping, seq: u64, kind: u32, loan: Option<PingLoan>) -> Result<(), BenchError> {
+    let loan = match loan {
+        Some(l) => l,
+        None => p
+            .loan_uninit()
+            .map_err(|e| BenchError::transport("loan ping", e))?,
+    };
     let mut s = loan.write_payload(ActArrayCmdMsg::default());
     let m = &mut s.payload_mut().meta;
     m.seq = seq;
@@ -308,7 +321,7 @@ fn sync(
 ) -> Result<(), BenchError> {
     let deadline = Instant::now() + READY_TIMEOUT;
     loop {
-        send_ping(p, 0, 0)?;
+        send_ping(p, 0, 0, None)?;
         notify(notifier)?;
         match recv_pong(sub, None, listener, 0, Duration::from_millis(10)) {
             Ok(_) => return Ok(()),
@@ -389,11 +402,21 @@ pub fn ping_pong(ctx: &mut RunCtx, echo: Echo, pace: Pace) -> Result<(), BenchEr
     let label = format!("{} {}{}", pace.scenario(), echo.key(), pace.label());
     let progress = Progress::new(ctx.progress, &label, warm + n);
     let start = Instant::now();
+    let mut ping_loan = None;
     for seq in 1..=warm + n {
         pace.wait_turn(start, seq);
         let t0 = monotonic_ns();
-        send_ping(&publisher, seq, 0)?;
+        send_ping(&publisher, seq, 0, ping_loan.take())?;
         notify(notifier.as_ref())?;
+        // In the command path's shape the pinger, as a spinning client does, loans its
+        // next ping's sample once one is sent, while the echo answers.
+        if echo == Echo::SpinState {
+            ping_loan = Some(
+                publisher
+                    .loan_uninit()
+                    .map_err(|e| BenchError::transport("loan ping", e))?,
+            );
+        }
         let (t1, stamp) = recv_pong(
             &subscriber,
             states.as_ref(),
@@ -408,7 +431,7 @@ pub fn ping_pong(ctx: &mut RunCtx, echo: Echo, pace: Pace) -> Result<(), BenchEr
         progress.tick(seq);
     }
     progress.finish();
-    send_ping(&publisher, warm + n + 1, STOP_KIND)?;
+    send_ping(&publisher, warm + n + 1, STOP_KIND, ping_loan.take())?;
     notify(notifier.as_ref())?;
     child.finish(Duration::from_secs(10))?;
     let oneway = read_histogram(&out)?;
