@@ -434,15 +434,24 @@ impl RunCtx {
 
     /// Adds a measurement.
     /// A series measured in several turns ([`Pace::Paced::turns`]) is one: a measurement
-    /// whose id is there already adds its samples to it.
+    /// whose id, label, strategy and metric are there already adds its samples to it. Two
+    /// different series under one id (a scenario's mistake) stay two, and it is logged.
     pub fn push(&mut self, m: Measurement) {
-        match self.measurements.iter_mut().find(|o| o.id == m.id) {
+        let same = |o: &Measurement| {
+            o.id == m.id && o.label == m.label && o.strategy == m.strategy && o.metric == m.metric
+        };
+        match self.measurements.iter_mut().find(|o| same(o)) {
             Some(o) => {
                 if let Err(e) = o.hist.add(&m.hist) {
                     tracing::warn!(id = %m.id, error = %e, "cannot merge a turn's samples: the turn is left out");
                 }
             }
-            None => self.measurements.push(m),
+            None => {
+                if self.measurements.iter().any(|o| o.id == m.id) {
+                    tracing::warn!(id = %m.id, label = %m.label, "two different series under one id");
+                }
+                self.measurements.push(m);
+            }
         }
     }
 
