@@ -66,3 +66,19 @@ fn bench_quick_reports_the_trajectory_tick_period_and_jitter() {
         assert!(report.contains(&format!("\"{id}\"")), "{id}: {report}");
     }
 }
+
+/// `limber bench --only floor,command --spin` (the benchmarks page's spinning runs), quick:
+/// the spinning pair back to back and at 1 kHz beside its floors, through the CLI.
+#[test]
+fn bench_quick_runs_the_spinning_pair_back_to_back_and_at_1_khz() {
+    let report = quick_report("floor,command", &["--spin", "--scale", "0.2"]);
+    for id in [
+        "floor.spin.oneway",
+        "floor.spin2.oneway",
+        "command.spin.oneway",
+        "command.paced.spin.oneway",
+        "command.paced.spin2.oneway",
+    ] {
+        assert!(report.contains(&format!("\"{id}\"")), "{id}: {report}");
+    }
+}
