@@ -89,9 +89,10 @@ pub enum Pace {
         /// `many.16.paced.*`, "..., beside 16 drivers").
         beside: Option<(&'static str, &'static str)>,
         /// In how many turns the series is measured, each with its own warm-up and a
-        /// share of the samples, merged into one series (the same id pushed again adds
-        /// to it: [`RunCtx::push`]): a path and its floor measured in alternate turns
-        /// meet the same phases of a VM whose speed changes over seconds. 1: one turn.
+        /// share of the samples, merged into one series (a measurement pushed again with
+        /// the same id, label, strategy and metric adds to it: [`RunCtx::push`]): a path
+        /// and its floor measured in alternate turns meet the same phases of a VM whose
+        /// speed changes over seconds. 1: one turn.
         turns: u32,
     },
 }

@@ -197,8 +197,8 @@ impl Arbiter {
             .lease
             .filter(|l| l.client_id == cmd.client_id)
             .map(|l| l.name);
-        // Only the set bits are visited (a command's handling walks this on every
-        // command: two scans of all 64 bits cost a spinning driver some 80 ns).
+        // Only the set bits are visited: this runs on every command, and two scans of
+        // all 64 bits took some 3 % of a spinning driver's time in a profile.
         for bit in set_bits(motion.cuts) {
             let cut = self.drivers[bit];
             let below = motion.cuts & ((1u64 << bit) - 1);
